@@ -1,0 +1,30 @@
+// How a walker's answers are judged against the oracle: used by the tests
+// and by the main job's disagreement column.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "cpu/mesh.h"
+#include "cpu/oracle.h"
+#include "cpu/ray.h"
+
+namespace meshcast {
+
+struct Agreement {
+  size_t rays = 0, ties = 0, wrong = 0, t_errors = 0;
+  double max_t_error = 0;
+  std::string first_problem;
+};
+
+// The foundation rules: the walker returns the oracle's hit/miss and triangle;
+// a different triangle is accepted only as an exact tie (the oracle hits the
+// walker's triangle at a t within `tolerance` of its own); t within
+// `tolerance` (1e-5 of the diagonal for the float formats).
+Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                  const std::vector<OracleHit>& oracle, double tolerance);
+
+// The mesh as a bit-packed blob stores it: every vertex moved to its decoded
+// grid position, computed from the input and the header's quantization box.
+Mesh quantized_mesh(const Mesh& mesh, const std::vector<uint8_t>& blob);
+
+}  // namespace meshcast

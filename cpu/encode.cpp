@@ -1,0 +1,363 @@
+#include "cpu/encode.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <unordered_map>
+
+#include "cpu/build.h"
+#include "cpu/pairs.h"
+#include "layout/aabbtree.h"
+#include "layout/float3.h"
+#include "layout/float3soa4.h"
+#include "layout/indexed8bitpacksoa4.h"
+#include "layout/quadtree.h"
+
+namespace meshcast {
+
+using layout::BlobHeader;
+using layout::TriCorners;
+
+namespace {
+
+// The parts of a triangle codec the writer needs, as a runtime value.
+struct CodecOps {
+  uint32_t format, slot_divisor;
+  bool bitpack;
+  uint32_t (*block_bytes)(uint32_t);
+  void (*encode)(const TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
+};
+
+template <class C>
+constexpr CodecOps ops_of(bool bitpack) {
+  return {C::kFormat, C::kSlotDivisor, bitpack, &C::block_bytes, &C::encode};
+}
+
+CodecOps codec_ops(uint32_t format) {
+  switch (format) {
+    case MC_TRI_FLOAT3: return ops_of<layout::Float3>(false);
+    case MC_TRI_FLOAT3SOA4: return ops_of<layout::Float3SOA4>(false);
+    case MC_TRI_INDEXED8BITPACKSOA4: return ops_of<layout::Indexed8BitPackSOA4>(true);
+  }
+  throw InputError("unknown triangle format " + std::to_string(format));
+}
+
+uint32_t align(uint64_t v, uint32_t a) { return uint32_t((v + a - 1) / a * a); }
+
+// Shared by both tree writers: the blob under construction.
+struct Writer {
+  const std::vector<TriCorners>& corners;
+  const BuildTree& tree;
+  CodecOps codec;
+  BlobHeader h{};
+  std::vector<uint8_t> bytes;
+  std::vector<uint64_t> pool;
+  std::unordered_map<uint64_t, uint32_t> last_index;
+  std::vector<uint32_t> remap;
+
+  // Encodes the leaf's triangles at tree-section offset `at`.
+  void write_leaf(const BuildNode& leaf, uint32_t at) {
+    std::vector<TriCorners> tris(leaf.count);
+    for (uint32_t i = 0; i < leaf.count; ++i) tris[i] = corners[tree.order[leaf.first + i]];
+    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index};
+    codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
+    uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
+    if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, 0);
+    for (uint32_t i = 0; i < leaf.count; ++i) remap[slot0 + i] = tree.order[leaf.first + i];
+  }
+};
+
+// AABBTree (§5.1), depth first: first child right behind its parent, the
+// leaf's triangle block right behind the leaf node.
+void write_aabbtree(Writer& w) {
+  const BuildTree& t = w.tree;
+  std::vector<uint64_t> size(t.nodes.size());
+  std::function<uint64_t(uint32_t)> measure = [&](uint32_t n) -> uint64_t {
+    const BuildNode& b = t.nodes[n];
+    size[n] = MC_AABB_NODE_BYTES + (b.leaf() ? w.codec.block_bytes(b.count) : measure(b.left) + measure(b.right));
+    return size[n];
+  };
+  uint64_t tree_size = measure(0);
+  if (tree_size > MC_AABB_VALUE_MASK)
+    throw InputError("the AABBTree section of " + std::to_string(tree_size) +
+                     " bytes exceeds its 31-bit child offsets");
+  w.h.tree_size = uint32_t(tree_size);
+  w.h.node_bytes = uint32_t(t.nodes.size() * MC_AABB_NODE_BYTES);
+  w.h.node_count = uint32_t(t.nodes.size());
+  w.h.triangle_base = 0;
+  w.h.root = 0;
+  return;
+}
+
+void fill_aabbtree(Writer& w) {
+  const BuildTree& t = w.tree;
+  std::function<uint32_t(uint32_t, uint32_t)> write = [&](uint32_t n, uint32_t at) -> uint32_t {
+    const BuildNode& b = t.nodes[n];
+    layout::AABBNode node{};
+    for (int a = 0; a < 3; ++a) node.min[a] = b.box.min[a], node.max[a] = b.box.max[a];
+    uint32_t end;
+    if (b.leaf()) {
+      node.properties = MC_AABB_LEAF_BIT | b.count;
+      w.write_leaf(b, at + MC_AABB_NODE_BYTES);
+      end = at + MC_AABB_NODE_BYTES + w.codec.block_bytes(b.count);
+    } else {
+      uint32_t right = write(b.left, at + MC_AABB_NODE_BYTES);
+      node.properties = right;
+      end = write(b.right, right);
+    }
+    std::memcpy(w.bytes.data() + w.h.tree_offset + at, &node, sizeof node);
+    return end;
+  };
+  write(0, 0);
+}
+
+// QuadTree (§5.6): every binary node that stays a node takes up to four
+// children, found by opening its largest interior descendant until four are
+// reached. Nodes are written depth first, triangle blocks after all nodes
+// ("triangles last", §4.3), which keeps 64-byte half-float nodes cache aligned.
+struct QuadPlan {
+  std::vector<std::array<int64_t, 4>> children;  // binary node index or -1
+  std::vector<uint32_t> binary_of;               // quad node -> binary node
+  std::vector<uint32_t> leaves;                  // binary leaves, in write order
+  std::vector<uint32_t> leaf_offset;             // per binary node (leaves)
+  std::vector<uint32_t> quad_index;              // per binary node (quad nodes)
+  uint32_t depth = 0;
+};
+
+QuadPlan plan_quadtree(const BuildTree& t) {
+  QuadPlan p;
+  p.leaf_offset.assign(t.nodes.size(), 0);
+  p.quad_index.assign(t.nodes.size(), 0);
+  std::function<void(uint32_t, uint32_t)> visit = [&](uint32_t n, uint32_t depth) {
+    if (t.nodes[n].leaf()) {
+      p.leaves.push_back(n);
+      return;
+    }
+    p.depth = std::max(p.depth, depth);
+    std::vector<uint32_t> list{t.nodes[n].left, t.nodes[n].right};
+    while (list.size() < 4) {
+      int open = -1;
+      for (size_t i = 0; i < list.size(); ++i)
+        if (!t.nodes[list[i]].leaf() &&
+            (open < 0 || t.nodes[list[i]].box.half_area() > t.nodes[list[size_t(open)]].box.half_area()))
+          open = int(i);
+      if (open < 0) break;
+      uint32_t m = list[size_t(open)];
+      list.erase(list.begin() + open);
+      list.insert(list.begin() + open, {t.nodes[m].left, t.nodes[m].right});
+    }
+    p.quad_index[n] = uint32_t(p.binary_of.size());
+    p.binary_of.push_back(n);
+    std::array<int64_t, 4> c{-1, -1, -1, -1};
+    for (size_t i = 0; i < list.size(); ++i) c[i] = list[i];
+    p.children.push_back(c);
+    for (uint32_t m : list) visit(m, depth + 1);
+  };
+  visit(0, 0);
+  return p;
+}
+
+template <class Bounds>
+void write_quadtree(Writer& w, const QuadPlan& p) {
+  const BuildTree& t = w.tree;
+  uint64_t nodes = uint64_t(p.binary_of.size()) * Bounds::kNodeBytes;
+  uint64_t end = nodes;
+  for (uint32_t leaf : p.leaves) end += w.codec.block_bytes(t.nodes[leaf].count);
+  if (end > MC_QUAD_OFFSET_MASK)
+    throw InputError("the " + std::string(layout::tree_format_name(Bounds::kFormat)) + " section of " +
+                     std::to_string(end) + " bytes exceeds its 27-bit child offsets (seed 000 5.6)");
+  w.h.tree_size = uint32_t(end);
+  w.h.node_bytes = uint32_t(nodes);
+  w.h.node_count = uint32_t(p.binary_of.size());
+  w.h.triangle_base = uint32_t(nodes);
+}
+
+template <class Bounds>
+void fill_quadtree(Writer& w, QuadPlan& p) {
+  const BuildTree& t = w.tree;
+  uint32_t at = w.h.triangle_base;
+  for (uint32_t leaf : p.leaves) {
+    p.leaf_offset[leaf] = at;
+    w.write_leaf(t.nodes[leaf], at);
+    at += w.codec.block_bytes(t.nodes[leaf].count);
+  }
+  auto props = [&](uint32_t n) {
+    return t.nodes[n].leaf() ? layout::quad_properties(t.nodes[n].count, p.leaf_offset[n])
+                             : layout::quad_properties(0, p.quad_index[n] * Bounds::kNodeBytes);
+  };
+  for (size_t q = 0; q < p.binary_of.size(); ++q) {
+    layout::QuadChild c[4];
+    for (int k = 0; k < 4; ++k) {
+      if (p.children[q][k] < 0) continue;
+      uint32_t n = uint32_t(p.children[q][k]);
+      for (int a = 0; a < 3; ++a) c[k].min[a] = t.nodes[n].box.min[a], c[k].max[a] = t.nodes[n].box.max[a];
+      c[k].properties = props(n);
+    }
+    uint8_t* out = w.bytes.data() + w.h.tree_offset + q * Bounds::kNodeBytes;
+    Bounds::encode(c, w.h, out);
+    for (int k = 0; k < 4; ++k) std::memcpy(out + Bounds::kPropertiesAt + 4 * k, &c[k].properties, 4);
+  }
+  w.h.root = props(0);
+}
+
+}  // namespace
+
+void quantization_bound(const float offset[3], const float scale[3], float bound[3]) {
+  for (int a = 0; a < 3; ++a) {
+    float top = std::fabs(offset[a]) + float(MC_BITPACK_MAX) * scale[a];
+    float ulp = std::nextafter(std::max(std::fabs(offset[a]), top), INFINITY) - std::max(std::fabs(offset[a]), top);
+    bound[a] = 0.5f * scale[a] + float(MC_BITPACK_MAX) * scale[a] * 0x1p-23f + ulp;
+  }
+}
+
+std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
+                                BuildReport* report) {
+  auto start = std::chrono::steady_clock::now();
+  check_mesh(mesh, name);
+  if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
+    throw InputError(name + ": leaf size " + std::to_string(o.leaf_size) + " is outside 1.." +
+                     std::to_string(MC_QUAD_MAX_COUNT) + " (5-bit triangle counts, seed 000 5.6)");
+  if (layout::tree_format_name(o.tree_format).empty()) throw InputError(name + ": unknown tree format");
+  CodecOps codec = codec_ops(o.triangle_format);
+
+  BlobHeader h{};
+  h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
+  h.tree_format = o.tree_format, h.triangle_format = o.triangle_format;
+  h.triangle_count = uint32_t(mesh.triangles.size());
+  h.leaf_size = o.leaf_size;
+  h.slot_divisor = codec.slot_divisor;
+
+  // Stored triangle corners: bit-packed formats quantize against the mesh box.
+  Box3 mesh_box = mesh.bounds();
+  for (int a = 0; a < 3; ++a) {
+    h.quant_offset[a] = codec.bitpack ? mesh_box.min[a] : 0.0f;
+    h.quant_scale[a] = codec.bitpack ? float((double(mesh_box.max[a]) - mesh_box.min[a]) / MC_BITPACK_MAX) : 0.0f;
+  }
+  std::vector<uint64_t> packed(codec.bitpack ? mesh.vertices.size() : 0);
+  for (size_t v = 0; v < packed.size(); ++v) {
+    float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
+    packed[v] = layout::bitpack_encode(p, h.quant_offset, h.quant_scale);
+  }
+  std::vector<TriCorners> corners(mesh.triangles.size());
+  std::vector<Box3> boxes(mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (int c = 0; c < 3; ++c) {
+      uint32_t v = mesh.triangles[t][c];
+      if (codec.bitpack) {
+        corners[t].packed[c] = packed[v];
+        layout::bitpack_decode(packed[v], h.quant_offset, h.quant_scale, corners[t].v[c]);
+      } else {
+        corners[t].packed[c] = 0;
+        corners[t].v[c][0] = mesh.vertices[v].x, corners[t].v[c][1] = mesh.vertices[v].y;
+        corners[t].v[c][2] = mesh.vertices[v].z;
+      }
+      boxes[t].grow(Vec3{corners[t].v[c][0], corners[t].v[c][1], corners[t].v[c][2]});
+    }
+  }
+
+  BuildTree tree = build_binning(boxes, o.leaf_size);
+  Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
+  BlobHeader& hd = writer.h;
+  const Box3& root = tree.nodes[0].box;
+  for (int a = 0; a < 3; ++a) hd.bounds_min[a] = root.min[a], hd.bounds_max[a] = root.max[a];
+  // Half-float bounds relative to the root centre, scaled by a power of two
+  // that puts the root's half extent near 2^14: far from both the half range
+  // limit (65504) and the subnormals.
+  float half_extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    hd.node_origin[a] = root.centre()[a];
+    half_extent = std::max({half_extent, std::fabs(root.max[a] - hd.node_origin[a]),
+                            std::fabs(hd.node_origin[a] - root.min[a])});
+  }
+  hd.node_scale = std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0);
+
+  QuadPlan plan;
+  uint32_t depth = tree.depth;
+  if (o.tree_format == MC_TREE_AABBTREE) {
+    write_aabbtree(writer);
+  } else {
+    plan = plan_quadtree(tree);
+    depth = plan.depth;
+    if (o.tree_format == MC_TREE_QUADTREE) write_quadtree<layout::QuadBoundsFloat>(writer, plan);
+    else write_quadtree<layout::QuadBoundsHalf>(writer, plan);
+  }
+  if (depth > MC_MAX_DEPTH)
+    throw InputError(name + ": the tree is " + std::to_string(depth) + " levels deep, beyond the walkers' limit of " +
+                     std::to_string(MC_MAX_DEPTH));
+  hd.max_depth = depth;
+  hd.leaf_count = tree.leaf_count();
+  hd.tree_offset = MC_BLOB_HEADER_BYTES;
+  hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
+  // The vertex pool is only known after encoding; reserve the worst case
+  // (3 vertices a triangle) and trim afterwards.
+  uint64_t worst_vertices = codec.bitpack ? 8ull * 3 * mesh.triangles.size() : 0;
+  if (hd.vertex_offset + worst_vertices > 0xF0000000ull)
+    throw InputError(name + ": the blob would exceed 4 GiB, the limit of its 32-bit offsets");
+  writer.bytes.assign(hd.vertex_offset + worst_vertices, 0);
+
+  if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer);
+  else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
+  else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
+
+  hd.vertex_size = uint32_t(writer.pool.size() * 8);
+  writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
+  if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
+
+  // Remap: slot -> input triangle, as few bits as the triangle count needs.
+  hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
+  hd.remap_entries = uint32_t(writer.remap.size());
+  hd.remap_offset = align(writer.bytes.size(), 8);
+  hd.remap_size = align((uint64_t(hd.remap_entries) * hd.remap_bits + 7) / 8 + 8, 8);
+  writer.bytes.resize(uint64_t(hd.remap_offset) + hd.remap_size, 0);
+  for (uint32_t s = 0; s < hd.remap_entries; ++s) {
+    uint64_t bit = uint64_t(s) * hd.remap_bits;
+    uint64_t word;
+    uint8_t* at = writer.bytes.data() + hd.remap_offset + (bit >> 3);
+    std::memcpy(&word, at, 8);
+    word |= uint64_t(writer.remap[s]) << (bit & 7);
+    std::memcpy(at, &word, 8);
+  }
+  hd.total_size = uint32_t(writer.bytes.size());
+  std::memcpy(writer.bytes.data(), &hd, sizeof hd);
+  layout::seal(writer.bytes);
+
+  if (report) {
+    report->binary_nodes = uint32_t(tree.nodes.size());
+    report->leaves = hd.leaf_count;
+    report->depth = depth;
+    report->sah_cost = tree.sah_cost;
+    report->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+  return std::move(writer.bytes);
+}
+
+std::vector<std::string> layout_names() {
+  std::vector<std::string> names;
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT})
+    for (uint32_t c : {MC_TRI_FLOAT3, MC_TRI_FLOAT3SOA4, MC_TRI_INDEXED8BITPACKSOA4})
+      names.push_back(layout_name(t, c));
+  return names;
+}
+
+std::string layout_name(uint32_t tree, uint32_t triangles) {
+  return std::string(layout::tree_format_name(tree)) + "/" + std::string(layout::triangle_format_name(triangles));
+}
+
+BuildOptions parse_layout(const std::string& text) {
+  auto lower = [](std::string s) {
+    for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return s;
+  };
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT})
+    for (uint32_t c : {MC_TRI_FLOAT3, MC_TRI_FLOAT3SOA4, MC_TRI_INDEXED8BITPACKSOA4})
+      if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8};
+  std::string valid;
+  for (const std::string& n : layout_names()) valid += "\n  " + n;
+  throw InputError("unknown layout '" + text + "'; valid layouts (TREE/TRIANGLES):" + valid);
+}
+
+}  // namespace meshcast

@@ -1,0 +1,40 @@
+// Writes a mesh into a blob: quantize (if the triangle format does), build
+// the binary tree from the stored triangles, lay it out in the tree format,
+// encode each leaf with the triangle format, then the remap and the header.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cpu/mesh.h"
+
+namespace meshcast {
+
+
+struct BuildOptions {
+  uint32_t tree_format = 3;      // MC_TREE_*
+  uint32_t triangle_format = 3;  // MC_TRI_*
+  uint32_t leaf_size = 8;        // 4, 8 or 16 in the source; 1..16 accepted
+};
+
+struct BuildReport {
+  uint32_t binary_nodes = 0, leaves = 0, depth = 0;
+  double sah_cost = 0;
+  double build_ms = 0;
+};
+
+// Throws InputError (naming `name`) for a mesh the layout cannot hold.
+std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, const std::string& name,
+                                BuildReport* report = nullptr);
+
+// "AABBTree/Float3" etc., case-insensitive. Throws InputError listing the
+// valid names for anything else.
+BuildOptions parse_layout(const std::string& text);
+std::string layout_name(uint32_t tree_format, uint32_t triangle_format);
+std::vector<std::string> layout_names();
+
+// Worst-case distance, per axis, between an input vertex and the position the
+// triangle format stores for it (0 for the float formats).
+void quantization_bound(const float offset[3], const float scale[3], float bound[3]);
+
+}  // namespace meshcast

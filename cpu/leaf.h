@@ -1,0 +1,69 @@
+// One leaf test for every triangle format: the codec's loader (below) turns a
+// group of 4 triangles into corners, triangle_test4 does the rest. Adding a
+// triangle format means adding a loader, not another walker.
+#pragma once
+#include <algorithm>
+
+#include "cpu/ray.h"
+#include "layout/float3.h"
+#include "layout/float3soa4.h"
+#include "layout/indexed8bitpacksoa4.h"
+
+namespace meshcast {
+
+struct Closest {
+  float t;
+  uint32_t slot = MC_NO_HIT;
+  float u = 0, v = 0;
+};
+
+template <class Codec>
+struct Loader;
+
+// Float3: triangles side by side, 9 floats each; gather lane i from triangle
+// first + i (clamped, so no lane reads past the block).
+template <>
+struct Loader<layout::Float3> {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, simd::F4 v[3][3]) {
+    const float* base = reinterpret_cast<const float*>(blob + block);
+    int i0 = int(first) * 9;
+    int last = int(count - 1) * 9;
+    simd::I4 idx = simd::iconst(i0, std::min(i0 + 9, last), std::min(i0 + 18, last), std::min(i0 + 27, last));
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) v[c][a] = simd::gather(base, idx + (c * 3 + a));
+  }
+};
+
+template <>
+struct Loader<layout::Float3SOA4> {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, simd::F4 v[3][3]) {
+    const uint8_t* p = blob + block + (first / 4) * MC_FLOAT3SOA4_BLOCK_BYTES;
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) v[c][a] = simd::F4::load(p + (c * 3 + a) * 16);
+  }
+};
+
+template <>
+struct Loader<layout::Indexed8BitPackSOA4> {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, simd::F4 v[3][3]) {
+    const layout::BlobHeader& h = layout::header_of(blob);
+    const uint8_t* vertices = blob + block + layout::load<uint32_t>(blob + block);
+    const uint8_t* idx = blob + block + MC_I8_HEADER_BYTES + (first / 4) * MC_I8_BLOCK_BYTES;
+    for (int c = 0; c < 3; ++c) simd::bitpack_gather(vertices, idx + c * 4, h.quant_offset, h.quant_scale, v[c]);
+  }
+};
+
+// Tests the `count` triangles of the block at blob offset `block`; slots of
+// the leaf start at `slot0`.
+template <class Codec>
+inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
+                      Closest& c) {
+  for (uint32_t first = 0; first < count; first += 4) {
+    simd::F4 v[3][3];
+    Loader<Codec>::load(blob, block, first, count, v);
+    LaneHit h = triangle_test4(r, v, simd::lanes_below(count - first), c.t);
+    if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
+  }
+}
+
+}  // namespace meshcast

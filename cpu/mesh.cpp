@@ -1,0 +1,58 @@
+#include "cpu/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshcast {
+
+void Box3::grow(const Vec3& p) {
+  min = {std::min(min.x, p.x), std::min(min.y, p.y), std::min(min.z, p.z)};
+  max = {std::max(max.x, p.x), std::max(max.y, p.y), std::max(max.z, p.z)};
+}
+
+void Box3::grow(const Box3& b) {
+  grow(b.min);
+  grow(b.max);
+}
+
+Vec3 Box3::centre() const {
+  return {0.5f * (min.x + max.x), 0.5f * (min.y + max.y), 0.5f * (min.z + max.z)};
+}
+
+Vec3 Box3::extent() const { return {max.x - min.x, max.y - min.y, max.z - min.z}; }
+
+float Box3::half_area() const {
+  if (empty()) return 0.0f;
+  Vec3 e = extent();
+  return e.x * e.y + e.y * e.z + e.z * e.x;
+}
+
+float Box3::diagonal() const {
+  Vec3 e = extent();
+  return std::sqrt(double(e.x) * e.x + double(e.y) * e.y + double(e.z) * e.z);
+}
+
+Box3 Mesh::bounds() const {
+  Box3 b;
+  for (const Triangle& t : triangles)
+    for (uint32_t v : t) b.grow(vertices[v]);
+  return b;
+}
+
+void check_mesh(const Mesh& mesh, const std::string& name) {
+  if (mesh.triangles.empty()) throw InputError(name + ": the mesh has no triangles");
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Vec3& v = mesh.vertices[i];
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      throw InputError(name + ": vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+  }
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (uint32_t v : mesh.triangles[t])
+      if (v >= mesh.vertices.size())
+        throw InputError(name + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) +
+                         " but the mesh has only " + std::to_string(mesh.vertices.size()) + " vertices");
+  if (mesh.triangles.size() > 0xFFFFFFFEu)
+    throw InputError(name + ": more than 2^32-2 triangles");
+}
+
+}  // namespace meshcast

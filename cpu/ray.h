@@ -1,0 +1,180 @@
+// Rays, hits, and the two tests every walker is built from:
+//  - a conservative ray/box test (Ize 2013, "Robust BVH Ray Traversal"): the
+//    far distance is widened by 1 + 2*gamma(3) so rounding in the slab
+//    arithmetic never culls a box the exact ray touches;
+//  - the watertight ray/triangle test (Woop, Benthin, Wald 2013): the ray is
+//    sheared so it runs along +z, edge functions are evaluated in 2D with the
+//    same operands for both triangles of a shared edge, and an edge function
+//    that rounds to exactly zero is recomputed in double, so a ray through a
+//    shared edge or vertex always hits at least one of its triangles.
+// Both are two-sided and accept t in [0, t_max].
+#pragma once
+#include <cmath>
+#include <cstdint>
+
+#include "cpu/simd.h"
+#include "layout/formats.h"
+
+namespace meshcast {
+
+struct Ray {
+  float org[3];
+  float dir[3];
+  float tmax;
+};
+
+static_assert(sizeof(Ray) == 28, "Ray is the 7 floats of a rays-file record");
+
+struct Hit {
+  float t = INFINITY;
+  uint32_t triangle = MC_NO_HIT;  // index in the caller's mesh
+  float u = 0, v = 0;             // barycentrics of corners 1 and 2
+};
+
+// A ray the walkers may walk: finite origin and direction, a direction that
+// is not zero, t_max not NaN and not negative (infinity allowed). Any other
+// ray is answered as a miss and counted.
+inline bool ray_is_walkable(const Ray& r) {
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(r.org[a]) || !std::isfinite(r.dir[a])) return false;
+  if (r.dir[0] == 0 && r.dir[1] == 0 && r.dir[2] == 0) return false;
+  return !std::isnan(r.tmax) && r.tmax >= 0;
+}
+
+// 1 + 2 * gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (Ize 2013).
+constexpr float kFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
+
+// Per-ray constants, computed once.
+struct RayPre {
+  float org[3], dir[3], inv[3];
+  // Box test: the near plane of each axis is the min plane for a direction
+  // with a clear sign bit and the max plane otherwise (-0 counts as negative,
+  // matching inv = -inf).
+  int near_is_max[3];
+  // Watertight test: kz = the dominant axis, kx/ky the others (swapped to
+  // keep the winding), shear constants S.
+  int kx, ky, kz;
+  float sx, sy, sz;
+
+  explicit RayPre(const Ray& r) {
+    for (int a = 0; a < 3; ++a) {
+      org[a] = r.org[a];
+      dir[a] = r.dir[a];
+      inv[a] = 1.0f / r.dir[a];  // +-inf for a zero component: see box_test
+      near_is_max[a] = std::signbit(r.dir[a]) ? 1 : 0;
+    }
+    float ax = std::fabs(dir[0]), ay = std::fabs(dir[1]), az = std::fabs(dir[2]);
+    kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    kx = (kz + 1) % 3;
+    ky = (kx + 1) % 3;
+    if (dir[kz] < 0) std::swap(kx, ky);
+    sx = dir[kx] / dir[kz];
+    sy = dir[ky] / dir[kz];
+    sz = 1.0f / dir[kz];
+  }
+};
+
+// Slab distances of one axis; a zero direction makes inv infinite, and a slab
+// plane through the origin then gives 0 * inf = NaN. The max/min below keep
+// their second operand on NaN, and that operand is never NaN, so such a slab
+// constrains nothing: the ray lies in the plane, on the closed box.
+inline float max_keep(float a, float b) { return a > b ? a : b; }
+inline float min_keep(float a, float b) { return a < b ? a : b; }
+
+// Scalar box test; returns the entry distance, or +inf for a miss.
+inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
+  float tn = 0.0f, tf = INFINITY;
+  for (int a = 0; a < 3; ++a) {
+    float nearp = r.near_is_max[a] ? mx[a] : mn[a];
+    float farp = r.near_is_max[a] ? mn[a] : mx[a];
+    tn = max_keep((nearp - r.org[a]) * r.inv[a], tn);
+    tf = min_keep((farp - r.org[a]) * r.inv[a], tf);
+  }
+  tf = min_keep(tf * kFarScale, closest);
+  return tn <= tf ? tn : INFINITY;
+}
+
+// Four boxes at once; `nearp[a]`/`farp[a]` are the near and far planes of axis a.
+inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
+  using simd::F4;
+  F4 tn = F4::splat(0.0f), tf = F4::splat(INFINITY);
+  for (int a = 0; a < 3; ++a) {
+    F4 o = F4::splat(r.org[a]), inv = F4::splat(r.inv[a]);
+    tn = simd::max((nearp[a] - o) * inv, tn);
+    tf = simd::min((farp[a] - o) * inv, tf);
+  }
+  tf = simd::min(tf * F4::splat(kFarScale), F4::splat(closest));
+  return simd::select(tn <= tf, tn, F4::splat(INFINITY));
+}
+
+// Closest accepted lane of four triangles, corners v[corner][axis].
+struct LaneHit {
+  int lane = -1;
+  float t = 0, u = 0, v = 0;
+};
+
+// Double-precision redo of one lane whose edge function rounded to zero.
+bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
+                            const float cy, const float az, const float bz, const float cz, float closest,
+                            LaneHit* out);
+
+inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 valid, float closest) {
+  using simd::F4;
+  const F4 ox = F4::splat(r.org[r.kx]), oy = F4::splat(r.org[r.ky]), oz = F4::splat(r.org[r.kz]);
+  const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
+  F4 ax = v[0][r.kx] - ox, ay = v[0][r.ky] - oy, az = v[0][r.kz] - oz;
+  F4 bx = v[1][r.kx] - ox, by = v[1][r.ky] - oy, bz = v[1][r.kz] - oz;
+  F4 cx = v[2][r.kx] - ox, cy = v[2][r.ky] - oy, cz = v[2][r.kz] - oz;
+  ax = ax - sx * az, ay = ay - sy * az;
+  bx = bx - sx * bz, by = by - sy * bz;
+  cx = cx - sx * cz, cy = cy - sy * cz;
+  F4 U = cx * by - cy * bx;
+  F4 V = ax * cy - ay * cx;
+  F4 W = bx * ay - by * ax;
+  const F4 zero = F4::splat(0.0f);
+  simd::M4 neg = (U < zero) | (V < zero) | (W < zero);
+  simd::M4 pos = (U > zero) | (V > zero) | (W > zero);
+  simd::M4 inside = simd::andnot(neg & pos, valid);
+  simd::M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
+  F4 det = U + V + W;
+  az = sz * az, bz = sz * bz, cz = sz * cz;
+  F4 T = U * az + V * bz + W * cz;
+  F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
+  F4 t = Ts / dets;
+  simd::M4 accept = inside & (det != zero) & (Ts >= zero) & (t <= F4::splat(closest));
+  accept = simd::andnot(edge_zero, accept);
+
+  LaneHit best;
+  int acc = simd::bits(accept);
+  float tl[4];
+  t.store(tl);
+  for (int m = acc; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    if (best.lane < 0 || tl[i] < best.t) best.lane = i, best.t = tl[i];
+  }
+  if (best.lane >= 0) {
+    float Ul[4], Vl[4], Wl[4];
+    U.store(Ul), V.store(Vl), W.store(Wl);
+    float d = Ul[best.lane] + Vl[best.lane] + Wl[best.lane];
+    best.u = Vl[best.lane] / d, best.v = Wl[best.lane] / d;
+  }
+  // Rare: an edge function of 0 in float; settle those lanes in double.
+  int redo = simd::bits(edge_zero & valid);
+  if (redo) {
+    float l[9][4];
+    ax.store(l[0]), ay.store(l[1]), bx.store(l[2]), by.store(l[3]), cx.store(l[4]), cy.store(l[5]);
+    az.store(l[6]), bz.store(l[7]), cz.store(l[8]);
+    for (int m = redo; m; m &= m - 1) {
+      int i = __builtin_ctz(m);
+      LaneHit h;
+      float limit = best.lane >= 0 ? best.t : closest;
+      if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i],
+                                 limit, &h) &&
+          (best.lane < 0 || h.t < best.t))
+        best = h, best.lane = i;
+    }
+  }
+  return best;
+}
+
+}  // namespace meshcast

@@ -1,0 +1,156 @@
+// Four-lane float and int types for the walkers. With AVX2 they are SSE/AVX
+// registers; with MESHCAST_SCALAR they are plain arrays, so one walker source
+// serves both builds and both are tested the same way.
+//
+// min/max keep the *second* operand when either is NaN (the SSE rule), and the
+// scalar path copies that rule: the box test relies on it to drop the NaN of
+// 0 * inf from a slab the ray lies in (see cpu/ray.h).
+#pragma once
+#include <bit>
+#include <cstdint>
+#include <cstring>
+
+#include "layout/block.h"
+#include "layout/half.h"
+
+#if !defined(MESHCAST_SCALAR)
+#include <immintrin.h>
+#endif
+
+namespace meshcast::simd {
+
+#if !defined(MESHCAST_SCALAR)
+
+struct F4 {
+  __m128 v;
+  static F4 splat(float f) { return {_mm_set1_ps(f)}; }
+  static F4 load(const void* p) { return {_mm_loadu_ps(static_cast<const float*>(p))}; }
+  void store(float* p) const { _mm_storeu_ps(p, v); }
+};
+struct I4 {
+  __m128i v;
+  static I4 load(const void* p) { return {_mm_loadu_si128(static_cast<const __m128i*>(p))}; }
+  void store(uint32_t* p) const { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
+};
+struct M4 { __m128 v; };  // lane mask
+
+inline F4 operator+(F4 a, F4 b) { return {_mm_add_ps(a.v, b.v)}; }
+inline F4 operator-(F4 a, F4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+inline F4 operator*(F4 a, F4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+inline F4 operator/(F4 a, F4 b) { return {_mm_div_ps(a.v, b.v)}; }
+inline F4 min(F4 a, F4 b) { return {_mm_min_ps(a.v, b.v)}; }
+inline F4 max(F4 a, F4 b) { return {_mm_max_ps(a.v, b.v)}; }
+inline F4 fma(F4 a, F4 b, F4 c) { return {_mm_fmadd_ps(a.v, b.v, c.v)}; }
+inline F4 abs(F4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }
+inline F4 xor_sign(F4 a, F4 sign_of) {  // a with its sign flipped where sign_of is negative
+  return {_mm_xor_ps(a.v, _mm_and_ps(sign_of.v, _mm_set1_ps(-0.0f)))};
+}
+inline M4 operator<(F4 a, F4 b) { return {_mm_cmplt_ps(a.v, b.v)}; }
+inline M4 operator<=(F4 a, F4 b) { return {_mm_cmple_ps(a.v, b.v)}; }
+inline M4 operator>(F4 a, F4 b) { return {_mm_cmpgt_ps(a.v, b.v)}; }
+inline M4 operator>=(F4 a, F4 b) { return {_mm_cmpge_ps(a.v, b.v)}; }
+inline M4 operator==(F4 a, F4 b) { return {_mm_cmpeq_ps(a.v, b.v)}; }
+inline M4 operator!=(F4 a, F4 b) { return {_mm_cmpneq_ps(a.v, b.v)}; }
+inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
+inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }
+inline M4 andnot(M4 a, M4 b) { return {_mm_andnot_ps(a.v, b.v)}; }  // b & ~a
+inline int bits(M4 m) { return _mm_movemask_ps(m.v); }
+inline M4 lanes_below(uint32_t n) {  // lanes 0..n-1 set
+  return {_mm_castsi128_ps(_mm_cmplt_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32(int(n))))};
+}
+inline F4 select(M4 m, F4 a, F4 b) { return {_mm_blendv_ps(b.v, a.v, m.v)}; }  // m ? a : b
+inline M4 nonzero(I4 a) { return {_mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(a.v, _mm_setzero_si128()), _mm_set1_epi32(-1)))}; }
+inline float lane(F4 a, int i) { alignas(16) float f[4]; _mm_store_ps(f, a.v); return f[i]; }
+inline F4 from_u8(const uint8_t* p) {  // 4 bytes -> 4 floats
+  int32_t x;
+  std::memcpy(&x, p, 4);
+  return {_mm_cvtepi32_ps(_mm_cvtepu8_epi32(_mm_cvtsi32_si128(x)))};
+}
+inline F4 from_half(const uint8_t* p) {  // 4 half floats -> 4 floats (F16C)
+  int64_t x;
+  std::memcpy(&x, p, 8);
+  return {_mm_cvtph_ps(_mm_cvtsi64_si128(x))};
+}
+// Four BitPack words (seed 000 §3.4) at base + 8 * index[i], decoded with the
+// same fma as layout::bitpack_decode.
+inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const float offset[3], const float scale[3],
+                           F4 out[3]) {
+  int32_t x;
+  std::memcpy(&x, index, 4);
+  __m128i idx = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(x));
+  __m256i w = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), idx, 8);
+  const __m256i mask = _mm256_set1_epi64x(MC_BITPACK_MAX);
+  const __m256i even = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+  for (int a = 0; a < 3; ++a) {
+    __m256i q = _mm256_and_si256(_mm256_srli_epi64(w, int(MC_BITPACK_BITS) * a), mask);
+    __m128i q32 = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(q, even));
+    out[a] = {_mm_fmadd_ps(_mm_cvtepi32_ps(q32), _mm_set1_ps(scale[a]), _mm_set1_ps(offset[a]))};
+  }
+}
+// Gather: base + 4 * idx[i] (floats).
+inline F4 gather(const float* base, I4 idx) { return {_mm_i32gather_ps(base, idx.v, 4)}; }
+inline I4 iconst(int a, int b, int c, int d) { return {_mm_setr_epi32(a, b, c, d)}; }
+inline I4 operator+(I4 a, int b) { return {_mm_add_epi32(a.v, _mm_set1_epi32(b))}; }
+
+#else  // MESHCAST_SCALAR
+
+struct F4 {
+  float v[4];
+  static F4 splat(float f) { return {{f, f, f, f}}; }
+  static F4 load(const void* p) { F4 r; std::memcpy(r.v, p, 16); return r; }
+  void store(float* p) const { std::memcpy(p, v, 16); }
+};
+struct I4 {
+  uint32_t v[4];
+  static I4 load(const void* p) { I4 r; std::memcpy(r.v, p, 16); return r; }
+  void store(uint32_t* p) const { std::memcpy(p, v, 16); }
+};
+struct M4 { bool v[4]; };
+
+#define MC_LANES(expr) { for (int i = 0; i < 4; ++i) r.v[i] = (expr); return r; }
+inline F4 operator+(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] + b.v[i]) }
+inline F4 operator-(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] - b.v[i]) }
+inline F4 operator*(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] * b.v[i]) }
+inline F4 operator/(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] / b.v[i]) }
+inline F4 min(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] < b.v[i] ? a.v[i] : b.v[i]) }  // NaN -> b
+inline F4 max(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] > b.v[i] ? a.v[i] : b.v[i]) }
+inline F4 fma(F4 a, F4 b, F4 c) { F4 r; MC_LANES(__builtin_fmaf(a.v[i], b.v[i], c.v[i])) }
+inline F4 abs(F4 a) { F4 r; MC_LANES(__builtin_fabsf(a.v[i])) }
+inline F4 xor_sign(F4 a, F4 s) { F4 r; MC_LANES(__builtin_signbit(s.v[i]) ? -a.v[i] : a.v[i]) }
+inline M4 operator<(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] < b.v[i]) }
+inline M4 operator<=(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] <= b.v[i]) }
+inline M4 operator>(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] > b.v[i]) }
+inline M4 operator>=(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] >= b.v[i]) }
+inline M4 operator==(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] == b.v[i]) }
+inline M4 operator!=(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] != b.v[i]) }
+inline M4 operator&(M4 a, M4 b) { M4 r; MC_LANES(a.v[i] && b.v[i]) }
+inline M4 operator|(M4 a, M4 b) { M4 r; MC_LANES(a.v[i] || b.v[i]) }
+inline M4 andnot(M4 a, M4 b) { M4 r; MC_LANES(!a.v[i] && b.v[i]) }
+inline int bits(M4 m) { return m.v[0] | m.v[1] << 1 | m.v[2] << 2 | m.v[3] << 3; }
+inline M4 lanes_below(uint32_t n) { M4 r; MC_LANES(uint32_t(i) < n) }
+inline F4 select(M4 m, F4 a, F4 b) { F4 r; MC_LANES(m.v[i] ? a.v[i] : b.v[i]) }
+inline M4 nonzero(I4 a) { M4 r; MC_LANES(a.v[i] != 0) }
+inline float lane(F4 a, int i) { return a.v[i]; }
+inline F4 from_u8(const uint8_t* p) { F4 r; MC_LANES(float(p[i])) }
+inline F4 from_half(const uint8_t* p) {
+  F4 r;
+  MC_LANES(layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
+}
+inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const float offset[3], const float scale[3],
+                           F4 out[3]) {
+  for (int i = 0; i < 4; ++i) {
+    uint64_t w;
+    std::memcpy(&w, base + 8 * index[i], 8);
+    float v[3];
+    layout::bitpack_decode(w, offset, scale, v);
+    for (int a = 0; a < 3; ++a) out[a].v[i] = v[a];
+  }
+}
+inline F4 gather(const float* base, I4 idx) { F4 r; MC_LANES(base[idx.v[i]]) }
+inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b), uint32_t(c), uint32_t(d)}}; }
+inline I4 operator+(I4 a, int b) { I4 r; MC_LANES(a.v[i] + uint32_t(b)) }
+#undef MC_LANES
+
+#endif
+
+}  // namespace meshcast::simd

@@ -1,0 +1,69 @@
+#include "cpu/trace.h"
+
+#include "cpu/mesh.h"
+#include "cpu/pairs.h"
+#include "cpu/walk.h"
+#include "layout/quadtree.h"
+
+namespace meshcast {
+
+namespace {
+
+struct Entry {
+  uint32_t tree, triangles;
+  WalkFn walk;
+};
+
+template <class Codec>
+constexpr WalkFn walker_for(uint32_t tree) {
+  switch (tree) {
+    case MC_TREE_AABBTREE: return &walk_aabbtree<Codec>;
+    case MC_TREE_QUADTREE: return &walk_quadtree<layout::QuadBoundsFloat, Codec>;
+    case MC_TREE_QUADTREEHALFFLOAT: return &walk_quadtree<layout::QuadBoundsHalf, Codec>;
+  }
+  return nullptr;
+}
+
+#define MC_CODEC_ENTRIES(Codec)                                                  \
+  {MC_TREE_AABBTREE, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_AABBTREE)},   \
+      {MC_TREE_QUADTREE, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_QUADTREE)}, \
+      {MC_TREE_QUADTREEHALFFLOAT, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_QUADTREEHALFFLOAT)},
+
+const Entry kWalkers[] = {MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRIES)};
+
+}  // namespace
+
+bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
+                            const float cy, const float az, const float bz, const float cz, float closest,
+                            LaneHit* out) {
+  double U = double(cx) * by - double(cy) * bx;
+  double V = double(ax) * cy - double(ay) * cx;
+  double W = double(bx) * ay - double(by) * ax;
+  if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return false;
+  double det = U + V + W;
+  if (det == 0) return false;
+  double T = U * az + V * bz + W * cz;
+  if (det < 0) T = -T, det = -det;
+  if (T < 0) return false;
+  float t = float(T / det);
+  if (!(t <= closest)) return false;
+  out->t = t, out->u = float(V / det), out->v = float(W / det);
+  return true;
+}
+
+BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : bytes_(bytes) {
+  std::string why = layout::validate(bytes);
+  if (!why.empty()) throw InputError(name + ": " + why);
+  const layout::BlobHeader& h = layout::header_of(bytes.data());
+  for (const Entry& e : kWalkers)
+    if (e.tree == h.tree_format && e.triangles == h.triangle_format) walk_ = e.walk;
+  if (!walk_) throw InputError(name + ": no walker for this layout");
+}
+
+uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits) const {
+  uint64_t skipped = 0;
+  walk_(bytes_.data(), rays.data(), hits.data(), std::min(rays.size(), hits.size()), &skipped);
+  return skipped;
+}
+
+}  // namespace meshcast

@@ -1,0 +1,28 @@
+// The CPU entry point: closest hits for a batch of rays against a blob.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cpu/ray.h"
+
+namespace meshcast {
+
+// A blob that passed layout::validate, kept with its walker.
+class BlobView {
+ public:
+  // Validates; throws InputError naming `name` and the problem.
+  BlobView(std::span<const uint8_t> bytes, const std::string& name);
+  // Traces one thread's batch; returns how many rays were not walkable.
+  uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits) const;
+  std::span<const uint8_t> bytes() const { return bytes_; }
+
+ private:
+  std::span<const uint8_t> bytes_;
+  void (*walk_)(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*) = nullptr;
+};
+
+// Double-precision fallback of the watertight test lives in trace.cpp.
+
+}  // namespace meshcast

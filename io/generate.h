@@ -1,0 +1,24 @@
+// Deterministic generated meshes for tests and benchmarks.
+#pragma once
+#include <cstdint>
+
+#include "cpu/mesh.h"
+
+namespace meshcast {
+
+// Closed, watertight UV sphere: `rings` >= 2 latitude bands, `segments` >= 3
+// longitude bands. Each pole is one vertex and the seam is not duplicated, so
+// every edge is shared by exactly two triangles. Outward-facing (CCW seen from
+// outside). 2 + (rings-1)*segments vertices, 2*(rings-1)*segments triangles.
+Mesh make_sphere(int rings, int segments, float radius, Vec3 centre);
+
+// Grid in the z=0 plane with vertices at the integer points (x, y), 0<=x<=nx,
+// 0<=y<=ny, two triangles per cell (2*nx*ny triangles), normals +z.
+Mesh make_grid_plane(int nx, int ny);
+
+// Heightfield terrain over an nx by ny grid of unit cells (2*nx*ny triangles),
+// heights from a smooth noise fixed by `seed` (a sum of a few sines whose
+// frequencies and phases come from the seed). Same arguments, same mesh.
+Mesh make_terrain(int nx, int ny, uint32_t seed);
+
+}  // namespace meshcast

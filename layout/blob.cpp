@@ -1,0 +1,216 @@
+#include "layout/blob.h"
+
+#include <cmath>
+#include <vector>
+
+#include "layout/aabbtree.h"
+#include "layout/float3.h"
+#include "layout/float3soa4.h"
+#include "layout/indexed8bitpacksoa4.h"
+#include "layout/quadtree.h"
+
+namespace meshcast::layout {
+
+uint32_t checksum(std::span<const uint8_t> bytes) {
+  uint32_t h = 2166136261u;
+  for (uint8_t b : bytes) h = (h ^ b) * 16777619u;
+  return h;
+}
+
+void seal(std::span<uint8_t> blob) {
+  BlobHeader h;
+  std::memcpy(&h, blob.data(), sizeof h);
+  h.checksum = checksum(blob.subspan(sizeof h));
+  std::memcpy(blob.data(), &h, sizeof h);
+}
+
+std::string_view tree_format_name(uint32_t f) {
+  switch (f) {
+    case MC_TREE_AABBTREE: return "AABBTree";
+    case MC_TREE_QUADTREE: return "QuadTree";
+    case MC_TREE_QUADTREEHALFFLOAT: return "QuadTreeHalfFloat";
+  }
+  return "";
+}
+
+std::string_view triangle_format_name(uint32_t f) {
+  switch (f) {
+    case MC_TRI_FLOAT3: return "Float3";
+    case MC_TRI_FLOAT3SOA4: return "Float3SOA4";
+    case MC_TRI_INDEXED8BITPACKSOA4: return "Indexed8BitPackSOA4";
+  }
+  return "";
+}
+
+namespace {
+
+std::string num(uint64_t v) { return std::to_string(v); }
+
+// Checks one leaf: its block lies in the triangle area of the tree section,
+// its slots lie in the remap, and the codec's own indices are in range.
+template <class Codec>
+std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block, uint32_t count) {
+  if (count == 0 || count > MC_QUAD_MAX_COUNT)
+    return "leaf at tree offset " + num(block) + " has " + num(count) + " triangles (allowed 1.." +
+           num(MC_QUAD_MAX_COUNT) + ")";
+  if (block < h.triangle_base || (block - h.triangle_base) % 4 != 0)
+    return "triangle block at tree offset " + num(block) + " lies before the triangle area (" +
+           num(h.triangle_base) + ") or is misaligned";
+  if (uint64_t(block) + Codec::block_bytes(count) > h.tree_size)
+    return "triangle block at tree offset " + num(block) + " of " + num(Codec::block_bytes(count)) +
+           " bytes runs past the tree section (" + num(h.tree_size) + " bytes)";
+  if (uint64_t((block - h.triangle_base) / h.slot_divisor) + count > h.remap_entries)
+    return "triangle block at tree offset " + num(block) + " maps past the remap (" + num(h.remap_entries) +
+           " entries)";
+  std::string why;
+  if (!Codec::check(blob, h.tree_offset + block, count, &why)) return why;
+  return "";
+}
+
+template <class Codec>
+std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  struct Item { uint32_t offset, depth; };
+  std::vector<Item> stack{{0, 0}};
+  uint64_t visited = 0;
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    if (++visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
+    if (it.depth > h.max_depth || it.depth > MC_MAX_DEPTH)
+      return "node at tree offset " + num(it.offset) + " is deeper than the limit " + num(MC_MAX_DEPTH);
+    if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_AABB_NODE_BYTES > h.tree_size)
+      return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
+    AABBNode n = load_aabb_node(blob + h.tree_offset + it.offset);
+    uint32_t next = it.offset + MC_AABB_NODE_BYTES;
+    if (n.is_leaf()) {
+      std::string e = check_leaf<Codec>(blob, h, next, n.value());
+      if (!e.empty()) return e;
+      *triangles += n.value();
+    } else {
+      if (n.value() <= next)
+        return "node at tree offset " + num(it.offset) + " has its second child at " + num(n.value()) +
+               ", not after its first child";
+      stack.push_back({next, it.depth + 1});
+      stack.push_back({n.value(), it.depth + 1});
+    }
+  }
+  return "";
+}
+
+template <class Bounds, class Codec>
+std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  struct Item { uint32_t properties, parent, depth; };
+  std::vector<Item> stack{{h.root, 0, 0}};
+  uint64_t visited = 0;
+  bool root = true;
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    uint32_t count = quad_count(it.properties), offset = quad_offset(it.properties);
+    if (count != 0) {
+      std::string e = check_leaf<Codec>(blob, h, offset, count);
+      if (!e.empty()) return e;
+      *triangles += count;
+      continue;
+    }
+    if (!root && offset <= it.parent)
+      return "node at tree offset " + num(offset) + " does not lie after its parent at " + num(it.parent);
+    root = false;
+    if (++visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
+    if (it.depth > h.max_depth || it.depth > MC_MAX_DEPTH)
+      return "node at tree offset " + num(offset) + " is deeper than the limit " + num(MC_MAX_DEPTH);
+    if (offset % 4 != 0 || uint64_t(offset) + Bounds::kNodeBytes > h.node_bytes)
+      return "node at tree offset " + num(offset) + " is misaligned or outside the node area (" +
+             num(h.node_bytes) + " bytes)";
+    const uint8_t* node = blob + h.tree_offset + offset;
+    for (int k = 0; k < 4; ++k) {
+      uint32_t p = quad_child_properties(node, Bounds::kPropertiesAt, k);
+      if (p == 0) continue;  // unused child: the walker never follows it
+      stack.push_back({p, offset, it.depth + 1});
+    }
+  }
+  return "";
+}
+
+template <class Codec>
+std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  switch (h.tree_format) {
+    case MC_TREE_AABBTREE: return walk_aabbtree<Codec>(blob, h, triangles);
+    case MC_TREE_QUADTREE: return walk_quadtree<QuadBoundsFloat, Codec>(blob, h, triangles);
+    case MC_TREE_QUADTREEHALFFLOAT: return walk_quadtree<QuadBoundsHalf, Codec>(blob, h, triangles);
+  }
+  return "unknown tree format " + num(h.tree_format);
+}
+
+struct Section { const char* name; uint32_t offset, size; };
+
+}  // namespace
+
+std::string validate(std::span<const uint8_t> blob) {
+  if (blob.size() < sizeof(BlobHeader))
+    return "blob of " + num(blob.size()) + " bytes is shorter than its header (" + num(sizeof(BlobHeader)) + ")";
+  BlobHeader h;
+  std::memcpy(&h, blob.data(), sizeof h);
+  if (h.magic != MC_BLOB_MAGIC) return "not a meshcast blob (bad magic)";
+  if (h.version != MC_BLOB_VERSION)
+    return "blob version " + num(h.version) + " is not the supported version " + num(MC_BLOB_VERSION);
+  if (h.total_size != blob.size())
+    return "blob is " + num(blob.size()) + " bytes but its header says " + num(h.total_size) + " (truncated?)";
+  if (checksum(blob.subspan(sizeof h)) != h.checksum) return "blob checksum does not match its contents";
+  if (tree_format_name(h.tree_format).empty()) return "unknown tree format " + num(h.tree_format);
+  if (triangle_format_name(h.triangle_format).empty()) return "unknown triangle format " + num(h.triangle_format);
+  if (h.triangle_count == 0 || h.triangle_count == MC_NO_HIT) return "triangle count out of range";
+
+  // Sections follow each other in order, inside the blob.
+  Section sections[] = {{"tree", h.tree_offset, h.tree_size},
+                        {"vertex", h.vertex_offset, h.vertex_size},
+                        {"remap", h.remap_offset, h.remap_size}};
+  uint64_t end = sizeof h;
+  for (const Section& s : sections) {
+    if (s.offset < end || s.offset % 4 != 0 || uint64_t(s.offset) + s.size > blob.size())
+      return std::string(s.name) + " section [" + num(s.offset) + ", +" + num(s.size) +
+             ") overlaps another, is misaligned, or runs past the blob (" + num(blob.size()) + " bytes)";
+    end = uint64_t(s.offset) + s.size;
+  }
+  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE ? MC_AABB_NODE_BYTES
+                       : h.tree_format == MC_TREE_QUADTREE ? MC_QUAD_NODE_BYTES : MC_QUADHALF_NODE_BYTES;
+  if (uint64_t(h.node_count) * node_size > h.tree_size)
+    return "node count " + num(h.node_count) + " does not fit the tree section";
+  if (h.node_bytes > h.tree_size || h.triangle_base > h.tree_size)
+    return "node area or triangle base lies past the tree section";
+  if (h.remap_bits == 0 || h.remap_bits > 32 || (uint64_t(1) << h.remap_bits) < h.triangle_count)
+    return "remap entries of " + num(h.remap_bits) + " bits cannot hold " + num(h.triangle_count) + " triangles";
+  if ((uint64_t(h.remap_entries) * h.remap_bits + 7) / 8 + 8 > h.remap_size)
+    return "remap section of " + num(h.remap_size) + " bytes is too small for " + num(h.remap_entries) + " entries";
+  for (uint32_t s = 0; s < h.remap_entries; ++s)
+    if (remap_entry(blob.data(), h, s) >= h.triangle_count)
+      return "remap entry " + num(s) + " names triangle " + num(remap_entry(blob.data(), h, s)) + " of " +
+             num(h.triangle_count);
+  if (h.tree_format == MC_TREE_QUADTREEHALFFLOAT &&
+      !(std::isfinite(h.node_scale) && h.node_scale > 0 && std::isfinite(h.node_origin[0]) &&
+        std::isfinite(h.node_origin[1]) && std::isfinite(h.node_origin[2])))
+    return "half-float node origin or scale is not finite";
+
+  uint64_t triangles = 0;
+  std::string e;
+  switch (h.triangle_format) {
+    case MC_TRI_FLOAT3:
+      if (h.slot_divisor != Float3::kSlotDivisor) return "slot divisor does not match Float3";
+      e = walk_tree<Float3>(blob.data(), h, &triangles);
+      break;
+    case MC_TRI_FLOAT3SOA4:
+      if (h.slot_divisor != Float3SOA4::kSlotDivisor) return "slot divisor does not match Float3SOA4";
+      e = walk_tree<Float3SOA4>(blob.data(), h, &triangles);
+      break;
+    case MC_TRI_INDEXED8BITPACKSOA4:
+      if (h.slot_divisor != Indexed8BitPackSOA4::kSlotDivisor) return "slot divisor does not match Indexed8BitPackSOA4";
+      e = walk_tree<Indexed8BitPackSOA4>(blob.data(), h, &triangles);
+      break;
+  }
+  if (!e.empty()) return e;
+  if (triangles != h.triangle_count)
+    return "leaves hold " + num(triangles) + " triangles but the header says " + num(h.triangle_count);
+  return "";
+}
+
+}  // namespace meshcast::layout

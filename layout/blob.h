@@ -1,0 +1,91 @@
+// The blob: one contiguous, versioned byte buffer holding a built mesh.
+//
+//   [BlobHeader][tree section: nodes and triangle blocks][vertex section][remap]
+//
+// The tree section holds the nodes and triangle blocks of the tree format in
+// the order its writer chose; offsets inside it are relative to its start.
+// The vertex section holds shared vertices for indexed triangle formats. The
+// remap turns a triangle slot (see slot_of) into the caller's triangle index.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "layout/formats.h"
+
+namespace meshcast::layout {
+
+struct BlobHeader {
+  uint32_t magic;
+  uint32_t version;
+  uint32_t tree_format;
+  uint32_t triangle_format;
+  uint32_t triangle_count;  // triangles of the input mesh
+  uint32_t node_count;      // nodes of the tree format (QuadTree: 4-wide nodes)
+  uint32_t leaf_count;      // triangle blocks
+  uint32_t max_depth;       // deepest node, root = 0
+  uint32_t leaf_size;       // largest triangle count the builder allowed a leaf
+  uint32_t root;            // AABBTree: offset of the root node; QuadTree: RootProperties
+  float bounds_min[3];      // box of the decoded triangles
+  float bounds_max[3];
+  float quant_offset[3];    // BitPack vertices: v = q * quant_scale + quant_offset
+  float quant_scale[3];
+  float node_origin[3];     // QuadTreeHalfFloat: bound = half * node_scale + node_origin
+  float node_scale;
+  uint32_t tree_offset, tree_size;
+  uint32_t node_bytes;      // bytes of nodes in the tree section (rest: triangle blocks)
+  uint32_t triangle_base;   // tree-section offset where slot numbering starts
+  uint32_t slot_divisor;    // bytes of triangle block per slot number
+  uint32_t vertex_offset, vertex_size;
+  uint32_t remap_offset, remap_size;
+  uint32_t remap_bits;      // bits per remap entry
+  uint32_t remap_entries;
+  uint32_t total_size;
+  uint32_t checksum;        // FNV-1a over every byte after the header
+  uint32_t reserved;
+};
+static_assert(sizeof(BlobHeader) == MC_BLOB_HEADER_BYTES);
+
+// FNV-1a, 32 bits: cheap, and enough to catch accidental damage. Validation
+// does not rely on it: every structural fact is checked on its own.
+uint32_t checksum(std::span<const uint8_t> bytes);
+void seal(std::span<uint8_t> blob);  // writes header.checksum
+
+// Proves, before any walker runs, that every offset, count, index and remap
+// entry is in range and that the tree is a tree (each child after its parent,
+// each node reached once, depth within MC_MAX_DEPTH). Returns "" when the
+// blob is valid, otherwise a message naming what is wrong and the limit.
+std::string validate(std::span<const uint8_t> blob);
+
+std::string_view tree_format_name(uint32_t f);
+std::string_view triangle_format_name(uint32_t f);
+
+// Unaligned little-endian loads used by the walkers and validation.
+template <class T>
+inline T load(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+
+inline const BlobHeader& header_of(const uint8_t* blob) {
+  return *reinterpret_cast<const BlobHeader*>(blob);
+}
+
+// Triangle slot of lane `lane` of the block at tree-section offset `block`.
+inline uint32_t slot_of(const BlobHeader& h, uint32_t block, uint32_t lane) {
+  return (block - h.triangle_base) / h.slot_divisor + lane;
+}
+
+// Bit-packed remap entry (remap_bits wide, LSB first). The section carries 8
+// bytes of padding so the 64-bit load never leaves it.
+inline uint32_t remap_entry(const uint8_t* blob, const BlobHeader& h, uint32_t slot) {
+  uint64_t bit = uint64_t(slot) * h.remap_bits;
+  uint64_t word = load<uint64_t>(blob + h.remap_offset + (bit >> 3));
+  return uint32_t((word >> (bit & 7)) & ((uint64_t(1) << h.remap_bits) - 1));
+}
+
+}  // namespace meshcast::layout

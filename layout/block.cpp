@@ -1,0 +1,81 @@
+#include <algorithm>
+#include <cmath>
+
+#include "layout/indexed8bitpacksoa4.h"
+
+namespace meshcast::layout {
+
+void bitpack_decode(uint64_t w, const float offset[3], const float scale[3], float out[3]) {
+  for (int a = 0; a < 3; ++a) out[a] = std::fma(float(bitpack_component(w, a)), scale[a], offset[a]);
+}
+
+uint64_t bitpack_encode(const float v[3], const float offset[3], const float scale[3]) {
+  uint64_t w = 0;
+  for (int a = 0; a < 3; ++a) {
+    uint32_t q = 0;
+    if (scale[a] > 0) {
+      double guess = std::round((double(v[a]) - offset[a]) / scale[a]);
+      guess = std::clamp(guess, 0.0, double(MC_BITPACK_MAX));
+      // Of the grid points around the guess, keep the one whose decode (the
+      // walker's own fma) lands nearest the original.
+      q = uint32_t(guess);
+      float best = std::fabs(std::fma(float(q), scale[a], offset[a]) - v[a]);
+      for (int64_t c = int64_t(guess) - 1; c <= int64_t(guess) + 1; ++c) {
+        if (c < 0 || c > MC_BITPACK_MAX) continue;
+        float err = std::fabs(std::fma(float(c), scale[a], offset[a]) - v[a]);
+        if (err < best) best = err, q = uint32_t(c);
+      }
+    }
+    w |= uint64_t(q) << (MC_BITPACK_BITS * a);
+  }
+  return w;
+}
+
+void Indexed8BitPackSOA4::encode(const TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out) {
+  std::vector<uint64_t>& pool = *ctx.vertices;
+  // Window [base, base + 256): ends 3*count past the pool's current end.
+  uint64_t end = pool.size() + 3ull * count;
+  uint32_t base = end > MC_I8_WINDOW ? uint32_t(end - MC_I8_WINDOW) : 0u;
+  uint8_t idx[3][32 * 4];
+  for (uint32_t i = 0; i < count; ++i)
+    for (int c = 0; c < 3; ++c) {
+      uint64_t w = tris[i].packed[c];
+      auto it = ctx.last_index->find(w);
+      uint32_t at;
+      if (it != ctx.last_index->end() && it->second >= base) {
+        at = it->second;
+      } else {
+        at = uint32_t(pool.size());
+        pool.push_back(w);
+        (*ctx.last_index)[w] = at;
+      }
+      idx[c][i] = uint8_t(at - base);
+    }
+  // Padding lanes repeat the last triangle.
+  for (uint32_t i = count; i < blocks(count) * 4; ++i)
+    for (int c = 0; c < 3; ++c) idx[c][i] = idx[c][count - 1];
+  uint32_t offset = ctx.vertex_section + 8 * base - ctx.block_address;
+  std::memcpy(out, &offset, 4);
+  for (uint32_t b = 0; b < blocks(count); ++b)
+    for (int c = 0; c < 3; ++c)
+      for (uint32_t lane = 0; lane < 4; ++lane)
+        out[MC_I8_HEADER_BYTES + b * MC_I8_BLOCK_BYTES + c * 4 + lane] = idx[c][b * 4 + lane];
+}
+
+bool Indexed8BitPackSOA4::check(const uint8_t* blob, uint32_t block, uint32_t count, std::string* why) {
+  const BlobHeader& h = header_of(blob);
+  uint64_t first = uint64_t(block) + load<uint32_t>(blob + block);
+  for (uint32_t i = 0; i < blocks(count) * 4; ++i)
+    for (int c = 0; c < 3; ++c) {
+      uint64_t at = first + 8ull * index(blob, block, i, c);
+      if (at < h.vertex_offset || at + 8 > uint64_t(h.vertex_offset) + h.vertex_size) {
+        *why = "Indexed8BitPackSOA4 block at " + std::to_string(block) + " indexes a vertex at byte " +
+               std::to_string(at) + ", outside the vertex section [" + std::to_string(h.vertex_offset) + ", " +
+               std::to_string(h.vertex_offset + h.vertex_size) + ")";
+        return false;
+      }
+    }
+  return true;
+}
+
+}  // namespace meshcast::layout

@@ -1,0 +1,38 @@
+// What a triangle codec is given to encode one leaf's block, and what it
+// decodes one triangle back to. Each codec lives in its own header
+// (float3.h, float3soa4.h, indexed8bitpacksoa4.h) with the same static members:
+//   kFormat, kSlotDivisor, kLanes, block_bytes(count), encode(...), decode(...)
+#pragma once
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "layout/blob.h"
+
+namespace meshcast::layout {
+
+// One triangle as the codec stores it: three corners, already at the
+// positions the walker will decode (bit-packed formats quantize first).
+struct TriCorners {
+  float v[3][3];     // corner, axis
+  uint64_t packed[3];  // BitPack word of each corner (bit-packed formats only)
+};
+
+// State shared by the blocks of one blob while it is written.
+struct BlockContext {
+  uint32_t block_address = 0;        // blob offset of the block being written
+  uint32_t vertex_section = 0;       // blob offset of the vertex section
+  std::vector<uint64_t>* vertices = nullptr;  // shared vertex pool (indexed formats)
+  std::unordered_map<uint64_t, uint32_t>* last_index = nullptr;  // word -> newest pool index
+};
+
+// The bit-packed vertex of seed 000 §3.4: 21 bits per component in a uint64,
+// x in the low bits. Decoding is one fused multiply-add per component, done
+// the same way (and so to the same bits) by every walker and shader.
+inline uint32_t bitpack_component(uint64_t w, int axis) {
+  return uint32_t(w >> (MC_BITPACK_BITS * axis)) & MC_BITPACK_MAX;
+}
+void bitpack_decode(uint64_t w, const float offset[3], const float scale[3], float out[3]);
+uint64_t bitpack_encode(const float v[3], const float offset[3], const float scale[3]);
+
+}  // namespace meshcast::layout

@@ -1,0 +1,56 @@
+// Names and numbers of every blob layout: the one list both the C++ code and
+// (later) the GLSL shaders include. Plain #defines in the common subset of C++
+// and GLSL, so a layout change is one edit.
+//
+// Seed 000 (Rouwé 2019) §3 triangle encodings, §5 tree types.
+#ifndef MESHCAST_LAYOUT_FORMATS_H
+#define MESHCAST_LAYOUT_FORMATS_H
+
+#define MC_BLOB_MAGIC 0x424C434Du   // "MCLB" little-endian
+#define MC_BLOB_VERSION 1u
+#define MC_BLOB_HEADER_BYTES 160u
+
+// Tree formats (seed 000 §5).
+#define MC_TREE_AABBTREE 1u            // §5.1
+#define MC_TREE_QUADTREE 2u            // §5.6
+#define MC_TREE_QUADTREEHALFFLOAT 3u   // §5.7
+
+// Triangle formats (seed 000 §3).
+#define MC_TRI_FLOAT3 1u               // §3.1
+#define MC_TRI_FLOAT3SOA4 2u           // §3.2
+#define MC_TRI_INDEXED8BITPACKSOA4 3u  // §3.9
+
+// AABBTree node (§5.1): BoundingBoxMin (3 floats), BoundingBoxMax (3 floats),
+// Properties (uint32). High bit set: a leaf whose low bits are its triangle
+// count, its block right behind the node. Clear: the first child is right
+// behind the node and the low bits are the second child's offset.
+#define MC_AABB_NODE_BYTES 28u
+#define MC_AABB_LEAF_BIT 0x80000000u
+#define MC_AABB_VALUE_MASK 0x7FFFFFFFu
+
+// QuadTree / QuadTreeHalfFloat child properties (§5.6): 5 bits of triangle
+// count on top (0: the child is a node), 27 bits of offset below.
+#define MC_QUAD_COUNT_SHIFT 27u
+#define MC_QUAD_OFFSET_MASK 0x07FFFFFFu
+#define MC_QUAD_MAX_COUNT 31u
+#define MC_QUAD_NODE_BYTES 112u        // 24 floats + 4 uint32
+#define MC_QUADHALF_NODE_BYTES 64u     // 24 half floats + 4 uint32: a cache line
+// Offsets are relative to the start of the tree section.
+
+// Triangle blocks.
+#define MC_FLOAT3_TRI_BYTES 36u        // 9 floats a triangle
+#define MC_SOA4_LANES 4u
+#define MC_FLOAT3SOA4_BLOCK_BYTES 144u // 3 corners x 3 axes x 4 lanes x 4 bytes
+#define MC_I8_HEADER_BYTES 4u          // OffsetToVertices (uint32)
+#define MC_I8_BLOCK_BYTES 12u          // 4 triangles x 3 8-bit indices, SOA
+#define MC_I8_WINDOW 256u              // vertices one 8-bit index reaches
+#define MC_BITPACK_BITS 21u            // per component, in a uint64 (§3.4)
+#define MC_BITPACK_MAX 2097151u        // 2^21 - 1
+
+// Stack limits the walkers rely on; validation proves the tree fits them.
+#define MC_MAX_DEPTH 64u
+
+// Hit triangle for a miss.
+#define MC_NO_HIT 0xFFFFFFFFu
+
+#endif

@@ -1,0 +1,72 @@
+#include "tests/testing.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+
+#include "io/generate.h"
+#include "io/read_mesh.h"
+#include "layout/blob.h"
+#include "layout/block.h"
+
+namespace meshcast::testing {
+
+std::optional<Mesh> data_mesh(const std::string& name) {
+  const char* dir = std::getenv("MESHCAST_DATA");
+  std::string path = std::string(dir ? dir : "data") + "/" + name + ".off";
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  return read_mesh(path);
+}
+
+std::vector<NamedMesh> test_meshes(bool large) {
+  static std::map<std::string, std::shared_ptr<const Mesh>> cache;
+  auto get = [&](const std::string& name, auto make) {
+    if (!cache.count(name)) cache[name] = std::make_shared<const Mesh>(make());
+    return NamedMesh{name, cache[name]};
+  };
+  std::vector<NamedMesh> out;
+  out.push_back(get("sphere", [] { return make_sphere(48, 96, 2.0f, {0.5f, -0.25f, 1.0f}); }));
+  out.push_back(get("grid_plane", [] { return make_grid_plane(40, 30); }));
+  out.push_back(get("terrain_64k", [] { return make_terrain(256, 128, 7); }));
+  for (const char* name : {"bunny00", "armadillo", "refined_elephant", "ChineseDragon-10kv"}) {
+    if (!cache.count(name)) {
+      std::optional<Mesh> m = data_mesh(name);
+      if (!m) continue;
+      cache[name] = std::make_shared<const Mesh>(std::move(*m));
+    }
+    out.push_back({name, cache[name]});
+  }
+  if (large) out.push_back(get("terrain_1M", [] { return make_terrain(1024, 512, 11); }));
+  return out;
+}
+
+const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count) {
+  static std::map<std::tuple<std::string, int, size_t>, std::vector<Ray>> cache;
+  auto key = std::make_tuple(m.name, int(kind), count);
+  if (!cache.count(key)) cache[key] = make_rays(*m.mesh, kind, count, 1234);
+  return cache[key];
+}
+
+const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays) {
+  static std::map<std::pair<std::string, int>, std::vector<OracleHit>> cache;
+  static std::map<std::string, std::unique_ptr<OracleTree>> trees;
+  auto key = std::make_pair(m.name, int(kind));
+  if (!cache.count(key)) {
+    if (!trees.count(m.name)) trees[m.name] = std::make_unique<OracleTree>(*m.mesh);
+    std::vector<OracleHit> answers(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) answers[i] = trees[m.name]->closest(rays[i]);
+    cache[key] = std::move(answers);
+  }
+  return cache[key];
+}
+
+std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped) {
+  BlobView view(blob, "test blob");
+  std::vector<Hit> hits(rays.size());
+  uint64_t s = view.trace(rays, hits);
+  if (skipped) *skipped = s;
+  return hits;
+}
+
+}  // namespace meshcast::testing

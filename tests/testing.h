@@ -1,0 +1,37 @@
+// Shared test helpers: the test meshes, oracle answers computed once per
+// mesh and ray set, and the agreement rules of the foundation issue.
+#pragma once
+#include <map>
+#include <tuple>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cpu/agreement.h"
+#include "cpu/encode.h"
+#include "cpu/mesh.h"
+#include "cpu/oracle.h"
+#include "cpu/rays.h"
+#include "cpu/trace.h"
+
+namespace meshcast::testing {
+
+// data/NAME.off under $MESHCAST_DATA, or nullopt if it is not there.
+std::optional<Mesh> data_mesh(const std::string& name);
+
+struct NamedMesh {
+  std::string name;
+  std::shared_ptr<const Mesh> mesh;
+};
+// Generated meshes plus the four public ones when present. `large` adds the
+// 1M+ triangle terrain.
+std::vector<NamedMesh> test_meshes(bool large);
+
+// Oracle answers (tree oracle) for a ray set, cached per (mesh, kind).
+const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays);
+const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count = 10000);
+
+std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr);
+
+}  // namespace meshcast::testing

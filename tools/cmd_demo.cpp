@@ -1,0 +1,102 @@
+// meshcast demo MESH: the main job. Builds the three layouts of the
+// foundation, casts 10,000 rays of each kind, compares every answer with the
+// double-precision oracle, prints a table and renders a picture.
+#include <cstdio>
+
+#include "cpu/agreement.h"
+#include "cpu/oracle.h"
+#include "cpu/rays.h"
+#include "cpu/trace.h"
+#include "io/read_mesh.h"
+#include "layout/blob.h"
+#include "tools/commands.h"
+#include "tools/common.h"
+#include "tools/render.h"
+
+namespace meshcast::tools {
+
+void add_demo(CLI::App& app) {
+  struct Args {
+    std::string input, png = "out/render.png";
+    size_t count = 10000;
+    uint32_t repeat = 5, leaf = 8;
+    int width = 800, height = 600;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("demo", "the main job: three layouts, three ray kinds, oracle, picture");
+  cmd->add_option("input", args->input, "mesh file")->required();
+  cmd->add_option("--count", args->count, "rays of each kind")->check(CLI::Range(size_t(1), size_t(10000000)));
+  cmd->add_option("--repeat", args->repeat, "timed passes; the median is reported")->check(CLI::Range(1, 100));
+  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--png", args->png, "picture to write");
+  cmd->add_option("--width", args->width)->check(CLI::Range(16, 8192));
+  cmd->add_option("--height", args->height)->check(CLI::Range(16, 8192));
+  cmd->callback([args] {
+    auto t0 = std::chrono::steady_clock::now();
+    Mesh mesh = read_mesh(args->input);
+    double load_ms = ms_since(t0);
+    std::printf("%s: %zu triangles, %zu vertices, read in %.0f ms\n", args->input.c_str(), mesh.triangles.size(),
+                mesh.vertices.size(), load_ms);
+    const RayKind kinds[] = {RayKind::Long, RayKind::Probe, RayKind::Radial};
+    const char* kind_names[] = {"long", "probe", "radial"};
+    std::vector<Ray> rays[3];
+    std::vector<OracleHit> oracle[3];
+    OracleTree tree(mesh);
+    for (int k = 0; k < 3; ++k) {
+      rays[k] = make_rays(mesh, kinds[k], args->count, 1);
+      oracle[k].resize(rays[k].size());
+      for (size_t i = 0; i < rays[k].size(); ++i) oracle[k][i] = tree.closest(rays[k][i]);
+    }
+    double tolerance = 1e-5 * mesh.bounds().diagonal();
+    std::printf("\n| layout | build ms | bytes/tri walked | remap B/tri | ns/ray long | ns/ray probe | ns/ray radial "
+                "| disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::vector<uint8_t> picture_blob;
+    std::vector<Hit> long_hits;
+    uint64_t disagreements_total = 0;
+    for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
+      BuildOptions o = layout_options(name, args->leaf);
+      BuildReport report;
+      std::vector<uint8_t> blob = build_blob(mesh, o, args->input, &report);
+      BlobView view(blob, name);
+      // The bit-packed layout is judged on the mesh it stores (its vertices
+      // moved by at most the quantization bound), the others on the input.
+      bool quantized = o.triangle_format == MC_TRI_INDEXED8BITPACKSOA4;
+      Mesh stored = quantized ? quantized_mesh(mesh, blob) : Mesh{};
+      std::unique_ptr<OracleTree> stored_tree = quantized ? std::make_unique<OracleTree>(stored) : nullptr;
+      double ns[3];
+      uint64_t disagreements = 0;
+      for (int k = 0; k < 3; ++k) {
+        std::vector<Hit> hits(rays[k].size());
+        std::vector<double> pass_ms;
+        for (uint32_t r = 0; r < args->repeat; ++r) {
+          auto t1 = std::chrono::steady_clock::now();
+          view.trace(rays[k], hits);
+          pass_ms.push_back(ms_since(t1));
+        }
+        ns[k] = median(pass_ms) * 1e6 / double(rays[k].size());
+        std::vector<OracleHit> answers = oracle[k];
+        if (quantized)
+          for (size_t i = 0; i < rays[k].size(); ++i) answers[i] = stored_tree->closest(rays[k][i]);
+        Agreement a = compare(quantized ? stored : mesh, rays[k], hits, answers, tolerance);
+        disagreements += a.wrong + a.t_errors;
+        if (k == 0) long_hits = hits;
+      }
+      SectionBytes s = section_bytes(blob);
+      double n = double(mesh.triangles.size());
+      std::printf("| %s | %.0f | %.2f | %.2f | %.0f | %.0f | %.0f | %llu |\n", name, report.build_ms, s.walked() / n,
+                  s.remap / n, ns[0], ns[1], ns[2], (unsigned long long)disagreements);
+      disagreements_total += disagreements;
+      picture_blob = std::move(blob);
+    }
+    std::printf("\n%zu rays of each kind, one thread, median of %u passes; disagreements = rays whose triangle or t "
+                "differs from the double-precision oracle beyond exact ties (t tolerance %.3g)\n",
+                args->count, args->repeat, tolerance);
+    Picture p = render(picture_blob, args->width, args->height, rays[0], long_hits);
+    write_png(args->png, p.width, p.height, p.rgb);
+    std::printf("picture: %s (%dx%d, QuadTreeHalfFloat/Indexed8BitPackSOA4, %.0f ns/ray; green: long-ray hits)\n",
+                args->png.c_str(), p.width, p.height, p.ns_per_ray);
+    if (disagreements_total) throw std::runtime_error("the walkers disagree with the oracle");
+  });
+}
+
+}  // namespace meshcast::tools

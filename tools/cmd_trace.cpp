@@ -1,0 +1,81 @@
+// meshcast trace MESH|BLOB --rays R.rays --out H.hits: one thread, the whole
+// batch cast --repeat times, the median pass reported per ray.
+#include <cstdio>
+
+#include "cpu/rays.h"
+#include "cpu/trace.h"
+#include "tools/commands.h"
+#include "tools/common.h"
+
+namespace meshcast::tools {
+
+void add_trace(CLI::App& app) {
+  struct Args {
+    std::string input, rays, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+    uint32_t leaf = 8, repeat = 5;
+    bool json = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh or blob, write a hits file");
+  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL) or blob")->required();
+  cmd->add_option("--rays", args->rays, "rays file")->required();
+  cmd->add_option("--out", args->out, "hits file to write")->required();
+  cmd->add_option("--layout", args->layout, "TREE/TRIANGLES when building from a mesh");
+  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
+  cmd->add_flag("--json", args->json, "print the figures as one JSON object");
+  cmd->callback([args] {
+    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf));
+    std::vector<Ray> rays = read_rays(args->rays);
+    BlobView view(in.blob, args->input);
+    std::vector<Hit> hits(rays.size());
+    std::vector<double> pass_ms;
+    uint64_t skipped = 0;
+    for (uint32_t r = 0; r < args->repeat; ++r) {
+      auto t0 = std::chrono::steady_clock::now();
+      skipped = view.trace(rays, hits);
+      pass_ms.push_back(ms_since(t0));
+    }
+    write_hits(args->out, hits);
+    size_t hit_count = 0;
+    for (const Hit& h : hits) hit_count += h.triangle != MC_NO_HIT;
+    const layout::BlobHeader& h = layout::header_of(in.blob.data());
+    double ns = rays.empty() ? 0 : median(pass_ms) * 1e6 / double(rays.size());
+    std::string layout = layout_name(h.tree_format, h.triangle_format);
+    if (args->json) {
+      std::printf("{\"input\":\"%s\",\"layout\":\"%s\",\"load_ms\":%.3f,\"build_ms\":%.3f,\"rays\":%zu,"
+                  "\"hits\":%zu,\"invalid_rays\":%llu,\"repeat\":%u,\"ns_per_ray\":%.2f}\n",
+                  args->input.c_str(), layout.c_str(), in.load_ms, in.build_ms, rays.size(), hit_count,
+                  (unsigned long long)skipped, args->repeat, ns);
+    } else {
+      std::printf("%s: %s, load %.1f ms, build %.1f ms\n", args->input.c_str(), layout.c_str(), in.load_ms,
+                  in.build_ms);
+      std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", rays.size(), hit_count,
+                  (unsigned long long)skipped);
+      std::printf("cast: %.1f ns/ray (median of %u passes, one thread)\n", ns, args->repeat);
+    }
+  });
+}
+
+void add_build(CLI::App& app) {
+  struct Args {
+    std::string input, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+    uint32_t leaf = 8;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("build", "build a mesh into a blob file");
+  cmd->add_option("input", args->input, "mesh file")->required();
+  cmd->add_option("--out", args->out, "blob file to write")->required();
+  cmd->add_option("--layout", args->layout, "TREE/TRIANGLES");
+  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->callback([args] {
+    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf));
+    if (!in.mesh) throw InputError(args->input + ": is already a blob; give a mesh file");
+    write_file(args->out, in.blob.data(), in.blob.size());
+    std::printf("%s: %zu triangles -> %s (%zu bytes, %.2f bytes/triangle), build %.1f ms\n", args->input.c_str(),
+                in.mesh->triangles.size(), args->out.c_str(), in.blob.size(),
+                double(in.blob.size()) / double(in.mesh->triangles.size()), in.build_ms);
+  });
+}
+
+}  // namespace meshcast::tools

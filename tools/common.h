@@ -1,0 +1,43 @@
+// What the subcommands of the meshcast program share: loading a mesh or a
+// blob, timing, and printing.
+#pragma once
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cpu/encode.h"
+#include "cpu/mesh.h"
+
+namespace meshcast::tools {
+
+struct Loaded {
+  std::optional<Mesh> mesh;  // absent when a blob file was given
+  std::vector<uint8_t> blob;
+  double load_ms = 0, build_ms = 0;
+  BuildReport report;
+};
+
+// A path whose first bytes are the blob magic is read as a blob (and
+// validated); anything else is read as a mesh and built with `options`.
+Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options);
+
+// Options of --layout and --leaf, with the defaults of the foundation issue.
+BuildOptions layout_options(const std::string& layout, uint32_t leaf);
+
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double median(std::vector<double> v);
+
+// Bytes of each blob section and per triangle.
+struct SectionBytes {
+  uint64_t header, nodes, triangles, vertices, remap, total;
+  uint64_t walked() const { return header + nodes + triangles + vertices; }
+};
+SectionBytes section_bytes(const std::vector<uint8_t>& blob);
+
+void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+
+}  // namespace meshcast::tools

@@ -18,6 +18,10 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
                         " tri " + std::to_string(oracle[i].triangle) + ")";
   };
   for (size_t i = 0; i < rays.size(); ++i) {
+    // t is in units of the direction; the tolerance is a distance.
+    const double len = std::sqrt(double(rays[i].dir[0]) * rays[i].dir[0] + double(rays[i].dir[1]) * rays[i].dir[1] +
+                                 double(rays[i].dir[2]) * rays[i].dir[2]);
+    const double t_tolerance = tolerance / len;
     const Hit& h = hits[i];
     const OracleHit& o = oracle[i];
     if (h.triangle == MC_NO_HIT && o.triangle == MC_NO_HIT) continue;
@@ -30,7 +34,7 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
       // A tie: the oracle itself hits the walker's triangle at the same t.
       double t = oracle_triangle(rays[i], mesh.corner(h.triangle, 0), mesh.corner(h.triangle, 1),
                                  mesh.corner(h.triangle, 2));
-      if (std::isfinite(t) && std::fabs(t - o.t) <= tolerance) {
+      if (std::isfinite(t) && std::fabs(t - o.t) <= t_tolerance) {
         ++a.ties;
       } else {
         ++a.wrong;
@@ -39,8 +43,8 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
       }
     }
     double err = std::fabs(double(h.t) - o.t);
-    a.max_t_error = std::max(a.max_t_error, err);
-    if (!(err <= tolerance)) {
+    a.max_t_error = std::max(a.max_t_error, err * len);
+    if (!(err <= t_tolerance)) {
       ++a.t_errors;
       note(i, "t differs by " + std::to_string(err));
     }

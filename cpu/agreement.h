@@ -19,7 +19,8 @@ struct Agreement {
 // The foundation rules: the walker returns the oracle's hit/miss and triangle;
 // a different triangle is accepted only as an exact tie (the oracle hits the
 // walker's triangle at a t within `tolerance` of its own); t within
-// `tolerance` (1e-5 of the diagonal for the float formats).
+// `tolerance`, a distance along the ray (1e-5 of the diagonal for the float
+// formats); max_t_error is a distance too.
 Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
                   const std::vector<OracleHit>& oracle, double tolerance);
 

@@ -290,7 +290,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
                      std::to_string(MC_MAX_DEPTH));
   hd.max_depth = depth;
   hd.leaf_count = tree.leaf_count();
-  hd.tree_offset = MC_BLOB_HEADER_BYTES;
+  hd.tree_offset = align(MC_BLOB_HEADER_BYTES, 64);  // 64-byte nodes start on a cache line
   hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
   // The vertex pool is only known after encoding; reserve the worst case
   // (3 vertices a triangle) and trim afterwards.

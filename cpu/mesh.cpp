@@ -27,7 +27,7 @@ float Box3::half_area() const {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-float Box3::diagonal() const {
+double Box3::diagonal() const {
   Vec3 e = extent();
   return std::sqrt(double(e.x) * e.x + double(e.y) * e.y + double(e.z) * e.z);
 }

@@ -25,7 +25,7 @@ struct Box3 {
   Vec3 centre() const;
   Vec3 extent() const;
   float half_area() const;  // SAH cost unit: xy + yz + zx
-  float diagonal() const;
+  double diagonal() const;
 };
 
 using Triangle = std::array<uint32_t, 3>;

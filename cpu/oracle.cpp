@@ -102,7 +102,7 @@ OracleHit OracleTree::closest(const Ray& ray) const {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
         uint32_t t = order_[i];
         double d = oracle_triangle(ray, mesh_.corner(t, 0), mesh_.corner(t, 1), mesh_.corner(t, 2));
-        if (d < best.t || (d == best.t && t < best.triangle)) best = {d, t};
+        if (d < best.t || (d == best.t && d != INFINITY && t < best.triangle)) best = {d, t};
       }
     } else {
       stack[++top] = n.right;

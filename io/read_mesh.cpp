@@ -11,7 +11,9 @@
 //    file order), turns `l` into 2-index and `p` into 1-index faces, and
 //    reports out-of-range/zero indices as errors.
 //  - PLY: keeps shared vertices and indexing; out-of-range (even negative)
-//    indices are passed through unchecked.
+//    indices are passed through unchecked. It loops forever on a header
+//    without end_header and reads garbage past the end of a truncated file,
+//    so the PLY layout is checked before Assimp is called.
 //  - STL: three own vertices per facet (the format has no indexing); one
 //    aiMesh per `solid`.
 //  - All text formats parse numbers with Assimp's fast_atoreal, which is not
@@ -187,6 +189,9 @@ Polys scan_obj(const std::string& path, std::string_view text) {
       }
       face_line.push_back(ln.number);
       p.start.push_back(face.size());
+    } else if (t[0] == "l" || t[0] == "p") {  // kept as a cornerless face, only to tell
+      face_line.push_back(ln.number);          // "points/lines only" from "empty"
+      p.start.push_back(face.size());
     }
   }
   for (size_t f = 0; f < p.faces(); ++f)
@@ -250,6 +255,72 @@ std::vector<Vec3> scan_stl_ascii(const std::string& path, std::string_view text)
     if (!t.empty() && t[0] == "vertex") v.push_back(parse_vec(path, ln, t, 1));
   }
   return v;
+}
+
+// PLY: checks the header and that the body holds every record it declares.
+// Assimp 5.2.5 loops forever without `end_header` and reads past the end of a
+// truncated file (garbage indices), so this runs before Assimp sees the file.
+void check_ply_layout(const std::string& path, std::string_view text) {
+  size_t end = text.find("end_header");
+  if (text.substr(0, 3) != "ply" || end == std::string_view::npos)
+    fail(path, "malformed file: no PLY header ending in end_header");
+  end = text.find('\n', end);
+  end = end == std::string_view::npos ? text.size() : end + 1;
+  struct Prop { int count_size = 0, size = 0; };  // count_size > 0: a list
+  struct Element { size_t n = 0; std::vector<Prop> props; };
+  std::vector<Element> elements;
+  auto type_size = [](std::string_view t) {
+    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+    if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+    if (t == "double" || t == "float64") return 8;
+    return 0;
+  };
+  Lines ln{text.substr(0, end)};
+  std::string_view line, format;
+  while (ln.next(line)) {
+    auto t = tokens(line);
+    long long n = 0;
+    if (t.empty()) continue;
+    if (t[0] == "format" && t.size() >= 2) format = t[1];
+    if (t[0] == "element" && (t.size() < 3 || !parse_int(t[2], n) || n < 0))
+      fail(path, ln.at() + "malformed file: bad element line");
+    if (t[0] == "element") elements.push_back({size_t(n), {}});
+    if (t[0] == "property") {
+      bool list = t.size() >= 5 && t[1] == "list";
+      Prop p{list ? type_size(t[2]) : 0, type_size(t[list ? 3 : 1])};
+      if (elements.empty() || p.size == 0 || (list && p.count_size == 0))
+        fail(path, ln.at() + "malformed file: bad property line");
+      elements.back().props.push_back(p);
+    }
+  }
+  size_t records = 0, pos = end;
+  for (const Element& e : elements) records += e.n;
+  if (format == "ascii") {  // one record per line
+    Lines body{text.substr(end)};
+    size_t have = 0;
+    while (have < records && body.next(line)) have += !tokens(line).empty();
+    if (have < records) fail(path, "malformed file: truncated, " + std::to_string(have) + " of " +
+                                       std::to_string(records) + " records");
+    return;
+  }
+  const bool big = format == "binary_big_endian";
+  if (!big && format != "binary_little_endian") fail(path, "malformed file: unknown PLY format");
+  for (const Element& e : elements)
+    for (size_t r = 0; r < e.n; ++r)
+      for (const Prop& p : e.props) {
+        uint64_t count = 1;
+        if (p.count_size) {
+          if (pos + p.count_size > text.size()) fail(path, "malformed file: truncated binary PLY");
+          count = 0;
+          for (int b = 0; b < p.count_size; ++b)  // unsigned read; a negative count is huge and fails below
+            count |= uint64_t((unsigned char)text[pos + (big ? p.count_size - 1 - b : b)]) << (8 * b);
+          pos += p.count_size;
+        }
+        pos += count * p.size;
+        if (pos > text.size()) fail(path, "malformed file: truncated binary PLY");
+      }
+  if (pos > text.size()) fail(path, "malformed file: truncated binary PLY");
 }
 
 Polys read_assimp(const std::string& path) {
@@ -347,6 +418,7 @@ Mesh read_mesh(const std::string& path) {
     check_polygons(path, result);
     cross_check(path, result, read_assimp(path));
   } else {
+    if (ext == ".ply") check_ply_layout(path, text);
     Polys as = read_assimp(path);
     if (ext == ".ply" && text.find("format ascii") < text.find("end_header")) {
       if (auto v = scan_ply_ascii(path, text)) take_coordinates(path, as, *v);

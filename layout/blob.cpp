@@ -17,10 +17,21 @@ uint32_t checksum(std::span<const uint8_t> bytes) {
   return h;
 }
 
+// The checksum covers the header (its own field read as 0) and the payload,
+// so no flipped bit anywhere goes unnoticed.
+static uint32_t blob_checksum(std::span<const uint8_t> blob) {
+  BlobHeader h;
+  std::memcpy(&h, blob.data(), sizeof h);
+  h.checksum = 0;
+  uint32_t head = checksum({reinterpret_cast<const uint8_t*>(&h), sizeof h});
+  uint32_t body = checksum(blob.subspan(sizeof h));
+  return head * 16777619u ^ body;
+}
+
 void seal(std::span<uint8_t> blob) {
   BlobHeader h;
   std::memcpy(&h, blob.data(), sizeof h);
-  h.checksum = checksum(blob.subspan(sizeof h));
+  h.checksum = blob_checksum(blob);
   std::memcpy(blob.data(), &h, sizeof h);
 }
 
@@ -156,7 +167,7 @@ std::string validate(std::span<const uint8_t> blob) {
     return "blob version " + num(h.version) + " is not the supported version " + num(MC_BLOB_VERSION);
   if (h.total_size != blob.size())
     return "blob is " + num(blob.size()) + " bytes but its header says " + num(h.total_size) + " (truncated?)";
-  if (checksum(blob.subspan(sizeof h)) != h.checksum) return "blob checksum does not match its contents";
+  if (blob_checksum(blob) != h.checksum) return "blob checksum does not match its contents";
   if (tree_format_name(h.tree_format).empty()) return "unknown tree format " + num(h.tree_format);
   if (triangle_format_name(h.triangle_format).empty()) return "unknown triangle format " + num(h.triangle_format);
   if (h.triangle_count == 0 || h.triangle_count == MC_NO_HIT) return "triangle count out of range";

@@ -44,7 +44,7 @@ struct BlobHeader {
   uint32_t remap_bits;      // bits per remap entry
   uint32_t remap_entries;
   uint32_t total_size;
-  uint32_t checksum;        // FNV-1a over every byte after the header
+  uint32_t checksum;        // FNV-1a over the header (this field as 0) and the payload
   uint32_t reserved;
 };
 static_assert(sizeof(BlobHeader) == MC_BLOB_HEADER_BYTES);

@@ -1,1 +1,123 @@
+// The builder, the blob writer and their limits.
 #include <gtest/gtest.h>
+
+#include <set>
+
+#include "cpu/build.h"
+#include "io/generate.h"
+#include "layout/blob.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+std::vector<Box3> triangle_boxes(const Mesh& m) {
+  std::vector<Box3> boxes(m.triangles.size());
+  for (size_t t = 0; t < m.triangles.size(); ++t)
+    for (int c = 0; c < 3; ++c) boxes[t].grow(m.corner(t, c));
+  return boxes;
+}
+
+bool contains(const Box3& outer, const Box3& inner) {
+  for (int a = 0; a < 3; ++a)
+    if (inner.min[a] < outer.min[a] || inner.max[a] > outer.max[a]) return false;
+  return true;
+}
+
+TEST(Binning, LeavesRespectTheLeafSizeAndCoverEveryTriangleOnce) {
+  Mesh m = make_terrain(64, 64, 3);
+  std::vector<Box3> boxes = triangle_boxes(m);
+  for (uint32_t leaf : {4u, 8u, 16u}) {
+    BuildTree t = build_binning(boxes, leaf);
+    std::multiset<uint32_t> seen;
+    for (const BuildNode& n : t.nodes) {
+      if (n.leaf()) {
+        EXPECT_LE(n.count, leaf);
+        for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+          seen.insert(t.order[i]);
+          EXPECT_TRUE(contains(n.box, boxes[t.order[i]]));
+        }
+      } else {
+        EXPECT_TRUE(contains(n.box, t.nodes[n.left].box));
+        EXPECT_TRUE(contains(n.box, t.nodes[n.right].box));
+      }
+    }
+    ASSERT_EQ(seen.size(), m.triangles.size());
+    for (uint32_t i = 0; i < m.triangles.size(); ++i) EXPECT_EQ(seen.count(i), 1u);
+    EXPECT_GT(t.sah_cost, 0);
+    EXPECT_LE(t.depth, 40u);
+  }
+}
+
+TEST(Binning, CoincidentCentresStillSplit) {
+  Mesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (int i = 0; i < 1000; ++i) m.triangles.push_back({0, 1, 2});
+  BuildTree t = build_binning(triangle_boxes(m), 8);
+  for (const BuildNode& n : t.nodes)
+    if (n.leaf()) EXPECT_LE(n.count, 8u);
+  EXPECT_LE(t.depth, 12u);
+}
+
+TEST(Build, TwoMillionTriangleTerrainBuildsAndValidates) {
+  Mesh m = make_terrain(1024, 1024, 5);
+  ASSERT_EQ(m.triangles.size(), 2097152u);
+  for (const char* layout : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
+    std::vector<uint8_t> blob = build_blob(m, parse_layout(layout), "terrain");
+    EXPECT_EQ(layout::validate(blob), "") << layout;
+  }
+}
+
+TEST(Build, RecommendedLayoutFitsSixteenBytesPerTriangleOnBunny) {
+  std::optional<Mesh> bunny = data_mesh("bunny00");
+  if (!bunny) GTEST_SKIP() << "data/bunny00.off not fetched";
+  std::vector<uint8_t> blob = build_blob(*bunny, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "bunny00");
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  // Everything a walk reads: header, nodes, triangle blocks, vertices.
+  double walked = double(h.vertex_offset + h.vertex_size) / double(h.triangle_count);
+  EXPECT_LE(walked, 16.0);
+  EXPECT_EQ(h.node_count * MC_QUADHALF_NODE_BYTES, h.node_bytes);
+  EXPECT_EQ(h.tree_offset % 64, 0u);  // 64-byte nodes on cache lines (given an aligned buffer)
+}
+
+TEST(Build, BadMeshesAreRefusedWithTheirNameAndProblem) {
+  Mesh empty;
+  EXPECT_THROW(build_blob(empty, {}, "empty.off"), InputError);
+  Mesh nan_vertex;
+  nan_vertex.vertices = {{0, 0, 0}, {1, NAN, 0}, {0, 1, 0}};
+  nan_vertex.triangles = {{0, 1, 2}};
+  try {
+    build_blob(nan_vertex, {}, "nan.obj");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nan.obj"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos);
+  }
+  Mesh bad_index;
+  bad_index.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  bad_index.triangles = {{0, 1, 3}};
+  try {
+    build_blob(bad_index, {}, "idx.ply");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("idx.ply"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("vertex 3"), std::string::npos);
+  }
+  Mesh ok = make_grid_plane(2, 2);
+  BuildOptions big_leaf = parse_layout("QuadTree/Float3");
+  big_leaf.leaf_size = 32;
+  EXPECT_THROW(build_blob(ok, big_leaf, "grid"), InputError);
+}
+
+TEST(Build, LayoutNamesAreCaseInsensitiveAndUnknownOnesListTheValid) {
+  EXPECT_EQ(parse_layout("quadtreehalffloat/indexed8bitpacksoa4").tree_format, MC_TREE_QUADTREEHALFFLOAT);
+  try {
+    parse_layout("SKDTree/Float3");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("AABBTree/Float3"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace meshcast::testing

@@ -140,7 +140,13 @@ TEST(ReadMeshErrors, MissingUnknownMalformed) {
   expect_error(write_file("garbage_index.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 x 2\n"), "malformed");
   expect_error(write_file("truncated.off", std::string("OFF\n6 2 0\n") + kVertText + "3 0 1 2\n"), "ends after");
   expect_error(write_file("garbage.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n"), "malformed");
-  expect_error(write_file("garbage.ply", "ply\nformat ascii 1.0\nnonsense\n"), "Assimp");
+  // Assimp hangs on a PLY header without end_header and reads past the end of
+  // truncated PLY files; the reader checks the layout first.
+  expect_error(write_file("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), "end_header");
+  expect_error(write_file("short.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n"), "truncated");
+  std::string bin = binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}});
+  expect_error(write_file("short_bin.ply", bin.substr(0, bin.size() - 6)), "truncated");
+  expect_error(write_file("garbage.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"), "malformed");
   expect_error(write_file("big_face.off", std::string("OFF\n6 1 0\n") + kVertText + "10 0 1 2 3 4 5 0 1 2 3\n"),
                "corners");
 }
@@ -167,9 +173,9 @@ TEST(ReadMeshErrors, OutOfRangeIndices) {
 TEST(ReadMeshErrors, EmptyAndPointsOrLinesOnly) {
   expect_error(write_file("empty.off", std::string("OFF\n6 0 0\n") + kVertText), "no faces");
   expect_error(write_file("empty.obj", std::string("v 0 0 0\nv 1 0 0\n")), "no faces");
-  expect_error(write_file("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\np 1\n"), "lines");
-  expect_error(write_file("lines.off", std::string("OFF\n6 2 0\n") + kVertText + "2 0 1\n1 2\n"), "lines");
-  expect_error(write_file("empty.stl", "solid x\nendsolid x\n"), "empty");
+  expect_error(write_file("pl.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\np 1\n"), "lines");
+  expect_error(write_file("pl.off", std::string("OFF\n6 2 0\n") + kVertText + "2 0 1\n1 2\n"), "lines");
+  expect_error(write_file("blank.stl", "solid x\nendsolid x\n"), "empty");
 }
 
 // --- the CGAL meshes against an independent, naive OFF parse ---------------

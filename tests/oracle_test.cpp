@@ -1,1 +1,84 @@
+// The oracle itself: analytic cases, ties, and the tree oracle against brute
+// force.
 #include <gtest/gtest.h>
+
+#include "cpu/oracle.h"
+#include "io/generate.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+Mesh one_triangle() {
+  Mesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.triangles = {{0, 1, 2}};
+  return m;
+}
+
+TEST(Oracle, AnalyticHitBothFaces) {
+  Mesh m = one_triangle();
+  Ray down{{0.25f, 0.25f, 2.0f}, {0, 0, -1}, INFINITY};
+  Ray up{{0.25f, 0.25f, -3.0f}, {0, 0, 2}, INFINITY};
+  EXPECT_DOUBLE_EQ(oracle_brute_force(m, down).t, 2.0);
+  EXPECT_DOUBLE_EQ(oracle_brute_force(m, up).t, 1.5);  // t in units of the direction
+  Ray miss{{0.75f, 0.75f, 2.0f}, {0, 0, -1}, INFINITY};
+  EXPECT_EQ(oracle_brute_force(m, miss).triangle, MC_NO_HIT);
+}
+
+TEST(Oracle, TMaxIsInclusiveAndOriginOnSurfaceHitsAtZero) {
+  Mesh m = one_triangle();
+  Ray exact{{0.25f, 0.25f, 2.0f}, {0, 0, -1}, 2.0f};
+  EXPECT_EQ(oracle_brute_force(m, exact).triangle, 0u);
+  Ray short_{{0.25f, 0.25f, 2.0f}, {0, 0, -1}, 1.999f};
+  EXPECT_EQ(oracle_brute_force(m, short_).triangle, MC_NO_HIT);
+  Ray on{{0.25f, 0.25f, 0.0f}, {0, 0, -1}, 0.0f};
+  EXPECT_DOUBLE_EQ(oracle_brute_force(m, on).t, 0.0);
+}
+
+TEST(Oracle, SharedEdgeAndVertexNeverLeak) {
+  Mesh grid = make_grid_plane(4, 4);
+  for (float x = 0.5f; x <= 3.5f; x += 0.5f)
+    for (float y = 0.5f; y <= 3.5f; y += 0.5f) {
+      Ray r{{x, y, 1.0f}, {0, 0, -1}, INFINITY};
+      OracleHit h = oracle_brute_force(grid, r);
+      ASSERT_NE(h.triangle, MC_NO_HIT) << x << "," << y;
+      EXPECT_DOUBLE_EQ(h.t, 1.0);
+    }
+}
+
+TEST(Oracle, TiesGoToTheLowestIndex) {
+  Mesh m = one_triangle();
+  m.triangles.push_back({2, 1, 0});  // the same triangle again, other winding
+  m.triangles.push_back({0, 1, 2});
+  Ray r{{0.2f, 0.2f, 1.0f}, {0, 0, -1}, INFINITY};
+  EXPECT_EQ(oracle_brute_force(m, r).triangle, 0u);
+  OracleTree tree(m);
+  EXPECT_EQ(tree.closest(r).triangle, 0u);
+}
+
+TEST(Oracle, DegenerateTrianglesAreNeverHit) {
+  Mesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 0, 0}};
+  m.triangles = {{0, 1, 2}, {0, 3, 1}};
+  Ray r{{1.0f, 0.0f, 1.0f}, {0, 0, -1}, INFINITY};
+  EXPECT_EQ(oracle_brute_force(m, r).triangle, MC_NO_HIT);
+}
+
+TEST(Oracle, TreeAgreesWithBruteForce) {
+  std::vector<NamedMesh> meshes = test_meshes(false);
+  for (const NamedMesh& m : meshes) {
+    OracleTree tree(*m.mesh);
+    for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
+      std::vector<Ray> rays = make_rays(*m.mesh, kind, m.mesh->triangles.size() > 20000 ? 300 : 1500, 77);
+      for (size_t i = 0; i < rays.size(); ++i) {
+        OracleHit a = tree.closest(rays[i]), b = oracle_brute_force(*m.mesh, rays[i]);
+        ASSERT_EQ(a.triangle, b.triangle) << m.name << " ray " << i;
+        if (a.triangle != MC_NO_HIT) ASSERT_EQ(a.t, b.t);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace meshcast::testing

@@ -1,1 +1,170 @@
+// The robustness corpus of ARCHITECTURE.md, for every layout: rays through
+// shared edges and vertices of closed meshes (a leak is a failure),
+// axis-parallel and signed-zero directions, grazing rays, far-from-origin,
+// tiny and huge meshes, slivers and degenerate triangles, NaN and infinite
+// rays, t_max of zero and infinity, origins on the surface.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "io/generate.h"
+#include "layout/blob.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+class Robustness : public ::testing::TestWithParam<std::string> {
+ protected:
+  BuildOptions options() const { return parse_layout(GetParam()); }
+  bool quantized() const { return options().triangle_format == MC_TRI_INDEXED8BITPACKSOA4; }
+  // Oracle answers on the mesh as stored (quantized for bit-packed formats).
+  void expect_oracle(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
+    std::vector<uint8_t> blob = build_blob(mesh, options(), what);
+    Mesh stored = quantized() ? quantized_mesh(mesh, blob) : mesh;
+    std::vector<OracleHit> oracle(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) oracle[i] = oracle_brute_force(stored, rays[i]);
+    std::vector<Hit> hits = trace_all(blob, rays);
+    Agreement a = compare(stored, rays, hits, oracle, 1e-5 * std::max(1e-30, mesh.bounds().diagonal()));
+    EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
+  }
+};
+
+// Closed sphere: rays from inside must all hit; rays aimed at its vertices
+// and edge midpoints from outside must all hit.
+TEST_P(Robustness, ClosedSphereNeverLeaks) {
+  Mesh s = make_sphere(24, 48, 1.0f, {0.1f, 0.2f, 0.3f});
+  std::vector<uint8_t> blob = build_blob(s, options(), "sphere");
+  std::vector<Ray> rays;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (int i = 0; i < 5000; ++i) rays.push_back({{0.1f + 0.3f * u(rng), 0.2f + 0.3f * u(rng), 0.3f + 0.3f * u(rng)},
+                                                 {u(rng), u(rng), u(rng)}, INFINITY});
+  // Through every vertex and edge midpoint from the centre, exactly.
+  for (const Triangle& t : s.triangles)
+    for (int c = 0; c < 3; ++c) {
+      Vec3 a = s.vertices[t[c]], b = s.vertices[t[(c + 1) % 3]];
+      Vec3 mid{0.5f * (a.x + b.x), 0.5f * (a.y + b.y), 0.5f * (a.z + b.z)};
+      for (Vec3 p : {a, mid}) rays.push_back({{0.1f, 0.2f, 0.3f}, {p.x - 0.1f, p.y - 0.2f, p.z - 0.3f}, INFINITY});
+    }
+  std::vector<Hit> hits = trace_all(blob, rays);
+  size_t leaks = 0;
+  for (const Hit& h : hits) leaks += h.triangle == MC_NO_HIT;
+  EXPECT_EQ(leaks, 0u);
+}
+
+// Integer grid: vertical rays through every vertex and edge midpoint, with
+// +0 and -0 in the parallel components.
+TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
+  Mesh g = make_grid_plane(16, 16);
+  std::vector<Ray> rays;
+  for (int x = 0; x <= 32; ++x)
+    for (int y = 0; y <= 32; ++y)
+      for (float zx : {0.0f, -0.0f})
+        for (float zy : {0.0f, -0.0f})
+          for (float dz : {-1.0f, 1.0f})
+            rays.push_back({{0.5f * x, 0.5f * y, -dz * 2.0f}, {zx, zy, dz}, INFINITY});
+  std::vector<uint8_t> blob = build_blob(g, options(), "grid");
+  std::vector<Hit> hits = trace_all(blob, rays);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    ASSERT_NE(hits[i].triangle, MC_NO_HIT) << "ray " << i << " leaked";
+    EXPECT_EQ(hits[i].t, 2.0f);
+  }
+  expect_oracle(g, rays, "grid");
+}
+
+TEST_P(Robustness, AxisParallelGrazingAndInPlane) {
+  Mesh g = make_grid_plane(8, 8);
+  std::vector<Ray> rays;
+  for (int i = 0; i <= 16; ++i) {
+    float c = 0.5f * i;
+    rays.push_back({{-1.0f, c, 0.0f}, {1, 0, 0}, INFINITY});          // in the plane
+    rays.push_back({{c, -1.0f, 1e-7f}, {0, 1, 0}, INFINITY});         // just above it
+    rays.push_back({{-1.0f, c, 1.0f}, {1, 0, -1e-6f}, INFINITY});     // grazing
+    rays.push_back({{c, c, 5.0f}, {0, 0, -1}, INFINITY});             // axis-parallel
+    rays.push_back({{-1.0f, -1.0f, 1.0f}, {c + 1, c + 1, -1}, INFINITY});
+  }
+  expect_oracle(g, rays, "grid in-plane");
+}
+
+TEST_P(Robustness, FarTinyAndHugeMeshes) {
+  std::mt19937 rng(2);
+  for (auto [radius, centre] : {std::pair{0.15f, Vec3{1000, -1000, 1000}}, std::pair{150.0f, Vec3{30000, 0, 0}},
+                                std::pair{1e-4f, Vec3{0, 0, 0}}, std::pair{1e5f, Vec3{0, 0, 0}},
+                                std::pair{0.01f, Vec3{1e5f, 1e5f, 1e5f}}}) {
+    Mesh s = make_sphere(16, 32, radius, centre);
+    std::vector<Ray> rays = make_rays(s, RayKind::Long, 400, rng());
+    for (const Ray& r : make_rays(s, RayKind::Radial, 200, rng())) rays.push_back(r);
+    expect_oracle(s, rays, "far/tiny/huge sphere");
+  }
+}
+
+TEST_P(Robustness, SliversAndDegenerateTriangles) {
+  Mesh m = make_grid_plane(6, 6);
+  uint32_t base = uint32_t(m.vertices.size());
+  m.vertices.push_back({1.0f, 1.0f, 0.5f});
+  m.vertices.push_back({5.0f, 5.0f, 0.5f});
+  m.vertices.push_back({3.0f, 3.0f, 0.5f});               // collinear: zero area
+  m.vertices.push_back({1.0f, 1.0f, 0.5f});               // duplicate position
+  m.vertices.push_back({5.0f, 5.0000005f, 0.5f});         // needle
+  m.triangles.push_back({base, base + 1, base + 2});
+  m.triangles.push_back({base, base + 3, base + 1});
+  m.triangles.push_back({base, base + 1, base + 4});
+  std::vector<Ray> rays;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0, 6);
+  for (int i = 0; i < 3000; ++i) rays.push_back({{u(rng), u(rng), 2.0f}, {0.01f * (u(rng) - 3), 0.0f, -1}, INFINITY});
+  for (int i = 0; i <= 40; ++i) {
+    float c = 1.0f + 0.1f * i;
+    rays.push_back({{c, c, 2.0f}, {0, 0, -1}, INFINITY});  // along the sliver
+  }
+  expect_oracle(m, rays, "slivers");
+}
+
+TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
+  Mesh g = make_grid_plane(4, 4);
+  std::vector<uint8_t> blob = build_blob(g, options(), "grid");
+  const float nan = NAN, inf = INFINITY;
+  std::vector<Ray> rays = {
+      {{nan, 1, 1}, {0, 0, -1}, inf}, {{1, 1, 1}, {0, nan, -1}, inf}, {{inf, 1, 1}, {0, 0, -1}, inf},
+      {{1, 1, 1}, {0, 0, -inf}, inf}, {{1, 1, 1}, {0, 0, 0}, inf},    {{1, 1, 1}, {-0.0f, 0.0f, -0.0f}, inf},
+      {{1, 1, 1}, {0, 0, -1}, nan},   {{1, 1, 1}, {0, 0, -1}, -1.0f},
+  };
+  uint64_t skipped = 0;
+  std::vector<Hit> hits = trace_all(blob, rays, &skipped);
+  EXPECT_EQ(skipped, rays.size());
+  for (const Hit& h : hits) {
+    EXPECT_EQ(h.triangle, MC_NO_HIT);
+    EXPECT_EQ(h.t, INFINITY);
+  }
+}
+
+TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
+  Mesh g = make_grid_plane(4, 4);
+  std::vector<Ray> rays = {
+      {{1.3f, 1.6f, 0.0f}, {0, 0, -1}, 0.0f},     // on the surface, t_max 0: hit at 0
+      {{1.3f, 1.6f, 0.0f}, {0.3f, 0.1f, 1}, 0.0f},
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, 0.0f},     // above, t_max 0: miss
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, 1.0f},     // exactly t_max: hit
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, 0.999f},   // just short: miss
+      {{1.3f, 1.6f, 1e30f}, {0, 0, -1}, INFINITY},
+      {{2.0f, 2.0f, 0.0f}, {0, 0, 1}, INFINITY},  // on a vertex, leaving
+  };
+  expect_oracle(g, rays, "t_max");
+  std::vector<Hit> hits = trace_all(build_blob(g, options(), "grid"), rays);
+  EXPECT_EQ(hits[0].t, 0.0f);
+  EXPECT_EQ(hits[2].triangle, MC_NO_HIT);
+  EXPECT_NE(hits[3].triangle, MC_NO_HIT);
+  EXPECT_EQ(hits[4].triangle, MC_NO_HIT);
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(layout_names()), [](const auto& info) {
+  std::string n = info.param;
+  for (char& c : n)
+    if (c == '/') c = '_';
+  return n;
+});
+
+}  // namespace
+}  // namespace meshcast::testing

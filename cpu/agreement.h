@@ -20,7 +20,11 @@ struct Agreement {
 // a different triangle is accepted only as an exact tie (the oracle hits the
 // walker's triangle at a t within `tolerance` of its own); t within
 // `tolerance`, a distance along the ray (1e-5 of the diagonal for the float
-// formats); max_t_error is a distance too.
+// formats), plus 4 float ulps of t for origins very far away; max_t_error is
+// a distance too.
+// Distance from p to the triangle abc, in double.
+double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
+
 Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
                   const std::vector<OracleHit>& oracle, double tolerance);
 

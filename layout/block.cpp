@@ -36,7 +36,9 @@ void Indexed8BitPackSOA4::encode(const TriCorners* tris, uint32_t count, BlockCo
   // Window [base, base + 256): ends 3*count past the pool's current end.
   uint64_t end = pool.size() + 3ull * count;
   uint32_t base = end > MC_I8_WINDOW ? uint32_t(end - MC_I8_WINDOW) : 0u;
-  uint8_t idx[3][32 * 4];
+  constexpr uint32_t kMaxLanes = (MC_QUAD_MAX_COUNT + 3) / 4 * 4;
+  if (count == 0 || count > MC_QUAD_MAX_COUNT) return;  // the writer never asks for this
+  uint8_t idx[3][kMaxLanes];
   for (uint32_t i = 0; i < count; ++i)
     for (int c = 0; c < 3; ++c) {
       uint64_t w = tris[i].packed[c];

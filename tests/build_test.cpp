@@ -55,7 +55,9 @@ TEST(Binning, CoincidentCentresStillSplit) {
   for (int i = 0; i < 1000; ++i) m.triangles.push_back({0, 1, 2});
   BuildTree t = build_binning(triangle_boxes(m), 8);
   for (const BuildNode& n : t.nodes)
-    if (n.leaf()) EXPECT_LE(n.count, 8u);
+    if (n.leaf()) {
+      EXPECT_LE(n.count, 8u);
+    }
   EXPECT_LE(t.depth, 12u);
 }
 

@@ -74,7 +74,9 @@ TEST(Oracle, TreeAgreesWithBruteForce) {
       for (size_t i = 0; i < rays.size(); ++i) {
         OracleHit a = tree.closest(rays[i]), b = oracle_brute_force(*m.mesh, rays[i]);
         ASSERT_EQ(a.triangle, b.triangle) << m.name << " ray " << i;
-        if (a.triangle != MC_NO_HIT) ASSERT_EQ(a.t, b.t);
+        if (a.triangle != MC_NO_HIT) {
+          ASSERT_EQ(a.t, b.t);
+        }
       }
     }
   }

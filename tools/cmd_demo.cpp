@@ -38,7 +38,6 @@ void add_demo(CLI::App& app) {
     std::printf("%s: %zu triangles, %zu vertices, read in %.0f ms\n", args->input.c_str(), mesh.triangles.size(),
                 mesh.vertices.size(), load_ms);
     const RayKind kinds[] = {RayKind::Long, RayKind::Probe, RayKind::Radial};
-    const char* kind_names[] = {"long", "probe", "radial"};
     std::vector<Ray> rays[3];
     std::vector<OracleHit> oracle[3];
     OracleTree tree(mesh);

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Prepares a fresh Debian 12 machine (run as root): installs what meshcast
+# needs from Debian's packages, fetches the public test meshes into data/
+# (git-ignored) and builds Release into build/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgtest-dev dpkg-dev)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# Public meshes: data/meshes/*.off of CGAL's demo data (libcgal-demo).
+if [[ ! -f data/bunny00.off ]]; then
+  echo "setup: fetching the public meshes from libcgal-demo"
+  tmp=$(mktemp -d)
+  trap 'rm -rf "$tmp"' EXIT
+  (cd "$tmp" && apt-get download libcgal-demo >/dev/null 2>&1 ||
+     { apt-get update -qq && apt-get download libcgal-demo >/dev/null; })
+  dpkg-deb -x "$tmp"/libcgal-demo_*.deb "$tmp/x"
+  mkdir -p data
+  tar -xzf "$tmp/x/usr/share/doc/libcgal-dev/data.tar.gz" -C "$tmp" --wildcards 'data/meshes/*.off'
+  mv "$tmp"/data/meshes/*.off data/
+fi
+for m in bunny00 armadillo refined_elephant ChineseDragon-10kv; do
+  [[ -f data/$m.off ]] || { echo "setup: data/$m.off is missing after the fetch" >&2; exit 1; }
+done
+
+jobs=$(nproc)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$jobs"

@@ -66,7 +66,7 @@ struct Writer {
     layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index};
     codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
     uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
-    if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, 0);
+    if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
     for (uint32_t i = 0; i < leaf.count; ++i) remap[slot0 + i] = tree.order[leaf.first + i];
   }
 };
@@ -309,17 +309,24 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   // Remap: slot -> input triangle, as few bits as the triangle count needs.
   hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
-  hd.remap_entries = uint32_t(writer.remap.size());
+  hd.remap_slots = uint32_t(writer.remap.size());
   hd.remap_offset = align(writer.bytes.size(), 8);
-  hd.remap_size = align((uint64_t(hd.remap_entries) * hd.remap_bits + 7) / 8 + 8, 8);
+  const uint32_t words = layout::remap_words(hd);
+  hd.remap_size = align(12ull * words + (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8, 8);
   writer.bytes.resize(uint64_t(hd.remap_offset) + hd.remap_size, 0);
-  for (uint32_t s = 0; s < hd.remap_entries; ++s) {
-    uint64_t bit = uint64_t(s) * hd.remap_bits;
+  uint8_t* used = writer.bytes.data() + hd.remap_offset;
+  uint8_t* rank = used + 8ull * words;
+  uint8_t* entries = rank + 4ull * words;
+  uint32_t index = 0;
+  for (uint32_t s = 0; s < hd.remap_slots; ++s) {
+    if (s % 64 == 0) std::memcpy(rank + 4ull * (s / 64), &index, 4);
+    if (writer.remap[s] == MC_NO_HIT) continue;
+    used[s / 8] |= uint8_t(1u << (s % 8));
+    uint64_t bit = uint64_t(index++) * hd.remap_bits;
     uint64_t word;
-    uint8_t* at = writer.bytes.data() + hd.remap_offset + (bit >> 3);
-    std::memcpy(&word, at, 8);
+    std::memcpy(&word, entries + (bit >> 3), 8);
     word |= uint64_t(writer.remap[s]) << (bit & 7);
-    std::memcpy(at, &word, 8);
+    std::memcpy(entries + (bit >> 3), &word, 8);
   }
   hd.total_size = uint32_t(writer.bytes.size());
   std::memcpy(writer.bytes.data(), &hd, sizeof hd);

@@ -20,36 +20,43 @@ struct Closest {
 template <class Codec>
 struct Loader;
 
+// A loader fills v[corner][j] with axis `axis[j]` of 4 triangles starting at
+// triangle `first` of the block (the ray's axis order, see triangle_test4).
+//
 // Float3: triangles side by side, 9 floats each; gather lane i from triangle
 // first + i (clamped, so no lane reads past the block).
 template <>
 struct Loader<layout::Float3> {
-  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, simd::F4 v[3][3]) {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, const int axis[3],
+                   simd::F4 v[3][3]) {
     const float* base = reinterpret_cast<const float*>(blob + block);
     int i0 = int(first) * 9;
     int last = int(count - 1) * 9;
     simd::I4 idx = simd::iconst(i0, std::min(i0 + 9, last), std::min(i0 + 18, last), std::min(i0 + 27, last));
     for (int c = 0; c < 3; ++c)
-      for (int a = 0; a < 3; ++a) v[c][a] = simd::gather(base, idx + (c * 3 + a));
+      for (int j = 0; j < 3; ++j) v[c][j] = simd::gather(base, idx + (c * 3 + axis[j]));
   }
 };
 
 template <>
 struct Loader<layout::Float3SOA4> {
-  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, simd::F4 v[3][3]) {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, const int axis[3],
+                   simd::F4 v[3][3]) {
     const uint8_t* p = blob + block + (first / 4) * MC_FLOAT3SOA4_BLOCK_BYTES;
     for (int c = 0; c < 3; ++c)
-      for (int a = 0; a < 3; ++a) v[c][a] = simd::F4::load(p + (c * 3 + a) * 16);
+      for (int j = 0; j < 3; ++j) v[c][j] = simd::F4::load(p + (c * 3 + axis[j]) * 16);
   }
 };
 
 template <>
 struct Loader<layout::Indexed8BitPackSOA4> {
-  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, simd::F4 v[3][3]) {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, const int axis[3],
+                   simd::F4 v[3][3]) {
     const layout::BlobHeader& h = layout::header_of(blob);
     const uint8_t* vertices = blob + block + layout::load<uint32_t>(blob + block);
     const uint8_t* idx = blob + block + MC_I8_HEADER_BYTES + (first / 4) * MC_I8_BLOCK_BYTES;
-    for (int c = 0; c < 3; ++c) simd::bitpack_gather(vertices, idx + c * 4, h.quant_offset, h.quant_scale, v[c]);
+    for (int c = 0; c < 3; ++c)
+      simd::bitpack_gather(vertices, idx + c * 4, h.quant_offset, h.quant_scale, axis, v[c]);
   }
 };
 
@@ -60,7 +67,7 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
                       Closest& c) {
   for (uint32_t first = 0; first < count; first += 4) {
     simd::F4 v[3][3];
-    Loader<Codec>::load(blob, block, first, count, v);
+    Loader<Codec>::load(blob, block, first, count, r.axis, v);
     LaneHit h = triangle_test4(r, v, simd::lanes_below(count - first), c.t);
     if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
   }

@@ -54,6 +54,7 @@ struct RayPre {
   // Watertight test: kz = the dominant axis, kx/ky the others (swapped to
   // keep the winding), shear constants S.
   int kx, ky, kz;
+  int axis[3];  // {kx, ky, kz}: loaders fetch corners in this order
   float sx, sy, sz;
 
   explicit RayPre(const Ray& r) {
@@ -71,6 +72,7 @@ struct RayPre {
     sx = dir[kx] / dir[kz];
     sy = dir[ky] / dir[kz];
     sz = 1.0f / dir[kz];
+    axis[0] = kx, axis[1] = ky, axis[2] = kz;
   }
 };
 
@@ -118,13 +120,15 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
                             const float cy, const float az, const float bz, const float cz, float closest,
                             LaneHit* out);
 
+// Corners come in the ray's axis order, v[corner][j] = axis r.axis[j], so the
+// test indexes registers with constants.
 inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 valid, float closest) {
   using simd::F4;
   const F4 ox = F4::splat(r.org[r.kx]), oy = F4::splat(r.org[r.ky]), oz = F4::splat(r.org[r.kz]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
-  F4 ax = v[0][r.kx] - ox, ay = v[0][r.ky] - oy, az = v[0][r.kz] - oz;
-  F4 bx = v[1][r.kx] - ox, by = v[1][r.ky] - oy, bz = v[1][r.kz] - oz;
-  F4 cx = v[2][r.kx] - ox, cy = v[2][r.ky] - oy, cz = v[2][r.kz] - oz;
+  F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;
+  F4 bx = v[1][0] - ox, by = v[1][1] - oy, bz = v[1][2] - oz;
+  F4 cx = v[2][0] - ox, cy = v[2][1] - oy, cz = v[2][2] - oz;
   ax = ax - sx * az, ay = ay - sy * az;
   bx = bx - sx * bz, by = by - sy * bz;
   cx = cx - sx * cz, cy = cy - sy * cz;

@@ -72,19 +72,20 @@ inline F4 from_half(const uint8_t* p) {  // 4 half floats -> 4 floats (F16C)
   return {_mm_cvtph_ps(_mm_cvtsi64_si128(x))};
 }
 // Four BitPack words (seed 000 §3.4) at base + 8 * index[i], decoded with the
-// same fma as layout::bitpack_decode.
+// same fma as layout::bitpack_decode; out[j] is axis `axis[j]`.
 inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const float offset[3], const float scale[3],
-                           F4 out[3]) {
+                           const int axis[3], F4 out[3]) {
   int32_t x;
   std::memcpy(&x, index, 4);
   __m128i idx = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(x));
   __m256i w = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), idx, 8);
   const __m256i mask = _mm256_set1_epi64x(MC_BITPACK_MAX);
   const __m256i even = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
-  for (int a = 0; a < 3; ++a) {
-    __m256i q = _mm256_and_si256(_mm256_srli_epi64(w, int(MC_BITPACK_BITS) * a), mask);
+  for (int j = 0; j < 3; ++j) {
+    int a = axis[j];
+    __m256i q = _mm256_and_si256(_mm256_srl_epi64(w, _mm_cvtsi32_si128(int(MC_BITPACK_BITS) * a)), mask);
     __m128i q32 = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(q, even));
-    out[a] = {_mm_fmadd_ps(_mm_cvtepi32_ps(q32), _mm_set1_ps(scale[a]), _mm_set1_ps(offset[a]))};
+    out[j] = {_mm_fmadd_ps(_mm_cvtepi32_ps(q32), _mm_set1_ps(scale[a]), _mm_set1_ps(offset[a]))};
   }
 }
 // Gather: base + 4 * idx[i] (floats).
@@ -137,13 +138,13 @@ inline F4 from_half(const uint8_t* p) {
   MC_LANES(layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
 }
 inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const float offset[3], const float scale[3],
-                           F4 out[3]) {
+                           const int axis[3], F4 out[3]) {
   for (int i = 0; i < 4; ++i) {
     uint64_t w;
     std::memcpy(&w, base + 8 * index[i], 8);
     float v[3];
     layout::bitpack_decode(w, offset, scale, v);
-    for (int a = 0; a < 3; ++a) out[a].v[i] = v[a];
+    for (int j = 0; j < 3; ++j) out[j].v[i] = v[axis[j]];
   }
 }
 inline F4 gather(const float* base, I4 idx) { F4 r; MC_LANES(base[idx.v[i]]) }

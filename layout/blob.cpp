@@ -70,9 +70,13 @@ std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block,
   if (uint64_t(block) + Codec::block_bytes(count) > h.tree_size)
     return "triangle block at tree offset " + num(block) + " of " + num(Codec::block_bytes(count)) +
            " bytes runs past the tree section (" + num(h.tree_size) + " bytes)";
-  if (uint64_t((block - h.triangle_base) / h.slot_divisor) + count > h.remap_entries)
-    return "triangle block at tree offset " + num(block) + " maps past the remap (" + num(h.remap_entries) +
-           " entries)";
+  uint64_t slot0 = (block - h.triangle_base) / h.slot_divisor;
+  if (slot0 + count > h.remap_slots)
+    return "triangle block at tree offset " + num(block) + " maps past the remap (" + num(h.remap_slots) +
+           " slots)";
+  for (uint64_t s = slot0; s < slot0 + count; ++s)
+    if (!(remap_used(blob, h, uint32_t(s >> 6)) >> (s & 63) & 1))
+      return "triangle block at tree offset " + num(block) + " uses slot " + num(s) + ", which the remap marks unused";
   std::string why;
   if (!Codec::check(blob, h.tree_offset + block, count, &why)) return why;
   return "";
@@ -191,11 +195,20 @@ std::string validate(std::span<const uint8_t> blob) {
     return "node area or triangle base lies past the tree section";
   if (h.remap_bits == 0 || h.remap_bits > 32 || (uint64_t(1) << h.remap_bits) < h.triangle_count)
     return "remap entries of " + num(h.remap_bits) + " bits cannot hold " + num(h.triangle_count) + " triangles";
-  if ((uint64_t(h.remap_entries) * h.remap_bits + 7) / 8 + 8 > h.remap_size)
-    return "remap section of " + num(h.remap_size) + " bytes is too small for " + num(h.remap_entries) + " entries";
-  for (uint32_t s = 0; s < h.remap_entries; ++s)
-    if (remap_entry(blob.data(), h, s) >= h.triangle_count)
-      return "remap entry " + num(s) + " names triangle " + num(remap_entry(blob.data(), h, s)) + " of " +
+  if (12ull * remap_words(h) + (uint64_t(h.triangle_count) * h.remap_bits + 7) / 8 + 8 > h.remap_size)
+    return "remap section of " + num(h.remap_size) + " bytes is too small for " + num(h.remap_slots) +
+           " slots and " + num(h.triangle_count) + " entries";
+  uint64_t used = 0;
+  for (uint32_t w = 0; w < remap_words(h); ++w) {
+    if (load<uint32_t>(blob.data() + h.remap_offset + 8ull * remap_words(h) + 4ull * w) != used)
+      return "remap rank of word " + num(w) + " does not count the used slots before it";
+    used += uint64_t(std::popcount(remap_used(blob.data(), h, w)));
+  }
+  if (used != h.triangle_count)
+    return "remap marks " + num(used) + " slots used for " + num(h.triangle_count) + " triangles";
+  for (uint32_t i = 0; i < h.triangle_count; ++i)
+    if (remap_packed(blob.data(), h, i) >= h.triangle_count)
+      return "remap entry " + num(i) + " names triangle " + num(remap_packed(blob.data(), h, i)) + " of " +
              num(h.triangle_count);
   if (h.tree_format == MC_TREE_QUADTREEHALFFLOAT &&
       !(std::isfinite(h.node_scale) && h.node_scale > 0 && std::isfinite(h.node_origin[0]) &&

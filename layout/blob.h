@@ -9,6 +9,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <bit>
 #include <cstring>
 #include <span>
 #include <string>
@@ -42,7 +43,7 @@ struct BlobHeader {
   uint32_t vertex_offset, vertex_size;
   uint32_t remap_offset, remap_size;
   uint32_t remap_bits;      // bits per remap entry
-  uint32_t remap_entries;
+  uint32_t remap_slots;     // slot numbers covered by the remap (used or not)
   uint32_t total_size;
   uint32_t checksum;        // FNV-1a over the header (this field as 0) and the payload
   uint32_t reserved;
@@ -80,12 +81,32 @@ inline uint32_t slot_of(const BlobHeader& h, uint32_t block, uint32_t lane) {
   return (block - h.triangle_base) / h.slot_divisor + lane;
 }
 
-// Bit-packed remap entry (remap_bits wide, LSB first). The section carries 8
-// bytes of padding so the 64-bit load never leaves it.
-inline uint32_t remap_entry(const uint8_t* blob, const BlobHeader& h, uint32_t slot) {
-  uint64_t bit = uint64_t(slot) * h.remap_bits;
-  uint64_t word = load<uint64_t>(blob + h.remap_offset + (bit >> 3));
+// The remap section, smaller than one entry a slot number because slot
+// numbers derived from block offsets leave holes (padding lanes, leaf
+// headers):
+//   used[W]   uint64: bit s set when slot number s holds a triangle
+//   rank[W]   uint32: used slot numbers before word w
+//   entries   triangle_count entries of remap_bits each, LSB first, in slot
+//             order, then 8 bytes of padding so a 64-bit load never leaves it
+// with W = ceil(remap_slots / 64). A slot's entry is number
+// rank[s/64] + popcount(used[s/64] below bit s%64).
+inline uint32_t remap_words(const BlobHeader& h) { return (h.remap_slots + 63) / 64; }
+
+inline uint32_t remap_packed(const uint8_t* blob, const BlobHeader& h, uint32_t index) {
+  uint64_t bit = uint64_t(index) * h.remap_bits;
+  uint64_t word = load<uint64_t>(blob + h.remap_offset + 12ull * remap_words(h) + (bit >> 3));
   return uint32_t((word >> (bit & 7)) & ((uint64_t(1) << h.remap_bits) - 1));
+}
+
+inline uint64_t remap_used(const uint8_t* blob, const BlobHeader& h, uint32_t word) {
+  return load<uint64_t>(blob + h.remap_offset + 8ull * word);
+}
+
+inline uint32_t remap_entry(const uint8_t* blob, const BlobHeader& h, uint32_t slot) {
+  uint32_t w = slot >> 6;
+  uint64_t below = remap_used(blob, h, w) & ((uint64_t(1) << (slot & 63)) - 1);
+  uint32_t rank = load<uint32_t>(blob + h.remap_offset + 8ull * remap_words(h) + 4ull * w);
+  return remap_packed(blob, h, rank + uint32_t(std::popcount(below)));
 }
 
 }  // namespace meshcast::layout

@@ -1,6 +1,7 @@
 // meshcast info MESH|BLOB: counts, bounds, layout and bytes per triangle by
 // section. "walked" is what a ray cast reads (header, nodes, triangle blocks,
 // vertices); the remap is read once per hit and reported beside it.
+#include <algorithm>
 #include <cstdio>
 
 #include "layout/blob.h"
@@ -58,7 +59,8 @@ void add_info(CLI::App& app) {
     row("walked", s.walked());
     row("remap", s.remap);
     row("total", s.total);
-    std::printf("  remap: %u bits an entry, %u entries\n", h.remap_bits, h.remap_entries);
+    std::printf("  remap: %u entries of %u bits, %u slot numbers (%.0f%% used)\n", h.triangle_count, h.remap_bits,
+                h.remap_slots, 100.0 * h.triangle_count / std::max(1u, h.remap_slots));
   });
 }
 

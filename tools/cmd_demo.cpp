@@ -3,6 +3,7 @@
 // double-precision oracle, prints a table and renders a picture.
 #include <cstdio>
 
+#include "bench/peer.h"
 #include "cpu/agreement.h"
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
@@ -47,11 +48,29 @@ void add_demo(CLI::App& app) {
       for (size_t i = 0; i < rays[k].size(); ++i) oracle[k][i] = tree.closest(rays[k][i]);
     }
     double tolerance = 1e-5 * mesh.bounds().diagonal();
-    std::printf("\n| layout | build ms | bytes/tri walked | remap B/tri | ns/ray long | ns/ray probe | ns/ray radial "
-                "| disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    const double n = double(mesh.triangles.size());
+    struct Row {
+      std::string name;
+      double build_ms, walked, remap, ns[3];
+      uint64_t disagreements;
+    };
+    std::vector<Row> rows;
+    // Median time per ray of --repeat passes over each ray set.
+    auto time_kinds = [&](auto&& cast, Row& row, auto&& answers_for) {
+      for (int k = 0; k < 3; ++k) {
+        std::vector<Hit> hits(rays[k].size());
+        std::vector<double> pass_ms;
+        for (uint32_t r = 0; r < args->repeat; ++r) {
+          auto t1 = std::chrono::steady_clock::now();
+          cast(rays[k], hits);
+          pass_ms.push_back(ms_since(t1));
+        }
+        row.ns[k] = median(pass_ms) * 1e6 / double(rays[k].size());
+        Agreement a = answers_for(k, hits);
+        row.disagreements += a.wrong + a.t_errors;
+      }
+    };
     std::vector<uint8_t> picture_blob;
-    std::vector<Hit> long_hits;
-    uint64_t disagreements_total = 0;
     for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
       BuildOptions o = layout_options(name, args->leaf);
       BuildReport report;
@@ -62,34 +81,48 @@ void add_demo(CLI::App& app) {
       bool quantized = o.triangle_format == MC_TRI_INDEXED8BITPACKSOA4;
       Mesh stored = quantized ? quantized_mesh(mesh, blob) : Mesh{};
       std::unique_ptr<OracleTree> stored_tree = quantized ? std::make_unique<OracleTree>(stored) : nullptr;
-      double ns[3];
-      uint64_t disagreements = 0;
-      for (int k = 0; k < 3; ++k) {
-        std::vector<Hit> hits(rays[k].size());
-        std::vector<double> pass_ms;
-        for (uint32_t r = 0; r < args->repeat; ++r) {
-          auto t1 = std::chrono::steady_clock::now();
-          view.trace(rays[k], hits);
-          pass_ms.push_back(ms_since(t1));
-        }
-        ns[k] = median(pass_ms) * 1e6 / double(rays[k].size());
-        std::vector<OracleHit> answers = oracle[k];
-        if (quantized)
-          for (size_t i = 0; i < rays[k].size(); ++i) answers[i] = stored_tree->closest(rays[k][i]);
-        Agreement a = compare(quantized ? stored : mesh, rays[k], hits, answers, tolerance);
-        disagreements += a.wrong + a.t_errors;
-        if (k == 0) long_hits = hits;
-      }
       SectionBytes s = section_bytes(blob);
-      double n = double(mesh.triangles.size());
-      std::printf("| %s | %.0f | %.2f | %.2f | %.0f | %.0f | %.0f | %llu |\n", name, report.build_ms, s.walked() / n,
-                  s.remap / n, ns[0], ns[1], ns[2], (unsigned long long)disagreements);
-      disagreements_total += disagreements;
+      Row row{name, report.build_ms, s.walked() / n, s.remap / n, {}, 0};
+      time_kinds([&](const std::vector<Ray>& r, std::vector<Hit>& h) { view.trace(r, h); }, row,
+                 [&](int k, const std::vector<Hit>& hits) {
+                   if (!quantized) return compare(mesh, rays[k], hits, oracle[k], tolerance);
+                   std::vector<OracleHit> answers(rays[k].size());
+                   for (size_t i = 0; i < rays[k].size(); ++i) answers[i] = stored_tree->closest(rays[k][i]);
+                   return compare(stored, rays[k], hits, answers, tolerance);
+                 });
+      rows.push_back(row);
       picture_blob = std::move(blob);
     }
+    uint64_t disagreements_total = 0;
+    for (const Row& r : rows) disagreements_total += r.disagreements;
+    // A peer measured in the same run, when meshcast was built with it.
+    std::unique_ptr<bench::Peer> peer = bench::make_embree(mesh);
+    if (peer) {
+      Row row{peer->name() + " (peer)", peer->build_ms(), double(peer->bytes()) / n, 0, {}, 0};
+      time_kinds([&](const std::vector<Ray>& r, std::vector<Hit>& h) { peer->trace(r, h); }, row,
+                 [&](int k, const std::vector<Hit>& hits) { return compare(mesh, rays[k], hits, oracle[k], tolerance); });
+      rows.push_back(row);
+    }
+    std::printf("\n| layout | build ms | bytes/tri walked | remap B/tri | ns/ray long | ns/ray probe | ns/ray radial "
+                "| disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (const Row& r : rows)
+      std::printf("| %s | %.0f | %.2f | %.2f | %.0f | %.0f | %.0f | %llu |\n", r.name.c_str(), r.build_ms, r.walked,
+                  r.remap, r.ns[0], r.ns[1], r.ns[2], (unsigned long long)r.disagreements);
     std::printf("\n%zu rays of each kind, one thread, median of %u passes; disagreements = rays whose triangle or t "
                 "differs from the double-precision oracle beyond exact ties (t tolerance %.3g)\n",
                 args->count, args->repeat, tolerance);
+    if (peer) {
+      std::printf("time / %s time (long, probe, radial):", peer->name().c_str());
+      for (size_t i = 0; i + 1 < rows.size(); ++i)
+        std::printf("  %s %.2f %.2f %.2f;", rows[i].name.c_str(), rows[i].ns[0] / rows.back().ns[0],
+                    rows[i].ns[1] / rows.back().ns[1], rows[i].ns[2] / rows.back().ns[2]);
+      std::printf("\n%s bytes/tri: the memory its device reported for the scene (vertices, indices, BVH)\n",
+                  peer->name().c_str());
+    } else {
+      std::printf("no peer: meshcast was built without Embree (apt-get install libembree-dev)\n");
+    }
+    std::vector<Hit> long_hits(rays[0].size());
+    BlobView(picture_blob, "picture").trace(rays[0], long_hits);
     Picture p = render(picture_blob, args->width, args->height, rays[0], long_hits);
     write_png(args->png, p.width, p.height, p.rgb);
     std::printf("picture: %s (%dx%d, QuadTreeHalfFloat/Indexed8BitPackSOA4, %.0f ns/ray; green: long-ray hits)\n",

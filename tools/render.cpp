@@ -54,6 +54,14 @@ Picture render(const std::vector<uint8_t>& blob, int width, int height, const st
     if (q[2] >= 0) continue;
     int x = int(std::floor(0.5f * width + focal * q[0] / -q[2]));
     int y = int(std::floor(0.5f * height - focal * q[1] / -q[2]));
+    // Only hits the camera sees: not behind the surface of their pixel.
+    if (x < 0 || y < 0 || x >= width || y >= height) continue;
+    const Hit& seen = hits[size_t(y) * width + x];
+    const Ray& pixel = rays[size_t(y) * width + x];
+    float len = std::sqrt(pixel.dir[0] * pixel.dir[0] + pixel.dir[1] * pixel.dir[1] + pixel.dir[2] * pixel.dir[2]);
+    if (seen.triangle == MC_NO_HIT ||
+        std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) > seen.t * len + 0.01f * radius)
+      continue;
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
         int xx = x + dx, yy = y + dy;

@@ -55,6 +55,14 @@ struct Builder {
     return first + count / 2;
   }
 
+  // Bin of a centre: computed the same way when binning and partitioning,
+  // and safe for any finite input (a tiny or huge extent never yields NaN
+  // or an index outside the bins).
+  static int bin_of(float c, float lo, float extent) {
+    float f = float((double(c) - lo) / extent * kBins);
+    return !(f > 0) ? 0 : (f >= kBins ? kBins - 1 : int(f));
+  }
+
   // SAH over binned centres on all three axes; returns the partition point.
   uint32_t split(uint32_t first, uint32_t count, const Box3& cbox) {
     uint32_t* begin = tree.order.data() + first;
@@ -66,9 +74,8 @@ struct Builder {
       if (!(extent > 0)) continue;
       std::array<Box3, kBins> bin_box;
       std::array<uint32_t, kBins> bin_count{};
-      float k = kBins * (1.0f - 1e-6f) / extent;
       for (uint32_t* p = begin; p != end; ++p) {
-        int b = std::min(kBins - 1, int((centres[*p][axis] - lo) * k));
+        int b = bin_of(centres[*p][axis], lo, extent);
         bin_box[b].grow(boxes[*p]);
         ++bin_count[b];
       }
@@ -93,9 +100,9 @@ struct Builder {
       }
     }
     if (best_axis < 0) return first + count / 2;  // all centres coincide: split by index
-    float lo = cbox.min[best_axis], k = kBins * (1.0f - 1e-6f) / (cbox.max[best_axis] - lo);
+    float lo = cbox.min[best_axis], extent = cbox.max[best_axis] - lo;
     uint32_t* mid = std::partition(begin, end, [&](uint32_t t) {
-      return std::min(kBins - 1, int((centres[t][best_axis] - lo) * k)) <= best_bin;
+      return bin_of(centres[t][best_axis], lo, extent) <= best_bin;
     });
     return first + uint32_t(mid - begin);
   }

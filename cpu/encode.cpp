@@ -273,7 +273,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     half_extent = std::max({half_extent, std::fabs(root.max[a] - hd.node_origin[a]),
                             std::fabs(hd.node_origin[a] - root.min[a])});
   }
-  hd.node_scale = std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0);
+  hd.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
 
   QuadPlan plan;
   uint32_t depth = tree.depth;

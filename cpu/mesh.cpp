@@ -10,9 +10,9 @@ void Box3::grow(const Vec3& p) {
   max = {std::max(max.x, p.x), std::max(max.y, p.y), std::max(max.z, p.z)};
 }
 
-void Box3::grow(const Box3& b) {
-  grow(b.min);
-  grow(b.max);
+void Box3::grow(const Box3& b) {  // min of minima, max of maxima: an empty b changes nothing
+  min = {std::min(min.x, b.min.x), std::min(min.y, b.min.y), std::min(min.z, b.min.z)};
+  max = {std::max(max.x, b.max.x), std::max(max.y, b.max.y), std::max(max.z, b.max.z)};
 }
 
 Vec3 Box3::centre() const {
@@ -45,6 +45,9 @@ void check_mesh(const Mesh& mesh, const std::string& name) {
     const Vec3& v = mesh.vertices[i];
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
       throw InputError(name + ": vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+    if (std::fabs(v.x) > kMaxCoordinate || std::fabs(v.y) > kMaxCoordinate || std::fabs(v.z) > kMaxCoordinate)
+      throw InputError(name + ": vertex " + std::to_string(i) + " lies beyond +-2^100, the coordinate range meshcast "
+                       "supports (box extents and areas must stay finite in float)");
   }
   for (size_t t = 0; t < mesh.triangles.size(); ++t)
     for (uint32_t v : mesh.triangles[t])

@@ -44,8 +44,12 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Coordinates beyond this (about 1.27e30) are refused: extents, areas and
+// half-float scales computed from them must stay finite in float.
+constexpr float kMaxCoordinate = 0x1p100f;
+
 // Checks what every layout relies on: at least one triangle, every index in
-// range, every coordinate finite. `name` is used in the message (a file path or
+// range, every coordinate finite and within kMaxCoordinate. `name` is used in the message (a file path or
 // a generator name). Throws InputError.
 void check_mesh(const Mesh& mesh, const std::string& name);
 

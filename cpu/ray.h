@@ -9,6 +9,7 @@
 //    shared edge or vertex always hits at least one of its triangles.
 // Both are two-sided and accept t in [0, t_max].
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -32,12 +33,15 @@ struct Hit {
 };
 
 // A ray the walkers may walk: finite origin and direction, a direction that
-// is not zero, t_max not NaN and not negative (infinity allowed). Any other
+// is not zero (nor denormal), t_max not NaN and not negative (infinity allowed). Any other
 // ray is answered as a miss and counted.
 inline bool ray_is_walkable(const Ray& r) {
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(r.org[a]) || !std::isfinite(r.dir[a])) return false;
-  if (r.dir[0] == 0 && r.dir[1] == 0 && r.dir[2] == 0) return false;
+  // A direction whose largest component is below FLT_MIN counts as zero:
+  // its reciprocal would overflow.
+  float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
+  if (!(m >= 0x1p-126f)) return false;
   return !std::isnan(r.tmax) && r.tmax >= 0;
 }
 
@@ -92,7 +96,9 @@ inline float box_test(const RayPre& r, const float mn[3], const float mx[3], flo
     tn = max_keep((nearp - r.org[a]) * r.inv[a], tn);
     tf = min_keep((farp - r.org[a]) * r.inv[a], tf);
   }
-  tf = min_keep(tf * kFarScale, closest);
+  // The cut-off at the closest hit is widened too, so a box whose entry
+  // rounds a few ulps past a hit it may still improve on is not dropped.
+  tf = min_keep(tf, closest) * kFarScale;
   return tn <= tf ? tn : INFINITY;
 }
 
@@ -105,7 +111,7 @@ inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::
     tn = simd::max((nearp[a] - o) * inv, tn);
     tf = simd::min((farp[a] - o) * inv, tf);
   }
-  tf = simd::min(tf * F4::splat(kFarScale), F4::splat(closest));
+  tf = simd::min(tf, F4::splat(closest)) * F4::splat(kFarScale);
   return simd::select(tn <= tf, tn, F4::splat(INFINITY));
 }
 

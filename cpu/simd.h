@@ -147,7 +147,11 @@ inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const fl
     for (int j = 0; j < 3; ++j) out[j].v[i] = v[axis[j]];
   }
 }
-inline F4 gather(const float* base, I4 idx) { F4 r; MC_LANES(base[idx.v[i]]) }
+inline F4 gather(const float* base, I4 idx) {
+  F4 r;
+  for (int i = 0; i < 4; ++i) std::memcpy(&r.v[i], reinterpret_cast<const uint8_t*>(base) + 4 * idx.v[i], 4);
+  return r;
+}
 inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b), uint32_t(c), uint32_t(d)}}; }
 inline I4 operator+(I4 a, int b) { I4 r; MC_LANES(a.v[i] + uint32_t(b)) }
 #undef MC_LANES

@@ -43,7 +43,7 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
   double det = U + V + W;
   if (det == 0) return false;
   double T = U * az + V * bz + W * cz;
-  if (det < 0) T = -T, det = -det;
+  if (det < 0) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0) return false;
   float t = float(T / det);
   if (!(t <= closest)) return false;

@@ -44,7 +44,7 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
         uint32_t block = at + MC_AABB_NODE_BYTES;
         test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
       }
-      while (top >= 0 && stack[top].tnear > c.t) --top;
+      while (top >= 0 && stack[top].tnear > c.t * kFarScale) --top;
       if (top < 0) break;
       at = stack[top--].node;
       node = layout::load_aabb_node(tree + at);

@@ -94,7 +94,7 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
         test_leaf<Codec>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
       }
       do --top;
-      while (top >= 0 && fraction_stack[top] > c.t);
+      while (top >= 0 && fraction_stack[top] > c.t * kFarScale);
     } while (top >= 0);
     hits[i] = finish_hit(blob, h, c);
   }

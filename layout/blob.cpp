@@ -164,6 +164,8 @@ struct Section { const char* name; uint32_t offset, size; };
 std::string validate(std::span<const uint8_t> blob) {
   if (blob.size() < sizeof(BlobHeader))
     return "blob of " + num(blob.size()) + " bytes is shorter than its header (" + num(sizeof(BlobHeader)) + ")";
+  if (reinterpret_cast<uintptr_t>(blob.data()) % alignof(BlobHeader) != 0)
+    return "blob buffer is not 4-byte aligned; load it into aligned memory";
   BlobHeader h;
   std::memcpy(&h, blob.data(), sizeof h);
   if (h.magic != MC_BLOB_MAGIC) return "not a meshcast blob (bad magic)";

@@ -56,8 +56,8 @@ uint32_t checksum(std::span<const uint8_t> bytes);
 void seal(std::span<uint8_t> blob);  // writes header.checksum
 
 // Proves, before any walker runs, that every offset, count, index and remap
-// entry is in range and that the tree is a tree (each child after its parent,
-// each node reached once, depth within MC_MAX_DEPTH). Returns "" when the
+// entry is in range and that every walk ends (each child after its parent,
+// node visits bounded by node_count, depth within MC_MAX_DEPTH). Returns "" when the
 // blob is valid, otherwise a message naming what is wrong and the limit.
 std::string validate(std::span<const uint8_t> blob);
 

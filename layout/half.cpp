@@ -82,11 +82,11 @@ uint16_t QuadBoundsHalf::encode_one(float v, const BlobHeader& hd, int axis, boo
   // The decode adds rounding of its own; step outward until it is on our side.
   for (int guard = 0; guard < 64; ++guard) {
     float d = decode_one(h, hd, axis);
-    if (up ? d >= v : d <= v) break;
+    if (up ? d >= v : d <= v) return h;
     float f = half_to_float(h);
     h = up ? float_to_half_up(std::nextafter(f, INFINITY)) : float_to_half_down(std::nextafter(f, -INFINITY));
   }
-  return h;
+  return up ? 0x7C00u : 0xFC00u;  // never reached in practice; infinity is always outward
 }
 
 }  // namespace meshcast::layout

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "io/generate.h"
 #include "layout/blob.h"
@@ -150,6 +151,154 @@ TEST(Blob, ResealedCorruptionIsRefusedOrWalkedSafely) {
   }
   EXPECT_GT(refused, 0u);
   EXPECT_GT(walked, 0u);  // flips of bounds or vertices still give a valid blob
+}
+
+}  // namespace
+}  // namespace meshcast::testing
+
+namespace meshcast::testing {
+namespace {
+
+using namespace layout;
+
+// Golden bytes: the seed's layouts, checked at literal offsets (not through
+// the constants of formats.h, so a swapped field shows here).
+Mesh two_triangles() {
+  Mesh m;
+  m.vertices = {{1, 2, 3}, {4, 5, 6}, {7, 8, 10}, {-1, -2, -3}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+template <class T>
+T at(const std::vector<uint8_t>& b, size_t offset) {
+  T v;
+  std::memcpy(&v, b.data() + offset, sizeof v);
+  return v;
+}
+
+TEST(GoldenBytes, AABBTreeFloat3IsSeed51And31) {
+  std::vector<uint8_t> b = build_blob(two_triangles(), parse_layout("AABBTree/Float3"), "golden");
+  size_t tree = at<uint32_t>(b, 104);  // header field tree_offset: after 10 uint32 and 16 floats
+  ASSERT_EQ(tree, 192u);
+  // One leaf: BoundingBoxMin, BoundingBoxMax, Properties = high bit | count.
+  EXPECT_EQ(at<float>(b, tree + 0), -1.0f);
+  EXPECT_EQ(at<float>(b, tree + 8), -3.0f);
+  EXPECT_EQ(at<float>(b, tree + 12), 7.0f);
+  EXPECT_EQ(at<float>(b, tree + 20), 10.0f);
+  EXPECT_EQ(at<uint32_t>(b, tree + 24), 0x80000002u);
+  // Float3 block right behind the node: 9 floats a triangle, corner order kept.
+  std::vector<float> corners;
+  for (int i = 0; i < 18; ++i) corners.push_back(at<float>(b, tree + 28 + 4 * i));
+  std::vector<float> a = {1, 2, 3, 4, 5, 6, 7, 8, 10}, c = {1, 2, 3, 7, 8, 10, -1, -2, -3};
+  std::vector<float> first(corners.begin(), corners.begin() + 9), second(corners.begin() + 9, corners.end());
+  EXPECT_TRUE((first == a && second == c) || (first == c && second == a));
+}
+
+TEST(GoldenBytes, QuadTreeFloat3SOA4IsSeed56And32) {
+  Mesh m = two_triangles();
+  BuildOptions o = parse_layout("QuadTree/Float3SOA4");
+  o.leaf_size = 1;  // two leaves under one node
+  std::vector<uint8_t> b = build_blob(m, o, "golden");
+  size_t tree = 192;
+  uint32_t root = at<uint32_t>(b, 9 * 4);
+  EXPECT_EQ(root, 0u);  // a node (count 0) at offset 0
+  // Node: MinX[4] MinY[4] MinZ[4] MaxX[4] MaxY[4] MaxZ[4] NodeProperties[4].
+  uint32_t p0 = at<uint32_t>(b, tree + 96), p1 = at<uint32_t>(b, tree + 100);
+  EXPECT_EQ(p0 >> 27, 1u);
+  EXPECT_EQ(p1 >> 27, 1u);
+  EXPECT_EQ(at<uint32_t>(b, tree + 104), 0u);  // unused children
+  EXPECT_EQ(at<float>(b, tree + 8), INFINITY);  // MinX of child 2
+  EXPECT_EQ(at<float>(b, tree + 48 + 8), -INFINITY);  // MaxX of child 2
+  // Child k's MinX at 4k, MaxZ at 80 + 4k, and its block holds X of corner 1 for 4 lanes first.
+  for (int k = 0; k < 2; ++k) {
+    uint32_t block = tree + (at<uint32_t>(b, tree + 96 + 4 * k) & 0x07FFFFFFu);
+    float x1 = at<float>(b, block), y1 = at<float>(b, block + 16), z3 = at<float>(b, block + 128);
+    EXPECT_EQ(x1, 1.0f);  // both triangles start at vertex 0
+    EXPECT_EQ(y1, 2.0f);
+    EXPECT_TRUE(z3 == 10.0f || z3 == -3.0f);
+    EXPECT_EQ(at<float>(b, block + 4), x1);  // padding lane repeats the triangle
+    float min_x = at<float>(b, tree + 4 * k), max_z = at<float>(b, tree + 80 + 4 * k);
+    EXPECT_EQ(min_x, z3 == 10.0f ? 1.0f : -1.0f);
+    EXPECT_EQ(max_z, 10.0f);  // both triangles reach z = 10
+  }
+}
+
+TEST(GoldenBytes, Indexed8BitPackSOA4IsSeed39) {
+  Mesh m = two_triangles();
+  std::vector<uint8_t> b = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "golden");
+  uint32_t root = at<uint32_t>(b, 9 * 4);
+  ASSERT_EQ(root >> 27, 2u);  // the root is one leaf of 2 triangles
+  uint32_t block = 192 + (root & 0x07FFFFFFu);
+  uint32_t offset_to_vertices = at<uint32_t>(b, block);
+  // 12-byte TriangleBlock: I11..I41, I12..I42, I13..I43; 4 distinct vertices.
+  std::set<uint8_t> used;
+  for (int i = 0; i < 12; ++i) used.insert(at<uint8_t>(b, block + 4 + i));
+  EXPECT_EQ(used.size(), 4u);
+  // Vertex I at <block> + OffsetToVertices + 8 I, 21 bits a component, x low.
+  const BlobHeader& h = header_of(b.data());
+  for (int lane = 0; lane < 2; ++lane) {
+    uint8_t i0 = at<uint8_t>(b, block + 4 + lane);
+    uint64_t w = at<uint64_t>(b, block + offset_to_vertices + 8 * i0);
+    float x = float(w & 0x1FFFFF) * h.quant_scale[0] + h.quant_offset[0];
+    EXPECT_NEAR(x, 1.0f, 1e-5);  // both triangles start at vertex (1, 2, 3)
+    EXPECT_NEAR(float((w >> 21) & 0x1FFFFF) * h.quant_scale[1] + h.quant_offset[1], 2.0f, 1e-5);
+    EXPECT_NEAR(float((w >> 42) & 0x1FFFFF) * h.quant_scale[2] + h.quant_offset[2], 3.0f, 1e-5);
+  }
+}
+
+// Hand-made structural faults, re-sealed so only the structure is judged.
+std::string corrupt(std::vector<uint8_t> b, size_t offset, uint32_t value) {
+  std::memcpy(b.data() + offset, &value, 4);
+  seal(b);
+  return validate(b);
+}
+
+TEST(Corruption, ChildBeforeItsParentIsRefused) {
+  std::vector<uint8_t> b = build_blob(make_sphere(8, 16, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "s");
+  // The root's properties: its second child pointing back at the root.
+  EXPECT_NE(corrupt(b, 192 + 24, 0u).find("not after its first child"), std::string::npos);
+  std::vector<uint8_t> q = build_blob(make_sphere(8, 16, 1, {0, 0, 0}), parse_layout("QuadTree/Float3"), "s");
+  // The root node's first child: a node at offset 0, the root itself.
+  std::string why = corrupt(q, 192 + 96, 0u);
+  EXPECT_TRUE(why.empty() || why.find("after its parent") != std::string::npos ||
+              why.find("leaves hold") != std::string::npos) << why;
+  // The second node's first child pointing back at the second node itself.
+  EXPECT_NE(corrupt(q, 192 + 112 + 96, 112u).find("after its parent"), std::string::npos);
+}
+
+TEST(Corruption, VertexIndexOutsideTheVertexSectionIsRefused) {
+  std::vector<uint8_t> b =
+      build_blob(make_sphere(8, 16, 1, {0, 0, 0}), parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "s");
+  const BlobHeader& h = header_of(b.data());
+  uint32_t first_block = h.tree_offset + h.triangle_base;
+  // OffsetToVertices pointing into the remap section.
+  uint32_t into_remap = h.remap_offset - first_block;
+  EXPECT_NE(corrupt(b, first_block, into_remap).find("outside the vertex section"), std::string::npos);
+}
+
+TEST(Corruption, WrongRemapRankIsRefused) {
+  std::vector<uint8_t> b = build_blob(make_sphere(16, 32, 1, {0, 0, 0}), parse_layout("QuadTree/Float3SOA4"), "s");
+  const BlobHeader& h = header_of(b.data());
+  ASSERT_GT(remap_words(h), 1u);
+  size_t rank1 = h.remap_offset + 8ull * remap_words(h) + 4;
+  EXPECT_NE(corrupt(b, rank1, at<uint32_t>(b, rank1) + 1).find("remap rank"), std::string::npos);
+}
+
+TEST(Corruption, DepthBeyondTheLimitIsRefused) {
+  std::vector<uint8_t> b = build_blob(make_sphere(8, 16, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "s");
+  // max_depth is the header's 8th field; a tree deeper than it claims is refused.
+  EXPECT_NE(corrupt(b, 7 * 4, 1u).find("deeper than"), std::string::npos);
+}
+
+TEST(Box, GrowingByAnEmptyBoxChangesNothing) {
+  Box3 b;
+  b.grow(Vec3{1, 2, 3});
+  Box3 empty;
+  b.grow(empty);
+  EXPECT_EQ(b.min.x, 1.0f);
+  EXPECT_EQ(b.max.z, 3.0f);
+  EXPECT_FLOAT_EQ(b.half_area(), 0.0f);
 }
 
 }  // namespace

@@ -70,6 +70,17 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
   for (size_t i = 0; i < hits.size(); ++i) {
     ASSERT_NE(hits[i].triangle, MC_NO_HIT) << "ray " << i << " leaked";
     EXPECT_EQ(hits[i].t, 2.0f);
+    // The barycentrics name the hit point (many of these rays take the
+    // double-precision fallback: they cross edges and vertices exactly).
+    const Hit& h = hits[i];
+    for (int a = 0; a < 2; ++a) {
+      float p = rays[i].org[a] + h.t * rays[i].dir[a];
+      float q = (1 - h.u - h.v) * g.corner(h.triangle, 0)[a] + h.u * g.corner(h.triangle, 1)[a] +
+                h.v * g.corner(h.triangle, 2)[a];
+      EXPECT_NEAR(p, q, quantized() ? 1e-4 : 1e-5) << "ray " << i;
+    }
+    EXPECT_GE(h.u, -1e-6f);
+    EXPECT_GE(h.v, -1e-6f);
   }
   expect_oracle(g, rays, "grid");
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "layout/blob.h"
 #include "tests/testing.h"
@@ -49,6 +50,14 @@ void check_layout(const std::string& layout_name_, bool large) {
 }
 
 TEST_P(WalkerVsOracle, AllMeshesAllRayKinds) { check_layout(GetParam(), false); }
+
+// CTest points MESHCAST_DATA at data/ (scripts/setup.sh fills it): there the
+// public meshes must be present, so they can never drop out silently.
+TEST(Data, PublicMeshesArePresentWhenCTestRuns) {
+  if (!std::getenv("MESHCAST_DATA")) GTEST_SKIP() << "MESHCAST_DATA not set (not run by CTest)";
+  for (const char* name : {"bunny00", "armadillo", "refined_elephant", "ChineseDragon-10kv"})
+    EXPECT_TRUE(data_mesh(name).has_value()) << name << ".off missing under " << std::getenv("MESHCAST_DATA");
+}
 
 INSTANTIATE_TEST_SUITE_P(Layouts, WalkerVsOracle, ::testing::ValuesIn(layout_names()),
                          [](const auto& info) {

@@ -51,9 +51,10 @@ Picture render(const std::vector<uint8_t>& blob, int width, int height, const st
     const Ray& r = markers[i];
     float q[3];
     for (int a = 0; a < 3; ++a) q[a] = r.org[a] + marker_hits[i].t * r.dir[a] - eye[a];
-    if (q[2] >= 0) continue;
-    int x = int(std::floor(0.5f * width + focal * q[0] / -q[2]));
-    int y = int(std::floor(0.5f * height - focal * q[1] / -q[2]));
+    if (!(q[2] < -1e-6f * radius)) continue;
+    float fx = std::floor(0.5f * width + focal * q[0] / -q[2]), fy = std::floor(0.5f * height - focal * q[1] / -q[2]);
+    if (!(fx >= 0 && fy >= 0 && fx < float(width) && fy < float(height))) continue;
+    int x = int(fx), y = int(fy);
     // Only hits the camera sees: not behind the surface of their pixel.
     if (x < 0 || y < 0 || x >= width || y >= height) continue;
     const Hit& seen = hits[size_t(y) * width + x];

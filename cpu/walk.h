@@ -28,4 +28,23 @@ inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Cl
   return hit;
 }
 
+// The batch loop every walker shares: an unwalkable ray becomes a counted
+// miss; walk_one(r, c) walks one ray, shortening c on every hit.
+template <class WalkOne>
+inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
+                         WalkOne&& walk_one) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  for (size_t i = 0; i < n; ++i) {
+    if (!ray_is_walkable(rays[i])) {
+      hits[i] = Hit{};
+      ++*skipped;
+      continue;
+    }
+    const RayPre r(rays[i]);
+    Closest c{rays[i].tmax};
+    walk_one(r, c);
+    hits[i] = finish_hit(blob, h, c);
+  }
+}
+
 }  // namespace meshcast

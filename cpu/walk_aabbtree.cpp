@@ -11,20 +11,13 @@ template <class Codec>
 void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for (size_t i = 0; i < n; ++i) {
-    hits[i] = Hit{};
-    if (!ray_is_walkable(rays[i])) {
-      ++*skipped;
-      continue;
-    }
-    const RayPre r(rays[i]);
-    Closest c{rays[i].tmax};
+  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
     struct Entry { uint32_t node; float tnear; };
     Entry stack[MC_MAX_DEPTH + 2];
     int top = -1;
     layout::AABBNode node = layout::load_aabb_node(tree);
     uint32_t at = 0;
-    if (box_test(r, node.min, node.max, c.t) == INFINITY) continue;
+    if (box_test(r, node.min, node.max, c.t) == INFINITY) return;
     for (;;) {
       if (!node.is_leaf()) {
         uint32_t left = at + MC_AABB_NODE_BYTES, right = node.value();
@@ -49,8 +42,7 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
       at = stack[top--].node;
       node = layout::load_aabb_node(tree + at);
     }
-    hits[i] = finish_hit(blob, h, c);
-  }
+  });
 }
 
 #define MC_INSTANTIATE(Codec) \

@@ -50,14 +50,7 @@ template <class Bounds, class Codec>
 void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for (size_t i = 0; i < n; ++i) {
-    hits[i] = Hit{};
-    if (!ray_is_walkable(rays[i])) {
-      ++*skipped;
-      continue;
-    }
-    const RayPre r(rays[i]);
-    Closest c{rays[i].tmax};
+  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
     uint32_t node_stack[kStackSize];
     float fraction_stack[kStackSize];
     node_stack[0] = h.root;
@@ -96,8 +89,7 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
       do --top;
       while (top >= 0 && fraction_stack[top] > c.t * kFarScale);
     } while (top >= 0);
-    hits[i] = finish_hit(blob, h, c);
-  }
+  });
 }
 
 #define MC_INSTANTIATE(Codec)                                                                                   \

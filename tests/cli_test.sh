@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# The meshcast program end to end: every subcommand, its JSON, and its errors
+# (clear message naming the input, non-zero exit, no crash).
+set -uo pipefail
+meshcast=$1
+data=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+passes=0
+check() {  # check NAME EXPECTED_EXIT PATTERN -- command...
+  local name=$1 want=$2 pattern=$3
+  shift 4
+  local out rc
+  out=$("$@" 2>&1)
+  rc=$?
+  if [[ $rc -ne $want ]] || ! grep -qE -- "$pattern" <<<"$out"; then
+    echo "FAIL $name: exit $rc (want $want), output:"
+    echo "$out" | head -20
+    failures=$((failures + 1))
+  else
+    echo "ok   $name"
+    passes=$((passes + 1))
+  fi
+}
+
+mesh=$data/bunny00.off
+[[ -f $mesh ]] || mesh=$work/tiny.off
+if [[ ! -f $data/bunny00.off ]]; then
+  printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n3 1 3 2\n' >"$mesh"
+fi
+
+check rays 0 "rays ->" -- "$meshcast" rays "$mesh" --kind long --count 500 --seed 3 --out "$work/r.rays"
+check rays-kind 105 "kind" -- "$meshcast" rays "$mesh" --kind sideways --count 5 --out "$work/x.rays"
+check build 0 "bytes/triangle" -- "$meshcast" build "$mesh" --layout quadtree/float3soa4 --leaf 4 --out "$work/m.blob"
+check info-blob 0 "QuadTree/Float3SOA4, leaf size 4" -- "$meshcast" info "$work/m.blob"
+check info-json 0 '"bytes_per_triangle":\{"header"' -- "$meshcast" info "$mesh" --json
+check trace 0 "ns/ray" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out "$work/h.hits" --repeat 2
+check trace-json 0 '"ns_per_ray":' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/h2.hits" --json
+# The two hits files agree (same triangle per ray): compare the triangle columns.
+if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
+            <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then
+  echo "FAIL hits of two layouts differ"; failures=$((failures + 1))
+fi
+check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout SKDTree/Float3
+check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
+printf 'OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n' >"$work/nan.off"
+check nan-mesh 2 "nan.off.*(NaN|nan)" -- "$meshcast" info "$work/nan.off"
+head -c 1000 "$work/m.blob" >"$work/cut.blob"
+check truncated-blob 2 "cut.blob.*(truncated|bytes)" -- "$meshcast" info "$work/cut.blob"
+cp "$work/m.blob" "$work/flip.blob"
+printf '\x55' | dd of="$work/flip.blob" bs=1 seek=300 conv=notrunc status=none
+check flipped-blob 2 "flip.blob.*checksum" -- "$meshcast" info "$work/flip.blob"
+head -c 30 "$work/r.rays" >"$work/cut.rays"
+check truncated-rays 2 "cut.rays" -- "$meshcast" trace "$work/m.blob" --rays "$work/cut.rays" --out "$work/x.hits"
+
+echo "$passes passed, $failures failed"
+exit $((failures > 0))

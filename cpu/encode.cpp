@@ -12,9 +12,7 @@
 #include "cpu/build.h"
 #include "cpu/pairs.h"
 #include "layout/aabbtree.h"
-#include "layout/float3.h"
-#include "layout/float3soa4.h"
-#include "layout/indexed8bitpacksoa4.h"
+#include "layout/codecs.h"
 #include "layout/quadtree.h"
 
 namespace meshcast {
@@ -32,18 +30,23 @@ struct CodecOps {
   void (*encode)(const TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
 
-template <class C>
-constexpr CodecOps ops_of(bool bitpack) {
-  return {C::kFormat, C::kSlotDivisor, bitpack, &C::block_bytes, &C::encode};
+CodecOps codec_ops(uint32_t format) {
+#define MC_OPS(Codec, name)                                                                         \
+  if (format == layout::Codec::kFormat)                                                            \
+    return {layout::Codec::kFormat, layout::Codec::kSlotDivisor, layout::Codec::kBitPack,        \
+            &layout::Codec::block_bytes, &layout::Codec::encode};
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_OPS)
+#undef MC_OPS
+  throw InputError("unknown triangle format " + std::to_string(format));
 }
 
-CodecOps codec_ops(uint32_t format) {
-  switch (format) {
-    case MC_TRI_FLOAT3: return ops_of<layout::Float3>(false);
-    case MC_TRI_FLOAT3SOA4: return ops_of<layout::Float3SOA4>(false);
-    case MC_TRI_INDEXED8BITPACKSOA4: return ops_of<layout::Indexed8BitPackSOA4>(true);
-  }
-  throw InputError("unknown triangle format " + std::to_string(format));
+// Every triangle format id, in the order of the list.
+std::vector<uint32_t> triangle_formats() {
+  std::vector<uint32_t> ids;
+#define MC_ID(Codec, name) ids.push_back(layout::Codec::kFormat);
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_ID)
+#undef MC_ID
+  return ids;
 }
 
 uint32_t align(uint64_t v, uint32_t a) { return uint32_t((v + a - 1) / a * a); }
@@ -55,7 +58,7 @@ struct Writer {
   CodecOps codec;
   BlobHeader h{};
   std::vector<uint8_t> bytes;
-  std::vector<uint64_t> pool;
+  std::vector<uint8_t> pool;
   std::unordered_map<uint64_t, uint32_t> last_index;
   std::vector<uint32_t> remap;
 
@@ -248,10 +251,12 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     for (int c = 0; c < 3; ++c) {
       uint32_t v = mesh.triangles[t][c];
       if (codec.bitpack) {
+        corners[t].vertex[c] = v;
         corners[t].packed[c] = packed[v];
         layout::bitpack_decode(packed[v], h.quant_offset, h.quant_scale, corners[t].v[c]);
       } else {
         corners[t].packed[c] = 0;
+        corners[t].vertex[c] = v;
         corners[t].v[c][0] = mesh.vertices[v].x, corners[t].v[c][1] = mesh.vertices[v].y;
         corners[t].v[c][2] = mesh.vertices[v].z;
       }
@@ -292,18 +297,19 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   hd.leaf_count = tree.leaf_count();
   hd.tree_offset = align(MC_BLOB_HEADER_BYTES, 64);  // 64-byte nodes start on a cache line
   hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
-  // The vertex pool is only known after encoding; reserve the worst case
-  // (3 vertices a triangle) and trim afterwards.
-  uint64_t worst_vertices = codec.bitpack ? 8ull * 3 * mesh.triangles.size() : 0;
-  if (hd.vertex_offset + worst_vertices > 0xF0000000ull)
-    throw InputError(name + ": the blob would exceed 4 GiB, the limit of its 32-bit offsets");
-  writer.bytes.assign(hd.vertex_offset + worst_vertices, 0);
+  writer.bytes.assign(hd.vertex_offset, 0);
+  try {
+    if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer);
+    else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
+    else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
+  } catch (const std::length_error& e) {  // a codec's own limit (index width)
+    throw InputError(name + ": " + layout_name(o.tree_format, o.triangle_format) + ": " + e.what());
+  }
+  // Vertices and remap at most 8 + 12 bytes a triangle on top of this.
+  if (uint64_t(hd.vertex_offset) + writer.pool.size() + 12ull * mesh.triangles.size() + 4096 > 0xF0000000ull)
+    throw InputError(name + ": the blob would exceed the 4 GiB its 32-bit offsets reach");
 
-  if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer);
-  else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
-  else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
-
-  hd.vertex_size = uint32_t(writer.pool.size() * 8);
+  hd.vertex_size = uint32_t(writer.pool.size());
   writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
   if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
 
@@ -342,10 +348,12 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   return std::move(writer.bytes);
 }
 
+bool moves_vertices(uint32_t triangle_format) { return codec_ops(triangle_format).bitpack; }
+
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
   for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT})
-    for (uint32_t c : {MC_TRI_FLOAT3, MC_TRI_FLOAT3SOA4, MC_TRI_INDEXED8BITPACKSOA4})
+    for (uint32_t c : triangle_formats())
       names.push_back(layout_name(t, c));
   return names;
 }
@@ -360,7 +368,7 @@ BuildOptions parse_layout(const std::string& text) {
     return s;
   };
   for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT})
-    for (uint32_t c : {MC_TRI_FLOAT3, MC_TRI_FLOAT3SOA4, MC_TRI_INDEXED8BITPACKSOA4})
+    for (uint32_t c : triangle_formats())
       if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8};
   std::string valid;
   for (const std::string& n : layout_names()) valid += "\n  " + n;

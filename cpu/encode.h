@@ -31,6 +31,10 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
 // valid names for anything else.
 BuildOptions parse_layout(const std::string& text);
 std::string layout_name(uint32_t tree_format, uint32_t triangle_format);
+
+// True for the triangle formats that quantize vertices against the mesh box
+// (BitPack words): they store quantized_mesh(), not the input mesh.
+bool moves_vertices(uint32_t triangle_format);
 std::vector<std::string> layout_names();
 
 // Worst-case distance, per axis, between an input vertex and the position the

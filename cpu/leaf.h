@@ -5,9 +5,7 @@
 #include <algorithm>
 
 #include "cpu/ray.h"
-#include "layout/float3.h"
-#include "layout/float3soa4.h"
-#include "layout/indexed8bitpacksoa4.h"
+#include "layout/codecs.h"
 
 namespace meshcast {
 
@@ -56,7 +54,32 @@ struct Loader<layout::Indexed8BitPackSOA4> {
     const uint8_t* vertices = blob + block + layout::load<uint32_t>(blob + block);
     const uint8_t* idx = blob + block + MC_I8_HEADER_BYTES + (first / 4) * MC_I8_BLOCK_BYTES;
     for (int c = 0; c < 3; ++c)
-      simd::bitpack_gather(vertices, idx + c * 4, h.quant_offset, h.quant_scale, axis, v[c]);
+      simd::bitpack_gather(vertices, simd::from_u8_index(idx + c * 4), h.quant_offset, h.quant_scale, axis, v[c]);
+  }
+};
+
+// Indexed formats: the 4 lanes' indices of each corner, then a gather of
+// float vertices (3 floats a record) or of BitPack words.
+template <class IndexT, bool kBitPack, bool kSoa, uint32_t kId>
+struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
+  using Codec = layout::Indexed<IndexT, kBitPack, kSoa, kId>;
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, const int axis[3],
+                   simd::F4 v[3][3]) {
+    const layout::BlobHeader& h = layout::header_of(blob);
+    const uint8_t* vertices = blob + h.vertex_offset;
+    uint32_t last = Codec::lanes(count) - 1;
+    for (int c = 0; c < 3; ++c) {
+      simd::I4 idx = simd::iconst(int(Codec::index(blob, block, first, c)),
+                                  int(Codec::index(blob, block, std::min(first + 1, last), c)),
+                                  int(Codec::index(blob, block, std::min(first + 2, last), c)),
+                                  int(Codec::index(blob, block, std::min(first + 3, last), c)));
+      if constexpr (kBitPack) {
+        simd::bitpack_gather(vertices, idx, h.quant_offset, h.quant_scale, axis, v[c]);
+      } else {
+        simd::I4 idx3 = idx + idx + idx;
+        for (int j = 0; j < 3; ++j) v[c][j] = simd::gather(reinterpret_cast<const float*>(vertices), idx3 + axis[j]);
+      }
+    }
   }
 };
 

@@ -1,12 +1,8 @@
-// The one list of layouts: every tree format carries every triangle format.
-// Walker instantiations and the dispatch table in trace.cpp are generated
-// from these lists, so adding a codec is one line here plus its Loader.
+// The one list of layouts: every tree format carries every triangle format
+// of layout/codecs.h. Walker instantiations and the dispatch table in
+// trace.cpp are generated from these lists.
 #pragma once
-
-#define MC_FOR_EACH_TRIANGLE_CODEC(X) \
-  X(Float3)                           \
-  X(Float3SOA4)                       \
-  X(Indexed8BitPackSOA4)
+#include "layout/codecs.h"
 
 #define MC_FOR_EACH_TREE(X)                         \
   X(AABBTree, MC_TREE_AABBTREE)                     \

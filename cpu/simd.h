@@ -73,12 +73,14 @@ inline F4 from_half(const uint8_t* p) {  // 4 half floats -> 4 floats (F16C)
 }
 // Four BitPack words (seed 000 §3.4) at base + 8 * index[i], decoded with the
 // same fma as layout::bitpack_decode; out[j] is axis `axis[j]`.
-inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const float offset[3], const float scale[3],
-                           const int axis[3], F4 out[3]) {
+inline I4 from_u8_index(const uint8_t* p) {  // 4 bytes -> 4 ints
   int32_t x;
-  std::memcpy(&x, index, 4);
-  __m128i idx = _mm_cvtepu8_epi32(_mm_cvtsi32_si128(x));
-  __m256i w = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), idx, 8);
+  std::memcpy(&x, p, 4);
+  return {_mm_cvtepu8_epi32(_mm_cvtsi32_si128(x))};
+}
+inline void bitpack_gather(const uint8_t* base, I4 index, const float offset[3], const float scale[3],
+                           const int axis[3], F4 out[3]) {
+  __m256i w = _mm256_i32gather_epi64(reinterpret_cast<const long long*>(base), index.v, 8);
   const __m256i mask = _mm256_set1_epi64x(MC_BITPACK_MAX);
   const __m256i even = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
   for (int j = 0; j < 3; ++j) {
@@ -92,6 +94,7 @@ inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const fl
 inline F4 gather(const float* base, I4 idx) { return {_mm_i32gather_ps(base, idx.v, 4)}; }
 inline I4 iconst(int a, int b, int c, int d) { return {_mm_setr_epi32(a, b, c, d)}; }
 inline I4 operator+(I4 a, int b) { return {_mm_add_epi32(a.v, _mm_set1_epi32(b))}; }
+inline I4 operator+(I4 a, I4 b) { return {_mm_add_epi32(a.v, b.v)}; }
 
 #else  // MESHCAST_SCALAR
 
@@ -137,11 +140,12 @@ inline F4 from_half(const uint8_t* p) {
   F4 r;
   MC_LANES(layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
 }
-inline void bitpack_gather(const uint8_t* base, const uint8_t index[4], const float offset[3], const float scale[3],
+inline I4 from_u8_index(const uint8_t* p) { I4 r; MC_LANES(uint32_t(p[i])) }
+inline void bitpack_gather(const uint8_t* base, I4 index, const float offset[3], const float scale[3],
                            const int axis[3], F4 out[3]) {
   for (int i = 0; i < 4; ++i) {
     uint64_t w;
-    std::memcpy(&w, base + 8 * index[i], 8);
+    std::memcpy(&w, base + 8ull * index.v[i], 8);
     float v[3];
     layout::bitpack_decode(w, offset, scale, v);
     for (int j = 0; j < 3; ++j) out[j].v[i] = v[axis[j]];
@@ -154,6 +158,7 @@ inline F4 gather(const float* base, I4 idx) {
 }
 inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b), uint32_t(c), uint32_t(d)}}; }
 inline I4 operator+(I4 a, int b) { I4 r; MC_LANES(a.v[i] + uint32_t(b)) }
+inline I4 operator+(I4 a, I4 b) { I4 r; MC_LANES(a.v[i] + b.v[i]) }
 #undef MC_LANES
 
 #endif

@@ -24,7 +24,7 @@ constexpr WalkFn walker_for(uint32_t tree) {
   return nullptr;
 }
 
-#define MC_CODEC_ENTRIES(Codec)                                                  \
+#define MC_CODEC_ENTRIES(Codec, name)                                                  \
   {MC_TREE_AABBTREE, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_AABBTREE)},   \
       {MC_TREE_QUADTREE, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_QUADTREE)}, \
       {MC_TREE_QUADTREEHALFFLOAT, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_QUADTREEHALFFLOAT)},

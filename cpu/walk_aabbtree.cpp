@@ -45,7 +45,7 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   });
 }
 
-#define MC_INSTANTIATE(Codec) \
+#define MC_INSTANTIATE(Codec, name) \
   template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 

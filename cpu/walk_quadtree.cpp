@@ -92,7 +92,7 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   });
 }
 
-#define MC_INSTANTIATE(Codec)                                                                                   \
+#define MC_INSTANTIATE(Codec, name)                                                                                   \
   template void walk_quadtree<layout::QuadBoundsFloat, layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, \
                                                                       uint64_t*);                               \
   template void walk_quadtree<layout::QuadBoundsHalf, layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t,  \

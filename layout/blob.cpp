@@ -4,9 +4,7 @@
 #include <vector>
 
 #include "layout/aabbtree.h"
-#include "layout/float3.h"
-#include "layout/float3soa4.h"
-#include "layout/indexed8bitpacksoa4.h"
+#include "layout/codecs.h"
 #include "layout/quadtree.h"
 
 namespace meshcast::layout {
@@ -45,11 +43,10 @@ std::string_view tree_format_name(uint32_t f) {
 }
 
 std::string_view triangle_format_name(uint32_t f) {
-  switch (f) {
-    case MC_TRI_FLOAT3: return "Float3";
-    case MC_TRI_FLOAT3SOA4: return "Float3SOA4";
-    case MC_TRI_INDEXED8BITPACKSOA4: return "Indexed8BitPackSOA4";
-  }
+#define MC_NAME(Codec, text) \
+  if (f == Codec::kFormat) return text;
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_NAME)
+#undef MC_NAME
   return "";
 }
 
@@ -219,20 +216,13 @@ std::string validate(std::span<const uint8_t> blob) {
 
   uint64_t triangles = 0;
   std::string e;
-  switch (h.triangle_format) {
-    case MC_TRI_FLOAT3:
-      if (h.slot_divisor != Float3::kSlotDivisor) return "slot divisor does not match Float3";
-      e = walk_tree<Float3>(blob.data(), h, &triangles);
-      break;
-    case MC_TRI_FLOAT3SOA4:
-      if (h.slot_divisor != Float3SOA4::kSlotDivisor) return "slot divisor does not match Float3SOA4";
-      e = walk_tree<Float3SOA4>(blob.data(), h, &triangles);
-      break;
-    case MC_TRI_INDEXED8BITPACKSOA4:
-      if (h.slot_divisor != Indexed8BitPackSOA4::kSlotDivisor) return "slot divisor does not match Indexed8BitPackSOA4";
-      e = walk_tree<Indexed8BitPackSOA4>(blob.data(), h, &triangles);
-      break;
+#define MC_WALK(Codec, text)                                                          \
+  if (h.triangle_format == Codec::kFormat) {                                          \
+    if (h.slot_divisor != Codec::kSlotDivisor) return "slot divisor does not match " text; \
+    e = walk_tree<Codec>(blob.data(), h, &triangles);                                 \
   }
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_WALK)
+#undef MC_WALK
   if (!e.empty()) return e;
   if (triangles != h.triangle_count)
     return "leaves hold " + num(triangles) + " triangles but the header says " + num(h.triangle_count);

@@ -32,9 +32,9 @@ uint64_t bitpack_encode(const float v[3], const float offset[3], const float sca
 }
 
 void Indexed8BitPackSOA4::encode(const TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out) {
-  std::vector<uint64_t>& pool = *ctx.vertices;
+  std::vector<uint8_t>& pool = *ctx.pool;
   // Window [base, base + 256): ends 3*count past the pool's current end.
-  uint64_t end = pool.size() + 3ull * count;
+  uint64_t end = pool.size() / 8 + 3ull * count;
   uint32_t base = end > MC_I8_WINDOW ? uint32_t(end - MC_I8_WINDOW) : 0u;
   constexpr uint32_t kMaxLanes = (MC_QUAD_MAX_COUNT + 3) / 4 * 4;
   if (count == 0 || count > MC_QUAD_MAX_COUNT) return;  // the writer never asks for this
@@ -47,8 +47,7 @@ void Indexed8BitPackSOA4::encode(const TriCorners* tris, uint32_t count, BlockCo
       if (it != ctx.last_index->end() && it->second >= base) {
         at = it->second;
       } else {
-        at = uint32_t(pool.size());
-        pool.push_back(w);
+        at = pool_append(pool, &w, 8);
         (*ctx.last_index)[w] = at;
       }
       idx[c][i] = uint8_t(at - base);

@@ -14,17 +14,28 @@ namespace meshcast::layout {
 // One triangle as the codec stores it: three corners, already at the
 // positions the walker will decode (bit-packed formats quantize first).
 struct TriCorners {
-  float v[3][3];     // corner, axis
+  float v[3][3];       // corner, axis
   uint64_t packed[3];  // BitPack word of each corner (bit-packed formats only)
+  uint32_t vertex[3];  // the input mesh's vertex of each corner
 };
 
 // State shared by the blocks of one blob while it is written.
 struct BlockContext {
-  uint32_t block_address = 0;        // blob offset of the block being written
-  uint32_t vertex_section = 0;       // blob offset of the vertex section
-  std::vector<uint64_t>* vertices = nullptr;  // shared vertex pool (indexed formats)
-  std::unordered_map<uint64_t, uint32_t>* last_index = nullptr;  // word -> newest pool index
+  uint32_t block_address = 0;   // blob offset of the block being written
+  uint32_t vertex_section = 0;  // blob offset of the vertex section
+  // Shared vertex pool of the indexed formats, as the vertex section's bytes,
+  // and the pool index a key (packed word or input vertex) last received.
+  std::vector<uint8_t>* pool = nullptr;
+  std::unordered_map<uint64_t, uint32_t>* last_index = nullptr;
 };
+
+// Appends a vertex record to the pool; returns its index (record number).
+inline uint32_t pool_append(std::vector<uint8_t>& pool, const void* record, size_t bytes) {
+  uint32_t index = uint32_t(pool.size() / bytes);
+  const uint8_t* p = static_cast<const uint8_t*>(record);
+  pool.insert(pool.end(), p, p + bytes);
+  return index;
+}
 
 // The bit-packed vertex of seed 000 §3.4: 21 bits per component in a uint64,
 // x in the low bits. Decoding is one fused multiply-add per component, done

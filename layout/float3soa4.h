@@ -14,6 +14,7 @@ struct Float3SOA4 {
   static constexpr uint32_t kFormat = MC_TRI_FLOAT3SOA4;
   static constexpr uint32_t kSlotDivisor = MC_FLOAT3SOA4_BLOCK_BYTES / MC_SOA4_LANES;
   static constexpr uint32_t kLanes = MC_SOA4_LANES;
+  static constexpr bool kBitPack = false;
   static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
   static uint32_t block_bytes(uint32_t count) { return blocks(count) * MC_FLOAT3SOA4_BLOCK_BYTES; }
   static void encode(const TriCorners* tris, uint32_t count, BlockContext&, uint8_t* out) {

@@ -19,6 +19,12 @@
 #define MC_TRI_FLOAT3 1u               // §3.1
 #define MC_TRI_FLOAT3SOA4 2u           // §3.2
 #define MC_TRI_INDEXED8BITPACKSOA4 3u  // §3.9
+#define MC_TRI_INDEXED16 4u            // §3.6
+#define MC_TRI_INDEXED32 5u            // §3.6
+#define MC_TRI_INDEXED16SOA4 6u        // §3.7
+#define MC_TRI_INDEXED32SOA4 7u        // §3.7
+#define MC_TRI_INDEXED16BITPACKSOA4 8u // §3.8
+#define MC_TRI_INDEXED32BITPACKSOA4 9u // §3.8
 
 // AABBTree node (§5.1): BoundingBoxMin (3 floats), BoundingBoxMax (3 floats),
 // Properties (uint32). High bit set: a leaf whose low bits are its triangle

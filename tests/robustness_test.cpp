@@ -18,7 +18,7 @@ namespace {
 class Robustness : public ::testing::TestWithParam<std::string> {
  protected:
   BuildOptions options() const { return parse_layout(GetParam()); }
-  bool quantized() const { return options().triangle_format == MC_TRI_INDEXED8BITPACKSOA4; }
+  bool quantized() const { return moves_vertices(options().triangle_format); }
   // Oracle answers on the mesh as stored (quantized for bit-packed formats).
   void expect_oracle(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
     std::vector<uint8_t> blob = build_blob(mesh, options(), what);

@@ -17,7 +17,7 @@ struct Case {
 
 class WalkerVsOracle : public ::testing::TestWithParam<std::string> {};
 
-bool is_bitpack(const BuildOptions& o) { return o.triangle_format == MC_TRI_INDEXED8BITPACKSOA4; }
+bool is_bitpack(const BuildOptions& o) { return moves_vertices(o.triangle_format); }
 
 void check_layout(const std::string& layout_name_, bool large) {
   BuildOptions options = parse_layout(layout_name_);

@@ -78,7 +78,7 @@ void add_demo(CLI::App& app) {
       BlobView view(blob, name);
       // The bit-packed layout is judged on the mesh it stores (its vertices
       // moved by at most the quantization bound), the others on the input.
-      bool quantized = o.triangle_format == MC_TRI_INDEXED8BITPACKSOA4;
+      bool quantized = moves_vertices(o.triangle_format);
       Mesh stored = quantized ? quantized_mesh(mesh, blob) : Mesh{};
       std::unique_ptr<OracleTree> stored_tree = quantized ? std::make_unique<OracleTree>(stored) : nullptr;
       SectionBytes s = section_bytes(blob);

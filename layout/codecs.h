@@ -1,0 +1,19 @@
+// The one list of triangle formats: validation, the writer, the walkers'
+// dispatch table and the layout names are all generated from it.
+#pragma once
+#include "layout/float3.h"
+#include "layout/float3soa4.h"
+#include "layout/indexed.h"
+#include "layout/indexed8bitpacksoa4.h"
+
+// X(codec type in meshcast::layout, its name as the seed writes it)
+#define MC_FOR_EACH_TRIANGLE_CODEC(X)                  \
+  X(Float3, "Float3")                                  \
+  X(Float3SOA4, "Float3SOA4")                          \
+  X(Indexed8BitPackSOA4, "Indexed8BitPackSOA4")        \
+  X(Indexed16, "Indexed16")                            \
+  X(Indexed32, "Indexed32")                            \
+  X(Indexed16SOA4, "Indexed16SOA4")                    \
+  X(Indexed32SOA4, "Indexed32SOA4")                    \
+  X(Indexed16BitPackSOA4, "Indexed16BitPackSOA4")      \
+  X(Indexed32BitPackSOA4, "Indexed32BitPackSOA4")

@@ -118,6 +118,46 @@ void fill_aabbtree(Writer& w) {
   write(0, 0);
 }
 
+// BruteForce: no tree. The "tree" is node 0 (the whole mesh) followed by one
+// leaf a chunk of MC_BRUTE_CHUNK triangles in input order; each becomes a
+// record [count][block].
+BuildTree chunk_tree(const std::vector<Box3>& boxes) {
+  BuildTree t;
+  t.order.resize(boxes.size());
+  t.nodes.emplace_back();
+  for (uint32_t i = 0; i < boxes.size(); ++i) t.order[i] = i, t.nodes[0].box.grow(boxes[i]);
+  for (uint32_t first = 0; first < boxes.size(); first += MC_BRUTE_CHUNK) {
+    BuildNode leaf;
+    leaf.first = first;
+    leaf.count = std::min<uint32_t>(MC_BRUTE_CHUNK, uint32_t(boxes.size()) - first);
+    for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(boxes[i]);
+    t.nodes.push_back(leaf);
+  }
+  return t;
+}
+
+void write_bruteforce(Writer& w) {
+  uint64_t size = 0;
+  for (size_t n = 1; n < w.tree.nodes.size(); ++n)
+    size += MC_BRUTE_RECORD_BYTES + w.codec.block_bytes(w.tree.nodes[n].count);
+  if (size > 0x7FFFFFFFu) throw InputError("the BruteForce section of " + std::to_string(size) + " bytes exceeds 2 GiB");
+  w.h.tree_size = uint32_t(size);
+  w.h.node_count = uint32_t(w.tree.nodes.size() - 1);
+  w.h.node_bytes = w.h.node_count * MC_BRUTE_RECORD_BYTES;  // the count words
+  w.h.triangle_base = 0;
+  w.h.root = 0;
+}
+
+void fill_bruteforce(Writer& w) {
+  uint32_t at = 0;
+  for (size_t n = 1; n < w.tree.nodes.size(); ++n) {
+    const BuildNode& leaf = w.tree.nodes[n];
+    std::memcpy(w.bytes.data() + w.h.tree_offset + at, &leaf.count, 4);
+    w.write_leaf(leaf, at + MC_BRUTE_RECORD_BYTES);
+    at += MC_BRUTE_RECORD_BYTES + w.codec.block_bytes(leaf.count);
+  }
+}
+
 // QuadTree (§5.6): every binary node that stays a node takes up to four
 // children, found by opening its largest interior descendant until four are
 // reached. Nodes are written depth first, triangle blocks after all nodes
@@ -264,7 +304,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     }
   }
 
-  BuildTree tree = build_binning(boxes, o.leaf_size);
+  BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes) : build_binning(boxes, o.leaf_size);
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
   const Box3& root = tree.nodes[0].box;
@@ -282,7 +322,10 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   QuadPlan plan;
   uint32_t depth = tree.depth;
-  if (o.tree_format == MC_TREE_AABBTREE) {
+  if (o.tree_format == MC_TREE_BRUTEFORCE) {
+    write_bruteforce(writer);
+    depth = 0;
+  } else if (o.tree_format == MC_TREE_AABBTREE) {
     write_aabbtree(writer);
   } else {
     plan = plan_quadtree(tree);
@@ -294,12 +337,13 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     throw InputError(name + ": the tree is " + std::to_string(depth) + " levels deep, beyond the walkers' limit of " +
                      std::to_string(MC_MAX_DEPTH));
   hd.max_depth = depth;
-  hd.leaf_count = tree.leaf_count();
+  hd.leaf_count = tree.leaf_count();  // BruteForce: the records
   hd.tree_offset = align(MC_BLOB_HEADER_BYTES, 64);  // 64-byte nodes start on a cache line
   hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
   writer.bytes.assign(hd.vertex_offset, 0);
   try {
-    if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer);
+    if (o.tree_format == MC_TREE_BRUTEFORCE) fill_bruteforce(writer);
+    else if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer);
     else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
     else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
   } catch (const std::length_error& e) {  // a codec's own limit (index width)
@@ -352,7 +396,7 @@ bool moves_vertices(uint32_t triangle_format) { return codec_ops(triangle_format
 
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT})
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
       names.push_back(layout_name(t, c));
   return names;
@@ -367,7 +411,7 @@ BuildOptions parse_layout(const std::string& text) {
     for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     return s;
   };
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT})
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
       if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8};
   std::string valid;

@@ -7,4 +7,5 @@
 #define MC_FOR_EACH_TREE(X)                         \
   X(AABBTree, MC_TREE_AABBTREE)                     \
   X(QuadTree, MC_TREE_QUADTREE)                     \
-  X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT)
+  X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT)   \
+  X(BruteForce, MC_TREE_BRUTEFORCE)

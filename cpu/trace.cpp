@@ -1,5 +1,7 @@
 #include "cpu/trace.h"
 
+#include <vector>
+
 #include "cpu/mesh.h"
 #include "cpu/pairs.h"
 #include "cpu/walk.h"
@@ -20,16 +22,26 @@ constexpr WalkFn walker_for(uint32_t tree) {
     case MC_TREE_AABBTREE: return &walk_aabbtree<Codec>;
     case MC_TREE_QUADTREE: return &walk_quadtree<layout::QuadBoundsFloat, Codec>;
     case MC_TREE_QUADTREEHALFFLOAT: return &walk_quadtree<layout::QuadBoundsHalf, Codec>;
+    case MC_TREE_BRUTEFORCE: return &walk_bruteforce<Codec>;
   }
   return nullptr;
 }
 
-#define MC_CODEC_ENTRIES(Codec, name)                                                  \
-  {MC_TREE_AABBTREE, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_AABBTREE)},   \
-      {MC_TREE_QUADTREE, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_QUADTREE)}, \
-      {MC_TREE_QUADTREEHALFFLOAT, layout::Codec::kFormat, walker_for<layout::Codec>(MC_TREE_QUADTREEHALFFLOAT)},
+// Every (tree, triangle format) pair of the two lists.
+std::vector<Entry> make_walkers() {
+  std::vector<Entry> entries;
+#define MC_TREE_ENTRY(Tree, tree_id) trees.push_back(tree_id);
+#define MC_CODEC_ENTRIES(Codec, name) \
+  for (uint32_t t : trees) entries.push_back({t, layout::Codec::kFormat, walker_for<layout::Codec>(t)});
+  std::vector<uint32_t> trees;
+  MC_FOR_EACH_TREE(MC_TREE_ENTRY)
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRIES)
+#undef MC_TREE_ENTRY
+#undef MC_CODEC_ENTRIES
+  return entries;
+}
 
-const Entry kWalkers[] = {MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRIES)};
+const std::vector<Entry> kWalkers = make_walkers();
 
 }  // namespace
 

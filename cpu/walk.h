@@ -18,6 +18,9 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 template <class Bounds, class Codec>
 void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
 
+template <class Codec>
+void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+
 // Turns the closest slot into the caller's hit.
 inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Closest& c) {
   Hit hit;

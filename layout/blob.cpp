@@ -38,6 +38,7 @@ std::string_view tree_format_name(uint32_t f) {
     case MC_TREE_AABBTREE: return "AABBTree";
     case MC_TREE_QUADTREE: return "QuadTree";
     case MC_TREE_QUADTREEHALFFLOAT: return "QuadTreeHalfFloat";
+    case MC_TREE_BRUTEFORCE: return "BruteForce";
   }
   return "";
 }
@@ -144,9 +145,30 @@ std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
   return "";
 }
 
+// BruteForce: the records must tile the tree section exactly.
+template <class Codec>
+std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  uint64_t at = 0, records = 0;
+  while (at < h.tree_size) {
+    if (at + MC_BRUTE_RECORD_BYTES > h.tree_size) return "BruteForce record at " + num(at) + " is cut short";
+    uint32_t count = load<uint32_t>(blob + h.tree_offset + at);
+    if (count > MC_BRUTE_CHUNK)
+      return "BruteForce record at " + num(at) + " holds " + num(count) + " triangles (at most " +
+             num(MC_BRUTE_CHUNK) + ")";
+    std::string e = check_leaf<Codec>(blob, h, uint32_t(at + MC_BRUTE_RECORD_BYTES), count);
+    if (!e.empty()) return e;
+    *triangles += count;
+    at += MC_BRUTE_RECORD_BYTES + Codec::block_bytes(count);
+    ++records;
+  }
+  if (records != h.node_count) return "BruteForce holds " + num(records) + " records, the header says " + num(h.node_count);
+  return "";
+}
+
 template <class Codec>
 std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   switch (h.tree_format) {
+    case MC_TREE_BRUTEFORCE: return walk_bruteforce<Codec>(blob, h, triangles);
     case MC_TREE_AABBTREE: return walk_aabbtree<Codec>(blob, h, triangles);
     case MC_TREE_QUADTREE: return walk_quadtree<QuadBoundsFloat, Codec>(blob, h, triangles);
     case MC_TREE_QUADTREEHALFFLOAT: return walk_quadtree<QuadBoundsHalf, Codec>(blob, h, triangles);
@@ -186,8 +208,10 @@ std::string validate(std::span<const uint8_t> blob) {
              ") overlaps another, is misaligned, or runs past the blob (" + num(blob.size()) + " bytes)";
     end = uint64_t(s.offset) + s.size;
   }
-  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE ? MC_AABB_NODE_BYTES
-                       : h.tree_format == MC_TREE_QUADTREE ? MC_QUAD_NODE_BYTES : MC_QUADHALF_NODE_BYTES;
+  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE     ? MC_AABB_NODE_BYTES
+                       : h.tree_format == MC_TREE_QUADTREE   ? MC_QUAD_NODE_BYTES
+                       : h.tree_format == MC_TREE_BRUTEFORCE ? MC_BRUTE_RECORD_BYTES
+                                                             : MC_QUADHALF_NODE_BYTES;
   if (uint64_t(h.node_count) * node_size > h.tree_size)
     return "node count " + num(h.node_count) + " does not fit the tree section";
   if (h.node_bytes > h.tree_size || h.triangle_base > h.tree_size)

@@ -14,6 +14,13 @@
 #define MC_TREE_AABBTREE 1u            // §5.1
 #define MC_TREE_QUADTREE 2u            // §5.6
 #define MC_TREE_QUADTREEHALFFLOAT 3u   // §5.7
+#define MC_TREE_BRUTEFORCE 4u          // §3.11: no tree, every triangle tested
+
+// BruteForce: the tree section is a run of records, [count (uint32)][block],
+// each block holding the next MC_BRUTE_CHUNK triangles in input order
+// (fewer in the last), so every triangle format fits its own limits.
+#define MC_BRUTE_RECORD_BYTES 4u
+#define MC_BRUTE_CHUNK 16u
 
 // Triangle formats (seed 000 §3).
 #define MC_TRI_FLOAT3 1u               // §3.1

@@ -49,9 +49,9 @@ const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count
 }
 
 const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays) {
-  static std::map<std::pair<std::string, int>, std::vector<OracleHit>> cache;
+  static std::map<std::tuple<std::string, int, size_t>, std::vector<OracleHit>> cache;
   static std::map<std::string, std::unique_ptr<OracleTree>> trees;
-  auto key = std::make_pair(m.name, int(kind));
+  auto key = std::make_tuple(m.name, int(kind), rays.size());
   if (!cache.count(key)) {
     if (!trees.count(m.name)) trees[m.name] = std::make_unique<OracleTree>(*m.mesh);
     std::vector<OracleHit> answers(rays.size());

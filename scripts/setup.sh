@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgtest-dev dpkg-dev
-          libembree-dev)  # Embree: a peer the main job measures beside meshcast, not a dependency
+          libembree-dev gnuplot-nox)  # Embree: a peer measured beside meshcast; gnuplot: bench plots
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -9,5 +9,6 @@ void add_build(CLI::App& app);
 void add_info(CLI::App& app);
 void add_rays(CLI::App& app);
 void add_demo(CLI::App& app);
+void add_bench(CLI::App& app);
 
 }  // namespace meshcast::tools

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   meshcast::tools::add_info(app);
   meshcast::tools::add_rays(app);
   meshcast::tools::add_demo(app);
+  meshcast::tools::add_bench(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

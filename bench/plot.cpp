@@ -1,0 +1,35 @@
+#include "bench/plot.h"
+
+#include <cstdlib>
+#include <fstream>
+
+namespace meshcast::bench {
+
+std::string plot_scatter(const std::string& png, const std::string& title, const std::string& xlabel,
+                         const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+  std::string script = png + ".gp";
+  std::ofstream gp(script);
+  gp << "set terminal pngcairo size 1100,750 font 'sans,10'\n"
+     << "set output '" << png << "'\n"
+     << "set title '" << title << "'\n"
+     << "set xlabel '" << xlabel << "'\nset ylabel '" << ylabel << "'\n"
+     << "set grid\nset key top right\nset offsets graph 0.02, graph 0.15, graph 0.05, graph 0.05\n"
+     << (log_y ? "set logscale y\n" : "") << "plot ";
+  for (size_t s = 0; s < series.size(); ++s) {
+    if (s) gp << ", ";
+    gp << "'-' using 1:2 with points pt 7 ps 1.2 title '" << series[s].title << "', '-' using 1:2:3 with labels "
+       << "offset 0.8,0.4 left font 'sans,8' notitle";
+  }
+  gp << "\n";
+  for (const Series& s : series)
+    for (int pass = 0; pass < 2; ++pass) {
+      for (const Point& p : s.points) gp << p.x << " " << p.y << " \"" << p.label << "\"\n";
+      gp << "e\n";
+    }
+  gp.close();
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) return "gnuplot not installed (apt-get install gnuplot-nox)";
+  if (std::system(("gnuplot '" + script + "'").c_str()) != 0) return "gnuplot failed on " + script;
+  return "";
+}
+
+}  // namespace meshcast::bench

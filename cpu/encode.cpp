@@ -27,7 +27,7 @@ struct CodecOps {
   uint32_t format, slot_divisor;
   bool bitpack;
   uint32_t (*block_bytes)(uint32_t);
-  void (*encode)(const TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
+  void (*encode)(TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
 
 CodecOps codec_ops(uint32_t format) {
@@ -54,7 +54,7 @@ uint32_t align(uint64_t v, uint32_t a) { return uint32_t((v + a - 1) / a * a); }
 // Shared by both tree writers: the blob under construction.
 struct Writer {
   const std::vector<TriCorners>& corners;
-  const BuildTree& tree;
+  BuildTree& tree;  // leaf boxes are refitted to what the codec stores
   CodecOps codec;
   BlobHeader h{};
   std::vector<uint8_t> bytes;
@@ -62,15 +62,52 @@ struct Writer {
   std::unordered_map<uint64_t, uint32_t> last_index;
   std::vector<uint32_t> remap;
 
-  // Encodes the leaf's triangles at tree-section offset `at`.
-  void write_leaf(const BuildNode& leaf, uint32_t at) {
+  // Encodes leaf node n's triangles at tree-section offset `at`. The codec
+  // hands back the triangles as stored (its order, its decoded corners): the
+  // remap follows that order and the leaf's box is refitted to those corners,
+  // so node bounds always contain what the walker will decode.
+  void write_leaf(uint32_t n, uint32_t at) {
+    BuildNode& leaf = tree.nodes[n];
     std::vector<TriCorners> tris(leaf.count);
-    for (uint32_t i = 0; i < leaf.count; ++i) tris[i] = corners[tree.order[leaf.first + i]];
+    for (uint32_t i = 0; i < leaf.count; ++i) {
+      tris[i] = corners[tree.order[leaf.first + i]];
+      tris[i].input = tree.order[leaf.first + i];
+    }
     layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index};
     codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
     uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
     if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
-    for (uint32_t i = 0; i < leaf.count; ++i) remap[slot0 + i] = tree.order[leaf.first + i];
+    leaf.box = Box3{};
+    for (uint32_t i = 0; i < leaf.count; ++i) {
+      remap[slot0 + i] = tris[i].input;
+      for (int c = 0; c < 3; ++c) leaf.box.grow(Vec3{tris[i].v[c][0], tris[i].v[c][1], tris[i].v[c][2]});
+    }
+  }
+
+  // Interior boxes from the refitted leaves (children follow their parent
+  // in the builder's node order), then the header's frame from the root.
+  void refit() {
+    for (size_t n = tree.nodes.size(); n-- > 0;) {
+      BuildNode& b = tree.nodes[n];
+      if (b.leaf() || b.left == 0) continue;
+      b.box = tree.nodes[b.left].box;
+      b.box.grow(tree.nodes[b.right].box);
+    }
+    frame(tree.nodes[0].box);
+  }
+
+  // Header bounds, and the frame of half-float bounds: relative to the root
+  // centre, scaled by a power of two that puts the root's half extent near
+  // 2^14, far from both the half range limit (65504) and the subnormals.
+  void frame(const Box3& root) {
+    float half_extent = 0;
+    for (int a = 0; a < 3; ++a) {
+      h.bounds_min[a] = root.min[a], h.bounds_max[a] = root.max[a];
+      h.node_origin[a] = root.centre()[a];
+      half_extent = std::max({half_extent, std::fabs(root.max[a] - h.node_origin[a]),
+                              std::fabs(h.node_origin[a] - root.min[a])});
+    }
+    h.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
   }
 };
 
@@ -96,26 +133,28 @@ void write_aabbtree(Writer& w) {
   return;
 }
 
+// Places every node (pre-order), encodes the leaves, refits, then writes
+// the nodes with the refitted boxes.
 void fill_aabbtree(Writer& w) {
   const BuildTree& t = w.tree;
-  std::function<uint32_t(uint32_t, uint32_t)> write = [&](uint32_t n, uint32_t at) -> uint32_t {
+  std::vector<uint32_t> offset(t.nodes.size());
+  std::function<uint32_t(uint32_t, uint32_t)> place = [&](uint32_t n, uint32_t at) -> uint32_t {
+    offset[n] = at;
+    const BuildNode& b = t.nodes[n];
+    if (b.leaf()) return at + MC_AABB_NODE_BYTES + w.codec.block_bytes(b.count);
+    return place(b.right, place(b.left, at + MC_AABB_NODE_BYTES));
+  };
+  place(0, 0);
+  for (uint32_t n = 0; n < t.nodes.size(); ++n)
+    if (t.nodes[n].leaf()) w.write_leaf(n, offset[n] + MC_AABB_NODE_BYTES);
+  w.refit();
+  for (uint32_t n = 0; n < t.nodes.size(); ++n) {
     const BuildNode& b = t.nodes[n];
     layout::AABBNode node{};
     for (int a = 0; a < 3; ++a) node.min[a] = b.box.min[a], node.max[a] = b.box.max[a];
-    uint32_t end;
-    if (b.leaf()) {
-      node.properties = MC_AABB_LEAF_BIT | b.count;
-      w.write_leaf(b, at + MC_AABB_NODE_BYTES);
-      end = at + MC_AABB_NODE_BYTES + w.codec.block_bytes(b.count);
-    } else {
-      uint32_t right = write(b.left, at + MC_AABB_NODE_BYTES);
-      node.properties = right;
-      end = write(b.right, right);
-    }
-    std::memcpy(w.bytes.data() + w.h.tree_offset + at, &node, sizeof node);
-    return end;
-  };
-  write(0, 0);
+    node.properties = b.leaf() ? (MC_AABB_LEAF_BIT | b.count) : offset[b.right];
+    std::memcpy(w.bytes.data() + w.h.tree_offset + offset[n], &node, sizeof node);
+  }
 }
 
 // BruteForce: no tree. The "tree" is node 0 (the whole mesh) followed by one
@@ -150,12 +189,15 @@ void write_bruteforce(Writer& w) {
 
 void fill_bruteforce(Writer& w) {
   uint32_t at = 0;
+  Box3 all;
   for (size_t n = 1; n < w.tree.nodes.size(); ++n) {
     const BuildNode& leaf = w.tree.nodes[n];
     std::memcpy(w.bytes.data() + w.h.tree_offset + at, &leaf.count, 4);
-    w.write_leaf(leaf, at + MC_BRUTE_RECORD_BYTES);
+    w.write_leaf(uint32_t(n), at + MC_BRUTE_RECORD_BYTES);
+    all.grow(leaf.box);
     at += MC_BRUTE_RECORD_BYTES + w.codec.block_bytes(leaf.count);
   }
+  w.frame(all);
 }
 
 // QuadTree (§5.6): every binary node that stays a node takes up to four
@@ -225,9 +267,10 @@ void fill_quadtree(Writer& w, QuadPlan& p) {
   uint32_t at = w.h.triangle_base;
   for (uint32_t leaf : p.leaves) {
     p.leaf_offset[leaf] = at;
-    w.write_leaf(t.nodes[leaf], at);
+    w.write_leaf(leaf, at);
     at += w.codec.block_bytes(t.nodes[leaf].count);
   }
+  w.refit();
   auto props = [&](uint32_t n) {
     return t.nodes[n].leaf() ? layout::quad_properties(t.nodes[n].count, p.leaf_offset[n])
                              : layout::quad_properties(0, p.quad_index[n] * Bounds::kNodeBytes);
@@ -307,18 +350,6 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes) : build_binning(boxes, o.leaf_size);
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
-  const Box3& root = tree.nodes[0].box;
-  for (int a = 0; a < 3; ++a) hd.bounds_min[a] = root.min[a], hd.bounds_max[a] = root.max[a];
-  // Half-float bounds relative to the root centre, scaled by a power of two
-  // that puts the root's half extent near 2^14: far from both the half range
-  // limit (65504) and the subnormals.
-  float half_extent = 0;
-  for (int a = 0; a < 3; ++a) {
-    hd.node_origin[a] = root.centre()[a];
-    half_extent = std::max({half_extent, std::fabs(root.max[a] - hd.node_origin[a]),
-                            std::fabs(hd.node_origin[a] - root.min[a])});
-  }
-  hd.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
 
   QuadPlan plan;
   uint32_t depth = tree.depth;

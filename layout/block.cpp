@@ -31,7 +31,7 @@ uint64_t bitpack_encode(const float v[3], const float offset[3], const float sca
   return w;
 }
 
-void Indexed8BitPackSOA4::encode(const TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out) {
+void Indexed8BitPackSOA4::encode(TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out) {
   std::vector<uint8_t>& pool = *ctx.pool;
   // Window [base, base + 256): ends 3*count past the pool's current end.
   uint64_t end = pool.size() / 8 + 3ull * count;

@@ -11,12 +11,16 @@
 
 namespace meshcast::layout {
 
-// One triangle as the codec stores it: three corners, already at the
-// positions the walker will decode (bit-packed formats quantize first).
+// One triangle as the codec stores it. The writer passes the leaf's
+// triangles with their corners (bit-packed formats already quantized against
+// the mesh box); encode() leaves them in the order it stored them, with the
+// corners the walker will decode, so the writer can build the remap and fit
+// the leaf's bounds to exactly what is stored.
 struct TriCorners {
   float v[3][3];       // corner, axis
   uint64_t packed[3];  // BitPack word of each corner (bit-packed formats only)
   uint32_t vertex[3];  // the input mesh's vertex of each corner
+  uint32_t input;      // the input mesh's triangle
 };
 
 // State shared by the blocks of one blob while it is written.

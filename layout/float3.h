@@ -12,7 +12,7 @@ struct Float3 {
   static constexpr uint32_t kLanes = 1;
   static constexpr bool kBitPack = false;
   static uint32_t block_bytes(uint32_t count) { return count * MC_FLOAT3_TRI_BYTES; }
-  static void encode(const TriCorners* tris, uint32_t count, BlockContext&, uint8_t* out) {
+  static void encode(TriCorners* tris, uint32_t count, BlockContext&, uint8_t* out) {
     for (uint32_t i = 0; i < count; ++i) std::memcpy(out + i * MC_FLOAT3_TRI_BYTES, tris[i].v, 36);
   }
   // Corners of triangle `i` of the block at blob offset `block`.

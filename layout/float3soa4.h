@@ -17,7 +17,7 @@ struct Float3SOA4 {
   static constexpr bool kBitPack = false;
   static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
   static uint32_t block_bytes(uint32_t count) { return blocks(count) * MC_FLOAT3SOA4_BLOCK_BYTES; }
-  static void encode(const TriCorners* tris, uint32_t count, BlockContext&, uint8_t* out) {
+  static void encode(TriCorners* tris, uint32_t count, BlockContext&, uint8_t* out) {
     for (uint32_t b = 0; b < blocks(count); ++b) {
       float soa[36];
       for (uint32_t lane = 0; lane < 4; ++lane) {

@@ -37,7 +37,7 @@ struct Indexed {
     return load<IndexT>(blob + block + slot(i, c) * kIndexBytes);
   }
 
-  static void encode(const TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out) {
+  static void encode(TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out) {
     for (uint32_t i = 0; i < lanes(count); ++i) {
       const TriCorners& t = tris[std::min(i, count - 1)];
       for (int c = 0; c < 3; ++c) {

@@ -30,7 +30,7 @@ struct Indexed8BitPackSOA4 {
   static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
   static uint32_t block_bytes(uint32_t count) { return MC_I8_HEADER_BYTES + blocks(count) * MC_I8_BLOCK_BYTES; }
 
-  static void encode(const TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out);
+  static void encode(TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out);
 
   static uint32_t vertex_address(const uint8_t* blob, uint32_t block, uint32_t index) {
     return block + load<uint32_t>(blob + block) + 8 * index;

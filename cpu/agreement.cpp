@@ -4,6 +4,7 @@
 
 #include "layout/blob.h"
 #include "layout/block.h"
+#include "layout/leaves.h"
 
 namespace meshcast {
 
@@ -123,6 +124,23 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
     }
   }
   return a;
+}
+
+Mesh stored_mesh(const std::vector<uint8_t>& blob) {
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  Mesh m;
+  m.vertices.resize(size_t(h.triangle_count) * 3);
+  m.triangles.resize(h.triangle_count);
+  layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t count) {
+    for (uint32_t i = 0; i < count; ++i) {
+      uint32_t t = layout::remap_entry(blob.data(), h, layout::slot_of(h, block, i));
+      float v[3][3];
+      layout::decode_triangle(blob.data(), h.tree_offset + block, i, v);
+      for (int c = 0; c < 3; ++c) m.vertices[size_t(t) * 3 + c] = {v[c][0], v[c][1], v[c][2]};
+      m.triangles[t] = {t * 3, t * 3 + 1, t * 3 + 2};
+    }
+  });
+  return m;
 }
 
 Mesh quantized_mesh(const Mesh& mesh, const std::vector<uint8_t>& blob) {

@@ -28,6 +28,11 @@ double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, 
 Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
                   const std::vector<OracleHit>& oracle, double tolerance);
 
+// The triangles as the blob stores them, decoded by its triangle format and
+// put back in input order: a triangle soup, three vertices a triangle. The
+// exact reference for formats that move vertices.
+Mesh stored_mesh(const std::vector<uint8_t>& blob);
+
 // The mesh as a bit-packed blob stores it: every vertex moved to its decoded
 // grid position, computed from the input and the header's quantization box.
 Mesh quantized_mesh(const Mesh& mesh, const std::vector<uint8_t>& blob);

@@ -25,7 +25,8 @@ namespace {
 // The parts of a triangle codec the writer needs, as a runtime value.
 struct CodecOps {
   uint32_t format, slot_divisor;
-  bool bitpack;
+  layout::GridKind grid;
+  uint32_t lanes;
   uint32_t (*block_bytes)(uint32_t);
   void (*encode)(TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
@@ -33,8 +34,8 @@ struct CodecOps {
 CodecOps codec_ops(uint32_t format) {
 #define MC_OPS(Codec, name)                                                                         \
   if (format == layout::Codec::kFormat)                                                            \
-    return {layout::Codec::kFormat, layout::Codec::kSlotDivisor, layout::Codec::kBitPack,        \
-            &layout::Codec::block_bytes, &layout::Codec::encode};
+    return {layout::Codec::kFormat, layout::Codec::kSlotDivisor, layout::Codec::kGrid,           \
+            layout::Codec::kLanes, &layout::Codec::block_bytes, &layout::Codec::encode};
   MC_FOR_EACH_TRIANGLE_CODEC(MC_OPS)
 #undef MC_OPS
   throw InputError("unknown triangle format " + std::to_string(format));
@@ -61,6 +62,7 @@ struct Writer {
   std::vector<uint8_t> pool;
   std::unordered_map<uint64_t, uint32_t> last_index;
   std::vector<uint32_t> remap;
+  uint32_t max_block_shift = 0;
 
   // Encodes leaf node n's triangles at tree-section offset `at`. The codec
   // hands back the triangles as stored (its order, its decoded corners): the
@@ -73,7 +75,7 @@ struct Writer {
       tris[i] = corners[tree.order[leaf.first + i]];
       tris[i].input = tree.order[leaf.first + i];
     }
-    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index};
+    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index, h.quant_scale, &max_block_shift};
     codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
     uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
     if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
@@ -157,18 +159,59 @@ void fill_aabbtree(Writer& w) {
   }
 }
 
+// kGridPowerOfTwo formats (BitPackSOA, layout/soa.h): blocks of `lanes`
+// consecutive triangles of each leaf; every vertex goes to the coarsest
+// block lattice among its blocks, repeated until no block needs a coarser
+// step, so all blocks decode a shared vertex to the same bits.
+void snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& corners, uint32_t lanes, const float grid[3],
+                            size_t vertex_count) {
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<uint32_t> shift(vertex_count, 0);
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const BuildNode& leaf : t.nodes) {
+        if (!leaf.leaf()) continue;
+        for (uint32_t b = 0; b < leaf.count; b += lanes) {
+          float lo = INFINITY, hi = -INFINITY;
+          uint32_t end = std::min(leaf.count, b + lanes);
+          for (uint32_t i = b; i < end; ++i)
+            for (int c = 0; c < 3; ++c) {
+              float v = corners[t.order[leaf.first + i]].v[c][axis];
+              lo = std::min(lo, v), hi = std::max(hi, v);
+            }
+          float step, offset;
+          uint32_t m;
+          layout::block_step(lo, hi, grid[axis], &step, &offset, &m);
+          for (uint32_t i = b; i < end; ++i)
+            for (int c = 0; c < 3; ++c) {
+              uint32_t v = corners[t.order[leaf.first + i]].vertex[c];
+              if (m > shift[v]) shift[v] = m, changed = true;
+            }
+        }
+      }
+      // Each vertex onto the lattice of its coarsest block (multiples of
+      // grid * 2^shift); every corner of a vertex moves the same way.
+      for (TriCorners& tc : corners)
+        for (int c = 0; c < 3; ++c) {
+          double step = double(grid[axis]) * std::ldexp(1.0, int(shift[tc.vertex[c]]));
+          if (step > 0) tc.v[c][axis] = float(std::round(double(tc.v[c][axis]) / step) * step);
+        }
+    }
+  }
+}
+
 // BruteForce: no tree. The "tree" is node 0 (the whole mesh) followed by one
-// leaf a chunk of MC_BRUTE_CHUNK triangles in input order; each becomes a
+// leaf a chunk of brute_chunk() triangles in input order; each becomes a
 // record [count][block].
-BuildTree chunk_tree(const std::vector<Box3>& boxes) {
+BuildTree chunk_tree(const std::vector<Box3>& boxes, uint32_t chunk) {
   BuildTree t;
   t.order.resize(boxes.size());
   t.nodes.emplace_back();
   for (uint32_t i = 0; i < boxes.size(); ++i) t.order[i] = i, t.nodes[0].box.grow(boxes[i]);
-  for (uint32_t first = 0; first < boxes.size(); first += MC_BRUTE_CHUNK) {
+  for (uint32_t first = 0; first < boxes.size(); first += chunk) {
     BuildNode leaf;
     leaf.first = first;
-    leaf.count = std::min<uint32_t>(MC_BRUTE_CHUNK, uint32_t(boxes.size()) - first);
+    leaf.count = std::min<uint32_t>(chunk, uint32_t(boxes.size()) - first);
     for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(boxes[i]);
     t.nodes.push_back(leaf);
   }
@@ -319,11 +362,22 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   // Stored triangle corners: bit-packed formats quantize against the mesh box.
   Box3 mesh_box = mesh.bounds();
+  const bool grid = codec.grid != layout::kGridNone;
   for (int a = 0; a < 3; ++a) {
-    h.quant_offset[a] = codec.bitpack ? mesh_box.min[a] : 0.0f;
-    h.quant_scale[a] = codec.bitpack ? float((double(mesh_box.max[a]) - mesh_box.min[a]) / MC_BITPACK_MAX) : 0.0f;
+    double lo = mesh_box.min[a], extent = double(mesh_box.max[a]) - lo;
+    if (codec.grid == layout::kGridMeshBox) {
+      h.quant_offset[a] = float(lo), h.quant_scale[a] = float(extent / MC_BITPACK_MAX);
+    } else if (codec.grid == layout::kGridPowerOfTwo) {
+      // The smallest power of two that spans the extent in 2^21 - 2 steps,
+      // and the grid point at or below the minimum.
+      // A flat axis keeps its one coordinate (step 0).
+      double step = extent > 0 ? std::ldexp(1.0, std::ilogb(extent / (MC_BITPACK_MAX - 1)) + 1) : 0.0;
+      h.quant_scale[a] = float(step), h.quant_offset[a] = step > 0 ? float(std::floor(lo / step) * step) : float(lo);
+    } else {
+      h.quant_offset[a] = 0, h.quant_scale[a] = 0;
+    }
   }
-  std::vector<uint64_t> packed(codec.bitpack ? mesh.vertices.size() : 0);
+  std::vector<uint64_t> packed(grid ? mesh.vertices.size() : 0);
   for (size_t v = 0; v < packed.size(); ++v) {
     float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
     packed[v] = layout::bitpack_encode(p, h.quant_offset, h.quant_scale);
@@ -333,7 +387,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (int c = 0; c < 3; ++c) {
       uint32_t v = mesh.triangles[t][c];
-      if (codec.bitpack) {
+      if (grid) {
         corners[t].vertex[c] = v;
         corners[t].packed[c] = packed[v];
         layout::bitpack_decode(packed[v], h.quant_offset, h.quant_scale, corners[t].v[c]);
@@ -347,7 +401,10 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     }
   }
 
-  BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes) : build_binning(boxes, o.leaf_size);
+  BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
+                                                       : build_binning(boxes, o.leaf_size);
+  if (codec.grid == layout::kGridPowerOfTwo)
+    snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale, mesh.vertices.size());
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
 
@@ -385,6 +442,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     throw InputError(name + ": the blob would exceed the 4 GiB its 32-bit offsets reach");
 
   hd.vertex_size = uint32_t(writer.pool.size());
+  hd.max_block_shift = writer.max_block_shift;
   writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
   if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
 
@@ -423,7 +481,24 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   return std::move(writer.bytes);
 }
 
-bool moves_vertices(uint32_t triangle_format) { return codec_ops(triangle_format).bitpack; }
+void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
+  const BlobHeader& h = layout::header_of(blob.data());
+  layout::GridKind grid = codec_ops(h.triangle_format).grid;
+  if (grid == layout::kGridMeshBox) return quantization_bound(h.quant_offset, h.quant_scale, bound);
+  for (int a = 0; a < 3; ++a) {
+    if (grid == layout::kGridNone) {
+      bound[a] = 0;
+      continue;
+    }
+    // Half the grid step, half the coarsest block step, and one rounding of
+    // the largest coordinate.
+    float top = std::max(std::fabs(h.bounds_min[a]), std::fabs(h.bounds_max[a]));
+    bound[a] = 0.5f * h.quant_scale[a] * (1.0f + std::ldexp(1.0f, int(h.max_block_shift))) +
+               (std::nextafter(top, INFINITY) - top);
+  }
+}
+
+bool moves_vertices(uint32_t triangle_format) { return codec_ops(triangle_format).grid != layout::kGridNone; }
 
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;

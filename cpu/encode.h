@@ -38,7 +38,11 @@ bool moves_vertices(uint32_t triangle_format);
 std::vector<std::string> layout_names();
 
 // Worst-case distance, per axis, between an input vertex and the position the
-// triangle format stores for it (0 for the float formats).
+// 21-bit BitPack grid of seed 000 §3.4 stores for it.
 void quantization_bound(const float offset[3], const float scale[3], float bound[3]);
+
+// The stated worst-case displacement, per axis, of any stored corner from
+// its input vertex, for the blob's triangle format (0 for the float ones).
+void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]);
 
 }  // namespace meshcast

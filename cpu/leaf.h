@@ -36,13 +36,29 @@ struct Loader<layout::Float3> {
   }
 };
 
-template <>
-struct Loader<layout::Float3SOA4> {
+// SOA blocks of N lanes: 4 consecutive lanes of a row are one load.
+template <uint32_t N, uint32_t kId>
+struct Loader<layout::Float3SOA<N, kId>> {
+  using Codec = layout::Float3SOA<N, kId>;
   static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, const int axis[3],
                    simd::F4 v[3][3]) {
-    const uint8_t* p = blob + block + (first / 4) * MC_FLOAT3SOA4_BLOCK_BYTES;
+    const uint8_t* p = blob + block + (first / N) * Codec::kBlockBytes;
     for (int c = 0; c < 3; ++c)
-      for (int j = 0; j < 3; ++j) v[c][j] = simd::F4::load(p + (c * 3 + axis[j]) * 16);
+      for (int j = 0; j < 3; ++j) v[c][j] = simd::F4::load(p + Codec::row(c, axis[j], first % N));
+  }
+};
+
+template <uint32_t N, uint32_t kId>
+struct Loader<layout::BitPackSOA<N, kId>> {
+  using Codec = layout::BitPackSOA<N, kId>;
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, const int axis[3],
+                   simd::F4 v[3][3]) {
+    const uint8_t* p = blob + block + (first / N) * Codec::kBlockBytes;
+    for (int j = 0; j < 3; ++j) {
+      simd::F4 scale = simd::F4::splat(layout::load<float>(p + Codec::kRowsBytes + 4 * axis[j]));
+      simd::F4 offset = simd::F4::splat(layout::load<float>(p + Codec::kRowsBytes + 12 + 4 * axis[j]));
+      for (int c = 0; c < 3; ++c) v[c][j] = simd::fma(simd::from_u16(p + Codec::row(c, axis[j], first % N)), scale, offset);
+    }
   }
 };
 

@@ -66,6 +66,11 @@ inline F4 from_u8(const uint8_t* p) {  // 4 bytes -> 4 floats
   std::memcpy(&x, p, 4);
   return {_mm_cvtepi32_ps(_mm_cvtepu8_epi32(_mm_cvtsi32_si128(x)))};
 }
+inline F4 from_u16(const uint8_t* p) {  // 4 uint16 -> 4 floats
+  int64_t x;
+  std::memcpy(&x, p, 8);
+  return {_mm_cvtepi32_ps(_mm_cvtepu16_epi32(_mm_cvtsi64_si128(x)))};
+}
 inline F4 from_half(const uint8_t* p) {  // 4 half floats -> 4 floats (F16C)
   int64_t x;
   std::memcpy(&x, p, 8);
@@ -136,6 +141,7 @@ inline F4 select(M4 m, F4 a, F4 b) { F4 r; MC_LANES(m.v[i] ? a.v[i] : b.v[i]) }
 inline M4 nonzero(I4 a) { M4 r; MC_LANES(a.v[i] != 0) }
 inline float lane(F4 a, int i) { return a.v[i]; }
 inline F4 from_u8(const uint8_t* p) { F4 r; MC_LANES(float(p[i])) }
+inline F4 from_u16(const uint8_t* p) { F4 r; MC_LANES(float(uint32_t(p[2 * i] | p[2 * i + 1] << 8))) }
 inline F4 from_half(const uint8_t* p) {
   F4 r;
   MC_LANES(layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))

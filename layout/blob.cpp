@@ -58,10 +58,11 @@ std::string num(uint64_t v) { return std::to_string(v); }
 // Checks one leaf: its block lies in the triangle area of the tree section,
 // its slots lie in the remap, and the codec's own indices are in range.
 template <class Codec>
-std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block, uint32_t count) {
-  if (count == 0 || count > MC_QUAD_MAX_COUNT)
+std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block, uint32_t count,
+                       uint32_t max_count = MC_QUAD_MAX_COUNT) {
+  if (count == 0 || count > max_count)
     return "leaf at tree offset " + num(block) + " has " + num(count) + " triangles (allowed 1.." +
-           num(MC_QUAD_MAX_COUNT) + ")";
+           num(max_count) + ")";
   if (block < h.triangle_base || (block - h.triangle_base) % 4 != 0)
     return "triangle block at tree offset " + num(block) + " lies before the triangle area (" +
            num(h.triangle_base) + ") or is misaligned";
@@ -152,10 +153,7 @@ std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* 
   while (at < h.tree_size) {
     if (at + MC_BRUTE_RECORD_BYTES > h.tree_size) return "BruteForce record at " + num(at) + " is cut short";
     uint32_t count = load<uint32_t>(blob + h.tree_offset + at);
-    if (count > MC_BRUTE_CHUNK)
-      return "BruteForce record at " + num(at) + " holds " + num(count) + " triangles (at most " +
-             num(MC_BRUTE_CHUNK) + ")";
-    std::string e = check_leaf<Codec>(blob, h, uint32_t(at + MC_BRUTE_RECORD_BYTES), count);
+    std::string e = check_leaf<Codec>(blob, h, uint32_t(at + MC_BRUTE_RECORD_BYTES), count, brute_chunk(Codec::kLanes));
     if (!e.empty()) return e;
     *triangles += count;
     at += MC_BRUTE_RECORD_BYTES + Codec::block_bytes(count);

@@ -46,7 +46,7 @@ struct BlobHeader {
   uint32_t remap_slots;     // slot numbers covered by the remap (used or not)
   uint32_t total_size;
   uint32_t checksum;        // FNV-1a over the header (this field as 0) and the payload
-  uint32_t reserved;
+  uint32_t max_block_shift; // BitPackSOA: largest m of a block step grid * 2^m (soa.h)
 };
 static_assert(sizeof(BlobHeader) == MC_BLOB_HEADER_BYTES);
 
@@ -75,6 +75,9 @@ inline T load(const uint8_t* p) {
 inline const BlobHeader& header_of(const uint8_t* blob) {
   return *reinterpret_cast<const BlobHeader*>(blob);
 }
+
+// Triangles a BruteForce record holds for a codec of `lanes` lanes.
+inline uint32_t brute_chunk(uint32_t lanes) { return lanes > MC_BRUTE_CHUNK ? lanes : MC_BRUTE_CHUNK; }
 
 // Triangle slot of lane `lane` of the block at tree-section offset `block`.
 inline uint32_t slot_of(const BlobHeader& h, uint32_t block, uint32_t lane) {

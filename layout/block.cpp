@@ -9,25 +9,24 @@ void bitpack_decode(uint64_t w, const float offset[3], const float scale[3], flo
   for (int a = 0; a < 3; ++a) out[a] = std::fma(float(bitpack_component(w, a)), scale[a], offset[a]);
 }
 
+uint32_t quantize(float v, float offset, float scale, uint32_t max) {
+  if (!(scale > 0)) return 0;
+  double guess = std::clamp(std::round((double(v) - offset) / scale), 0.0, double(max));
+  // Of the grid points around the guess, keep the one whose decode (the
+  // walker's own fma) lands nearest the original.
+  uint32_t q = uint32_t(guess);
+  float best = std::fabs(std::fma(float(q), scale, offset) - v);
+  for (int64_t c = int64_t(guess) - 1; c <= int64_t(guess) + 1; ++c) {
+    if (c < 0 || c > int64_t(max)) continue;
+    float err = std::fabs(std::fma(float(c), scale, offset) - v);
+    if (err < best) best = err, q = uint32_t(c);
+  }
+  return q;
+}
+
 uint64_t bitpack_encode(const float v[3], const float offset[3], const float scale[3]) {
   uint64_t w = 0;
-  for (int a = 0; a < 3; ++a) {
-    uint32_t q = 0;
-    if (scale[a] > 0) {
-      double guess = std::round((double(v[a]) - offset[a]) / scale[a]);
-      guess = std::clamp(guess, 0.0, double(MC_BITPACK_MAX));
-      // Of the grid points around the guess, keep the one whose decode (the
-      // walker's own fma) lands nearest the original.
-      q = uint32_t(guess);
-      float best = std::fabs(std::fma(float(q), scale[a], offset[a]) - v[a]);
-      for (int64_t c = int64_t(guess) - 1; c <= int64_t(guess) + 1; ++c) {
-        if (c < 0 || c > MC_BITPACK_MAX) continue;
-        float err = std::fabs(std::fma(float(c), scale[a], offset[a]) - v[a]);
-        if (err < best) best = err, q = uint32_t(c);
-      }
-    }
-    w |= uint64_t(q) << (MC_BITPACK_BITS * a);
-  }
+  for (int a = 0; a < 3; ++a) w |= uint64_t(quantize(v[a], offset[a], scale[a], MC_BITPACK_MAX)) << (MC_BITPACK_BITS * a);
   return w;
 }
 

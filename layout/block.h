@@ -1,6 +1,6 @@
 // What a triangle codec is given to encode one leaf's block, and what it
 // decodes one triangle back to. Each codec lives in its own header
-// (float3.h, float3soa4.h, indexed8bitpacksoa4.h) with the same static members:
+// (float3.h, soa.h, indexed.h, indexed8bitpacksoa4.h) with the same static members:
 //   kFormat, kSlotDivisor, kLanes, block_bytes(count), encode(...), decode(...)
 #pragma once
 #include <cstdint>
@@ -23,6 +23,14 @@ struct TriCorners {
   uint32_t input;      // the input mesh's triangle
 };
 
+// How a triangle format places vertices before encoding:
+//   kGridNone      stored as given (floats)
+//   kGridMeshBox   BitPack grid of seed 000 §3.4 over the mesh box:
+//                  scale = extent / (2^21 - 1), offset = box minimum
+//   kGridPowerOfTwo the same 21-bit range with a power-of-two step and an
+//                  offset on that step, so block-relative codes decode exactly
+enum GridKind : uint32_t { kGridNone = 0, kGridMeshBox = 1, kGridPowerOfTwo = 2 };
+
 // State shared by the blocks of one blob while it is written.
 struct BlockContext {
   uint32_t block_address = 0;   // blob offset of the block being written
@@ -31,6 +39,8 @@ struct BlockContext {
   // and the pool index a key (packed word or input vertex) last received.
   std::vector<uint8_t>* pool = nullptr;
   std::unordered_map<uint64_t, uint32_t>* last_index = nullptr;
+  const float* grid_step = nullptr;   // the mesh grid (header quant_scale), kGridPowerOfTwo formats
+  uint32_t* max_block_shift = nullptr;  // largest m of a BitPackSOA block (soa.h)
 };
 
 // Appends a vertex record to the pool; returns its index (record number).
@@ -48,6 +58,9 @@ inline uint32_t bitpack_component(uint64_t w, int axis) {
   return uint32_t(w >> (MC_BITPACK_BITS * axis)) & MC_BITPACK_MAX;
 }
 void bitpack_decode(uint64_t w, const float offset[3], const float scale[3], float out[3]);
+// The grid point q in [0, max] whose decode fma(q, scale, offset) lies
+// nearest v (0 when scale is 0).
+uint32_t quantize(float v, float offset, float scale, uint32_t max);
 uint64_t bitpack_encode(const float v[3], const float offset[3], const float scale[3]);
 
 }  // namespace meshcast::layout

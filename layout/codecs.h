@@ -2,7 +2,7 @@
 // dispatch table and the layout names are all generated from it.
 #pragma once
 #include "layout/float3.h"
-#include "layout/float3soa4.h"
+#include "layout/soa.h"
 #include "layout/indexed.h"
 #include "layout/indexed8bitpacksoa4.h"
 
@@ -16,4 +16,8 @@
   X(Indexed16SOA4, "Indexed16SOA4")                    \
   X(Indexed32SOA4, "Indexed32SOA4")                    \
   X(Indexed16BitPackSOA4, "Indexed16BitPackSOA4")      \
-  X(Indexed32BitPackSOA4, "Indexed32BitPackSOA4")
+  X(Indexed32BitPackSOA4, "Indexed32BitPackSOA4")      \
+  X(Float3SOA8, "Float3SOA8")                          \
+  X(Float3SOA128, "Float3SOA128")                      \
+  X(BitPackSOA4, "BitPackSOA4")                        \
+  X(BitPackSOA128, "BitPackSOA128")

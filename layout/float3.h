@@ -10,7 +10,7 @@ struct Float3 {
   static constexpr uint32_t kFormat = MC_TRI_FLOAT3;
   static constexpr uint32_t kSlotDivisor = MC_FLOAT3_TRI_BYTES;  // exactly one slot a triangle
   static constexpr uint32_t kLanes = 1;
-  static constexpr bool kBitPack = false;
+  static constexpr GridKind kGrid = kGridNone;
   static uint32_t block_bytes(uint32_t count) { return count * MC_FLOAT3_TRI_BYTES; }
   static void encode(TriCorners* tris, uint32_t count, BlockContext&, uint8_t* out) {
     for (uint32_t i = 0; i < count; ++i) std::memcpy(out + i * MC_FLOAT3_TRI_BYTES, tris[i].v, 36);

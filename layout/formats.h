@@ -17,8 +17,8 @@
 #define MC_TREE_BRUTEFORCE 4u          // §3.11: no tree, every triangle tested
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
-// each block holding the next MC_BRUTE_CHUNK triangles in input order
-// (fewer in the last), so every triangle format fits its own limits.
+// each block holding the next brute_chunk(lanes) triangles in input order
+// (fewer in the last): 16, or the codec's block width when wider (128).
 #define MC_BRUTE_RECORD_BYTES 4u
 #define MC_BRUTE_CHUNK 16u
 
@@ -32,6 +32,10 @@
 #define MC_TRI_INDEXED32SOA4 7u        // §3.7
 #define MC_TRI_INDEXED16BITPACKSOA4 8u // §3.8
 #define MC_TRI_INDEXED32BITPACKSOA4 9u // §3.8
+#define MC_TRI_FLOAT3SOA8 10u          // §3.3
+#define MC_TRI_FLOAT3SOA128 11u        // §7 (GPU brute force blocks)
+#define MC_TRI_BITPACKSOA4 12u         // §3.5
+#define MC_TRI_BITPACKSOA128 13u       // §7
 
 // AABBTree node (§5.1): BoundingBoxMin (3 floats), BoundingBoxMax (3 floats),
 // Properties (uint32). High bit set: a leaf whose low bits are its triangle
@@ -53,7 +57,6 @@
 // Triangle blocks.
 #define MC_FLOAT3_TRI_BYTES 36u        // 9 floats a triangle
 #define MC_SOA4_LANES 4u
-#define MC_FLOAT3SOA4_BLOCK_BYTES 144u // 3 corners x 3 axes x 4 lanes x 4 bytes
 #define MC_I8_HEADER_BYTES 4u          // OffsetToVertices (uint32)
 #define MC_I8_BLOCK_BYTES 12u          // 4 triangles x 3 8-bit indices, SOA
 #define MC_I8_WINDOW 256u              // vertices one 8-bit index reaches

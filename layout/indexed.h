@@ -24,7 +24,7 @@ struct Indexed {
   static constexpr uint32_t kFormat = kFormatId;
   static constexpr uint32_t kIndexBytes = sizeof(IndexT);
   static constexpr uint32_t kVertexBytes = kBitPackVertices ? 8 : 12;
-  static constexpr bool kBitPack = kBitPackVertices;
+  static constexpr GridKind kGrid = kBitPackVertices ? kGridMeshBox : kGridNone;
   static constexpr uint32_t kLanes = kSoa ? MC_SOA4_LANES : 1;
   static constexpr uint32_t kSlotDivisor = 3 * kIndexBytes;  // bytes of indices a triangle
   static constexpr uint64_t kMaxVertices = uint64_t(IndexT(~IndexT(0))) + 1;

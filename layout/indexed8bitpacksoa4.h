@@ -25,7 +25,7 @@ struct Indexed8BitPackSOA4 {
   // A leaf of b blocks takes 4 + 12b bytes for 4b slots: 3 bytes a slot
   // number leaves room for every slot (and 1-2 unused numbers a leaf).
   static constexpr uint32_t kSlotDivisor = 3;
-  static constexpr bool kBitPack = true;
+  static constexpr GridKind kGrid = kGridMeshBox;
   static constexpr uint32_t kLanes = MC_SOA4_LANES;
   static uint32_t blocks(uint32_t count) { return (count + 3) / 4; }
   static uint32_t block_bytes(uint32_t count) { return MC_I8_HEADER_BYTES + blocks(count) * MC_I8_BLOCK_BYTES; }

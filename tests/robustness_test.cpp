@@ -22,7 +22,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
   // Oracle answers on the mesh as stored (quantized for bit-packed formats).
   void expect_oracle(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
     std::vector<uint8_t> blob = build_blob(mesh, options(), what);
-    Mesh stored = quantized() ? quantized_mesh(mesh, blob) : mesh;
+    Mesh stored = quantized() ? stored_mesh(blob) : mesh;
     std::vector<OracleHit> oracle(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) oracle[i] = oracle_brute_force(stored, rays[i]);
     std::vector<Hit> hits = trace_all(blob, rays);

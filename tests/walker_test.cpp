@@ -32,7 +32,7 @@ void check_layout(const std::string& layout_name_, bool large) {
     // against the stated bound separately (QuantizedVerticesWithinBound).
     NamedMesh reference = m;
     if (is_bitpack(options))
-      reference = {m.name + "#quantized", std::make_shared<const Mesh>(quantized_mesh(*m.mesh, blob))};
+      reference = {m.name + "#" + layout_name_, std::make_shared<const Mesh>(stored_mesh(blob))};
     // BruteForce tests every triangle for every ray: fewer rays keep it quick.
     size_t count = options.tree_format == MC_TREE_BRUTEFORCE ? 400 : 10000;
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
@@ -76,25 +76,29 @@ TEST(WalkerVsOracleLarge, Terrain1M) {
     check_layout(name, true);
 }
 
-// Bit packing moves each vertex by at most the stated bound, and leaves
-// vertices shared between triangles shared (same decoded bits everywhere).
-TEST(QuantizedVerticesWithinBound, PublicAndGeneratedMeshes) {
-  for (const NamedMesh& m : test_meshes(false)) {
-    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), m.name);
-    const layout::BlobHeader& h = layout::header_of(blob.data());
-    float bound[3];
-    quantization_bound(h.quant_offset, h.quant_scale, bound);
-    Mesh q = quantized_mesh(*m.mesh, blob);
-    Box3 box = m.mesh->bounds();
-    for (int a = 0; a < 3; ++a) {
-      // The bound is half a grid step plus float rounding: about 2^-22 of the
-      // extent. Check it is that small, then that every vertex obeys it.
-      EXPECT_LE(bound[a], (box.max[a] - box.min[a]) * 0x1p-21f + 1e-30f + std::fabs(box.max[a]) * 0x1p-22f);
+// Every triangle format keeps each stored corner within its stated bound of
+// the input vertex (0 for the float formats: stored exactly), checked on the
+// decoded blob against the input mesh.
+TEST(StoredCornersWithinBound, EveryFormatEveryMesh) {
+  for (const NamedMesh& m : test_meshes(false))
+    for (const std::string& name : layout_names()) {
+      if (name.rfind("QuadTree/", 0) != 0 && name.rfind("BruteForce/", 0) != 0) continue;
+      std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
+      float bound[3];
+      displacement_bound(blob, bound);
+      Box3 box = m.mesh->bounds();
+      for (int a = 0; a < 3; ++a)  // small: a few 2^-21 of the extent at most
+        EXPECT_LE(bound[a], (box.max[a] - box.min[a]) * 0x1p-15f + std::fabs(box.max[a]) * 0x1p-22f + 1e-37f) << name;
+      Mesh stored = stored_mesh(blob);
+      double worst = 0;
+      for (size_t t = 0; t < m.mesh->triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c)
+          for (int a = 0; a < 3; ++a) {
+            double d = std::fabs(double(stored.corner(t, c)[a]) - m.mesh->corner(t, c)[a]);
+            worst = std::max(worst, d / std::max(bound[a], 1e-38f));
+            ASSERT_LE(d, bound[a]) << name << " on " << m.name << ", triangle " << t << " corner " << c;
+          }
     }
-    for (size_t v = 0; v < q.vertices.size(); ++v)
-      for (int a = 0; a < 3; ++a)
-        ASSERT_LE(std::fabs(q.vertices[v][a] - m.mesh->vertices[v][a]), bound[a]) << m.name << " vertex " << v;
-  }
 }
 
 }  // namespace

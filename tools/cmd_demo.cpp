@@ -79,7 +79,7 @@ void add_demo(CLI::App& app) {
       // The bit-packed layout is judged on the mesh it stores (its vertices
       // moved by at most the quantization bound), the others on the input.
       bool quantized = moves_vertices(o.triangle_format);
-      Mesh stored = quantized ? quantized_mesh(mesh, blob) : Mesh{};
+      Mesh stored = quantized ? stored_mesh(blob) : Mesh{};
       std::unique_ptr<OracleTree> stored_tree = quantized ? std::make_unique<OracleTree>(stored) : nullptr;
       SectionBytes s = section_bytes(blob);
       Row row{name, report.build_ms, s.walked() / n, s.remap / n, {}, 0};

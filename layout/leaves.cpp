@@ -1,0 +1,62 @@
+#include "layout/leaves.h"
+
+#include <vector>
+
+#include "layout/aabbtree.h"
+#include "layout/codecs.h"
+#include "layout/quadtree.h"
+
+namespace meshcast::layout {
+
+void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint32_t)>& visit) {
+  const BlobHeader& h = header_of(blob);
+  const uint8_t* tree = blob + h.tree_offset;
+  if (h.tree_format == MC_TREE_BRUTEFORCE) {
+    for (uint32_t at = 0; at < h.tree_size;) {
+      uint32_t count = load<uint32_t>(tree + at);
+      visit(at + MC_BRUTE_RECORD_BYTES, count);
+      uint32_t bytes = 0;
+#define MC_BYTES(Codec, name) \
+  if (h.triangle_format == Codec::kFormat) bytes = Codec::block_bytes(count);
+      MC_FOR_EACH_TRIANGLE_CODEC(MC_BYTES)
+#undef MC_BYTES
+      at += MC_BRUTE_RECORD_BYTES + bytes;
+    }
+  } else if (h.tree_format == MC_TREE_AABBTREE) {
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+      uint32_t at = stack.back();
+      stack.pop_back();
+      AABBNode n = load_aabb_node(tree + at);
+      if (n.is_leaf()) {
+        visit(at + MC_AABB_NODE_BYTES, n.value());
+      } else {
+        stack.push_back(n.value());
+        stack.push_back(at + MC_AABB_NODE_BYTES);
+      }
+    }
+  } else {
+    uint32_t props_at = h.tree_format == MC_TREE_QUADTREE ? QuadBoundsFloat::kPropertiesAt : QuadBoundsHalf::kPropertiesAt;
+    std::vector<uint32_t> stack{h.root};
+    while (!stack.empty()) {
+      uint32_t p = stack.back();
+      stack.pop_back();
+      if (quad_count(p)) {
+        visit(quad_offset(p), quad_count(p));
+        continue;
+      }
+      for (int k = 3; k >= 0; --k)
+        if (uint32_t c = quad_child_properties(tree + quad_offset(p), props_at, k)) stack.push_back(c);
+    }
+  }
+}
+
+void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]) {
+  const BlobHeader& h = header_of(blob);
+#define MC_DECODE(Codec, name) \
+  if (h.triangle_format == Codec::kFormat) return Codec::decode(blob, block, i, out);
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_DECODE)
+#undef MC_DECODE
+}
+
+}  // namespace meshcast::layout

@@ -26,16 +26,24 @@ namespace {
 struct CodecOps {
   uint32_t format, slot_divisor;
   layout::GridKind grid;
+  bool nested;  // blocks on nested lattices of the grid (BitPackSOA)
   uint32_t lanes;
   uint32_t (*block_bytes)(uint32_t);
   void (*encode)(TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
 
+template <class C>
+constexpr bool nested_blocks() {
+  if constexpr (requires { C::kNestedBlocks; }) return C::kNestedBlocks;
+  return false;
+}
+
 CodecOps codec_ops(uint32_t format) {
 #define MC_OPS(Codec, name)                                                                         \
   if (format == layout::Codec::kFormat)                                                            \
     return {layout::Codec::kFormat, layout::Codec::kSlotDivisor, layout::Codec::kGrid,           \
-            layout::Codec::kLanes, &layout::Codec::block_bytes, &layout::Codec::encode};
+            nested_blocks<layout::Codec>(), layout::Codec::kLanes, &layout::Codec::block_bytes,   \
+            &layout::Codec::encode};
   MC_FOR_EACH_TRIANGLE_CODEC(MC_OPS)
 #undef MC_OPS
   throw InputError("unknown triangle format " + std::to_string(format));
@@ -403,7 +411,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
                                                        : build_binning(boxes, o.leaf_size);
-  if (codec.grid == layout::kGridPowerOfTwo)
+  if (codec.nested)
     snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale, mesh.vertices.size());
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;

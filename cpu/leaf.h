@@ -36,6 +36,19 @@ struct Loader<layout::Float3> {
   }
 };
 
+// BitPack: three words a triangle; gather corner c of 4 triangles.
+template <>
+struct Loader<layout::BitPack> {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, const int axis[3],
+                   simd::F4 v[3][3]) {
+    const layout::BlobHeader& h = layout::header_of(blob);
+    int last = int(count - 1) * 3, i0 = int(first) * 3;
+    simd::I4 idx = simd::iconst(i0, std::min(i0 + 3, last), std::min(i0 + 6, last), std::min(i0 + 9, last));
+    for (int c = 0; c < 3; ++c)
+      simd::bitpack_gather(blob + block, idx + c, h.quant_offset, h.quant_scale, axis, v[c]);
+  }
+};
+
 // SOA blocks of N lanes: 4 consecutive lanes of a row are one load.
 template <uint32_t N, uint32_t kId>
 struct Loader<layout::Float3SOA<N, kId>> {

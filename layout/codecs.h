@@ -1,6 +1,7 @@
 // The one list of triangle formats: validation, the writer, the walkers'
 // dispatch table and the layout names are all generated from it.
 #pragma once
+#include "layout/bitpack.h"
 #include "layout/float3.h"
 #include "layout/soa.h"
 #include "layout/indexed.h"
@@ -20,4 +21,5 @@
   X(Float3SOA8, "Float3SOA8")                          \
   X(Float3SOA128, "Float3SOA128")                      \
   X(BitPackSOA4, "BitPackSOA4")                        \
-  X(BitPackSOA128, "BitPackSOA128")
+  X(BitPackSOA128, "BitPackSOA128")                    \
+  X(BitPack, "BitPack")

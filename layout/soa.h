@@ -77,6 +77,7 @@ struct BitPackSOA {
   static constexpr uint32_t kSlotDivisor = kBlockBytes / N;
   static constexpr uint32_t kMax = 65535;
   static constexpr GridKind kGrid = kGridPowerOfTwo;
+  static constexpr bool kNestedBlocks = true;  // 16-bit blocks on nested lattices
   static uint32_t blocks(uint32_t count) { return (count + N - 1) / N; }
   static uint32_t block_bytes(uint32_t count) { return blocks(count) * kBlockBytes; }
   static uint32_t row(int c, int a, uint32_t lane) { return ((uint32_t(c) * 3 + uint32_t(a)) * N + lane) * 2; }

@@ -53,6 +53,14 @@ struct Loader<layout::BitPack> {
 template <uint32_t N, uint32_t kId>
 struct Loader<layout::Float3SOA<N, kId>> {
   using Codec = layout::Float3SOA<N, kId>;
+  // Blocks of 8 or more lanes are tested 8 at a time (AVX2, seed 000 §3.3).
+  static constexpr int kWidth = N % 8 == 0 ? 8 : 4;
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, const int axis[3],
+                   simd::F8 v[3][3]) {
+    const uint8_t* p = blob + block + (first / N) * Codec::kBlockBytes;
+    for (int c = 0; c < 3; ++c)
+      for (int j = 0; j < 3; ++j) v[c][j] = simd::F8::load(p + Codec::row(c, axis[j], first % N));
+  }
   static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t, const int axis[3],
                    simd::F4 v[3][3]) {
     const uint8_t* p = blob + block + (first / N) * Codec::kBlockBytes;
@@ -114,13 +122,27 @@ struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
 
 // Tests the `count` triangles of the block at blob offset `block`; slots of
 // the leaf start at `slot0`.
+template <class L>
+constexpr int width_of() {
+  if constexpr (requires { L::kWidth; }) return L::kWidth;
+  return 4;
+}
+
 template <class Codec>
 inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                       Closest& c) {
-  for (uint32_t first = 0; first < count; first += 4) {
-    simd::F4 v[3][3];
-    Loader<Codec>::load(blob, block, first, count, r.axis, v);
-    LaneHit h = triangle_test4(r, v, simd::lanes_below(count - first), c.t);
+  constexpr int kWidth = width_of<Loader<Codec>>();
+  for (uint32_t first = 0; first < count; first += kWidth) {
+    LaneHit h;
+    if constexpr (kWidth == 8) {
+      simd::F8 v[3][3];
+      Loader<Codec>::load(blob, block, first, count, r.axis, v);
+      h = triangle_test(r, v, simd::lanes_below8(count - first), c.t);
+    } else {
+      simd::F4 v[3][3];
+      Loader<Codec>::load(blob, block, first, count, r.axis, v);
+      h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
+    }
     if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
   }
 }

@@ -127,9 +127,11 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
                             LaneHit* out);
 
 // Corners come in the ray's axis order, v[corner][j] = axis r.axis[j], so the
-// test indexes registers with constants.
-inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 valid, float closest) {
-  using simd::F4;
+// test indexes registers with constants. One source for every width: F4 (SSE,
+// 4 triangles) and F8 (AVX2, 8 triangles).
+template <class F4, class M4>
+inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
+  constexpr int kW = F4::kLanes;
   const F4 ox = F4::splat(r.org[r.kx]), oy = F4::splat(r.org[r.ky]), oz = F4::splat(r.org[r.kz]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
   F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;
@@ -142,28 +144,28 @@ inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 
   F4 V = ax * cy - ay * cx;
   F4 W = bx * ay - by * ax;
   const F4 zero = F4::splat(0.0f);
-  simd::M4 neg = (U < zero) | (V < zero) | (W < zero);
-  simd::M4 pos = (U > zero) | (V > zero) | (W > zero);
-  simd::M4 inside = simd::andnot(neg & pos, valid);
-  simd::M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
+  M4 neg = (U < zero) | (V < zero) | (W < zero);
+  M4 pos = (U > zero) | (V > zero) | (W > zero);
+  M4 inside = simd::andnot(neg & pos, valid);
+  M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
   F4 det = U + V + W;
   az = sz * az, bz = sz * bz, cz = sz * cz;
   F4 T = U * az + V * bz + W * cz;
   F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
   F4 t = Ts / dets;
-  simd::M4 accept = inside & (det != zero) & (Ts >= zero) & (t <= F4::splat(closest));
+  M4 accept = inside & (det != zero) & (Ts >= zero) & (t <= F4::splat(closest));
   accept = simd::andnot(edge_zero, accept);
 
   LaneHit best;
   int acc = simd::bits(accept);
-  float tl[4];
+  float tl[kW];
   t.store(tl);
   for (int m = acc; m; m &= m - 1) {
     int i = __builtin_ctz(m);
     if (best.lane < 0 || tl[i] < best.t) best.lane = i, best.t = tl[i];
   }
   if (best.lane >= 0) {
-    float Ul[4], Vl[4], Wl[4];
+    float Ul[kW], Vl[kW], Wl[kW];
     U.store(Ul), V.store(Vl), W.store(Wl);
     float d = Ul[best.lane] + Vl[best.lane] + Wl[best.lane];
     best.u = Vl[best.lane] / d, best.v = Wl[best.lane] / d;
@@ -171,7 +173,7 @@ inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 
   // Rare: an edge function of 0 in float; settle those lanes in double.
   int redo = simd::bits(edge_zero & valid);
   if (redo) {
-    float l[9][4];
+    float l[9][kW];
     ax.store(l[0]), ay.store(l[1]), bx.store(l[2]), by.store(l[3]), cx.store(l[4]), cy.store(l[5]);
     az.store(l[6]), bz.store(l[7]), cz.store(l[8]);
     for (int m = redo; m; m &= m - 1) {
@@ -185,6 +187,10 @@ inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 
     }
   }
   return best;
+}
+
+inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 valid, float closest) {
+  return triangle_test(r, v, valid, closest);
 }
 
 }  // namespace meshcast

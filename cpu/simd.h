@@ -22,6 +22,7 @@ namespace meshcast::simd {
 #if !defined(MESHCAST_SCALAR)
 
 struct F4 {
+  static constexpr int kLanes = 4;
   __m128 v;
   static F4 splat(float f) { return {_mm_set1_ps(f)}; }
   static F4 load(const void* p) { return {_mm_loadu_ps(static_cast<const float*>(p))}; }
@@ -101,9 +102,40 @@ inline I4 iconst(int a, int b, int c, int d) { return {_mm_setr_epi32(a, b, c, d
 inline I4 operator+(I4 a, int b) { return {_mm_add_epi32(a.v, _mm_set1_epi32(b))}; }
 inline I4 operator+(I4 a, I4 b) { return {_mm_add_epi32(a.v, b.v)}; }
 
+
+// Eight lanes (AVX2), for the 8-wide triangle formats (Float3SOA8).
+struct F8 {
+  static constexpr int kLanes = 8;
+  __m256 v;
+  static F8 splat(float f) { return {_mm256_set1_ps(f)}; }
+  static F8 load(const void* p) { return {_mm256_loadu_ps(static_cast<const float*>(p))}; }
+  void store(float* p) const { _mm256_storeu_ps(p, v); }
+};
+struct M8 { __m256 v; };
+inline F8 operator+(F8 a, F8 b) { return {_mm256_add_ps(a.v, b.v)}; }
+inline F8 operator-(F8 a, F8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
+inline F8 operator*(F8 a, F8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
+inline F8 operator/(F8 a, F8 b) { return {_mm256_div_ps(a.v, b.v)}; }
+inline F8 abs(F8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.v)}; }
+inline F8 xor_sign(F8 a, F8 s) { return {_mm256_xor_ps(a.v, _mm256_and_ps(s.v, _mm256_set1_ps(-0.0f)))}; }
+inline M8 operator<(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
+inline M8 operator<=(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)}; }
+inline M8 operator>(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+inline M8 operator>=(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GE_OQ)}; }
+inline M8 operator==(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
+inline M8 operator!=(F8 a, F8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_NEQ_UQ)}; }
+inline M8 operator&(M8 a, M8 b) { return {_mm256_and_ps(a.v, b.v)}; }
+inline M8 operator|(M8 a, M8 b) { return {_mm256_or_ps(a.v, b.v)}; }
+inline M8 andnot(M8 a, M8 b) { return {_mm256_andnot_ps(a.v, b.v)}; }
+inline int bits(M8 m) { return _mm256_movemask_ps(m.v); }
+inline M8 lanes_below8(uint32_t n) {
+  return {_mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(int(n)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)))};
+}
+
 #else  // MESHCAST_SCALAR
 
 struct F4 {
+  static constexpr int kLanes = 4;
   float v[4];
   static F4 splat(float f) { return {{f, f, f, f}}; }
   static F4 load(const void* p) { F4 r; std::memcpy(r.v, p, 16); return r; }
@@ -166,6 +198,34 @@ inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b)
 inline I4 operator+(I4 a, int b) { I4 r; MC_LANES(a.v[i] + uint32_t(b)) }
 inline I4 operator+(I4 a, I4 b) { I4 r; MC_LANES(a.v[i] + b.v[i]) }
 #undef MC_LANES
+
+struct F8 {
+  static constexpr int kLanes = 8;
+  float v[8];
+  static F8 splat(float f) { F8 r; for (float& x : r.v) x = f; return r; }
+  static F8 load(const void* p) { F8 r; std::memcpy(r.v, p, 32); return r; }
+  void store(float* p) const { std::memcpy(p, v, 32); }
+};
+struct M8 { bool v[8]; };
+#define MC_LANES8(expr) { for (int i = 0; i < 8; ++i) r.v[i] = (expr); return r; }
+inline F8 operator+(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] + b.v[i]) }
+inline F8 operator-(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] - b.v[i]) }
+inline F8 operator*(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] * b.v[i]) }
+inline F8 operator/(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] / b.v[i]) }
+inline F8 abs(F8 a) { F8 r; MC_LANES8(__builtin_fabsf(a.v[i])) }
+inline F8 xor_sign(F8 a, F8 s) { F8 r; MC_LANES8(__builtin_signbit(s.v[i]) ? -a.v[i] : a.v[i]) }
+inline M8 operator<(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] < b.v[i]) }
+inline M8 operator<=(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] <= b.v[i]) }
+inline M8 operator>(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] > b.v[i]) }
+inline M8 operator>=(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] >= b.v[i]) }
+inline M8 operator==(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] == b.v[i]) }
+inline M8 operator!=(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] != b.v[i]) }
+inline M8 operator&(M8 a, M8 b) { M8 r; MC_LANES8(a.v[i] && b.v[i]) }
+inline M8 operator|(M8 a, M8 b) { M8 r; MC_LANES8(a.v[i] || b.v[i]) }
+inline M8 andnot(M8 a, M8 b) { M8 r; MC_LANES8(!a.v[i] && b.v[i]) }
+inline int bits(M8 m) { int b = 0; for (int i = 0; i < 8; ++i) b |= int(m.v[i]) << i; return b; }
+inline M8 lanes_below8(uint32_t n) { M8 r; MC_LANES8(uint32_t(i) < n) }
+#undef MC_LANES8
 
 #endif
 

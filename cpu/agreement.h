@@ -16,15 +16,23 @@ struct Agreement {
   std::string first_problem;
 };
 
-// The foundation rules: the walker returns the oracle's hit/miss and triangle;
-// a different triangle is accepted only as an exact tie (the oracle hits the
-// walker's triangle at a t within `tolerance` of its own); t within
-// `tolerance`, a distance along the ray (1e-5 of the diagonal for the float
-// formats), plus 4 float ulps of t for origins very far away; max_t_error is
-// a distance too.
-// Distance from p to the triangle abc, in double.
+// Distances in double: to the triangle abc, and to its nearest edge.
 double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
+double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
 
+// The foundation rules: the walker returns the oracle's hit/miss and
+// triangle, with t within `tolerance`, a distance along the ray (1e-5 of the
+// diagonal), plus 4 float ulps of t for origins very far away. Where only
+// rounding decides, a difference is counted as a tie instead:
+//  - another triangle at the same t that touches the oracle's hit point
+//    (a shared edge or vertex, coincident triangles);
+//  - a walker hit against an oracle miss at the ends of the segment (origin
+//    on the surface, surface at t_max), on the hit triangle's edge, or for a
+//    ray lying in the triangle's plane;
+//  - a walker miss against an oracle hit at the ends of the segment.
+// A walker miss in the middle of a triangle is always wrong; leaks through
+// shared edges are checked by the closed-mesh tests. max_t_error is a
+// distance.
 Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
                   const std::vector<OracleHit>& oracle, double tolerance);
 

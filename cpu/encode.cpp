@@ -26,9 +26,11 @@ namespace {
 struct CodecOps {
   uint32_t format, slot_divisor;
   layout::GridKind grid;
-  bool nested;  // blocks on nested lattices of the grid (BitPackSOA)
+  uint32_t grid_bits;  // codes a component of the mesh grid (21; CompressedStrip 20)
+  bool nested;         // blocks on nested lattices of the grid (BitPackSOA)
+  bool moves_floats;   // stores floats it has changed (UncompressedStrip)
   uint32_t lanes;
-  uint32_t (*block_bytes)(uint32_t);
+  uint32_t (*measure)(TriCorners*, uint32_t);  // bytes of a leaf's block
   void (*encode)(TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
 
@@ -37,13 +39,28 @@ constexpr bool nested_blocks() {
   if constexpr (requires { C::kNestedBlocks; }) return C::kNestedBlocks;
   return false;
 }
+template <class C>
+constexpr uint32_t grid_bits() {
+  if constexpr (requires { C::kGridBits; }) return C::kGridBits;
+  return MC_BITPACK_BITS;
+}
+template <class C>
+constexpr bool moves_floats() {
+  if constexpr (requires { C::kMovesFloats; }) return C::kMovesFloats;
+  return false;
+}
+template <class C>
+uint32_t measure(TriCorners* tris, uint32_t count) {
+  if constexpr (requires { C::measure(tris, count); }) return C::measure(tris, count);
+  return C::block_bytes(count);
+}
 
 CodecOps codec_ops(uint32_t format) {
 #define MC_OPS(Codec, name)                                                                         \
   if (format == layout::Codec::kFormat)                                                            \
-    return {layout::Codec::kFormat, layout::Codec::kSlotDivisor, layout::Codec::kGrid,           \
-            nested_blocks<layout::Codec>(), layout::Codec::kLanes, &layout::Codec::block_bytes,   \
-            &layout::Codec::encode};
+    return {layout::Codec::kFormat,        layout::Codec::kSlotDivisor,   layout::Codec::kGrid,        \
+            grid_bits<layout::Codec>(),    nested_blocks<layout::Codec>(), moves_floats<layout::Codec>(), \
+            layout::Codec::kLanes,         &measure<layout::Codec>,       &layout::Codec::encode};
   MC_FOR_EACH_TRIANGLE_CODEC(MC_OPS)
 #undef MC_OPS
   throw InputError("unknown triangle format " + std::to_string(format));
@@ -71,6 +88,25 @@ struct Writer {
   std::unordered_map<uint64_t, uint32_t> last_index;
   std::vector<uint32_t> remap;
   uint32_t max_block_shift = 0;
+  std::vector<uint32_t> leaf_bytes;  // per node: its block's bytes (leaves)
+
+  std::vector<TriCorners> leaf_triangles(uint32_t n) const {
+    const BuildNode& leaf = tree.nodes[n];
+    std::vector<TriCorners> tris(leaf.count);
+    for (uint32_t i = 0; i < leaf.count; ++i) {
+      tris[i] = corners[tree.order[leaf.first + i]];
+      tris[i].input = tree.order[leaf.first + i];
+    }
+    return tris;
+  }
+  void measure_leaves() {
+    leaf_bytes.assign(tree.nodes.size(), 0);
+    for (uint32_t n = 0; n < tree.nodes.size(); ++n)
+      if (tree.nodes[n].leaf()) {
+        std::vector<TriCorners> tris = leaf_triangles(n);
+        leaf_bytes[n] = codec.measure(tris.data(), tree.nodes[n].count);
+      }
+  }
 
   // Encodes leaf node n's triangles at tree-section offset `at`. The codec
   // hands back the triangles as stored (its order, its decoded corners): the
@@ -78,12 +114,8 @@ struct Writer {
   // so node bounds always contain what the walker will decode.
   void write_leaf(uint32_t n, uint32_t at) {
     BuildNode& leaf = tree.nodes[n];
-    std::vector<TriCorners> tris(leaf.count);
-    for (uint32_t i = 0; i < leaf.count; ++i) {
-      tris[i] = corners[tree.order[leaf.first + i]];
-      tris[i].input = tree.order[leaf.first + i];
-    }
-    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index, h.quant_scale, &max_block_shift};
+    std::vector<TriCorners> tris = leaf_triangles(n);
+    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index, h.quant_scale, &max_block_shift, &h};
     codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
     uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
     if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
@@ -128,7 +160,7 @@ void write_aabbtree(Writer& w) {
   std::vector<uint64_t> size(t.nodes.size());
   std::function<uint64_t(uint32_t)> measure = [&](uint32_t n) -> uint64_t {
     const BuildNode& b = t.nodes[n];
-    size[n] = MC_AABB_NODE_BYTES + (b.leaf() ? w.codec.block_bytes(b.count) : measure(b.left) + measure(b.right));
+    size[n] = MC_AABB_NODE_BYTES + (b.leaf() ? w.leaf_bytes[n] : measure(b.left) + measure(b.right));
     return size[n];
   };
   uint64_t tree_size = measure(0);
@@ -151,7 +183,7 @@ void fill_aabbtree(Writer& w) {
   std::function<uint32_t(uint32_t, uint32_t)> place = [&](uint32_t n, uint32_t at) -> uint32_t {
     offset[n] = at;
     const BuildNode& b = t.nodes[n];
-    if (b.leaf()) return at + MC_AABB_NODE_BYTES + w.codec.block_bytes(b.count);
+    if (b.leaf()) return at + MC_AABB_NODE_BYTES + w.leaf_bytes[n];
     return place(b.right, place(b.left, at + MC_AABB_NODE_BYTES));
   };
   place(0, 0);
@@ -229,7 +261,7 @@ BuildTree chunk_tree(const std::vector<Box3>& boxes, uint32_t chunk) {
 void write_bruteforce(Writer& w) {
   uint64_t size = 0;
   for (size_t n = 1; n < w.tree.nodes.size(); ++n)
-    size += MC_BRUTE_RECORD_BYTES + w.codec.block_bytes(w.tree.nodes[n].count);
+    size += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
   if (size > 0x7FFFFFFFu) throw InputError("the BruteForce section of " + std::to_string(size) + " bytes exceeds 2 GiB");
   w.h.tree_size = uint32_t(size);
   w.h.node_count = uint32_t(w.tree.nodes.size() - 1);
@@ -246,7 +278,7 @@ void fill_bruteforce(Writer& w) {
     std::memcpy(w.bytes.data() + w.h.tree_offset + at, &leaf.count, 4);
     w.write_leaf(uint32_t(n), at + MC_BRUTE_RECORD_BYTES);
     all.grow(leaf.box);
-    at += MC_BRUTE_RECORD_BYTES + w.codec.block_bytes(leaf.count);
+    at += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
   }
   w.frame(all);
 }
@@ -302,7 +334,7 @@ void write_quadtree(Writer& w, const QuadPlan& p) {
   const BuildTree& t = w.tree;
   uint64_t nodes = uint64_t(p.binary_of.size()) * Bounds::kNodeBytes;
   uint64_t end = nodes;
-  for (uint32_t leaf : p.leaves) end += w.codec.block_bytes(t.nodes[leaf].count);
+  for (uint32_t leaf : p.leaves) end += w.leaf_bytes[leaf];
   if (end > MC_QUAD_OFFSET_MASK)
     throw InputError("the " + std::string(layout::tree_format_name(Bounds::kFormat)) + " section of " +
                      std::to_string(end) + " bytes exceeds its 27-bit child offsets (seed 000 5.6)");
@@ -319,7 +351,7 @@ void fill_quadtree(Writer& w, QuadPlan& p) {
   for (uint32_t leaf : p.leaves) {
     p.leaf_offset[leaf] = at;
     w.write_leaf(leaf, at);
-    at += w.codec.block_bytes(t.nodes[leaf].count);
+    at += w.leaf_bytes[leaf];
   }
   w.refit();
   auto props = [&](uint32_t n) {
@@ -379,7 +411,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
       // The smallest power of two that spans the extent in 2^21 - 2 steps,
       // and the grid point at or below the minimum.
       // A flat axis keeps its one coordinate (step 0).
-      double step = extent > 0 ? std::ldexp(1.0, std::ilogb(extent / (MC_BITPACK_MAX - 1)) + 1) : 0.0;
+      double codes = std::ldexp(1.0, int(codec.grid_bits)) - 2;
+      double step = extent > 0 ? std::ldexp(1.0, std::ilogb(extent / codes) + 1) : 0.0;
       h.quant_scale[a] = float(step), h.quant_offset[a] = step > 0 ? float(std::floor(lo / step) * step) : float(lo);
     } else {
       h.quant_offset[a] = 0, h.quant_scale[a] = 0;
@@ -415,6 +448,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale, mesh.vertices.size());
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
+  writer.measure_leaves();
 
   QuadPlan plan;
   uint32_t depth = tree.depth;
@@ -494,19 +528,22 @@ void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
   layout::GridKind grid = codec_ops(h.triangle_format).grid;
   if (grid == layout::kGridMeshBox) return quantization_bound(h.quant_offset, h.quant_scale, bound);
   for (int a = 0; a < 3; ++a) {
-    if (grid == layout::kGridNone) {
-      bound[a] = 0;
+    float top = std::max(std::fabs(h.bounds_min[a]), std::fabs(h.bounds_max[a]));
+    if (grid == layout::kGridNone) {  // floats kept, or moved by 1 ulp (UncompressedStrip)
+      bound[a] = codec_ops(h.triangle_format).moves_floats ? std::nextafter(top, INFINITY) - top : 0.0f;
       continue;
     }
     // Half the grid step, half the coarsest block step, and one rounding of
     // the largest coordinate.
-    float top = std::max(std::fabs(h.bounds_min[a]), std::fabs(h.bounds_max[a]));
     bound[a] = 0.5f * h.quant_scale[a] * (1.0f + std::ldexp(1.0f, int(h.max_block_shift))) +
                (std::nextafter(top, INFINITY) - top);
   }
 }
 
-bool moves_vertices(uint32_t triangle_format) { return codec_ops(triangle_format).grid != layout::kGridNone; }
+bool moves_vertices(uint32_t triangle_format) {
+  CodecOps c = codec_ops(triangle_format);
+  return c.grid != layout::kGridNone || c.moves_floats;
+}
 
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;

@@ -122,15 +122,43 @@ struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
 
 // Tests the `count` triangles of the block at blob offset `block`; slots of
 // the leaf start at `slot0`.
+// Strips have no loader: see test_sequential_leaf.
+template <class Record, uint32_t kId>
+struct Loader<layout::Strip<Record, kId>> {
+  static void load(const uint8_t*, uint32_t, uint32_t, uint32_t, const int*, simd::F4[3][3]) {}
+};
+
 template <class L>
 constexpr int width_of() {
   if constexpr (requires { L::kWidth; }) return L::kWidth;
   return 4;
 }
 
+// Strips decode vertex after vertex: the whole leaf into SOA rows first
+// (at most 31 triangles, MC_QUAD_MAX_COUNT), then the same 4-wide test.
+template <class Codec>
+inline void test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count,
+                                 uint32_t slot0, Closest& c) {
+  alignas(16) float rows[9][32];
+  for (auto& row : rows)  // padding lanes: masked, but kept finite
+    for (uint32_t i = count; i < (count + 3) / 4 * 4; ++i) row[i] = 0.0f;
+  Codec::read(blob, block, count, ~0ull, [&](uint32_t i, const float (*p)[3]) {
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) rows[k * 3 + a][i] = p[k][a];
+  });
+  for (uint32_t first = 0; first < count; first += 4) {
+    simd::F4 v[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j) v[k][j] = simd::F4::load(&rows[k * 3 + r.axis[j]][first]);
+    LaneHit h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
+    if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
+  }
+}
+
 template <class Codec>
 inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                       Closest& c) {
+  if constexpr (requires { Codec::kSequential; }) return test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
   constexpr int kWidth = width_of<Loader<Codec>>();
   for (uint32_t first = 0; first < count; first += kWidth) {
     LaneHit h;

@@ -13,7 +13,7 @@ void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, 
       uint32_t count = layout::load<uint32_t>(blob + h.tree_offset + at);
       uint32_t block = at + MC_BRUTE_RECORD_BYTES;
       test_leaf<Codec>(blob, r, h.tree_offset + block, count, layout::slot_of(h, block, 0), c);
-      at = block + Codec::block_bytes(count);
+      at = block + uint32_t(layout::stored_bytes<Codec>(blob, h.tree_offset + block, count, ~0ull));
     }
   });
 }

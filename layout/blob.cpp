@@ -66,9 +66,10 @@ std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block,
   if (block < h.triangle_base || (block - h.triangle_base) % 4 != 0)
     return "triangle block at tree offset " + num(block) + " lies before the triangle area (" +
            num(h.triangle_base) + ") or is misaligned";
-  if (uint64_t(block) + Codec::block_bytes(count) > h.tree_size)
-    return "triangle block at tree offset " + num(block) + " of " + num(Codec::block_bytes(count)) +
-           " bytes runs past the tree section (" + num(h.tree_size) + " bytes)";
+  uint64_t bytes = block <= h.tree_size ? stored_bytes<Codec>(blob, h.tree_offset + block, count, h.tree_size - block) : 0;
+  if (bytes == 0 || uint64_t(block) + bytes > h.tree_size)
+    return "triangle block at tree offset " + num(block) + " for " + num(count) +
+           " triangles is broken or runs past the tree section (" + num(h.tree_size) + " bytes)";
   uint64_t slot0 = (block - h.triangle_base) / h.slot_divisor;
   if (slot0 + count > h.remap_slots)
     return "triangle block at tree offset " + num(block) + " maps past the remap (" + num(h.remap_slots) +
@@ -156,7 +157,7 @@ std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* 
     std::string e = check_leaf<Codec>(blob, h, uint32_t(at + MC_BRUTE_RECORD_BYTES), count, brute_chunk(Codec::kLanes));
     if (!e.empty()) return e;
     *triangles += count;
-    at += MC_BRUTE_RECORD_BYTES + Codec::block_bytes(count);
+    at += MC_BRUTE_RECORD_BYTES + stored_bytes<Codec>(blob, h.tree_offset + uint32_t(at) + MC_BRUTE_RECORD_BYTES, count, ~0ull);
     ++records;
   }
   if (records != h.node_count) return "BruteForce holds " + num(records) + " records, the header says " + num(h.node_count);

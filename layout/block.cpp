@@ -79,3 +79,57 @@ bool Indexed8BitPackSOA4::check(const uint8_t* blob, uint32_t block, uint32_t co
 }
 
 }  // namespace meshcast::layout
+
+#include "layout/strip.h"
+
+namespace meshcast::layout {
+
+std::vector<StripVertex> stripify(TriCorners* tris, uint32_t count) {
+  std::vector<StripVertex> seq;
+  std::vector<TriCorners> order;
+  std::vector<bool> used(count, false);
+  auto vertex = [](const TriCorners& t, int c, uint32_t flag) {
+    return StripVertex{{t.v[c][0], t.v[c][1], t.v[c][2]}, t.vertex[c], flag};
+  };
+  for (uint32_t start = 0; start < count; ++start) {
+    if (used[start]) continue;
+    used[start] = true;
+    TriCorners prev = tris[start];
+    seq.push_back(vertex(prev, 0, kStartV1));
+    seq.push_back(vertex(prev, 1, kStartV2));
+    seq.push_back(vertex(prev, 2, 0));
+    order.push_back(prev);
+    // Extend through any unused triangle sharing an edge with `prev`.
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (uint32_t u = 0; u < count && !grew; ++u) {
+        if (used[u]) continue;
+        for (uint32_t flag : {0u, 1u, 2u, 4u, 5u, 6u}) {
+          int a = int(flag & 3), b = (a + 1 + int(flag >> 2)) % 3;
+          // Take A and B out of u's corners; the one left is C.
+          int left[3] = {0, 1, 2}, n = 3;
+          auto take = [&](uint32_t id) {
+            for (int k = 0; k < n; ++k)
+              if (tris[u].vertex[left[k]] == id) return left[k] = left[--n], true;
+            return false;
+          };
+          if (!take(prev.vertex[a]) || !take(prev.vertex[b])) continue;
+          TriCorners next = tris[u];
+          int c = left[0];
+          for (int k = 0; k < 3; ++k) next.v[0][k] = prev.v[a][k], next.v[1][k] = prev.v[b][k], next.v[2][k] = tris[u].v[c][k];
+          next.vertex[0] = prev.vertex[a], next.vertex[1] = prev.vertex[b], next.vertex[2] = tris[u].vertex[c];
+          seq.push_back(vertex(next, 2, flag));
+          order.push_back(next);
+          used[u] = true;
+          prev = next;
+          grew = true;
+          break;
+        }
+      }
+    }
+  }
+  std::copy(order.begin(), order.end(), tris);
+  return seq;
+}
+
+}  // namespace meshcast::layout

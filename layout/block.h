@@ -41,7 +41,17 @@ struct BlockContext {
   std::unordered_map<uint64_t, uint32_t>* last_index = nullptr;
   const float* grid_step = nullptr;   // the mesh grid (header quant_scale), kGridPowerOfTwo formats
   uint32_t* max_block_shift = nullptr;  // largest m of a BitPackSOA block (soa.h)
+  const BlobHeader* header = nullptr;   // the blob's header as far as it is known (grids)
 };
+
+// Bytes a block of `count` triangles takes in a blob: block_bytes(count) for
+// fixed-size formats; formats whose blocks vary (strips) read their own,
+// returning 0 when the block does not end within `limit` bytes or is broken.
+template <class C>
+uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit) {
+  if constexpr (requires { C::stored_bytes(blob, block, count, limit); }) return C::stored_bytes(blob, block, count, limit);
+  else return C::block_bytes(count);
+}
 
 // Appends a vertex record to the pool; returns its index (record number).
 inline uint32_t pool_append(std::vector<uint8_t>& pool, const void* record, size_t bytes) {

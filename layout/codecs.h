@@ -4,6 +4,7 @@
 #include "layout/bitpack.h"
 #include "layout/float3.h"
 #include "layout/soa.h"
+#include "layout/strip.h"
 #include "layout/indexed.h"
 #include "layout/indexed8bitpacksoa4.h"
 
@@ -22,4 +23,6 @@
   X(Float3SOA128, "Float3SOA128")                      \
   X(BitPackSOA4, "BitPackSOA4")                        \
   X(BitPackSOA128, "BitPackSOA128")                    \
-  X(BitPack, "BitPack")
+  X(BitPack, "BitPack")                                \
+  X(UncompressedStrip, "UncompressedStrip")            \
+  X(CompressedStrip, "CompressedStrip")

@@ -37,6 +37,8 @@
 #define MC_TRI_BITPACKSOA4 12u         // §3.5
 #define MC_TRI_BITPACKSOA128 13u       // §7
 #define MC_TRI_BITPACK 14u             // §3.4
+#define MC_TRI_UNCOMPRESSEDSTRIP 15u   // §3.10
+#define MC_TRI_COMPRESSEDSTRIP 16u     // §3.10
 
 // AABBTree node (§5.1): BoundingBoxMin (3 floats), BoundingBoxMax (3 floats),
 // Properties (uint32). High bit set: a leaf whose low bits are its triangle

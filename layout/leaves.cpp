@@ -17,7 +17,8 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint3
       visit(at + MC_BRUTE_RECORD_BYTES, count);
       uint32_t bytes = 0;
 #define MC_BYTES(Codec, name) \
-  if (h.triangle_format == Codec::kFormat) bytes = Codec::block_bytes(count);
+  if (h.triangle_format == Codec::kFormat)                                                           \
+    bytes = uint32_t(stored_bytes<Codec>(blob, h.tree_offset + at + MC_BRUTE_RECORD_BYTES, count, ~0ull));
       MC_FOR_EACH_TRIANGLE_CODEC(MC_BYTES)
 #undef MC_BYTES
       at += MC_BRUTE_RECORD_BYTES + bytes;

@@ -147,6 +147,22 @@ TEST(Build, BadMeshesAreRefusedWithTheirNameAndProblem) {
   EXPECT_THROW(build_blob(ok, big_leaf, "grid"), InputError);
 }
 
+// Format limits are build errors that name the limit.
+TEST(Build, SixteenBitIndicesRefuseMeshesBeyondTheirReach) {
+  Mesh big = make_grid_plane(300, 300);  // 90,601 vertices
+  for (const char* layout : {"QuadTree/Indexed16", "BruteForce/Indexed16SOA4", "AABBTree/Indexed16BitPackSOA4"}) {
+    try {
+      build_blob(big, parse_layout(layout), "grid300");
+      FAIL() << layout;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("16-bit indices reach 65536 vertices"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("grid300"), std::string::npos);
+    }
+  }
+  // 32-bit indices take the same mesh.
+  EXPECT_EQ(layout::validate(build_blob(big, parse_layout("QuadTree/Indexed32"), "grid300")), "");
+}
+
 TEST(Build, LayoutNamesAreCaseInsensitiveAndUnknownOnesListTheValid) {
   EXPECT_EQ(parse_layout("quadtreehalffloat/indexed8bitpacksoa4").tree_format, MC_TREE_QUADTREEHALFFLOAT);
   try {

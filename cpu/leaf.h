@@ -106,10 +106,17 @@ struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
     const uint8_t* vertices = blob + h.vertex_offset;
     uint32_t last = Codec::lanes(count) - 1;
     for (int c = 0; c < 3; ++c) {
-      simd::I4 idx = simd::iconst(int(Codec::index(blob, block, first, c)),
-                                  int(Codec::index(blob, block, std::min(first + 1, last), c)),
-                                  int(Codec::index(blob, block, std::min(first + 2, last), c)),
-                                  int(Codec::index(blob, block, std::min(first + 3, last), c)));
+      simd::I4 idx;
+      if constexpr (kSoa) {  // the 4 lanes' indices side by side: one load (§3.7)
+        const uint8_t* p = blob + block + Codec::slot(first, c) * Codec::kIndexBytes;
+        if constexpr (sizeof(IndexT) == 2) idx = simd::from_u16_index(p);
+        else idx = simd::I4::load(p);
+      } else {
+        idx = simd::iconst(int(Codec::index(blob, block, first, c)),
+                           int(Codec::index(blob, block, std::min(first + 1, last), c)),
+                           int(Codec::index(blob, block, std::min(first + 2, last), c)),
+                           int(Codec::index(blob, block, std::min(first + 3, last), c)));
+      }
       if constexpr (kBitPack) {
         simd::bitpack_gather(vertices, idx, h.quant_offset, h.quant_scale, axis, v[c]);
       } else {

@@ -101,6 +101,11 @@ inline F4 gather(const float* base, I4 idx) { return {_mm_i32gather_ps(base, idx
 inline I4 iconst(int a, int b, int c, int d) { return {_mm_setr_epi32(a, b, c, d)}; }
 inline I4 operator+(I4 a, int b) { return {_mm_add_epi32(a.v, _mm_set1_epi32(b))}; }
 inline I4 operator+(I4 a, I4 b) { return {_mm_add_epi32(a.v, b.v)}; }
+inline I4 from_u16_index(const uint8_t* p) {  // 4 uint16 -> 4 ints
+  int64_t x;
+  std::memcpy(&x, p, 8);
+  return {_mm_cvtepu16_epi32(_mm_cvtsi64_si128(x))};
+}
 
 
 // Eight lanes (AVX2), for the 8-wide triangle formats (Float3SOA8).
@@ -197,6 +202,7 @@ inline F4 gather(const float* base, I4 idx) {
 inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b), uint32_t(c), uint32_t(d)}}; }
 inline I4 operator+(I4 a, int b) { I4 r; MC_LANES(a.v[i] + uint32_t(b)) }
 inline I4 operator+(I4 a, I4 b) { I4 r; MC_LANES(a.v[i] + b.v[i]) }
+inline I4 from_u16_index(const uint8_t* p) { I4 r; MC_LANES(uint32_t(p[2 * i] | p[2 * i + 1] << 8)) }
 #undef MC_LANES
 
 struct F8 {

@@ -1,5 +1,6 @@
 #include "layout/leaves.h"
 
+#include <cmath>
 #include <vector>
 
 #include "layout/aabbtree.h"
@@ -48,6 +49,45 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint3
       }
       for (int k = 3; k >= 0; --k)
         if (uint32_t c = quad_child_properties(tree + quad_offset(p), props_at, k)) stack.push_back(c);
+    }
+  }
+}
+
+void for_each_leaf_box(const uint8_t* blob,
+                       const std::function<void(uint32_t, uint32_t, const float[3], const float[3])>& visit) {
+  const BlobHeader& h = header_of(blob);
+  const uint8_t* tree = blob + h.tree_offset;
+  if (h.tree_format == MC_TREE_BRUTEFORCE) {
+    const float lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
+    return for_each_leaf(blob, [&](uint32_t block, uint32_t count) { visit(block, count, lo, hi); });
+  }
+  if (h.tree_format == MC_TREE_AABBTREE) {
+    return for_each_leaf(blob, [&](uint32_t block, uint32_t count) {
+      AABBNode n = load_aabb_node(tree + block - MC_AABB_NODE_BYTES);
+      visit(block, count, n.min, n.max);
+    });
+  }
+  bool half = h.tree_format == MC_TREE_QUADTREEHALFFLOAT;
+  uint32_t props_at = half ? QuadBoundsHalf::kPropertiesAt : QuadBoundsFloat::kPropertiesAt;
+  std::vector<uint32_t> stack{h.root};
+  if (quad_count(h.root)) {  // a root leaf has no box above it
+    const float lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
+    return visit(quad_offset(h.root), quad_count(h.root), lo, hi);
+  }
+  while (!stack.empty()) {
+    const uint8_t* node = tree + quad_offset(stack.back());
+    stack.pop_back();
+    for (int k = 0; k < 4; ++k) {
+      uint32_t c = quad_child_properties(node, props_at, k);
+      if (!c) continue;
+      if (!quad_count(c)) {
+        stack.push_back(c);
+        continue;
+      }
+      float lo[3], hi[3];
+      if (half) QuadBoundsHalf::decode(node, h, k, lo, hi);
+      else QuadBoundsFloat::decode(node, h, k, lo, hi);
+      visit(quad_offset(c), quad_count(c), lo, hi);
     }
   }
 }

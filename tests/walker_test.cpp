@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "layout/blob.h"
+#include "layout/leaves.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -74,6 +75,28 @@ INSTANTIATE_TEST_SUITE_P(Layouts, WalkerVsOracle, ::testing::ValuesIn(layout_nam
 TEST(WalkerVsOracleLarge, Terrain1M) {
   for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4"})
     check_layout(name, true);
+}
+
+// Every leaf's bounds, as the walker decodes them (half floats included),
+// contain every corner its triangle format decodes, for every layout.
+TEST(LeafBoundsContainDecodedCorners, EveryLayoutEveryMesh) {
+  for (const NamedMesh& m : test_meshes(false))
+    for (const std::string& name : layout_names()) {
+      if (name.rfind("BruteForce/", 0) == 0) continue;
+      std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
+      const layout::BlobHeader& h = layout::header_of(blob.data());
+      size_t corners = 0;
+      layout::for_each_leaf_box(blob.data(), [&](uint32_t block, uint32_t count, const float lo[3], const float hi[3]) {
+        for (uint32_t i = 0; i < count; ++i) {
+          float v[3][3];
+          layout::decode_triangle(blob.data(), h.tree_offset + block, i, v);
+          for (int c = 0; c < 3; ++c, ++corners)
+            for (int a = 0; a < 3; ++a)
+              ASSERT_TRUE(lo[a] <= v[c][a] && v[c][a] <= hi[a]) << name << " on " << m.name << ": corner outside its leaf box";
+        }
+      });
+      EXPECT_EQ(corners, 3 * m.mesh->triangles.size()) << name;
+    }
 }
 
 // Every triangle format keeps each stored corner within its stated bound of

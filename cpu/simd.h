@@ -139,51 +139,59 @@ inline M8 lanes_below8(uint32_t n) {
 
 #else  // MESHCAST_SCALAR
 
-struct F4 {
-  static constexpr int kLanes = 4;
-  float v[4];
-  static F4 splat(float f) { return {{f, f, f, f}}; }
-  static F4 load(const void* p) { F4 r; std::memcpy(r.v, p, 16); return r; }
-  void store(float* p) const { std::memcpy(p, v, 16); }
+// One template for both widths: N plain lanes.
+template <int N>
+struct FN {
+  static constexpr int kLanes = N;
+  float v[N];
+  static FN splat(float f) { FN r; for (float& x : r.v) x = f; return r; }
+  static FN load(const void* p) { FN r; std::memcpy(r.v, p, sizeof r.v); return r; }
+  void store(float* p) const { std::memcpy(p, v, sizeof v); }
 };
+template <int N>
+struct MN { bool v[N]; };
+using F4 = FN<4>;
+using M4 = MN<4>;
+using F8 = FN<8>;
+using M8 = MN<8>;
 struct I4 {
   uint32_t v[4];
   static I4 load(const void* p) { I4 r; std::memcpy(r.v, p, 16); return r; }
   void store(uint32_t* p) const { std::memcpy(p, v, 16); }
 };
-struct M4 { bool v[4]; };
 
-#define MC_LANES(expr) { for (int i = 0; i < 4; ++i) r.v[i] = (expr); return r; }
-inline F4 operator+(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] + b.v[i]) }
-inline F4 operator-(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] - b.v[i]) }
-inline F4 operator*(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] * b.v[i]) }
-inline F4 operator/(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] / b.v[i]) }
-inline F4 min(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] < b.v[i] ? a.v[i] : b.v[i]) }  // NaN -> b
-inline F4 max(F4 a, F4 b) { F4 r; MC_LANES(a.v[i] > b.v[i] ? a.v[i] : b.v[i]) }
-inline F4 fma(F4 a, F4 b, F4 c) { F4 r; MC_LANES(__builtin_fmaf(a.v[i], b.v[i], c.v[i])) }
-inline F4 abs(F4 a) { F4 r; MC_LANES(__builtin_fabsf(a.v[i])) }
-inline F4 xor_sign(F4 a, F4 s) { F4 r; MC_LANES(__builtin_signbit(s.v[i]) ? -a.v[i] : a.v[i]) }
-inline M4 operator<(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] < b.v[i]) }
-inline M4 operator<=(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] <= b.v[i]) }
-inline M4 operator>(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] > b.v[i]) }
-inline M4 operator>=(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] >= b.v[i]) }
-inline M4 operator==(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] == b.v[i]) }
-inline M4 operator!=(F4 a, F4 b) { M4 r; MC_LANES(a.v[i] != b.v[i]) }
-inline M4 operator&(M4 a, M4 b) { M4 r; MC_LANES(a.v[i] && b.v[i]) }
-inline M4 operator|(M4 a, M4 b) { M4 r; MC_LANES(a.v[i] || b.v[i]) }
-inline M4 andnot(M4 a, M4 b) { M4 r; MC_LANES(!a.v[i] && b.v[i]) }
-inline int bits(M4 m) { return m.v[0] | m.v[1] << 1 | m.v[2] << 2 | m.v[3] << 3; }
-inline M4 lanes_below(uint32_t n) { M4 r; MC_LANES(uint32_t(i) < n) }
-inline F4 select(M4 m, F4 a, F4 b) { F4 r; MC_LANES(m.v[i] ? a.v[i] : b.v[i]) }
-inline M4 nonzero(I4 a) { M4 r; MC_LANES(a.v[i] != 0) }
+#define MC_LANES(R, expr) { R r; for (int i = 0; i < int(sizeof r.v / sizeof r.v[0]); ++i) r.v[i] = (expr); return r; }
+#define MC_FLOAT_OP(op) \
+  template <int N> inline FN<N> operator op(FN<N> a, FN<N> b) MC_LANES(FN<N>, a.v[i] op b.v[i])
+#define MC_COMPARE(op) \
+  template <int N> inline MN<N> operator op(FN<N> a, FN<N> b) MC_LANES(MN<N>, a.v[i] op b.v[i])
+MC_FLOAT_OP(+) MC_FLOAT_OP(-) MC_FLOAT_OP(*) MC_FLOAT_OP(/)
+MC_COMPARE(<) MC_COMPARE(<=) MC_COMPARE(>) MC_COMPARE(>=) MC_COMPARE(==) MC_COMPARE(!=)
+#undef MC_FLOAT_OP
+#undef MC_COMPARE
+template <int N> inline FN<N> min(FN<N> a, FN<N> b) MC_LANES(FN<N>, a.v[i] < b.v[i] ? a.v[i] : b.v[i])  // NaN -> b
+template <int N> inline FN<N> max(FN<N> a, FN<N> b) MC_LANES(FN<N>, a.v[i] > b.v[i] ? a.v[i] : b.v[i])
+template <int N> inline FN<N> fma(FN<N> a, FN<N> b, FN<N> c) MC_LANES(FN<N>, __builtin_fmaf(a.v[i], b.v[i], c.v[i]))
+template <int N> inline FN<N> abs(FN<N> a) MC_LANES(FN<N>, __builtin_fabsf(a.v[i]))
+template <int N> inline FN<N> xor_sign(FN<N> a, FN<N> s) MC_LANES(FN<N>, __builtin_signbit(s.v[i]) ? -a.v[i] : a.v[i])
+template <int N> inline MN<N> operator&(MN<N> a, MN<N> b) MC_LANES(MN<N>, a.v[i] && b.v[i])
+template <int N> inline MN<N> operator|(MN<N> a, MN<N> b) MC_LANES(MN<N>, a.v[i] || b.v[i])
+template <int N> inline MN<N> andnot(MN<N> a, MN<N> b) MC_LANES(MN<N>, !a.v[i] && b.v[i])
+template <int N> inline FN<N> select(MN<N> m, FN<N> a, FN<N> b) MC_LANES(FN<N>, m.v[i] ? a.v[i] : b.v[i])
+template <int N> inline int bits(MN<N> m) { int b = 0; for (int i = 0; i < N; ++i) b |= int(m.v[i]) << i; return b; }
+inline M4 lanes_below(uint32_t n) MC_LANES(M4, uint32_t(i) < n)
+inline M8 lanes_below8(uint32_t n) MC_LANES(M8, uint32_t(i) < n)
+inline M4 nonzero(I4 a) MC_LANES(M4, a.v[i] != 0)
 inline float lane(F4 a, int i) { return a.v[i]; }
-inline F4 from_u8(const uint8_t* p) { F4 r; MC_LANES(float(p[i])) }
-inline F4 from_u16(const uint8_t* p) { F4 r; MC_LANES(float(uint32_t(p[2 * i] | p[2 * i + 1] << 8))) }
-inline F4 from_half(const uint8_t* p) {
-  F4 r;
-  MC_LANES(layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
-}
-inline I4 from_u8_index(const uint8_t* p) { I4 r; MC_LANES(uint32_t(p[i])) }
+inline F4 from_u8(const uint8_t* p) MC_LANES(F4, float(p[i]))
+inline F4 from_u16(const uint8_t* p) MC_LANES(F4, float(uint32_t(p[2 * i] | p[2 * i + 1] << 8)))
+inline F4 from_half(const uint8_t* p) MC_LANES(F4, layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
+inline I4 from_u8_index(const uint8_t* p) MC_LANES(I4, uint32_t(p[i]))
+inline I4 from_u16_index(const uint8_t* p) MC_LANES(I4, uint32_t(p[2 * i] | p[2 * i + 1] << 8))
+inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b), uint32_t(c), uint32_t(d)}}; }
+inline I4 operator+(I4 a, int b) MC_LANES(I4, a.v[i] + uint32_t(b))
+inline I4 operator+(I4 a, I4 b) MC_LANES(I4, a.v[i] + b.v[i])
+#undef MC_LANES
 inline void bitpack_gather(const uint8_t* base, I4 index, const float offset[3], const float scale[3],
                            const int axis[3], F4 out[3]) {
   for (int i = 0; i < 4; ++i) {
@@ -199,39 +207,6 @@ inline F4 gather(const float* base, I4 idx) {
   for (int i = 0; i < 4; ++i) std::memcpy(&r.v[i], reinterpret_cast<const uint8_t*>(base) + 4 * idx.v[i], 4);
   return r;
 }
-inline I4 iconst(int a, int b, int c, int d) { return {{uint32_t(a), uint32_t(b), uint32_t(c), uint32_t(d)}}; }
-inline I4 operator+(I4 a, int b) { I4 r; MC_LANES(a.v[i] + uint32_t(b)) }
-inline I4 operator+(I4 a, I4 b) { I4 r; MC_LANES(a.v[i] + b.v[i]) }
-inline I4 from_u16_index(const uint8_t* p) { I4 r; MC_LANES(uint32_t(p[2 * i] | p[2 * i + 1] << 8)) }
-#undef MC_LANES
-
-struct F8 {
-  static constexpr int kLanes = 8;
-  float v[8];
-  static F8 splat(float f) { F8 r; for (float& x : r.v) x = f; return r; }
-  static F8 load(const void* p) { F8 r; std::memcpy(r.v, p, 32); return r; }
-  void store(float* p) const { std::memcpy(p, v, 32); }
-};
-struct M8 { bool v[8]; };
-#define MC_LANES8(expr) { for (int i = 0; i < 8; ++i) r.v[i] = (expr); return r; }
-inline F8 operator+(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] + b.v[i]) }
-inline F8 operator-(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] - b.v[i]) }
-inline F8 operator*(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] * b.v[i]) }
-inline F8 operator/(F8 a, F8 b) { F8 r; MC_LANES8(a.v[i] / b.v[i]) }
-inline F8 abs(F8 a) { F8 r; MC_LANES8(__builtin_fabsf(a.v[i])) }
-inline F8 xor_sign(F8 a, F8 s) { F8 r; MC_LANES8(__builtin_signbit(s.v[i]) ? -a.v[i] : a.v[i]) }
-inline M8 operator<(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] < b.v[i]) }
-inline M8 operator<=(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] <= b.v[i]) }
-inline M8 operator>(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] > b.v[i]) }
-inline M8 operator>=(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] >= b.v[i]) }
-inline M8 operator==(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] == b.v[i]) }
-inline M8 operator!=(F8 a, F8 b) { M8 r; MC_LANES8(a.v[i] != b.v[i]) }
-inline M8 operator&(M8 a, M8 b) { M8 r; MC_LANES8(a.v[i] && b.v[i]) }
-inline M8 operator|(M8 a, M8 b) { M8 r; MC_LANES8(a.v[i] || b.v[i]) }
-inline M8 andnot(M8 a, M8 b) { M8 r; MC_LANES8(!a.v[i] && b.v[i]) }
-inline int bits(M8 m) { int b = 0; for (int i = 0; i < 8; ++i) b |= int(m.v[i]) << i; return b; }
-inline M8 lanes_below8(uint32_t n) { M8 r; MC_LANES8(uint32_t(i) < n) }
-#undef MC_LANES8
 
 #endif
 

@@ -2,6 +2,7 @@
 // triangle boxes and centres, so one builder serves every format.
 #pragma once
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "cpu/mesh.h"
@@ -23,11 +24,26 @@ struct BuildTree {
   uint32_t leaf_count() const;
 };
 
-// Binning (seed 000 §4.1, after Günther et al. 2007): at each node, triangle
-// centres are sorted into bins along each axis and the split with the lowest
-// surface area heuristic is taken. A node with at most `leaf_size` triangles
-// becomes a leaf; a larger one is always split (by index at the median when
-// all centres coincide), so no leaf exceeds leaf_size.
+// The splitters of seed 000 §4.1. Every one builds top down (build_topdown.h):
+// a node with at most `leaf_size` triangles becomes a leaf; a larger one is
+// always split, so no leaf exceeds leaf_size.
+enum class Splitter { Binning, LongestAxis, Mean, Morton, FixedLeafSize };
+
+// SAH over 32 binned centres per axis (Günther et al. 2007).
 BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size);
+BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size);
+
+// "Binning", "LongestAxis", ... case-insensitive; throws InputError listing
+// the valid names.
+Splitter parse_splitter(const std::string& name);
+const char* splitter_name(Splitter s);
+std::vector<Splitter> all_splitters();
+
+// One splitter step (see build_topdown.h for the contract).
+struct BinningSplit {
+  const std::vector<Box3>& boxes;
+  const std::vector<Vec3>& centres;
+  uint32_t operator()(uint32_t* begin, uint32_t* end, const Box3& cbox) const;
+};
 
 }  // namespace meshcast

@@ -443,7 +443,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   }
 
   BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
-                                                       : build_binning(boxes, o.leaf_size);
+                                                       : build_tree(boxes, o.splitter, o.leaf_size);
   if (codec.nested)
     snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale, mesh.vertices.size());
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
@@ -564,7 +564,7 @@ BuildOptions parse_layout(const std::string& text) {
   };
   for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
-      if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8};
+      if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8, Splitter::Binning};
   std::string valid;
   for (const std::string& n : layout_names()) valid += "\n  " + n;
   throw InputError("unknown layout '" + text + "'; valid layouts (TREE/TRIANGLES):" + valid);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cpu/build.h"
 #include "cpu/mesh.h"
 
 namespace meshcast {
@@ -14,7 +15,8 @@ namespace meshcast {
 struct BuildOptions {
   uint32_t tree_format = 3;      // MC_TREE_*
   uint32_t triangle_format = 3;  // MC_TRI_*
-  uint32_t leaf_size = 8;        // 4, 8 or 16 in the source; 1..16 accepted
+  uint32_t leaf_size = 8;        // 4, 8 or 16 in the source; 1..31 accepted
+  Splitter splitter = Splitter::Binning;  // seed 000 §4.1
 };
 
 struct BuildReport {

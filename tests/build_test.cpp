@@ -85,6 +85,36 @@ TEST(Binning, BeatsAMedianSplit) {
   }
 }
 
+TEST(Splitters, EveryOneRespectsTheLeafSizeAndCoversEveryTriangleOnce) {
+  Mesh m = make_terrain(48, 40, 3);
+  std::vector<Box3> boxes = triangle_boxes(m);
+  for (Splitter s : all_splitters())
+    for (uint32_t leaf : {4u, 8u, 16u}) {
+      BuildTree t = build_tree(boxes, s, leaf);
+      std::vector<int> seen(m.triangles.size(), 0);
+      uint32_t leaves = 0, not_multiple_of_4 = 0;
+      for (const BuildNode& n : t.nodes) {
+        if (!n.leaf()) {
+          EXPECT_TRUE(contains(n.box, t.nodes[n.left].box) && contains(n.box, t.nodes[n.right].box));
+          continue;
+        }
+        ++leaves;
+        EXPECT_LE(n.count, leaf) << splitter_name(s);
+        not_multiple_of_4 += n.count % 4 != 0;
+        for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+          ++seen[t.order[i]];
+          EXPECT_TRUE(contains(n.box, boxes[t.order[i]]));
+        }
+      }
+      for (int c : seen) ASSERT_EQ(c, 1) << splitter_name(s);
+      // FixedLeafSize: whole groups of 4, but for the one short group.
+      if (s == Splitter::FixedLeafSize && leaf >= 4) EXPECT_LE(not_multiple_of_4, 1u);
+      EXPECT_LE(t.depth, 48u) << splitter_name(s);
+    }
+  EXPECT_EQ(parse_splitter("morton"), Splitter::Morton);
+  EXPECT_THROW(parse_splitter("Octree"), InputError);
+}
+
 TEST(Binning, CoincidentCentresStillSplit) {
   Mesh m;
   m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};

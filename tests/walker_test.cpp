@@ -55,6 +55,26 @@ void check_layout(const std::string& layout_name_, bool large) {
 
 TEST_P(WalkerVsOracle, AllMeshesAllRayKinds) { check_layout(GetParam(), false); }
 
+// Every splitter's trees walk to the oracle's answers.
+TEST(WalkerVsOracleSplitters, EverySplitterOnTheFoundationLayouts) {
+  for (Splitter s : all_splitters())
+    for (const NamedMesh& m : test_meshes(false)) {
+      if (m.name != "sphere" && m.name != "terrain_64k" && m.name != "bunny00") continue;
+      for (const char* name : {"AABBTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
+        BuildOptions o = parse_layout(name);
+        o.splitter = s;
+        std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name);
+        NamedMesh reference = m;
+        if (moves_vertices(o.triangle_format))
+          reference = {m.name + "#" + name + "#" + splitter_name(s), std::make_shared<const Mesh>(stored_mesh(blob))};
+        const std::vector<Ray>& rays = test_rays(m, RayKind::Long, 2000);
+        Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, RayKind::Long, rays),
+                              1e-5 * m.mesh->bounds().diagonal());
+        EXPECT_EQ(a.wrong + a.t_errors, 0u) << splitter_name(s) << " " << name << " on " << m.name << ": " << a.first_problem;
+      }
+    }
+}
+
 // CTest points MESHCAST_DATA at data/ (scripts/setup.sh fills it): there the
 // public meshes must be present, so they can never drop out silently.
 TEST(Data, PublicMeshesArePresentWhenCTestRuns) {

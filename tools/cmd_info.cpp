@@ -12,7 +12,7 @@ namespace meshcast::tools {
 
 void add_info(CLI::App& app) {
   struct Args {
-    std::string input, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+    std::string input, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter = "Binning";
     uint32_t leaf = 8;
     bool json = false;
   };
@@ -21,9 +21,10 @@ void add_info(CLI::App& app) {
   cmd->add_option("input", args->input, "mesh file or blob")->required();
   cmd->add_option("--layout", args->layout, "TREE/TRIANGLES when building from a mesh");
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--splitter", args->splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
   cmd->add_flag("--json", args->json, "print the same as one JSON object");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf));
+    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf, args->splitter));
     const layout::BlobHeader& h = layout::header_of(in.blob.data());
     SectionBytes s = section_bytes(in.blob);
     double n = h.triangle_count;

@@ -11,7 +11,7 @@ namespace meshcast::tools {
 
 void add_trace(CLI::App& app) {
   struct Args {
-    std::string input, rays, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+    std::string input, rays, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter = "Binning";
     uint32_t leaf = 8, repeat = 5;
     bool json = false;
   };
@@ -22,10 +22,11 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--out", args->out, "hits file to write")->required();
   cmd->add_option("--layout", args->layout, "TREE/TRIANGLES when building from a mesh");
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--splitter", args->splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
   cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf));
+    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf, args->splitter));
     std::vector<Ray> rays = read_rays(args->rays);
     BlobView view(in.blob, args->input);
     std::vector<Hit> hits(rays.size());
@@ -59,7 +60,7 @@ void add_trace(CLI::App& app) {
 
 void add_build(CLI::App& app) {
   struct Args {
-    std::string input, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+    std::string input, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter = "Binning";
     uint32_t leaf = 8;
   };
   auto args = std::make_shared<Args>();
@@ -68,8 +69,9 @@ void add_build(CLI::App& app) {
   cmd->add_option("--out", args->out, "blob file to write")->required();
   cmd->add_option("--layout", args->layout, "TREE/TRIANGLES");
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--splitter", args->splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf));
+    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf, args->splitter));
     if (!in.mesh) throw InputError(args->input + ": is already a blob; give a mesh file");
     write_file(args->out, in.blob.data(), in.blob.size());
     std::printf("%s: %zu triangles -> %s (%zu bytes, %.2f bytes/triangle), build %.1f ms\n", args->input.c_str(),

@@ -31,9 +31,10 @@ Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options) {
   return out;
 }
 
-BuildOptions layout_options(const std::string& layout, uint32_t leaf) {
+BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter) {
   BuildOptions o = parse_layout(layout);
   o.leaf_size = leaf;
+  o.splitter = parse_splitter(splitter);
   return o;
 }
 

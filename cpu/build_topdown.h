@@ -1,0 +1,78 @@
+// The top-down recursion every splitter of seed 000 §4.1 shares: a node
+// with at most leaf_size triangles is a leaf, a larger one is split by the
+// splitter (or at the median of the longest centre axis when the splitter
+// cannot separate them, and always below kSplitterDepth so the depth stays
+// within the walkers' stacks). Splitters see only triangle boxes and centres.
+#pragma once
+#include <algorithm>
+
+#include "cpu/build.h"
+
+namespace meshcast {
+
+constexpr uint32_t kSplitterDepth = 40;
+
+// SAH cost relative to the root box, unit costs for nodes and triangles.
+inline double sah_cost(const BuildTree& t) {
+  double root = std::max(1e-30, double(t.nodes[0].box.half_area())), cost = 0;
+  for (const BuildNode& n : t.nodes) cost += n.box.half_area() / root * (n.leaf() ? n.count : 1.0);
+  return cost;
+}
+
+// Split(begin, end, centre box) reorders [begin, end) and returns the count
+// of the left part; 0 or the whole count means "cannot split".
+template <class Split>
+struct TopDown {
+  const std::vector<Box3>& boxes;
+  const std::vector<Vec3>& centres;
+  uint32_t leaf_size;
+  Split& split;
+  BuildTree tree;
+
+  uint32_t build(uint32_t first, uint32_t count, uint32_t depth) {
+    uint32_t index = uint32_t(tree.nodes.size());
+    tree.nodes.emplace_back();
+    tree.depth = std::max(tree.depth, depth);
+    Box3 box, cbox;
+    for (uint32_t i = first; i < first + count; ++i) box.grow(boxes[tree.order[i]]), cbox.grow(centres[tree.order[i]]);
+    tree.nodes[index].box = box;
+    if (count <= leaf_size) {
+      tree.nodes[index].first = first, tree.nodes[index].count = count;
+      return index;
+    }
+    uint32_t* begin = tree.order.data() + first;
+    uint32_t left = depth < kSplitterDepth ? split(begin, begin + count, cbox) : 0;
+    if (left == 0 || left >= count) left = median(begin, count, cbox);
+    uint32_t l = build(first, left, depth + 1);
+    uint32_t r = build(first + left, count - left, depth + 1);
+    tree.nodes[index].left = l, tree.nodes[index].right = r;
+    return index;
+  }
+
+  uint32_t median(uint32_t* begin, uint32_t count, const Box3& cbox) {
+    Vec3 e = cbox.extent();
+    int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    std::nth_element(begin, begin + count / 2, begin + count,
+                     [&](uint32_t a, uint32_t b) { return centres[a][axis] < centres[b][axis]; });
+    return count / 2;
+  }
+
+  // `order`: the starting order (identity when empty), kept by splitters
+  // that cut ranges of a presorted sequence (Morton).
+  BuildTree run(std::vector<uint32_t> order = {}) {
+    if (order.empty()) {
+      order.resize(boxes.size());
+      for (uint32_t i = 0; i < boxes.size(); ++i) order[i] = i;
+    }
+    tree.order = std::move(order);
+    tree.nodes.reserve(2 * boxes.size() / std::max(1u, leaf_size) + 1);
+    build(0, uint32_t(boxes.size()), 0);
+    tree.sah_cost = sah_cost(tree);
+    return std::move(tree);
+  }
+};
+
+std::vector<Vec3> box_centres(const std::vector<Box3>& boxes);
+
+
+}  // namespace meshcast

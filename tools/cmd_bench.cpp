@@ -5,6 +5,7 @@
 
 #include "bench/encodings.h"
 #include "bench/plot.h"
+#include "bench/trees.h"
 #include "io/read_mesh.h"
 #include "tools/commands.h"
 #include "tools/common.h"
@@ -20,6 +21,7 @@ void add_bench(CLI::App& app) {
     uint32_t repeat = 7;
   };
   auto args = std::make_shared<Args>();
+  using ArgsT = Args;
   CLI::App* cmd = bench->add_subcommand("encodings", "seed 000 3.11: every triangle encoding, brute force and in a QuadTree");
   cmd->add_option("mesh", args->input, "mesh file (default data/bunny00.off)");
   cmd->add_option("--rays", args->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
@@ -61,6 +63,46 @@ void add_bench(CLI::App& app) {
                                           {brute, tree}, true);
     std::printf("\ncsv: %s\nplot: %s\n", csv_path.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
+
+  // §4.1 and §4.2: the same columns, one table each.
+  for (const char* which : {"splitters", "leafsize"}) {
+    auto targs = std::make_shared<ArgsT>();
+    std::string what = std::string(which) == "splitters" ? "seed 000 4.1: every splitter, AABBTree with Float3 and Float3SOA4, leaf 8"
+                                                         : "seed 000 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning";
+    CLI::App* sub = bench->add_subcommand(which, what);
+    sub->add_option("mesh", targs->input, "mesh file (default data/bunny00.off)");
+    sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
+    sub->add_option("--repeat", targs->repeat, "passes; minimum and median reported")->check(CLI::Range(1, 1000));
+    sub->add_option("--out-dir", targs->out_dir, "where the CSV goes");
+    std::string kind = which;
+    sub->callback([targs, kind] {
+      Mesh mesh = read_mesh(targs->input);
+      std::filesystem::create_directories(targs->out_dir);
+      std::vector<bench::TreeRow> rows = kind == "splitters"
+                                             ? bench::bench_splitters(mesh, targs->input, targs->rays, targs->repeat)
+                                             : bench::bench_leafsize(mesh, targs->input, targs->rays, targs->repeat);
+      double scale = 1024.0 / double(targs->rays);
+      std::printf("\n%s, %zu triangles, %zu long rays, one thread; ms for 1024 rays (minimum of %u passes, median "
+                  "beside it); seed column: seed 000 (i7-7700HQ, 2019)\n\n",
+                  targs->input.c_str(), mesh.triangles.size(), targs->rays, targs->repeat);
+      std::printf("| %s | layout | ms (min) | median | seed | build ms | SAH cost | tree B/tri | walked B/tri | "
+                  "disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+                  kind == "splitters" ? "splitter" : "leaf size");
+      std::ofstream csv(targs->out_dir + "/" + kind + ".csv");
+      csv << "label,layout,min_ms_1024,median_ms_1024,seed,build_ms,sah_cost,tree_bytes_per_tri,walked_bytes_per_tri,"
+             "disagreements\n";
+      for (const bench::TreeRow& r : rows) {
+        const bench::Timing& t = r.timing;
+        std::printf("| %s | %s | %.3f | %.3f | %.2f | %.0f | %.1f | %.2f | %.2f | %llu |\n", r.label.c_str(),
+                    r.layout.c_str(), t.min_ms * scale, t.median_ms * scale, r.seed_ms, t.build_ms, t.sah_cost,
+                    t.tree_bytes, t.walked_bytes, (unsigned long long)t.disagreements);
+        csv << r.label << "," << r.layout << "," << t.min_ms * scale << "," << t.median_ms * scale << "," << r.seed_ms
+            << "," << t.build_ms << "," << t.sah_cost << "," << t.tree_bytes << "," << t.walked_bytes << ","
+            << t.disagreements << "\n";
+      }
+      std::printf("\ncsv: %s/%s.csv\n", targs->out_dir.c_str(), kind.c_str());
+    });
+  }
 }
 
 }  // namespace meshcast::tools

@@ -1,0 +1,46 @@
+#include "bench/measure.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "cpu/agreement.h"
+#include "cpu/trace.h"
+#include "layout/blob.h"
+
+namespace meshcast::bench {
+
+
+
+Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
+               const std::vector<OracleHit>& oracle, uint32_t repeat) {
+  BuildReport report;
+  std::vector<uint8_t> blob = build_blob(mesh, options, name, &report);
+  BlobView view(blob, name);
+  std::vector<Hit> hits(rays.size());
+  std::vector<double> ms;
+  for (uint32_t r = 0; r < repeat; ++r) {
+    auto t0 = std::chrono::steady_clock::now();
+    view.trace(rays, hits);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  // Bytes of the triangle encoding: its blocks and its shared vertices.
+  double bytes = double(h.tree_size - h.node_bytes + h.vertex_size) / h.triangle_count;
+  // Formats that move vertices are judged on the triangles they store.
+  double tolerance = 1e-5 * mesh.bounds().diagonal();
+  Agreement a;
+  if (moves_vertices(h.triangle_format)) {
+    Mesh stored = stored_mesh(blob);
+    OracleTree stored_tree(stored);
+    std::vector<OracleHit> answers(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) answers[i] = stored_tree.closest(rays[i]);
+    a = compare(stored, rays, hits, answers, tolerance);
+  } else {
+    a = compare(mesh, rays, hits, oracle, tolerance);
+  }
+  double tree_bytes = double(h.node_bytes) / h.triangle_count, walked = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
+  return {ms.front(), ms[ms.size() / 2], bytes, a.wrong + a.t_errors, report.build_ms, tree_bytes, walked, report.sah_cost};
+}
+
+}  // namespace meshcast::bench

@@ -1,0 +1,25 @@
+// One measured layout: build it, time a ray set over repeated passes, judge
+// the answers against the oracle. Shared by the `meshcast bench` tables.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "cpu/encode.h"
+#include "cpu/oracle.h"
+
+namespace meshcast::bench {
+
+struct Timing {
+  double min_ms, median_ms;  // for the whole ray set
+  double bytes;              // triangle blocks + shared vertices, per triangle
+  uint64_t disagreements;    // with the oracle (over the stored mesh for formats that move vertices)
+  double build_ms;
+  double tree_bytes;         // nodes, per triangle
+  double walked_bytes;       // everything a walk reads, per triangle
+  double sah_cost;
+};
+
+Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
+               const std::vector<OracleHit>& oracle, uint32_t repeat);
+
+}  // namespace meshcast::bench

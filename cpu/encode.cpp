@@ -200,13 +200,18 @@ void fill_aabbtree(Writer& w) {
 }
 
 // kGridPowerOfTwo formats (BitPackSOA, layout/soa.h): blocks of `lanes`
-// consecutive triangles of each leaf; every vertex goes to the coarsest
-// block lattice among its blocks, repeated until no block needs a coarser
-// step, so all blocks decode a shared vertex to the same bits.
-void snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& corners, uint32_t lanes, const float grid[3],
-                            size_t vertex_count) {
+// consecutive triangles of each leaf; every position goes to the coarsest
+// block lattice among the blocks that use it, repeated until no block needs
+// a coarser step, so all blocks decode a shared position to the same bits.
+// Positions are keyed by their mesh-grid word (so unwelded copies of a
+// vertex move together) and rounded once, from the grid position, to their
+// final lattice. Returns the largest shift.
+uint32_t snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& corners, uint32_t lanes,
+                                const float grid[3]) {
+  const std::vector<TriCorners> original = corners;
+  uint32_t largest = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    std::vector<uint32_t> shift(vertex_count, 0);
+    std::unordered_map<uint64_t, uint32_t> shift;  // grid word -> lattice shift
     for (bool changed = true; changed;) {
       changed = false;
       for (const BuildNode& leaf : t.nodes) {
@@ -224,20 +229,23 @@ void snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& corners
           layout::block_step(lo, hi, grid[axis], &step, &offset, &m);
           for (uint32_t i = b; i < end; ++i)
             for (int c = 0; c < 3; ++c) {
-              uint32_t v = corners[t.order[leaf.first + i]].vertex[c];
-              if (m > shift[v]) shift[v] = m, changed = true;
+              uint32_t& s = shift[original[t.order[leaf.first + i]].packed[c]];
+              if (m > s) s = m, changed = true;
             }
         }
       }
-      // Each vertex onto the lattice of its coarsest block (multiples of
-      // grid * 2^shift); every corner of a vertex moves the same way.
-      for (TriCorners& tc : corners)
+      for (size_t k = 0; k < corners.size(); ++k)
         for (int c = 0; c < 3; ++c) {
-          double step = double(grid[axis]) * std::ldexp(1.0, int(shift[tc.vertex[c]]));
-          if (step > 0) tc.v[c][axis] = float(std::round(double(tc.v[c][axis]) / step) * step);
+          auto it = shift.find(original[k].packed[c]);
+          uint32_t m = it == shift.end() ? 0 : it->second;
+          double step = double(grid[axis]) * std::ldexp(1.0, int(m));
+          float v = original[k].v[c][axis];
+          corners[k].v[c][axis] = step > 0 ? float(std::round(double(v) / step) * step) : v;
         }
     }
+    for (const auto& [word, m] : shift) largest = std::max(largest, m);
   }
+  return largest;
 }
 
 // BruteForce: no tree. The "tree" is node 0 (the whole mesh) followed by one
@@ -444,8 +452,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
                                                        : build_tree(boxes, o.splitter, o.leaf_size);
-  if (codec.nested)
-    snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale, mesh.vertices.size());
+  uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
   writer.measure_leaves();
@@ -484,7 +491,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     throw InputError(name + ": the blob would exceed the 4 GiB its 32-bit offsets reach");
 
   hd.vertex_size = uint32_t(writer.pool.size());
-  hd.max_block_shift = writer.max_block_shift;
+  hd.max_block_shift = std::max(writer.max_block_shift, lattice_shift);
   writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
   if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
 
@@ -533,10 +540,11 @@ void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
       bound[a] = codec_ops(h.triangle_format).moves_floats ? std::nextafter(top, INFINITY) - top : 0.0f;
       continue;
     }
-    // Half the grid step, half the coarsest block step, and one rounding of
-    // the largest coordinate.
-    bound[a] = 0.5f * h.quant_scale[a] * (1.0f + std::ldexp(1.0f, int(h.max_block_shift))) +
-               (std::nextafter(top, INFINITY) - top);
+    // Half the grid step (the input rounded to the mesh grid), half the
+    // coarsest block step for nested formats (the grid position rounded once
+    // to its block lattice), and one rounding of the largest coordinate.
+    float lattice = codec_ops(h.triangle_format).nested ? 0.5f * h.quant_scale[a] * std::ldexp(1.0f, int(h.max_block_shift)) : 0.0f;
+    bound[a] = 0.5f * h.quant_scale[a] + lattice + (std::nextafter(top, INFINITY) - top);
   }
 }
 

@@ -143,13 +143,14 @@ constexpr int width_of() {
 
 // Strips decode vertex after vertex: the whole leaf into SOA rows first
 // (at most 31 triangles, MC_QUAD_MAX_COUNT), then the same 4-wide test.
+// Returns the block's bytes (what the decode read).
 template <class Codec>
-inline void test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count,
-                                 uint32_t slot0, Closest& c) {
+inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count,
+                                     uint32_t slot0, Closest& c) {
   alignas(16) float rows[9][32];
   for (auto& row : rows)  // padding lanes: masked, but kept finite
     for (uint32_t i = count; i < (count + 3) / 4 * 4; ++i) row[i] = 0.0f;
-  Codec::read(blob, block, count, ~0ull, [&](uint32_t i, const float (*p)[3]) {
+  uint64_t bytes = Codec::read(blob, block, count, ~0ull, [&](uint32_t i, const float (*p)[3]) {
     for (int k = 0; k < 3; ++k)
       for (int a = 0; a < 3; ++a) rows[k * 3 + a][i] = p[k][a];
   });
@@ -160,12 +161,16 @@ inline void test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint32_t 
     LaneHit h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
     if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
   }
+  return bytes;
 }
 
 template <class Codec>
 inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                       Closest& c) {
-  if constexpr (requires { Codec::kSequential; }) return test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
+  if constexpr (requires { Codec::kSequential; }) {
+    test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
+    return;
+  }
   constexpr int kWidth = width_of<Loader<Codec>>();
   for (uint32_t first = 0; first < count; first += kWidth) {
     LaneHit h;

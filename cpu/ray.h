@@ -29,7 +29,8 @@ static_assert(sizeof(Ray) == 28, "Ray is the 7 floats of a rays-file record");
 struct Hit {
   float t = INFINITY;
   uint32_t triangle = MC_NO_HIT;  // index in the caller's mesh
-  float u = 0, v = 0;             // barycentrics of corners 1 and 2
+  float u = 0, v = 0;             // barycentrics of corners 1 and 2 (strips: of a
+                                  // rotation of the triangle's corners, the winding kept)
 };
 
 // A ray the walkers may walk: finite origin and direction, a direction that

@@ -12,8 +12,13 @@ void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, 
     for (uint32_t at = 0; at < h.tree_size;) {
       uint32_t count = layout::load<uint32_t>(blob + h.tree_offset + at);
       uint32_t block = at + MC_BRUTE_RECORD_BYTES;
-      test_leaf<Codec>(blob, r, h.tree_offset + block, count, layout::slot_of(h, block, 0), c);
-      at = block + uint32_t(layout::stored_bytes<Codec>(blob, h.tree_offset + block, count, ~0ull));
+      if constexpr (requires { Codec::kSequential; }) {  // strips: the decode tells the length
+        at = block + uint32_t(test_sequential_leaf<Codec>(blob, r, h.tree_offset + block, count,
+                                                          layout::slot_of(h, block, 0), c));
+      } else {
+        test_leaf<Codec>(blob, r, h.tree_offset + block, count, layout::slot_of(h, block, 0), c);
+        at = block + Codec::block_bytes(count);
+      }
     }
   });
 }

@@ -104,7 +104,20 @@ std::vector<StripVertex> stripify(TriCorners* tris, uint32_t count) {
       grew = false;
       for (uint32_t u = 0; u < count && !grew; ++u) {
         if (used[u]) continue;
-        for (uint32_t flag : {0u, 1u, 2u, 4u, 5u, 6u}) {
+        // Of the flags that reach u through a shared edge, prefer one that
+        // keeps u's winding (A, B, C a rotation of u's corners): both orders
+        // of every edge are available (flags 0/5, 1/6, 2/4).
+        uint32_t flags[6] = {0u, 1u, 2u, 4u, 5u, 6u};
+        std::stable_sort(flags, flags + 6, [&](uint32_t x, uint32_t y) {
+          auto keeps = [&](uint32_t f) {
+            int a = int(f & 3), b = (a + 1 + int(f >> 2)) % 3;
+            for (int k = 0; k < 3; ++k)
+              if (tris[u].vertex[k] == prev.vertex[a] && tris[u].vertex[(k + 1) % 3] == prev.vertex[b]) return true;
+            return false;
+          };
+          return keeps(x) && !keeps(y);
+        });
+        for (uint32_t flag : flags) {
           int a = int(flag & 3), b = (a + 1 + int(flag >> 2)) % 3;
           // Take A and B out of u's corners; the one left is C.
           int left[3] = {0, 1, 2}, n = 3;

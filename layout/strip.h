@@ -141,7 +141,7 @@ struct Strip {
       uint32_t flag = Record::read(blob + block + at, h, v);
       at += Record::kBytes;
       // Grammar: a strip starts V1, V2, then a triangle from them (flag 0).
-      bool ok = flag == kStartV1 ? (last != kStartV1)
+      bool ok = flag == kStartV1 ? (last != kStartV1 && last != kStartV2)
                 : flag == kStartV2 ? (last == kStartV1)
                 : last == kStartV2 ? flag == 0
                                    : (last != kStartV1 && last <= kStartV2);

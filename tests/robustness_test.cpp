@@ -31,10 +31,24 @@ class Robustness : public ::testing::TestWithParam<std::string> {
   }
 };
 
-// Closed sphere: rays from inside must all hit; rays aimed at its vertices
-// and edge midpoints from outside must all hit.
+// The same surface with every triangle owning its three vertices (as STL
+// gives it): equal positions must still decode to equal bits.
+Mesh unwelded(const Mesh& m) {
+  Mesh soup;
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    uint32_t base = uint32_t(soup.vertices.size());
+    for (int c = 0; c < 3; ++c) soup.vertices.push_back(m.corner(t, c));
+    soup.triangles.push_back({base, base + 1, base + 2});
+  }
+  return soup;
+}
+
+// Closed sphere, welded and unwelded: rays from inside must all hit; rays
+// aimed at its vertices and edge midpoints from the centre must all hit.
 TEST_P(Robustness, ClosedSphereNeverLeaks) {
+  for (bool soup : {false, true}) {
   Mesh s = make_sphere(24, 48, 1.0f, {0.1f, 0.2f, 0.3f});
+  if (soup) s = unwelded(s);
   std::vector<uint8_t> blob = build_blob(s, options(), "sphere");
   std::vector<Ray> rays;
   std::mt19937 rng(1);
@@ -51,7 +65,8 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
   std::vector<Hit> hits = trace_all(blob, rays);
   size_t leaks = 0;
   for (const Hit& h : hits) leaks += h.triangle == MC_NO_HIT;
-  EXPECT_EQ(leaks, 0u);
+  EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded");
+  }
 }
 
 // Integer grid: vertical rays through every vertex and edge midpoint, with

@@ -177,7 +177,7 @@ void write_aabbtree(Writer& w) {
 
 // Places every node (pre-order), encodes the leaves, refits, then writes
 // the nodes with the refitted boxes.
-void fill_aabbtree(Writer& w) {
+void fill_aabbtree(Writer& w, bool split_axis, const std::vector<uint8_t>& axis) {
   const BuildTree& t = w.tree;
   std::vector<uint32_t> offset(t.nodes.size());
   std::function<uint32_t(uint32_t, uint32_t)> place = [&](uint32_t n, uint32_t at) -> uint32_t {
@@ -195,6 +195,7 @@ void fill_aabbtree(Writer& w) {
     layout::AABBNode node{};
     for (int a = 0; a < 3; ++a) node.min[a] = b.box.min[a], node.max[a] = b.box.max[a];
     node.properties = b.leaf() ? (MC_AABB_LEAF_BIT | b.count) : offset[b.right];
+    if (split_axis && !b.leaf()) node.properties |= uint32_t(axis[n]) << MC_SPLITAXIS_SHIFT;
     std::memcpy(w.bytes.data() + w.h.tree_offset + offset[n], &node, sizeof node);
   }
 }
@@ -289,6 +290,24 @@ void fill_bruteforce(Writer& w) {
     at += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
   }
   w.frame(all);
+}
+
+// AABBTreeSplitAxis (§5.2): each interior node's axis is the one along which
+// its children's centres lie farthest apart, and its children are ordered
+// lower first along it. (The builders do not record the axis they split on;
+// this one is the axis that separates the two children most.)
+std::vector<uint8_t> order_by_split_axis(BuildTree& t) {
+  std::vector<uint8_t> axis(t.nodes.size(), 0);
+  for (size_t n = 0; n < t.nodes.size(); ++n) {
+    BuildNode& b = t.nodes[n];
+    if (b.leaf()) continue;
+    Vec3 l = t.nodes[b.left].box.centre(), r = t.nodes[b.right].box.centre();
+    float d[3] = {std::fabs(l.x - r.x), std::fabs(l.y - r.y), std::fabs(l.z - r.z)};
+    int a = d[0] >= d[1] && d[0] >= d[2] ? 0 : (d[1] >= d[2] ? 1 : 2);
+    axis[n] = uint8_t(a);
+    if (l[a] > r[a]) std::swap(b.left, b.right);
+  }
+  return axis;
 }
 
 // QuadTree (§5.6): every binary node that stays a node takes up to four
@@ -452,6 +471,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
                                                        : build_tree(boxes, o.splitter, o.leaf_size);
+  std::vector<uint8_t> split_axes;
+  if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) split_axes = order_by_split_axis(tree);
   uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
@@ -462,8 +483,11 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   if (o.tree_format == MC_TREE_BRUTEFORCE) {
     write_bruteforce(writer);
     depth = 0;
-  } else if (o.tree_format == MC_TREE_AABBTREE) {
+  } else if (o.tree_format == MC_TREE_AABBTREE || o.tree_format == MC_TREE_AABBTREESPLITAXIS) {
     write_aabbtree(writer);
+    if (o.tree_format == MC_TREE_AABBTREESPLITAXIS && hd.tree_size > MC_SPLITAXIS_OFFSET_MASK)
+      throw InputError(name + ": the AABBTreeSplitAxis section of " + std::to_string(hd.tree_size) +
+                       " bytes exceeds its 29-bit child offsets (seed 000 5.2)");
   } else {
     plan = plan_quadtree(tree);
     depth = plan.depth;
@@ -480,7 +504,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   writer.bytes.assign(hd.vertex_offset, 0);
   try {
     if (o.tree_format == MC_TREE_BRUTEFORCE) fill_bruteforce(writer);
-    else if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer);
+    else if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer, false, {});
+    else if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) fill_aabbtree(writer, true, split_axes);
     else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
     else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
   } catch (const std::length_error& e) {  // a codec's own limit (index width)
@@ -555,7 +580,8 @@ bool moves_vertices(uint32_t triangle_format) {
 
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT,
+                     MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
       names.push_back(layout_name(t, c));
   return names;
@@ -570,7 +596,8 @@ BuildOptions parse_layout(const std::string& text) {
     for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     return s;
   };
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT,
+                     MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
       if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8, Splitter::Binning};
   std::string valid;

@@ -8,4 +8,5 @@
   X(AABBTree, MC_TREE_AABBTREE)                     \
   X(QuadTree, MC_TREE_QUADTREE)                     \
   X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT)   \
-  X(BruteForce, MC_TREE_BRUTEFORCE)
+  X(BruteForce, MC_TREE_BRUTEFORCE)                 \
+  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS)

@@ -23,6 +23,7 @@ constexpr WalkFn walker_for(uint32_t tree) {
     case MC_TREE_QUADTREE: return &walk_quadtree<layout::QuadBoundsFloat, Codec>;
     case MC_TREE_QUADTREEHALFFLOAT: return &walk_quadtree<layout::QuadBoundsHalf, Codec>;
     case MC_TREE_BRUTEFORCE: return &walk_bruteforce<Codec>;
+    case MC_TREE_AABBTREESPLITAXIS: return &walk_aabbtree_splitaxis<Codec>;
   }
   return nullptr;
 }

@@ -45,8 +45,40 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   });
 }
 
-#define MC_INSTANTIATE(Codec, name) \
-  template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
+// AABBTreeSplitAxis walker (seed 000 §5.2): a node's box is tested when it
+// is reached; an interior node sends the ray first into the child on its
+// side of the split axis (the first child is the lower one) and pushes the
+// other.
+template <class Codec>
+void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  const uint8_t* tree = blob + h.tree_offset;
+  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+    uint32_t stack[MC_MAX_DEPTH + 2];
+    int top = -1;
+    uint32_t at = 0;
+    for (;;) {
+      layout::AABBNode node = layout::load_aabb_node(tree + at);
+      if (box_test(r, node.min, node.max, c.t) != INFINITY) {
+        if (!node.is_leaf()) {
+          uint32_t lower = at + MC_AABB_NODE_BYTES, upper = layout::aabb_second_child(node, true);
+          bool positive = !r.near_is_max[layout::aabb_split_axis(node)];
+          stack[++top] = positive ? upper : lower;
+          at = positive ? lower : upper;
+          continue;
+        }
+        uint32_t block = at + MC_AABB_NODE_BYTES;
+        test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
+      }
+      if (top < 0) break;
+      at = stack[top--];
+    }
+  });
+}
+
+#define MC_INSTANTIATE(Codec, name)                                                                 \
+  template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*); \
+  template void walk_aabbtree_splitaxis<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -3,6 +3,7 @@
 // Properties high bit set: leaf, low bits = triangle count, block follows the
 // node. Clear: first child follows the node, low bits = tree-section offset of
 // the second child. The root node sits at tree-section offset 0.
+// AABBTreeSplitAxis (§5.2) uses the same node, see aabb_second_child.
 #pragma once
 #include <cstring>
 
@@ -21,5 +22,12 @@ struct AABBNode {
 static_assert(sizeof(AABBNode) == MC_AABB_NODE_BYTES);
 
 inline AABBNode load_aabb_node(const uint8_t* p) { return load<AABBNode>(p); }
+
+// The second child of an interior node: AABBTree keeps 31 bits of offset,
+// AABBTreeSplitAxis 29 (two bits of split axis above them).
+inline uint32_t aabb_second_child(const AABBNode& n, bool split_axis) {
+  return split_axis ? n.properties & MC_SPLITAXIS_OFFSET_MASK : n.value();
+}
+inline uint32_t aabb_split_axis(const AABBNode& n) { return (n.properties >> MC_SPLITAXIS_SHIFT) & 3; }
 
 }  // namespace meshcast::layout

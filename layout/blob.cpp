@@ -39,6 +39,7 @@ std::string_view tree_format_name(uint32_t f) {
     case MC_TREE_QUADTREE: return "QuadTree";
     case MC_TREE_QUADTREEHALFFLOAT: return "QuadTreeHalfFloat";
     case MC_TREE_BRUTEFORCE: return "BruteForce";
+    case MC_TREE_AABBTREESPLITAXIS: return "AABBTreeSplitAxis";
   }
   return "";
 }
@@ -97,16 +98,20 @@ std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
       return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
     AABBNode n = load_aabb_node(blob + h.tree_offset + it.offset);
     uint32_t next = it.offset + MC_AABB_NODE_BYTES;
+    const bool split_axis = h.tree_format == MC_TREE_AABBTREESPLITAXIS;
     if (n.is_leaf()) {
       std::string e = check_leaf<Codec>(blob, h, next, n.value());
       if (!e.empty()) return e;
       *triangles += n.value();
     } else {
-      if (n.value() <= next)
-        return "node at tree offset " + num(it.offset) + " has its second child at " + num(n.value()) +
+      uint32_t second = aabb_second_child(n, split_axis);
+      if (second <= next)
+        return "node at tree offset " + num(it.offset) + " has its second child at " + num(second) +
                ", not after its first child";
+      if (split_axis && aabb_split_axis(n) > 2)
+        return "node at tree offset " + num(it.offset) + " names split axis " + num(aabb_split_axis(n)) + " (0..2)";
       stack.push_back({next, it.depth + 1});
-      stack.push_back({n.value(), it.depth + 1});
+      stack.push_back({second, it.depth + 1});
     }
   }
   return "";
@@ -168,7 +173,8 @@ template <class Codec>
 std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   switch (h.tree_format) {
     case MC_TREE_BRUTEFORCE: return walk_bruteforce<Codec>(blob, h, triangles);
-    case MC_TREE_AABBTREE: return walk_aabbtree<Codec>(blob, h, triangles);
+    case MC_TREE_AABBTREE:
+    case MC_TREE_AABBTREESPLITAXIS: return walk_aabbtree<Codec>(blob, h, triangles);
     case MC_TREE_QUADTREE: return walk_quadtree<QuadBoundsFloat, Codec>(blob, h, triangles);
     case MC_TREE_QUADTREEHALFFLOAT: return walk_quadtree<QuadBoundsHalf, Codec>(blob, h, triangles);
   }
@@ -207,7 +213,8 @@ std::string validate(std::span<const uint8_t> blob) {
              ") overlaps another, is misaligned, or runs past the blob (" + num(blob.size()) + " bytes)";
     end = uint64_t(s.offset) + s.size;
   }
-  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE     ? MC_AABB_NODE_BYTES
+  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS
+                           ? MC_AABB_NODE_BYTES
                        : h.tree_format == MC_TREE_QUADTREE   ? MC_QUAD_NODE_BYTES
                        : h.tree_format == MC_TREE_BRUTEFORCE ? MC_BRUTE_RECORD_BYTES
                                                              : MC_QUADHALF_NODE_BYTES;

@@ -15,6 +15,7 @@
 #define MC_TREE_QUADTREE 2u            // §5.6
 #define MC_TREE_QUADTREEHALFFLOAT 3u   // §5.7
 #define MC_TREE_BRUTEFORCE 4u          // §3.11: no tree, every triangle tested
+#define MC_TREE_AABBTREESPLITAXIS 5u   // §5.2
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
@@ -47,6 +48,11 @@
 #define MC_AABB_NODE_BYTES 28u
 #define MC_AABB_LEAF_BIT 0x80000000u
 #define MC_AABB_VALUE_MASK 0x7FFFFFFFu
+// AABBTreeSplitAxis (§5.2): an interior node's properties keep 2 bits of
+// split axis above a 29-bit second-child offset; its first child is the one
+// lower along that axis.
+#define MC_SPLITAXIS_SHIFT 29u
+#define MC_SPLITAXIS_OFFSET_MASK 0x1FFFFFFFu
 
 // QuadTree / QuadTreeHalfFloat child properties (§5.6): 5 bits of triangle
 // count on top (0: the child is a node), 27 bits of offset below.

@@ -24,7 +24,7 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint3
 #undef MC_BYTES
       at += MC_BRUTE_RECORD_BYTES + bytes;
     }
-  } else if (h.tree_format == MC_TREE_AABBTREE) {
+  } else if (h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS) {
     std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
       uint32_t at = stack.back();
@@ -33,7 +33,7 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint3
       if (n.is_leaf()) {
         visit(at + MC_AABB_NODE_BYTES, n.value());
       } else {
-        stack.push_back(n.value());
+        stack.push_back(aabb_second_child(n, h.tree_format == MC_TREE_AABBTREESPLITAXIS));
         stack.push_back(at + MC_AABB_NODE_BYTES);
       }
     }
@@ -61,7 +61,7 @@ void for_each_leaf_box(const uint8_t* blob,
     const float lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
     return for_each_leaf(blob, [&](uint32_t block, uint32_t count) { visit(block, count, lo, hi); });
   }
-  if (h.tree_format == MC_TREE_AABBTREE) {
+  if (h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS) {
     return for_each_leaf(blob, [&](uint32_t block, uint32_t count) {
       AABBNode n = load_aabb_node(tree + block - MC_AABB_NODE_BYTES);
       visit(block, count, n.min, n.max);

@@ -247,6 +247,28 @@ TEST(GoldenBytes, Indexed8BitPackSOA4IsSeed39) {
   }
 }
 
+TEST(GoldenBytes, AABBTreeSplitAxisIsSeed52) {
+  std::vector<uint8_t> b = build_blob(make_sphere(8, 16, 1, {0, 0, 0}), parse_layout("AABBTreeSplitAxis/Float3"), "s");
+  const size_t tree = 192;
+  size_t interior = 0;
+  std::vector<uint32_t> stack{0};
+  while (!stack.empty()) {
+    uint32_t node = stack.back();
+    stack.pop_back();
+    uint32_t props = at<uint32_t>(b, tree + node + 24);
+    if (props & 0x80000000u) continue;  // leaf
+    ++interior;
+    uint32_t axis = props >> 29, second = props & 0x1FFFFFFFu, first = node + 28;
+    ASSERT_LE(axis, 2u);
+    // Node: min at 0, max at 12; the first child is the lower along the axis.
+    float first_centre = at<float>(b, tree + first + 4 * axis) + at<float>(b, tree + first + 12 + 4 * axis);
+    float second_centre = at<float>(b, tree + second + 4 * axis) + at<float>(b, tree + second + 12 + 4 * axis);
+    EXPECT_LE(first_centre, second_centre);
+    stack.push_back(first), stack.push_back(second);
+  }
+  EXPECT_GT(interior, 10u);
+}
+
 // Hand-made structural faults, re-sealed so only the structure is judged.
 std::string corrupt(std::vector<uint8_t> b, size_t offset, uint32_t value) {
   std::memcpy(b.data() + offset, &value, 4);

@@ -310,6 +310,68 @@ std::vector<uint8_t> order_by_split_axis(BuildTree& t) {
   return axis;
 }
 
+// AABBTreePNS (§5.3, seed 002): nodes depth first by index, then the blocks.
+struct PnsPlan {
+  std::vector<uint32_t> index;  // per binary node: its node index
+  std::vector<uint32_t> block;  // per binary leaf: tree-section offset of its block
+  std::vector<uint32_t> leaves; // leaves in block order
+};
+
+PnsPlan plan_pns(Writer& w) {
+  const BuildTree& t = w.tree;
+  PnsPlan p{std::vector<uint32_t>(t.nodes.size()), std::vector<uint32_t>(t.nodes.size()), {}};
+  uint32_t next = 0;
+  std::function<void(uint32_t)> visit = [&](uint32_t n) {
+    p.index[n] = next++;
+    if (t.nodes[n].leaf()) return p.leaves.push_back(n);
+    visit(t.nodes[n].left);
+    visit(t.nodes[n].right);
+  };
+  visit(0);
+  uint64_t base = uint64_t(next) * MC_AABB_NODE_BYTES, at = base;
+  for (uint32_t leaf : p.leaves) {
+    p.block[leaf] = uint32_t(at);
+    if ((at - base) / 4 > MC_PNS_BLOCK_MASK) throw InputError("AABBTreePNS: triangle blocks beyond its 26-bit offsets (256 MiB)");
+    at += w.leaf_bytes[leaf];
+  }
+  if (next > MC_PNS_INDEX_MASK) throw InputError("AABBTreePNS: more than 2^23 nodes");
+  if (at > 0x7FFFFFFFu) throw InputError("AABBTreePNS: the tree section exceeds 2 GiB");
+  w.h.node_count = next;
+  w.h.node_bytes = uint32_t(base);
+  w.h.triangle_base = uint32_t(base);
+  w.h.tree_size = uint32_t(at);
+  w.h.root = 0;
+  return p;
+}
+
+// The 8 bits of seed 002: for the octant with sign bits (x, y, z), bit
+// z | y << 1 | x << 2 is set when the second child's centre lies nearer
+// along that octant's diagonal.
+uint32_t pns_code(const Box3& first, const Box3& second) {
+  Vec3 a = first.centre(), b = second.centre();
+  uint32_t code = 0;
+  for (uint32_t octant = 0; octant < 8; ++octant) {
+    float dx = octant & 4 ? -1.0f : 1.0f, dy = octant & 2 ? -1.0f : 1.0f, dz = octant & 1 ? -1.0f : 1.0f;
+    double d = double(a.x - b.x) * dx + double(a.y - b.y) * dy + double(a.z - b.z) * dz;
+    if (d > 0) code |= 1u << octant;
+  }
+  return code;
+}
+
+void fill_pns(Writer& w, const PnsPlan& p) {
+  const BuildTree& t = w.tree;
+  for (uint32_t leaf : p.leaves) w.write_leaf(leaf, p.block[leaf]);
+  w.refit();
+  for (uint32_t n = 0; n < t.nodes.size(); ++n) {
+    const BuildNode& b = t.nodes[n];
+    layout::AABBNode node{};
+    for (int a = 0; a < 3; ++a) node.min[a] = b.box.min[a], node.max[a] = b.box.max[a];
+    node.properties = b.leaf() ? MC_AABB_LEAF_BIT | b.count << MC_PNS_COUNT_SHIFT | (p.block[n] - w.h.triangle_base) / 4
+                               : pns_code(t.nodes[b.left].box, t.nodes[b.right].box) << MC_PNS_SHIFT | p.index[b.right];
+    std::memcpy(w.bytes.data() + w.h.tree_offset + uint64_t(p.index[n]) * MC_AABB_NODE_BYTES, &node, sizeof node);
+  }
+}
+
 // QuadTree (§5.6): every binary node that stays a node takes up to four
 // children, found by opening its largest interior descendant until four are
 // reached. Nodes are written depth first, triangle blocks after all nodes
@@ -479,10 +541,13 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   writer.measure_leaves();
 
   QuadPlan plan;
+  PnsPlan pns_plan;
   uint32_t depth = tree.depth;
   if (o.tree_format == MC_TREE_BRUTEFORCE) {
     write_bruteforce(writer);
     depth = 0;
+  } else if (o.tree_format == MC_TREE_AABBTREEPNS) {
+    pns_plan = plan_pns(writer);
   } else if (o.tree_format == MC_TREE_AABBTREE || o.tree_format == MC_TREE_AABBTREESPLITAXIS) {
     write_aabbtree(writer);
     if (o.tree_format == MC_TREE_AABBTREESPLITAXIS && hd.tree_size > MC_SPLITAXIS_OFFSET_MASK)
@@ -506,6 +571,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     if (o.tree_format == MC_TREE_BRUTEFORCE) fill_bruteforce(writer);
     else if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer, false, {});
     else if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) fill_aabbtree(writer, true, split_axes);
+    else if (o.tree_format == MC_TREE_AABBTREEPNS) fill_pns(writer, pns_plan);
     else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
     else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
   } catch (const std::length_error& e) {  // a codec's own limit (index width)
@@ -580,8 +646,8 @@ bool moves_vertices(uint32_t triangle_format) {
 
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT,
-                     MC_TREE_BRUTEFORCE})
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_AABBTREEPNS, MC_TREE_QUADTREE,
+                     MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
       names.push_back(layout_name(t, c));
   return names;
@@ -596,8 +662,8 @@ BuildOptions parse_layout(const std::string& text) {
     for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     return s;
   };
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_QUADTREE, MC_TREE_QUADTREEHALFFLOAT,
-                     MC_TREE_BRUTEFORCE})
+  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_AABBTREEPNS, MC_TREE_QUADTREE,
+                     MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
     for (uint32_t c : triangle_formats())
       if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8, Splitter::Binning};
   std::string valid;

@@ -9,4 +9,5 @@
   X(QuadTree, MC_TREE_QUADTREE)                     \
   X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT)   \
   X(BruteForce, MC_TREE_BRUTEFORCE)                 \
-  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS)
+  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS)   \
+  X(AABBTreePNS, MC_TREE_AABBTREEPNS)

@@ -24,6 +24,7 @@ constexpr WalkFn walker_for(uint32_t tree) {
     case MC_TREE_QUADTREEHALFFLOAT: return &walk_quadtree<layout::QuadBoundsHalf, Codec>;
     case MC_TREE_BRUTEFORCE: return &walk_bruteforce<Codec>;
     case MC_TREE_AABBTREESPLITAXIS: return &walk_aabbtree_splitaxis<Codec>;
+    case MC_TREE_AABBTREEPNS: return &walk_aabbtree_pns<Codec>;
   }
   return nullptr;
 }

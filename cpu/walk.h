@@ -22,6 +22,9 @@ template <class Codec>
 void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
 
 template <class Codec>
+void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+
+template <class Codec>
 void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
 
 // Turns the closest slot into the caller's hit.

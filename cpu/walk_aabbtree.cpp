@@ -76,7 +76,38 @@ void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, si
   });
 }
 
+// AABBTreePNS walker (seed 000 §5.3, seed 002): as AABBTreeSplitAxis, but
+// the near child is one AND away: bit octant(dir) of the node's 8 bits.
+template <class Codec>
+void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  const uint8_t* tree = blob + h.tree_offset;
+  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+    const uint32_t octant = layout::pns_octant(r.dir);
+    uint32_t stack[MC_MAX_DEPTH + 2];
+    int top = -1;
+    uint32_t index = 0;
+    for (;;) {
+      layout::AABBNode node = layout::load_aabb_node(tree + uint64_t(index) * MC_AABB_NODE_BYTES);
+      if (box_test(r, node.min, node.max, c.t) != INFINITY) {
+        if (!node.is_leaf()) {
+          uint32_t children[2] = {index + 1, layout::pns_second_index(node)};
+          uint32_t bit = layout::pns_bits(node) >> octant & 1;
+          stack[++top] = children[bit ^ 1];
+          index = children[bit];
+          continue;
+        }
+        uint32_t block = layout::pns_leaf_block(node, h);
+        test_leaf<Codec>(blob, r, h.tree_offset + block, layout::pns_leaf_count(node), layout::slot_of(h, block, 0), c);
+      }
+      if (top < 0) break;
+      index = stack[top--];
+    }
+  });
+}
+
 #define MC_INSTANTIATE(Codec, name)                                                                 \
+  template void walk_aabbtree_pns<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*); \
   template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*); \
   template void walk_aabbtree_splitaxis<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)

@@ -5,6 +5,7 @@
 // the second child. The root node sits at tree-section offset 0.
 // AABBTreeSplitAxis (§5.2) uses the same node, see aabb_second_child.
 #pragma once
+#include <cmath>
 #include <cstring>
 
 #include "layout/blob.h"
@@ -29,5 +30,17 @@ inline uint32_t aabb_second_child(const AABBNode& n, bool split_axis) {
   return split_axis ? n.properties & MC_SPLITAXIS_OFFSET_MASK : n.value();
 }
 inline uint32_t aabb_split_axis(const AABBNode& n) { return (n.properties >> MC_SPLITAXIS_SHIFT) & 3; }
+
+// AABBTreePNS fields (see formats.h).
+inline uint32_t pns_bits(const AABBNode& n) { return (n.properties >> MC_PNS_SHIFT) & 0xFF; }
+inline uint32_t pns_second_index(const AABBNode& n) { return n.properties & MC_PNS_INDEX_MASK; }
+inline uint32_t pns_leaf_count(const AABBNode& n) { return (n.properties >> MC_PNS_COUNT_SHIFT) & 31; }
+inline uint32_t pns_leaf_block(const AABBNode& n, const BlobHeader& h) {
+  return h.triangle_base + 4 * (n.properties & MC_PNS_BLOCK_MASK);
+}
+// The octant bit of seed 002: sign bits of the direction, z | y << 1 | x << 2.
+inline uint32_t pns_octant(const float dir[3]) {
+  return uint32_t(std::signbit(dir[2])) | uint32_t(std::signbit(dir[1])) << 1 | uint32_t(std::signbit(dir[0])) << 2;
+}
 
 }  // namespace meshcast::layout

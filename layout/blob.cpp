@@ -40,6 +40,7 @@ std::string_view tree_format_name(uint32_t f) {
     case MC_TREE_QUADTREEHALFFLOAT: return "QuadTreeHalfFloat";
     case MC_TREE_BRUTEFORCE: return "BruteForce";
     case MC_TREE_AABBTREESPLITAXIS: return "AABBTreeSplitAxis";
+    case MC_TREE_AABBTREEPNS: return "AABBTreePNS";
   }
   return "";
 }
@@ -152,6 +153,38 @@ std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
   return "";
 }
 
+// AABBTreePNS: nodes by index, each child after its parent.
+template <class Codec>
+std::string walk_pns(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  struct Item { uint32_t index, depth; };
+  std::vector<Item> stack{{0, 0}};
+  uint64_t visited = 0;
+  if (h.node_count == 0 || uint64_t(h.node_count) * MC_AABB_NODE_BYTES != h.triangle_base)
+    return "AABBTreePNS: the triangle base must follow the " + num(h.node_count) + " nodes";
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    if (++visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
+    if (it.index >= h.node_count) return "node index " + num(it.index) + " past the " + num(h.node_count) + " nodes";
+    if (it.depth > h.max_depth || it.depth > MC_MAX_DEPTH)
+      return "node " + num(it.index) + " is deeper than the limit " + num(MC_MAX_DEPTH);
+    AABBNode n = load_aabb_node(blob + h.tree_offset + uint64_t(it.index) * MC_AABB_NODE_BYTES);
+    if (n.is_leaf()) {
+      uint64_t block = uint64_t(h.triangle_base) + 4ull * (n.properties & MC_PNS_BLOCK_MASK);
+      if (block > h.tree_size) return "leaf " + num(it.index) + " points past the tree section";
+      std::string e = check_leaf<Codec>(blob, h, uint32_t(block), pns_leaf_count(n));
+      if (!e.empty()) return e;
+      *triangles += pns_leaf_count(n);
+      continue;
+    }
+    uint32_t second = pns_second_index(n);
+    if (second <= it.index + 1) return "node " + num(it.index) + " has its second child at " + num(second) + ", not after its first";
+    stack.push_back({it.index + 1, it.depth + 1});
+    stack.push_back({second, it.depth + 1});
+  }
+  return "";
+}
+
 // BruteForce: the records must tile the tree section exactly.
 template <class Codec>
 std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
@@ -173,6 +206,7 @@ template <class Codec>
 std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   switch (h.tree_format) {
     case MC_TREE_BRUTEFORCE: return walk_bruteforce<Codec>(blob, h, triangles);
+    case MC_TREE_AABBTREEPNS: return walk_pns<Codec>(blob, h, triangles);
     case MC_TREE_AABBTREE:
     case MC_TREE_AABBTREESPLITAXIS: return walk_aabbtree<Codec>(blob, h, triangles);
     case MC_TREE_QUADTREE: return walk_quadtree<QuadBoundsFloat, Codec>(blob, h, triangles);
@@ -213,7 +247,8 @@ std::string validate(std::span<const uint8_t> blob) {
              ") overlaps another, is misaligned, or runs past the blob (" + num(blob.size()) + " bytes)";
     end = uint64_t(s.offset) + s.size;
   }
-  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS
+  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS ||
+                               h.tree_format == MC_TREE_AABBTREEPNS
                            ? MC_AABB_NODE_BYTES
                        : h.tree_format == MC_TREE_QUADTREE   ? MC_QUAD_NODE_BYTES
                        : h.tree_format == MC_TREE_BRUTEFORCE ? MC_BRUTE_RECORD_BYTES

@@ -16,6 +16,7 @@
 #define MC_TREE_QUADTREEHALFFLOAT 3u   // §5.7
 #define MC_TREE_BRUTEFORCE 4u          // §3.11: no tree, every triangle tested
 #define MC_TREE_AABBTREESPLITAXIS 5u   // §5.2
+#define MC_TREE_AABBTREEPNS 6u         // §5.3 and seed 002
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
@@ -53,6 +54,19 @@
 // lower along that axis.
 #define MC_SPLITAXIS_SHIFT 29u
 #define MC_SPLITAXIS_OFFSET_MASK 0x1FFFFFFFu
+// AABBTreePNS (§5.3, seed 002): the AABBTree node, written nodes first (depth
+// first, node k at 28 k, first child k + 1) and triangle blocks after them,
+// so properties address nodes by index and blocks in 4-byte units:
+//   interior: bit 31 clear, 8 precomputed-node-sorting bits (23-30), second
+//             child's node index (0-22: 8M nodes)
+//   leaf:     bit 31 set, triangle count (26-30), block offset / 4 from the
+//             triangle base (0-25: 256 MiB)
+// The source kept byte offsets beside the 8 bits and ran out of them on its
+// 2.26M-triangle scene; these reach about 64M triangles at 8 a leaf.
+#define MC_PNS_SHIFT 23u
+#define MC_PNS_INDEX_MASK 0x007FFFFFu
+#define MC_PNS_COUNT_SHIFT 26u
+#define MC_PNS_BLOCK_MASK 0x03FFFFFFu
 
 // QuadTree / QuadTreeHalfFloat child properties (§5.6): 5 bits of triangle
 // count on top (0: the child is a node), 27 bits of offset below.

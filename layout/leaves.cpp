@@ -24,6 +24,11 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint3
 #undef MC_BYTES
       at += MC_BRUTE_RECORD_BYTES + bytes;
     }
+  } else if (h.tree_format == MC_TREE_AABBTREEPNS) {
+    for (uint32_t k = 0; k < h.node_count; ++k) {
+      AABBNode n = load_aabb_node(tree + uint64_t(k) * MC_AABB_NODE_BYTES);
+      if (n.is_leaf()) visit(pns_leaf_block(n, h), pns_leaf_count(n));
+    }
   } else if (h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS) {
     std::vector<uint32_t> stack{0};
     while (!stack.empty()) {
@@ -60,6 +65,13 @@ void for_each_leaf_box(const uint8_t* blob,
   if (h.tree_format == MC_TREE_BRUTEFORCE) {
     const float lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
     return for_each_leaf(blob, [&](uint32_t block, uint32_t count) { visit(block, count, lo, hi); });
+  }
+  if (h.tree_format == MC_TREE_AABBTREEPNS) {
+    for (uint32_t k = 0; k < h.node_count; ++k) {
+      AABBNode n = load_aabb_node(tree + uint64_t(k) * MC_AABB_NODE_BYTES);
+      if (n.is_leaf()) visit(pns_leaf_block(n, h), pns_leaf_count(n), n.min, n.max);
+    }
+    return;
   }
   if (h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS) {
     return for_each_leaf(blob, [&](uint32_t block, uint32_t count) {

@@ -269,6 +269,27 @@ TEST(GoldenBytes, AABBTreeSplitAxisIsSeed52) {
   EXPECT_GT(interior, 10u);
 }
 
+TEST(GoldenBytes, AABBTreePNSIsSeed53And002) {
+  Mesh m;  // two triangles 10 apart along x: the octants with x < 0 see the second first
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {10, 0, 0}, {11, 0, 0}, {10, 1, 0}};
+  m.triangles = {{0, 1, 2}, {3, 4, 5}};
+  BuildOptions o = parse_layout("AABBTreePNS/Float3");
+  o.leaf_size = 1;
+  std::vector<uint8_t> b = build_blob(m, o, "pns");
+  const size_t tree = 192;
+  uint32_t root = at<uint32_t>(b, tree + 24);
+  EXPECT_EQ(root >> 31, 0u);
+  EXPECT_EQ(root >> 23 & 0xFF, 0xF0u);  // bit z | y << 1 | x << 2 set for x negative
+  EXPECT_EQ(root & 0x7FFFFFu, 2u);      // second child: node 2 (node 1 is the first)
+  uint32_t first = at<uint32_t>(b, tree + 28 + 24), second = at<uint32_t>(b, tree + 56 + 24);
+  EXPECT_EQ(first >> 31, 1u);
+  EXPECT_EQ(first >> 26 & 31, 1u);  // one triangle
+  EXPECT_EQ(at<float>(b, tree + 28 + 0), 0.0f);   // the lower child first
+  EXPECT_EQ(at<float>(b, tree + 56 + 0), 10.0f);
+  // Blocks follow the 3 nodes, 4-byte units from there.
+  EXPECT_EQ(192 + 3 * 28 + 4 * (second & 0x3FFFFFFu), 192 + 3 * 28 + 36u);
+}
+
 // Hand-made structural faults, re-sealed so only the structure is judged.
 std::string corrupt(std::vector<uint8_t> b, size_t offset, uint32_t value) {
   std::memcpy(b.data() + offset, &value, 4);

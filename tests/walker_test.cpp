@@ -102,6 +102,7 @@ TEST(WalkerVsOracleLarge, Terrain1M) {
 TEST(LeafBoundsContainDecodedCorners, EveryLayoutEveryMesh) {
   for (const NamedMesh& m : test_meshes(false))
     for (const std::string& name : layout_names()) {
+      if (m.name == "armadillo" || m.name == "refined_elephant") continue;  // bunny00 and the dragon suffice
       if (name.rfind("BruteForce/", 0) == 0) continue;
       std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
       const layout::BlobHeader& h = layout::header_of(blob.data());

@@ -53,4 +53,21 @@ std::vector<TreeRow> bench_leafsize(const Mesh& mesh, const std::string& name, s
   return rows;
 }
 
+std::vector<TreeRow> bench_trees(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat) {
+  // Seed 000 §6: time for 1024 rays and tree size without triangles (bytes),
+  // Stanford Bunny, Float3, Binning, 8 triangles a leaf.
+  const std::map<std::string, std::pair<double, double>> seed = {
+      {"QuadTree", {0.53, 646340}}, {"QuadTreeHalfFloat", {0.54, 378212}}, {"AABBTree", {0.62, 651476}},
+      {"AABBTreeSplitAxis", {0.67, 651476}}, {"AABBTreePNS", {0.68, 651476}}};
+  Setup s = setup(mesh, rays);
+  std::vector<TreeRow> rows;
+  for (const char* tree : {"QuadTree", "QuadTreeHalfFloat", "AABBTree", "AABBTreeSplitAxis", "AABBTreePNS"}) {
+    BuildOptions o = parse_layout(std::string(tree) + "/Float3");
+    TreeRow row{tree, std::string(tree) + "/Float3", seed.at(tree).first, measure(mesh, name, o, s.rays, s.oracle, repeat)};
+    row.seed_tree_bytes = seed.at(tree).second;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 }  // namespace meshcast::bench

@@ -108,7 +108,9 @@ TEST(Splitters, EveryOneRespectsTheLeafSizeAndCoversEveryTriangleOnce) {
       }
       for (int c : seen) ASSERT_EQ(c, 1) << splitter_name(s);
       // FixedLeafSize: whole groups of 4, but for the one short group.
-      if (s == Splitter::FixedLeafSize && leaf >= 4) EXPECT_LE(not_multiple_of_4, 1u);
+      if (s == Splitter::FixedLeafSize && leaf >= 4) {
+        EXPECT_LE(not_multiple_of_4, 1u);
+      }
       EXPECT_LE(t.depth, 48u) << splitter_name(s);
     }
   EXPECT_EQ(parse_splitter("morton"), Splitter::Morton);

@@ -65,10 +65,11 @@ void add_bench(CLI::App& app) {
   });
 
   // §4.1 and §4.2: the same columns, one table each.
-  for (const char* which : {"splitters", "leafsize"}) {
+  for (const char* which : {"splitters", "leafsize", "trees"}) {
     auto targs = std::make_shared<ArgsT>();
     std::string what = std::string(which) == "splitters" ? "seed 000 4.1: every splitter, AABBTree with Float3 and Float3SOA4, leaf 8"
-                                                         : "seed 000 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning";
+                       : std::string(which) == "leafsize" ? "seed 000 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning"
+                                                          : "seed 000 6: every tree format with Float3, Binning, leaf 8";
     CLI::App* sub = bench->add_subcommand(which, what);
     sub->add_option("mesh", targs->input, "mesh file (default data/bunny00.off)");
     sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
@@ -78,24 +79,27 @@ void add_bench(CLI::App& app) {
     sub->callback([targs, kind] {
       Mesh mesh = read_mesh(targs->input);
       std::filesystem::create_directories(targs->out_dir);
-      std::vector<bench::TreeRow> rows = kind == "splitters"
-                                             ? bench::bench_splitters(mesh, targs->input, targs->rays, targs->repeat)
-                                             : bench::bench_leafsize(mesh, targs->input, targs->rays, targs->repeat);
+      std::vector<bench::TreeRow> rows =
+          kind == "splitters" ? bench::bench_splitters(mesh, targs->input, targs->rays, targs->repeat)
+          : kind == "leafsize" ? bench::bench_leafsize(mesh, targs->input, targs->rays, targs->repeat)
+                               : bench::bench_trees(mesh, targs->input, targs->rays, targs->repeat);
       double scale = 1024.0 / double(targs->rays);
       std::printf("\n%s, %zu triangles, %zu long rays, one thread; ms for 1024 rays (minimum of %u passes, median "
                   "beside it); seed column: seed 000 (i7-7700HQ, 2019)\n\n",
                   targs->input.c_str(), mesh.triangles.size(), targs->rays, targs->repeat);
-      std::printf("| %s | layout | ms (min) | median | seed | build ms | SAH cost | tree B/tri | walked B/tri | "
-                  "disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
-                  kind == "splitters" ? "splitter" : "leaf size");
+      std::printf("| %s | layout | ms (min) | median | seed | build ms | SAH cost | tree bytes (seed) | tree B/tri | "
+                  "walked B/tri | disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+                  kind == "splitters" ? "splitter" : kind == "leafsize" ? "leaf size" : "tree");
       std::ofstream csv(targs->out_dir + "/" + kind + ".csv");
       csv << "label,layout,min_ms_1024,median_ms_1024,seed,build_ms,sah_cost,tree_bytes_per_tri,walked_bytes_per_tri,"
              "disagreements\n";
       for (const bench::TreeRow& r : rows) {
         const bench::Timing& t = r.timing;
-        std::printf("| %s | %s | %.3f | %.3f | %.2f | %.0f | %.1f | %.2f | %.2f | %llu |\n", r.label.c_str(),
+        std::string seed_bytes = r.seed_tree_bytes > 0 ? " (" + std::to_string(uint64_t(r.seed_tree_bytes)) + ")" : "";
+        std::printf("| %s | %s | %.3f | %.3f | %.2f | %.0f | %.1f | %.0f%s | %.2f | %.2f | %llu |\n", r.label.c_str(),
                     r.layout.c_str(), t.min_ms * scale, t.median_ms * scale, r.seed_ms, t.build_ms, t.sah_cost,
-                    t.tree_bytes, t.walked_bytes, (unsigned long long)t.disagreements);
+                    t.tree_bytes * double(mesh.triangles.size()), seed_bytes.c_str(), t.tree_bytes, t.walked_bytes,
+                    (unsigned long long)t.disagreements);
         csv << r.label << "," << r.layout << "," << t.min_ms * scale << "," << t.median_ms * scale << "," << r.seed_ms
             << "," << t.build_ms << "," << t.sah_cost << "," << t.tree_bytes << "," << t.walked_bytes << ","
             << t.disagreements << "\n";

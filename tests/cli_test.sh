@@ -42,6 +42,11 @@ if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
             <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then
   echo "FAIL hits of two layouts differ"; failures=$((failures + 1))
 fi
+check bench-encodings 0 "csv: .*encodings.csv" -- "$meshcast" bench encodings "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-trees 0 "AABBTreePNS/Float3" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-splitters 0 "FixedLeafSize" -- "$meshcast" bench splitters "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
+check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout SKDTree/Float3
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
 printf 'OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n' >"$work/nan.off"

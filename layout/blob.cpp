@@ -1,5 +1,6 @@
 #include "layout/blob.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -84,6 +85,16 @@ std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block,
   return "";
 }
 
+// What every node walk of the validator checks on reaching a node: visits
+// bounded by node_count (so a walk of a corrupted DAG stays linear) and the
+// depth by MC_MAX_DEPTH (the walkers' stacks).
+std::string reach(uint64_t* visited, uint32_t depth, const BlobHeader& h, const std::string& node) {
+  if (++*visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
+  if (depth > h.max_depth || depth > MC_MAX_DEPTH)
+    return node + " is deeper than the limit " + num(std::min<uint32_t>(h.max_depth, MC_MAX_DEPTH));
+  return "";
+}
+
 template <class Codec>
 std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   struct Item { uint32_t offset, depth; };
@@ -92,9 +103,7 @@ std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
-    if (++visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
-    if (it.depth > h.max_depth || it.depth > MC_MAX_DEPTH)
-      return "node at tree offset " + num(it.offset) + " is deeper than the limit " + num(MC_MAX_DEPTH);
+    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(it.offset)); !e.empty()) return e;
     if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_AABB_NODE_BYTES > h.tree_size)
       return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
     AABBNode n = load_aabb_node(blob + h.tree_offset + it.offset);
@@ -137,9 +146,7 @@ std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
     if (!root && offset <= it.parent)
       return "node at tree offset " + num(offset) + " does not lie after its parent at " + num(it.parent);
     root = false;
-    if (++visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
-    if (it.depth > h.max_depth || it.depth > MC_MAX_DEPTH)
-      return "node at tree offset " + num(offset) + " is deeper than the limit " + num(MC_MAX_DEPTH);
+    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(offset)); !e.empty()) return e;
     if (offset % 4 != 0 || uint64_t(offset) + Bounds::kNodeBytes > h.node_bytes)
       return "node at tree offset " + num(offset) + " is misaligned or outside the node area (" +
              num(h.node_bytes) + " bytes)";
@@ -164,10 +171,8 @@ std::string walk_pns(const uint8_t* blob, const BlobHeader& h, uint64_t* triangl
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
-    if (++visited > h.node_count) return "tree reaches more nodes than node_count (" + num(h.node_count) + ")";
+    if (std::string e = reach(&visited, it.depth, h, "node " + num(it.index)); !e.empty()) return e;
     if (it.index >= h.node_count) return "node index " + num(it.index) + " past the " + num(h.node_count) + " nodes";
-    if (it.depth > h.max_depth || it.depth > MC_MAX_DEPTH)
-      return "node " + num(it.index) + " is deeper than the limit " + num(MC_MAX_DEPTH);
     AABBNode n = load_aabb_node(blob + h.tree_offset + uint64_t(it.index) * MC_AABB_NODE_BYTES);
     if (n.is_leaf()) {
       uint64_t block = uint64_t(h.triangle_base) + 4ull * (n.properties & MC_PNS_BLOCK_MASK);

@@ -171,15 +171,4 @@ Mesh stored_mesh(const std::vector<uint8_t>& blob) {
   return m;
 }
 
-Mesh quantized_mesh(const Mesh& mesh, const std::vector<uint8_t>& blob) {
-  const layout::BlobHeader& h = layout::header_of(blob.data());
-  Mesh q = mesh;
-  for (Vec3& v : q.vertices) {
-    float p[3] = {v.x, v.y, v.z}, d[3];
-    layout::bitpack_decode(layout::bitpack_encode(p, h.quant_offset, h.quant_scale), h.quant_offset, h.quant_scale, d);
-    v = {d[0], d[1], d[2]};
-  }
-  return q;
-}
-
 }  // namespace meshcast

@@ -41,8 +41,4 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
 // exact reference for formats that move vertices.
 Mesh stored_mesh(const std::vector<uint8_t>& blob);
 
-// The mesh as a bit-packed blob stores it: every vertex moved to its decoded
-// grid position, computed from the input and the header's quantization box.
-Mesh quantized_mesh(const Mesh& mesh, const std::vector<uint8_t>& blob);
-
 }  // namespace meshcast

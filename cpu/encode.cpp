@@ -157,13 +157,9 @@ struct Writer {
 // leaf's triangle block right behind the leaf node.
 void write_aabbtree(Writer& w) {
   const BuildTree& t = w.tree;
-  std::vector<uint64_t> size(t.nodes.size());
-  std::function<uint64_t(uint32_t)> measure = [&](uint32_t n) -> uint64_t {
-    const BuildNode& b = t.nodes[n];
-    size[n] = MC_AABB_NODE_BYTES + (b.leaf() ? w.leaf_bytes[n] : measure(b.left) + measure(b.right));
-    return size[n];
-  };
-  uint64_t tree_size = measure(0);
+  // Every node, and behind each leaf its block.
+  uint64_t tree_size = uint64_t(t.nodes.size()) * MC_AABB_NODE_BYTES;
+  for (uint32_t bytes : w.leaf_bytes) tree_size += bytes;
   if (tree_size > MC_AABB_VALUE_MASK)
     throw InputError("the AABBTree section of " + std::to_string(tree_size) +
                      " bytes exceeds its 31-bit child offsets");
@@ -172,7 +168,6 @@ void write_aabbtree(Writer& w) {
   w.h.node_count = uint32_t(t.nodes.size());
   w.h.triangle_base = 0;
   w.h.root = 0;
-  return;
 }
 
 // Places every node (pre-order), encodes the leaves, refits, then writes
@@ -420,7 +415,6 @@ QuadPlan plan_quadtree(const BuildTree& t) {
 
 template <class Bounds>
 void write_quadtree(Writer& w, const QuadPlan& p) {
-  const BuildTree& t = w.tree;
   uint64_t nodes = uint64_t(p.binary_of.size()) * Bounds::kNodeBytes;
   uint64_t end = nodes;
   for (uint32_t leaf : p.leaves) end += w.leaf_bytes[leaf];
@@ -536,7 +530,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   std::vector<uint8_t> split_axes;
   if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) split_axes = order_by_split_axis(tree);
   uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
-  Writer writer{corners, tree, codec, h, {}, {}, {}, {}};
+  Writer writer{corners, tree, codec, h, {}, {}, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
   writer.measure_leaves();
 
@@ -612,9 +606,6 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   layout::seal(writer.bytes);
 
   if (report) {
-    report->binary_nodes = uint32_t(tree.nodes.size());
-    report->leaves = hd.leaf_count;
-    report->depth = depth;
     report->sah_cost = tree.sah_cost;
     report->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }

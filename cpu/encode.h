@@ -20,7 +20,6 @@ struct BuildOptions {
 };
 
 struct BuildReport {
-  uint32_t binary_nodes = 0, leaves = 0, depth = 0;
   double sah_cost = 0;
   double build_ms = 0;
 };
@@ -34,8 +33,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
 BuildOptions parse_layout(const std::string& text);
 std::string layout_name(uint32_t tree_format, uint32_t triangle_format);
 
-// True for the triangle formats that quantize vertices against the mesh box
-// (BitPack words): they store quantized_mesh(), not the input mesh.
+// True for the triangle formats that store moved vertices (grids, cleared
+// flag bits): they are judged against stored_mesh(), not the input mesh.
 bool moves_vertices(uint32_t triangle_format);
 std::vector<std::string> layout_names();
 

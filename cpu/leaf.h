@@ -1,5 +1,5 @@
 // One leaf test for every triangle format: the codec's loader (below) turns a
-// group of 4 triangles into corners, triangle_test4 does the rest. Adding a
+// group of 4 triangles into corners, triangle_test does the rest. Adding a
 // triangle format means adding a loader, not another walker.
 #pragma once
 #include <algorithm>
@@ -19,7 +19,7 @@ template <class Codec>
 struct Loader;
 
 // A loader fills v[corner][j] with axis `axis[j]` of 4 triangles starting at
-// triangle `first` of the block (the ray's axis order, see triangle_test4).
+// triangle `first` of the block (the ray's axis order, see triangle_test).
 //
 // Float3: triangles side by side, 9 floats each; gather lane i from triangle
 // first + i (clamped, so no lane reads past the block).
@@ -129,12 +129,6 @@ struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
 
 // Tests the `count` triangles of the block at blob offset `block`; slots of
 // the leaf start at `slot0`.
-// Strips have no loader: see test_sequential_leaf.
-template <class Record, uint32_t kId>
-struct Loader<layout::Strip<Record, kId>> {
-  static void load(const uint8_t*, uint32_t, uint32_t, uint32_t, const int*, simd::F4[3][3]) {}
-};
-
 template <class L>
 constexpr int width_of() {
   if constexpr (requires { L::kWidth; }) return L::kWidth;
@@ -167,23 +161,23 @@ inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint3
 template <class Codec>
 inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                       Closest& c) {
-  if constexpr (requires { Codec::kSequential; }) {
+  if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
     test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
-    return;
-  }
-  constexpr int kWidth = width_of<Loader<Codec>>();
-  for (uint32_t first = 0; first < count; first += kWidth) {
-    LaneHit h;
-    if constexpr (kWidth == 8) {
-      simd::F8 v[3][3];
-      Loader<Codec>::load(blob, block, first, count, r.axis, v);
-      h = triangle_test(r, v, simd::lanes_below8(count - first), c.t);
-    } else {
-      simd::F4 v[3][3];
-      Loader<Codec>::load(blob, block, first, count, r.axis, v);
-      h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
+  } else {
+    constexpr int kWidth = width_of<Loader<Codec>>();
+    for (uint32_t first = 0; first < count; first += kWidth) {
+      LaneHit h;
+      if constexpr (kWidth == 8) {
+        simd::F8 v[3][3];
+        Loader<Codec>::load(blob, block, first, count, r.axis, v);
+        h = triangle_test(r, v, simd::lanes_below8(count - first), c.t);
+      } else {
+        simd::F4 v[3][3];
+        Loader<Codec>::load(blob, block, first, count, r.axis, v);
+        h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
+      }
+      if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
     }
-    if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
   }
 }
 

@@ -58,7 +58,6 @@ struct RayPre {
   int near_is_max[3];
   // Watertight test: kz = the dominant axis, kx/ky the others (swapped to
   // keep the winding), shear constants S.
-  int kx, ky, kz;
   int axis[3];  // {kx, ky, kz}: loaders fetch corners in this order
   float sx, sy, sz;
 
@@ -70,9 +69,8 @@ struct RayPre {
       near_is_max[a] = std::signbit(r.dir[a]) ? 1 : 0;
     }
     float ax = std::fabs(dir[0]), ay = std::fabs(dir[1]), az = std::fabs(dir[2]);
-    kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-    kx = (kz + 1) % 3;
-    ky = (kx + 1) % 3;
+    int kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
     if (dir[kz] < 0) std::swap(kx, ky);
     sx = dir[kx] / dir[kz];
     sy = dir[ky] / dir[kz];
@@ -133,7 +131,7 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
 template <class F4, class M4>
 inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
   constexpr int kW = F4::kLanes;
-  const F4 ox = F4::splat(r.org[r.kx]), oy = F4::splat(r.org[r.ky]), oz = F4::splat(r.org[r.kz]);
+  const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
   F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;
   F4 bx = v[1][0] - ox, by = v[1][1] - oy, bz = v[1][2] - oz;
@@ -188,10 +186,6 @@ inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float 
     }
   }
   return best;
-}
-
-inline LaneHit triangle_test4(const RayPre& r, const simd::F4 v[3][3], simd::M4 valid, float closest) {
-  return triangle_test(r, v, valid, closest);
 }
 
 }  // namespace meshcast

@@ -61,12 +61,6 @@ inline M4 lanes_below(uint32_t n) {  // lanes 0..n-1 set
 }
 inline F4 select(M4 m, F4 a, F4 b) { return {_mm_blendv_ps(b.v, a.v, m.v)}; }  // m ? a : b
 inline M4 nonzero(I4 a) { return {_mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(a.v, _mm_setzero_si128()), _mm_set1_epi32(-1)))}; }
-inline float lane(F4 a, int i) { alignas(16) float f[4]; _mm_store_ps(f, a.v); return f[i]; }
-inline F4 from_u8(const uint8_t* p) {  // 4 bytes -> 4 floats
-  int32_t x;
-  std::memcpy(&x, p, 4);
-  return {_mm_cvtepi32_ps(_mm_cvtepu8_epi32(_mm_cvtsi32_si128(x)))};
-}
 inline F4 from_u16(const uint8_t* p) {  // 4 uint16 -> 4 floats
   int64_t x;
   std::memcpy(&x, p, 8);
@@ -182,8 +176,6 @@ template <int N> inline int bits(MN<N> m) { int b = 0; for (int i = 0; i < N; ++
 inline M4 lanes_below(uint32_t n) MC_LANES(M4, uint32_t(i) < n)
 inline M8 lanes_below8(uint32_t n) MC_LANES(M8, uint32_t(i) < n)
 inline M4 nonzero(I4 a) MC_LANES(M4, a.v[i] != 0)
-inline float lane(F4 a, int i) { return a.v[i]; }
-inline F4 from_u8(const uint8_t* p) MC_LANES(F4, float(p[i]))
 inline F4 from_u16(const uint8_t* p) MC_LANES(F4, float(uint32_t(p[2 * i] | p[2 * i + 1] << 8)))
 inline F4 from_half(const uint8_t* p) MC_LANES(F4, layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
 inline I4 from_u8_index(const uint8_t* p) MC_LANES(I4, uint32_t(p[i]))

@@ -1,14 +1,10 @@
 #include "tests/testing.h"
 
-#include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <mutex>
 
 #include "io/generate.h"
 #include "io/read_mesh.h"
-#include "layout/blob.h"
-#include "layout/block.h"
 
 namespace meshcast::testing {
 

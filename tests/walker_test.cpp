@@ -12,13 +12,7 @@
 namespace meshcast::testing {
 namespace {
 
-struct Case {
-  std::string layout;
-};
-
 class WalkerVsOracle : public ::testing::TestWithParam<std::string> {};
-
-bool is_bitpack(const BuildOptions& o) { return moves_vertices(o.triangle_format); }
 
 void check_layout(const std::string& layout_name_, bool large) {
   BuildOptions options = parse_layout(layout_name_);
@@ -32,7 +26,7 @@ void check_layout(const std::string& layout_name_, bool large) {
     // gives the exact answers; the distance to the input mesh is checked
     // against the stated bound separately (QuantizedVerticesWithinBound).
     NamedMesh reference = m;
-    if (is_bitpack(options))
+    if (moves_vertices(options.triangle_format))
       reference = {m.name + "#" + layout_name_, std::make_shared<const Mesh>(stored_mesh(blob))};
     // BruteForce tests every triangle for every ray: fewer rays keep it quick.
     size_t count = options.tree_format == MC_TREE_BRUTEFORCE ? 400 : 10000;

@@ -30,8 +30,12 @@ struct BuildTree {
 enum class Splitter { Binning, LongestAxis, Mean, Morton, FixedLeafSize };
 
 // SAH over 32 binned centres per axis (Günther et al. 2007).
-BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size);
-BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size);
+// `depth_limit`: nodes at that depth become leaves whatever their count
+// (StacklessLBVH's D - 1); InputError when such a leaf would exceed
+// MC_QUAD_MAX_COUNT triangles.
+BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit = ~0u);
+BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size,
+                     uint32_t depth_limit = ~0u);
 
 // "Binning", "LongestAxis", ... case-insensitive; throws InputError listing
 // the valid names.

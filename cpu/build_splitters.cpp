@@ -91,7 +91,8 @@ struct MortonSplit {
 
 // FixedLeafSize: groups of 4 consecutive triangles in Morton order become
 // the primitives of a Binning build with leaves of leaf_size / 4 groups.
-BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vector<Vec3>& centres, uint32_t leaf) {
+BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vector<Vec3>& centres, uint32_t leaf,
+                                uint32_t depth_limit) {
   constexpr uint32_t kGroup = 4;
   std::vector<uint32_t> order = morton_order(morton_codes(centres));
   size_t groups = (order.size() + kGroup - 1) / kGroup;
@@ -99,7 +100,7 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
   for (size_t i = 0; i < order.size(); ++i) group_boxes[i / kGroup].grow(boxes[order[i]]);
   std::vector<Vec3> group_centres = box_centres(group_boxes);
   BinningSplit split{group_boxes, group_centres};
-  BuildTree g = TopDown<BinningSplit>{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}}.run();
+  BuildTree g = TopDown<BinningSplit>{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}, depth_limit}.run();
   // Back to triangles: each group position expands to its members.
   std::vector<uint32_t> start(groups + 1, 0);
   BuildTree t;
@@ -115,6 +116,10 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
       uint32_t first = start[n.first], end = start[n.first + n.count];
       n.first = first, n.count = end - first;
     }
+  for (const BuildNode& n : t.nodes)
+    if (n.leaf() && n.count > MC_QUAD_MAX_COUNT)
+      throw InputError("depth limit " + std::to_string(depth_limit + 1) + " leaves " + std::to_string(n.count) +
+                       " triangles in one leaf, more than " + std::to_string(MC_QUAD_MAX_COUNT) + "; raise the depth limit");
   t.depth = g.depth;
   t.sah_cost = sah_cost(t);
   return t;
@@ -122,27 +127,27 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
 
 }  // namespace
 
-BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size) {
+BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size, uint32_t depth_limit) {
   leaf_size = std::max(1u, leaf_size);
   std::vector<Vec3> centres = box_centres(boxes);
   switch (splitter) {
-    case Splitter::Binning: return build_binning(boxes, leaf_size);
+    case Splitter::Binning: return build_binning(boxes, leaf_size, depth_limit);
     case Splitter::LongestAxis: {
       LongestAxisSplit s{centres};
-      return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}}.run();
+      return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}, depth_limit}.run();
     }
     case Splitter::Mean: {
       MeanSplit s{centres};
-      return TopDown<MeanSplit>{boxes, centres, leaf_size, s, {}}.run();
+      return TopDown<MeanSplit>{boxes, centres, leaf_size, s, {}, depth_limit}.run();
     }
     case Splitter::Morton: {
       std::vector<uint32_t> codes = morton_codes(centres);
       MortonSplit s{codes};
-      return TopDown<MortonSplit>{boxes, centres, leaf_size, s, {}}.run(morton_order(codes));
+      return TopDown<MortonSplit>{boxes, centres, leaf_size, s, {}, depth_limit}.run(morton_order(codes));
     }
-    case Splitter::FixedLeafSize: return build_fixed_leaf_size(boxes, centres, leaf_size);
+    case Splitter::FixedLeafSize: return build_fixed_leaf_size(boxes, centres, leaf_size, depth_limit);
   }
-  return build_binning(boxes, leaf_size);
+  return build_binning(boxes, leaf_size, depth_limit);
 }
 
 std::vector<Splitter> all_splitters() {

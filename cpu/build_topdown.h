@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "cpu/build.h"
+#include "layout/formats.h"
 
 namespace meshcast {
 
@@ -28,6 +29,7 @@ struct TopDown {
   uint32_t leaf_size;
   Split& split;
   BuildTree tree;
+  uint32_t depth_limit = ~0u;
 
   uint32_t build(uint32_t first, uint32_t count, uint32_t depth) {
     uint32_t index = uint32_t(tree.nodes.size());
@@ -36,17 +38,30 @@ struct TopDown {
     Box3 box, cbox;
     for (uint32_t i = first; i < first + count; ++i) box.grow(boxes[tree.order[i]]), cbox.grow(centres[tree.order[i]]);
     tree.nodes[index].box = box;
-    if (count <= leaf_size) {
+    if (count > capacity(depth))
+      throw InputError("depth limit " + std::to_string(depth_limit + 1) + " holds at most " +
+                       std::to_string(capacity(depth)) + " triangles (" + std::to_string(MC_QUAD_MAX_COUNT) +
+                       " a leaf), not " + std::to_string(count) + "; raise the depth limit");
+    if (count <= leaf_size || depth >= depth_limit) {
       tree.nodes[index].first = first, tree.nodes[index].count = count;
       return index;
     }
     uint32_t* begin = tree.order.data() + first;
     uint32_t left = depth < kSplitterDepth ? split(begin, begin + count, cbox) : 0;
-    if (left == 0 || left >= count) left = median(begin, count, cbox);
+    // Under a depth limit a side must still fit the levels left below it
+    // (halving each level, MC_QUAD_MAX_COUNT a leaf); a split that would
+    // overfill one becomes a median split, which always fits.
+    if (left == 0 || left >= count || std::max(left, count - left) > capacity(depth + 1)) left = median(begin, count, cbox);
     uint32_t l = build(first, left, depth + 1);
     uint32_t r = build(first + left, count - left, depth + 1);
     tree.nodes[index].left = l, tree.nodes[index].right = r;
     return index;
+  }
+
+  // Most triangles a subtree rooted at `depth` can hold under depth_limit.
+  uint64_t capacity(uint32_t depth) const {
+    if (depth_limit >= 40) return ~0ull;
+    return uint64_t(MC_QUAD_MAX_COUNT) << (depth_limit - std::min(depth, depth_limit));
   }
 
   uint32_t median(uint32_t* begin, uint32_t count, const Box3& cbox) {

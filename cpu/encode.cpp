@@ -14,6 +14,7 @@
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
 #include "layout/quadtree.h"
+#include "cpu/writer.h"
 
 namespace meshcast {
 
@@ -21,18 +22,6 @@ using layout::BlobHeader;
 using layout::TriCorners;
 
 namespace {
-
-// The parts of a triangle codec the writer needs, as a runtime value.
-struct CodecOps {
-  uint32_t format, slot_divisor;
-  layout::GridKind grid;
-  uint32_t grid_bits;  // codes a component of the mesh grid (21; CompressedStrip 20)
-  bool nested;         // blocks on nested lattices of the grid (BitPackSOA)
-  bool moves_floats;   // stores floats it has changed (UncompressedStrip)
-  uint32_t lanes;
-  uint32_t (*measure)(TriCorners*, uint32_t);  // bytes of a leaf's block
-  void (*encode)(TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
-};
 
 template <class C>
 constexpr bool nested_blocks() {
@@ -55,6 +44,8 @@ uint32_t measure(TriCorners* tris, uint32_t count) {
   return C::block_bytes(count);
 }
 
+}  // namespace
+
 CodecOps codec_ops(uint32_t format) {
 #define MC_OPS(Codec, name)                                                                         \
   if (format == layout::Codec::kFormat)                                                            \
@@ -66,6 +57,17 @@ CodecOps codec_ops(uint32_t format) {
   throw InputError("unknown triangle format " + std::to_string(format));
 }
 
+namespace {
+
+// Every tree format id, in the order of cpu/pairs.h.
+std::vector<uint32_t> tree_formats() {
+  std::vector<uint32_t> ids;
+#define MC_ID(Tree, id) ids.push_back(id);
+  MC_FOR_EACH_TREE(MC_ID)
+#undef MC_ID
+  return ids;
+}
+
 // Every triangle format id, in the order of the list.
 std::vector<uint32_t> triangle_formats() {
   std::vector<uint32_t> ids;
@@ -74,84 +76,6 @@ std::vector<uint32_t> triangle_formats() {
 #undef MC_ID
   return ids;
 }
-
-uint32_t align(uint64_t v, uint32_t a) { return uint32_t((v + a - 1) / a * a); }
-
-// Shared by both tree writers: the blob under construction.
-struct Writer {
-  const std::vector<TriCorners>& corners;
-  BuildTree& tree;  // leaf boxes are refitted to what the codec stores
-  CodecOps codec;
-  BlobHeader h{};
-  std::vector<uint8_t> bytes;
-  std::vector<uint8_t> pool;
-  std::unordered_map<uint64_t, uint32_t> last_index;
-  std::vector<uint32_t> remap;
-  uint32_t max_block_shift = 0;
-  std::vector<uint32_t> leaf_bytes;  // per node: its block's bytes (leaves)
-
-  std::vector<TriCorners> leaf_triangles(uint32_t n) const {
-    const BuildNode& leaf = tree.nodes[n];
-    std::vector<TriCorners> tris(leaf.count);
-    for (uint32_t i = 0; i < leaf.count; ++i) {
-      tris[i] = corners[tree.order[leaf.first + i]];
-      tris[i].input = tree.order[leaf.first + i];
-    }
-    return tris;
-  }
-  void measure_leaves() {
-    leaf_bytes.assign(tree.nodes.size(), 0);
-    for (uint32_t n = 0; n < tree.nodes.size(); ++n)
-      if (tree.nodes[n].leaf()) {
-        std::vector<TriCorners> tris = leaf_triangles(n);
-        leaf_bytes[n] = codec.measure(tris.data(), tree.nodes[n].count);
-      }
-  }
-
-  // Encodes leaf node n's triangles at tree-section offset `at`. The codec
-  // hands back the triangles as stored (its order, its decoded corners): the
-  // remap follows that order and the leaf's box is refitted to those corners,
-  // so node bounds always contain what the walker will decode.
-  void write_leaf(uint32_t n, uint32_t at) {
-    BuildNode& leaf = tree.nodes[n];
-    std::vector<TriCorners> tris = leaf_triangles(n);
-    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index, h.quant_scale, &max_block_shift, &h};
-    codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
-    uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
-    if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
-    leaf.box = Box3{};
-    for (uint32_t i = 0; i < leaf.count; ++i) {
-      remap[slot0 + i] = tris[i].input;
-      for (int c = 0; c < 3; ++c) leaf.box.grow(Vec3{tris[i].v[c][0], tris[i].v[c][1], tris[i].v[c][2]});
-    }
-  }
-
-  // Interior boxes from the refitted leaves (children follow their parent
-  // in the builder's node order), then the header's frame from the root.
-  void refit() {
-    for (size_t n = tree.nodes.size(); n-- > 0;) {
-      BuildNode& b = tree.nodes[n];
-      if (b.leaf() || b.left == 0) continue;
-      b.box = tree.nodes[b.left].box;
-      b.box.grow(tree.nodes[b.right].box);
-    }
-    frame(tree.nodes[0].box);
-  }
-
-  // Header bounds, and the frame of half-float bounds: relative to the root
-  // centre, scaled by a power of two that puts the root's half extent near
-  // 2^14, far from both the half range limit (65504) and the subnormals.
-  void frame(const Box3& root) {
-    float half_extent = 0;
-    for (int a = 0; a < 3; ++a) {
-      h.bounds_min[a] = root.min[a], h.bounds_max[a] = root.max[a];
-      h.node_origin[a] = root.centre()[a];
-      half_extent = std::max({half_extent, std::fabs(root.max[a] - h.node_origin[a]),
-                              std::fabs(h.node_origin[a] - root.min[a])});
-    }
-    h.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
-  }
-};
 
 // AABBTree (§5.1), depth first: first child right behind its parent, the
 // leaf's triangle block right behind the leaf node.
@@ -339,20 +263,6 @@ PnsPlan plan_pns(Writer& w) {
   return p;
 }
 
-// The 8 bits of seed 002: for the octant with sign bits (x, y, z), bit
-// z | y << 1 | x << 2 is set when the second child's centre lies nearer
-// along that octant's diagonal.
-uint32_t pns_code(const Box3& first, const Box3& second) {
-  Vec3 a = first.centre(), b = second.centre();
-  uint32_t code = 0;
-  for (uint32_t octant = 0; octant < 8; ++octant) {
-    float dx = octant & 4 ? -1.0f : 1.0f, dy = octant & 2 ? -1.0f : 1.0f, dz = octant & 1 ? -1.0f : 1.0f;
-    double d = double(a.x - b.x) * dx + double(a.y - b.y) * dy + double(a.z - b.z) * dz;
-    if (d > 0) code |= 1u << octant;
-  }
-  return code;
-}
-
 void fill_pns(Writer& w, const PnsPlan& p) {
   const BuildTree& t = w.tree;
   for (uint32_t leaf : p.leaves) w.write_leaf(leaf, p.block[leaf]);
@@ -525,8 +435,21 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
     }
   }
 
-  BuildTree tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
-                                                       : build_tree(boxes, o.splitter, o.leaf_size);
+  uint32_t depth_limit = ~0u;
+  if (o.tree_format == MC_TREE_STACKLESSLBVH) {
+    uint32_t d = o.lbvh_depth ? o.lbvh_depth : uint32_t(std::bit_width(mesh.triangles.size())) + 1;
+    if (d > MC_LBVH_MAX_DEPTH + 1)
+      throw InputError(name + ": StacklessLBVH depth limit " + std::to_string(d) + " exceeds " +
+                       std::to_string(MC_LBVH_MAX_DEPTH + 1) + " (2^26 node slots)");
+    depth_limit = d - 1;
+  }
+  BuildTree tree;
+  try {
+    tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
+                                               : build_tree(boxes, o.splitter, o.leaf_size, depth_limit);
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + std::string(layout::tree_format_name(o.tree_format)) + ": " + e.what());
+  }
   std::vector<uint8_t> split_axes;
   if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) split_axes = order_by_split_axis(tree);
   uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
@@ -537,7 +460,13 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   QuadPlan plan;
   PnsPlan pns_plan;
   uint32_t depth = tree.depth;
-  if (o.tree_format == MC_TREE_BRUTEFORCE) {
+  std::unique_ptr<TreeWriter> tree_writer;
+  if (o.tree_format == MC_TREE_AABBTREECOMPRESSED) tree_writer = make_compressed_writer();
+  if (o.tree_format == MC_TREE_SKDTREE) tree_writer = make_skd_writer();
+  if (o.tree_format == MC_TREE_STACKLESSLBVH) tree_writer = make_lbvh_writer(o.lbvh_near_first);
+  if (tree_writer) {
+    tree_writer->plan(writer);
+  } else if (o.tree_format == MC_TREE_BRUTEFORCE) {
     write_bruteforce(writer);
     depth = 0;
   } else if (o.tree_format == MC_TREE_AABBTREEPNS) {
@@ -562,7 +491,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
   writer.bytes.assign(hd.vertex_offset, 0);
   try {
-    if (o.tree_format == MC_TREE_BRUTEFORCE) fill_bruteforce(writer);
+    if (tree_writer) tree_writer->fill(writer);
+    else if (o.tree_format == MC_TREE_BRUTEFORCE) fill_bruteforce(writer);
     else if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer, false, {});
     else if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) fill_aabbtree(writer, true, split_axes);
     else if (o.tree_format == MC_TREE_AABBTREEPNS) fill_pns(writer, pns_plan);
@@ -637,8 +567,7 @@ bool moves_vertices(uint32_t triangle_format) {
 
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_AABBTREEPNS, MC_TREE_QUADTREE,
-                     MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
+  for (uint32_t t : tree_formats())
     for (uint32_t c : triangle_formats())
       names.push_back(layout_name(t, c));
   return names;
@@ -653,10 +582,15 @@ BuildOptions parse_layout(const std::string& text) {
     for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     return s;
   };
-  for (uint32_t t : {MC_TREE_AABBTREE, MC_TREE_AABBTREESPLITAXIS, MC_TREE_AABBTREEPNS, MC_TREE_QUADTREE,
-                     MC_TREE_QUADTREEHALFFLOAT, MC_TREE_BRUTEFORCE})
+  for (uint32_t t : tree_formats())
     for (uint32_t c : triangle_formats())
-      if (lower(layout_name(t, c)) == lower(text)) return {t, c, 8, Splitter::Binning};
+      if (lower(layout_name(t, c)) == lower(text)) {
+        BuildOptions o;
+        o.tree_format = t, o.triangle_format = c;
+        // The seed 001 heap is built by Morton-code middle split.
+        if (t == MC_TREE_STACKLESSLBVH) o.splitter = Splitter::Morton;
+        return o;
+      }
   std::string valid;
   for (const std::string& n : layout_names()) valid += "\n  " + n;
   throw InputError("unknown layout '" + text + "'; valid layouts (TREE/TRIANGLES):" + valid);

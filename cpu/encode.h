@@ -17,6 +17,12 @@ struct BuildOptions {
   uint32_t triangle_format = 3;  // MC_TRI_*
   uint32_t leaf_size = 8;        // 4, 8 or 16 in the source; 1..31 accepted
   Splitter splitter = Splitter::Binning;  // seed 000 §4.1
+  // StacklessLBVH (seed 001): the depth limit D (leaves at depth D - 1 at
+  // most; 0: bit_width(triangles) + 1, the seed's choice for its meshes),
+  // and whether interior nodes carry seed 002's bits so each ray visits the
+  // nearer child first (false: left first, as the seed).
+  uint32_t lbvh_depth = 0;
+  bool lbvh_near_first = true;
 };
 
 struct BuildReport {

@@ -25,6 +25,9 @@ constexpr WalkFn walker_for(uint32_t tree) {
     case MC_TREE_BRUTEFORCE: return &walk_bruteforce<Codec>;
     case MC_TREE_AABBTREESPLITAXIS: return &walk_aabbtree_splitaxis<Codec>;
     case MC_TREE_AABBTREEPNS: return &walk_aabbtree_pns<Codec>;
+    case MC_TREE_AABBTREECOMPRESSED: return &walk_aabbtree_compressed<Codec>;
+    case MC_TREE_SKDTREE: return &walk_skdtree<Codec>;
+    case MC_TREE_STACKLESSLBVH: return &walk_lbvh<Codec>;
   }
   return nullptr;
 }

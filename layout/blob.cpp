@@ -6,6 +6,9 @@
 
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
+#include "layout/compressed.h"
+#include "layout/lbvh.h"
+#include "layout/skdtree.h"
 #include "layout/quadtree.h"
 
 namespace meshcast::layout {
@@ -42,6 +45,9 @@ std::string_view tree_format_name(uint32_t f) {
     case MC_TREE_BRUTEFORCE: return "BruteForce";
     case MC_TREE_AABBTREESPLITAXIS: return "AABBTreeSplitAxis";
     case MC_TREE_AABBTREEPNS: return "AABBTreePNS";
+    case MC_TREE_AABBTREECOMPRESSED: return "AABBTreeCompressed";
+    case MC_TREE_SKDTREE: return "SKDTree";
+    case MC_TREE_STACKLESSLBVH: return "StacklessLBVH";
   }
   return "";
 }
@@ -190,6 +196,114 @@ std::string walk_pns(const uint8_t* blob, const BlobHeader& h, uint64_t* triangl
   return "";
 }
 
+// AABBTreeCompressed: the section header, then nodes and blocks, each
+// right child after its node, each left child right behind it.
+template <class Codec>
+std::string walk_compressed(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  if (h.tree_size < MC_COMPRESSED_HEADER_BYTES) return "AABBTreeCompressed: the tree section is shorter than its header";
+  const uint8_t* tree = blob + h.tree_offset;
+  CompressedBox root = compressed_root_box(tree);
+  for (int a = 0; a < 3; ++a)
+    if (!(root.min[a] <= root.max[a]) || !std::isfinite(root.min[a]) || !std::isfinite(root.max[a]))
+      return "AABBTreeCompressed: the root box is empty or not finite";
+  if (uint32_t count = compressed_root_count(tree)) {
+    std::string e = check_leaf<Codec>(blob, h, MC_COMPRESSED_HEADER_BYTES, count);
+    *triangles += count;
+    return e;
+  }
+  struct Item { uint32_t offset, depth; };
+  std::vector<Item> stack{{MC_COMPRESSED_HEADER_BYTES, 0}};
+  uint64_t visited = 0;
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(it.offset)); !e.empty()) return e;
+    if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_COMPRESSED_NODE_BYTES > h.tree_size)
+      return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
+    CompressedNode n = load<CompressedNode>(tree + it.offset);
+    uint32_t left = it.offset + MC_COMPRESSED_NODE_BYTES;
+    if (n.right <= left)
+      return "node at tree offset " + num(it.offset) + " has its right child at " + num(n.right) + ", not after its left";
+    const uint32_t child[2] = {left, n.right}, count[2] = {n.left_count(), n.right_count()};
+    for (int k = 0; k < 2; ++k) {
+      if (count[k] == 0) {
+        stack.push_back({child[k], it.depth + 1});
+        continue;
+      }
+      std::string e = check_leaf<Codec>(blob, h, child[k], count[k]);
+      if (!e.empty()) return e;
+      *triangles += count[k];
+    }
+  }
+  return "";
+}
+
+// SKDTree: interior nodes and leaves of two sizes, each right child after
+// its node.
+template <class Codec>
+std::string walk_skd(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  const uint8_t* tree = blob + h.tree_offset;
+  for (int a = 0; a < 3; ++a)
+    if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
+      return "SKDTree: the root box in the header is empty or not finite";
+  struct Item { uint32_t offset, depth; };
+  std::vector<Item> stack{{0, 0}};
+  uint64_t visited = 0;
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(it.offset)); !e.empty()) return e;
+    if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_SKD_LEAF_BYTES > h.tree_size)
+      return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
+    uint32_t p = load<uint32_t>(tree + it.offset);
+    if (skd_is_leaf(p)) {
+      std::string e = check_leaf<Codec>(blob, h, it.offset + MC_SKD_LEAF_BYTES, skd_value(p));
+      if (!e.empty()) return e;
+      *triangles += skd_value(p);
+      continue;
+    }
+    uint32_t left = it.offset + MC_SKD_INTERIOR_BYTES;
+    if (uint64_t(left) > h.tree_size || skd_value(p) <= left)
+      return "node at tree offset " + num(it.offset) + " has its right child at " + num(skd_value(p)) + ", not after its left";
+    if (!std::isfinite(skd_left_plane(tree + it.offset)) || !std::isfinite(skd_right_plane(tree + it.offset)))
+      return "node at tree offset " + num(it.offset) + " has a plane that is not finite";
+    stack.push_back({left, it.depth + 1});
+    stack.push_back({skd_value(p), it.depth + 1});
+  }
+  return "";
+}
+
+// StacklessLBVH: every node a walk reaches is a leaf or has both children
+// inside the array; holes are never reached.
+template <class Codec>
+std::string walk_lbvh(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  const uint8_t* tree = blob + h.tree_offset;
+  if (h.node_count == 0 || h.node_count > (1u << (MC_LBVH_MAX_DEPTH + 1)) - 1 ||
+      uint64_t(h.node_count) * MC_LBVH_NODE_BYTES != h.triangle_base)
+    return "StacklessLBVH: " + num(h.node_count) + " node slots do not fit its heap or its triangle base";
+  struct Item { uint32_t index, depth; };
+  std::vector<Item> stack{{1, 0}};
+  uint64_t visited = 0;
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    if (std::string e = reach(&visited, it.depth, h, "node " + num(it.index)); !e.empty()) return e;
+    LBVHNode n = load_lbvh_node(tree, it.index);
+    if (n.count == 0) return "node " + num(it.index) + " is a hole but its parent is an interior node";
+    if (n.count > 0) {
+      std::string e = check_leaf<Codec>(blob, h, n.position, uint32_t(n.count));
+      if (!e.empty()) return e;
+      *triangles += uint32_t(n.count);
+      continue;
+    }
+    if (uint64_t(it.index) * 2 + 1 > h.node_count)
+      return "node " + num(it.index) + " has children past the " + num(h.node_count) + " node slots";
+    stack.push_back({2 * it.index, it.depth + 1});
+    stack.push_back({2 * it.index + 1, it.depth + 1});
+  }
+  return "";
+}
+
 // BruteForce: the records must tile the tree section exactly.
 template <class Codec>
 std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
@@ -212,6 +326,9 @@ std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triang
   switch (h.tree_format) {
     case MC_TREE_BRUTEFORCE: return walk_bruteforce<Codec>(blob, h, triangles);
     case MC_TREE_AABBTREEPNS: return walk_pns<Codec>(blob, h, triangles);
+    case MC_TREE_AABBTREECOMPRESSED: return walk_compressed<Codec>(blob, h, triangles);
+    case MC_TREE_SKDTREE: return walk_skd<Codec>(blob, h, triangles);
+    case MC_TREE_STACKLESSLBVH: return walk_lbvh<Codec>(blob, h, triangles);
     case MC_TREE_AABBTREE:
     case MC_TREE_AABBTREESPLITAXIS: return walk_aabbtree<Codec>(blob, h, triangles);
     case MC_TREE_QUADTREE: return walk_quadtree<QuadBoundsFloat, Codec>(blob, h, triangles);
@@ -252,12 +369,18 @@ std::string validate(std::span<const uint8_t> blob) {
              ") overlaps another, is misaligned, or runs past the blob (" + num(blob.size()) + " bytes)";
     end = uint64_t(s.offset) + s.size;
   }
-  uint32_t node_size = h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS ||
-                               h.tree_format == MC_TREE_AABBTREEPNS
-                           ? MC_AABB_NODE_BYTES
-                       : h.tree_format == MC_TREE_QUADTREE   ? MC_QUAD_NODE_BYTES
-                       : h.tree_format == MC_TREE_BRUTEFORCE ? MC_BRUTE_RECORD_BYTES
-                                                             : MC_QUADHALF_NODE_BYTES;
+  uint32_t node_size = 0;  // the smallest node of the format
+  switch (h.tree_format) {
+    case MC_TREE_AABBTREE:
+    case MC_TREE_AABBTREESPLITAXIS:
+    case MC_TREE_AABBTREEPNS: node_size = MC_AABB_NODE_BYTES; break;
+    case MC_TREE_AABBTREECOMPRESSED: node_size = MC_COMPRESSED_NODE_BYTES; break;
+    case MC_TREE_SKDTREE: node_size = MC_SKD_LEAF_BYTES; break;
+    case MC_TREE_STACKLESSLBVH: node_size = MC_LBVH_NODE_BYTES; break;
+    case MC_TREE_QUADTREE: node_size = MC_QUAD_NODE_BYTES; break;
+    case MC_TREE_QUADTREEHALFFLOAT: node_size = MC_QUADHALF_NODE_BYTES; break;
+    default: node_size = MC_BRUTE_RECORD_BYTES;
+  }
   if (uint64_t(h.node_count) * node_size > h.tree_size)
     return "node count " + num(h.node_count) + " does not fit the tree section";
   if (h.node_bytes > h.tree_size || h.triangle_base > h.tree_size)

@@ -17,6 +17,9 @@
 #define MC_TREE_BRUTEFORCE 4u          // §3.11: no tree, every triangle tested
 #define MC_TREE_AABBTREESPLITAXIS 5u   // §5.2
 #define MC_TREE_AABBTREEPNS 6u         // §5.3 and seed 002
+#define MC_TREE_AABBTREECOMPRESSED 7u  // §5.4
+#define MC_TREE_SKDTREE 8u             // §5.5
+#define MC_TREE_STACKLESSLBVH 9u       // seed 001
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
@@ -67,6 +70,46 @@
 #define MC_PNS_INDEX_MASK 0x007FFFFFu
 #define MC_PNS_COUNT_SHIFT 26u
 #define MC_PNS_BLOCK_MASK 0x03FFFFFFu
+
+// AABBTreeCompressed (§5.4): the tree section opens with
+//   RootBoundsMin (3 floats), RootBoundsMax (3 floats), RootTriangleCount
+// then the root node (RootTriangleCount 0) or the root's triangle block.
+// A node is 12 bytes:
+//   NodeBoundsMin  bits 0-20: 7-bit min x, y, z; 21-23: side bits x, y, z;
+//                  24-31: left child's triangle count (0: a node)
+//   NodeBoundsMax  the same for the max, with the right child's count
+//   RightChildOffset (tree-section offset of the right node or block)
+// The left child (node or block) follows the node. Of the two children's
+// values of a component one equals the parent's; the other is stored as q,
+// bound = parent.min + q * (parent.max - parent.min) / 127, with side bit 0
+// when it is the left child's. q = 127 decodes to parent.max exactly.
+#define MC_COMPRESSED_HEADER_BYTES 28u
+#define MC_COMPRESSED_NODE_BYTES 12u
+#define MC_COMPRESSED_STEPS 127u
+#define MC_COMPRESSED_SIDE_SHIFT 21u
+#define MC_COMPRESSED_COUNT_SHIFT 24u
+
+// SKDTree (§5.5): a uint32 Properties, axis in bits 30-31 (3: a leaf), the
+// low 30 bits the leaf's triangle count or the right child's tree-section
+// offset. An interior node is followed by LeftPlane and RightPlane (floats):
+// the left child lies at or below LeftPlane, the right child at or above
+// RightPlane, along the axis; the left child follows the planes, a leaf's
+// block follows its Properties. The root box is the blob header's bounds.
+#define MC_SKD_LEAF_AXIS 3u
+#define MC_SKD_AXIS_SHIFT 30u
+#define MC_SKD_VALUE_MASK 0x3FFFFFFFu
+#define MC_SKD_INTERIOR_BYTES 12u
+#define MC_SKD_LEAF_BYTES 4u
+
+// StacklessLBVH (seed 001): nodes in heap order, node n (root 1, children
+// 2n and 2n+1) at tree-section offset 32 (n - 1), triangle blocks after the
+// array. A node is BoundingBoxMin, BoundingBoxMax (6 floats), Count (int32:
+// > 0 a leaf's triangles, < 0 minus the triangles below an interior node,
+// 0 a hole no walk reaches) and Position: a leaf's block offset; for an
+// interior node the 8 precomputed-node-sorting bits of seed 002 (which child
+// a ray of each octant visits first; all 0 walks left first as the seed).
+#define MC_LBVH_NODE_BYTES 32u
+#define MC_LBVH_MAX_DEPTH 25u          // 2^26 - 1 slots: 2 GiB of nodes
 
 // QuadTree / QuadTreeHalfFloat child properties (§5.6): 5 bits of triangle
 // count on top (0: the child is a node), 27 bits of offset below.

@@ -1,107 +1,156 @@
 #include "layout/leaves.h"
 
 #include <cmath>
-#include <vector>
 
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
+#include "layout/compressed.h"
+#include "layout/lbvh.h"
 #include "layout/quadtree.h"
+#include "layout/skdtree.h"
 
 namespace meshcast::layout {
 
-void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint32_t)>& visit) {
-  const BlobHeader& h = header_of(blob);
-  const uint8_t* tree = blob + h.tree_offset;
-  if (h.tree_format == MC_TREE_BRUTEFORCE) {
+namespace {
+
+PathBox box_of(const float min[3], const float max[3]) {
+  PathBox b;
+  for (int a = 0; a < 3; ++a) b.min[a] = min[a], b.max[a] = max[a];
+  return b;
+}
+
+// One descent per tree family; `path` grows and shrinks with the recursion
+// (depth is bounded by validation).
+struct Descent {
+  const uint8_t* blob;
+  const BlobHeader& h;
+  const uint8_t* tree;
+  const LeafPathVisitor& visit;
+  std::vector<PathBox> path;
+
+  void leaf(uint32_t block, uint32_t count, const PathBox* own) {
+    if (own) path.push_back(*own);
+    visit(block, count, path);
+    if (own) path.pop_back();
+  }
+
+  void bruteforce() {
     for (uint32_t at = 0; at < h.tree_size;) {
       uint32_t count = load<uint32_t>(tree + at);
-      visit(at + MC_BRUTE_RECORD_BYTES, count);
-      uint32_t bytes = 0;
+      leaf(at + MC_BRUTE_RECORD_BYTES, count, nullptr);
+      uint64_t bytes = 0;
 #define MC_BYTES(Codec, name) \
-  if (h.triangle_format == Codec::kFormat)                                                           \
-    bytes = uint32_t(stored_bytes<Codec>(blob, h.tree_offset + at + MC_BRUTE_RECORD_BYTES, count, ~0ull));
+  if (h.triangle_format == Codec::kFormat) bytes = stored_bytes<Codec>(blob, h.tree_offset + at + MC_BRUTE_RECORD_BYTES, count, ~0ull);
       MC_FOR_EACH_TRIANGLE_CODEC(MC_BYTES)
 #undef MC_BYTES
-      at += MC_BRUTE_RECORD_BYTES + bytes;
+      at += MC_BRUTE_RECORD_BYTES + uint32_t(bytes);
     }
-  } else if (h.tree_format == MC_TREE_AABBTREEPNS) {
-    for (uint32_t k = 0; k < h.node_count; ++k) {
-      AABBNode n = load_aabb_node(tree + uint64_t(k) * MC_AABB_NODE_BYTES);
-      if (n.is_leaf()) visit(pns_leaf_block(n, h), pns_leaf_count(n));
+  }
+
+  void aabbtree(uint32_t at) {
+    AABBNode n = load_aabb_node(tree + at);
+    PathBox b = box_of(n.min, n.max);
+    if (n.is_leaf()) return leaf(at + MC_AABB_NODE_BYTES, n.value(), &b);
+    path.push_back(b);
+    aabbtree(at + MC_AABB_NODE_BYTES);
+    aabbtree(aabb_second_child(n, h.tree_format == MC_TREE_AABBTREESPLITAXIS));
+    path.pop_back();
+  }
+
+  void pns(uint32_t index) {
+    AABBNode n = load_aabb_node(tree + uint64_t(index) * MC_AABB_NODE_BYTES);
+    PathBox b = box_of(n.min, n.max);
+    if (n.is_leaf()) return leaf(pns_leaf_block(n, h), pns_leaf_count(n), &b);
+    path.push_back(b);
+    pns(index + 1);
+    pns(pns_second_index(n));
+    path.pop_back();
+  }
+
+  void compressed(uint32_t at, const CompressedBox& box) {
+    CompressedNode n = load<CompressedNode>(tree + at);
+    CompressedBox child[2];
+    n.unpack(box, child[0], child[1]);
+    const uint32_t offset[2] = {at + MC_COMPRESSED_NODE_BYTES, n.right}, count[2] = {n.left_count(), n.right_count()};
+    path.push_back(box_of(box.min, box.max));
+    for (int k = 0; k < 2; ++k) {
+      PathBox b = box_of(child[k].min, child[k].max);
+      if (count[k]) leaf(offset[k], count[k], &b);
+      else compressed(offset[k], child[k]);
     }
-  } else if (h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS) {
-    std::vector<uint32_t> stack{0};
-    while (!stack.empty()) {
-      uint32_t at = stack.back();
-      stack.pop_back();
-      AABBNode n = load_aabb_node(tree + at);
-      if (n.is_leaf()) {
-        visit(at + MC_AABB_NODE_BYTES, n.value());
-      } else {
-        stack.push_back(aabb_second_child(n, h.tree_format == MC_TREE_AABBTREESPLITAXIS));
-        stack.push_back(at + MC_AABB_NODE_BYTES);
-      }
-    }
-  } else {
-    uint32_t props_at = h.tree_format == MC_TREE_QUADTREE ? QuadBoundsFloat::kPropertiesAt : QuadBoundsHalf::kPropertiesAt;
-    std::vector<uint32_t> stack{h.root};
-    while (!stack.empty()) {
-      uint32_t p = stack.back();
-      stack.pop_back();
-      if (quad_count(p)) {
-        visit(quad_offset(p), quad_count(p));
+    path.pop_back();
+  }
+
+  void skd(uint32_t at, const PathBox& region) {
+    uint32_t p = load<uint32_t>(tree + at);
+    if (skd_is_leaf(p)) return leaf(at + MC_SKD_LEAF_BYTES, skd_value(p), &region);
+    PathBox l, r;
+    skd_child_regions(tree + at, region.min, region.max, l.min, l.max, r.min, r.max);
+    path.push_back(region);
+    skd(at + MC_SKD_INTERIOR_BYTES, l);
+    skd(skd_value(p), r);
+    path.pop_back();
+  }
+
+  void lbvh(uint32_t index) {
+    LBVHNode n = load_lbvh_node(tree, index);
+    PathBox b = box_of(n.min, n.max);
+    if (n.count > 0) return leaf(n.position, uint32_t(n.count), &b);
+    path.push_back(b);
+    lbvh(2 * index);
+    lbvh(2 * index + 1);
+    path.pop_back();
+  }
+
+  template <class Bounds>
+  void quadtree(uint32_t properties) {
+    const uint8_t* node = tree + quad_offset(properties);
+    for (int k = 0; k < 4; ++k) {
+      uint32_t c = quad_child_properties(node, Bounds::kPropertiesAt, k);
+      if (!c) continue;
+      PathBox b;
+      Bounds::decode(node, h, k, b.min, b.max);
+      if (quad_count(c)) {
+        leaf(quad_offset(c), quad_count(c), &b);
         continue;
       }
-      for (int k = 3; k >= 0; --k)
-        if (uint32_t c = quad_child_properties(tree + quad_offset(p), props_at, k)) stack.push_back(c);
+      path.push_back(b);
+      quadtree<Bounds>(c);
+      path.pop_back();
     }
+  }
+};
+
+}  // namespace
+
+void for_each_leaf_path(const uint8_t* blob, const LeafPathVisitor& visit) {
+  const BlobHeader& h = header_of(blob);
+  Descent d{blob, h, blob + h.tree_offset, visit, {}};
+  switch (h.tree_format) {
+    case MC_TREE_BRUTEFORCE: return d.bruteforce();
+    case MC_TREE_AABBTREE:
+    case MC_TREE_AABBTREESPLITAXIS: return d.aabbtree(0);
+    case MC_TREE_AABBTREEPNS: return d.pns(0);
+    case MC_TREE_AABBTREECOMPRESSED: {
+      CompressedBox root = compressed_root_box(d.tree);
+      if (uint32_t count = compressed_root_count(d.tree)) {
+        PathBox b = box_of(root.min, root.max);
+        return d.leaf(MC_COMPRESSED_HEADER_BYTES, count, &b);
+      }
+      return d.compressed(MC_COMPRESSED_HEADER_BYTES, root);
+    }
+    case MC_TREE_SKDTREE: return d.skd(0, box_of(h.bounds_min, h.bounds_max));
+    case MC_TREE_STACKLESSLBVH: return d.lbvh(1);
+    case MC_TREE_QUADTREE:
+    case MC_TREE_QUADTREEHALFFLOAT:
+      if (quad_count(h.root)) return d.leaf(quad_offset(h.root), quad_count(h.root), nullptr);
+      if (h.tree_format == MC_TREE_QUADTREE) return d.quadtree<QuadBoundsFloat>(h.root);
+      return d.quadtree<QuadBoundsHalf>(h.root);
   }
 }
 
-void for_each_leaf_box(const uint8_t* blob,
-                       const std::function<void(uint32_t, uint32_t, const float[3], const float[3])>& visit) {
-  const BlobHeader& h = header_of(blob);
-  const uint8_t* tree = blob + h.tree_offset;
-  if (h.tree_format == MC_TREE_BRUTEFORCE) {
-    const float lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
-    return for_each_leaf(blob, [&](uint32_t block, uint32_t count) { visit(block, count, lo, hi); });
-  }
-  if (h.tree_format == MC_TREE_AABBTREEPNS) {
-    for (uint32_t k = 0; k < h.node_count; ++k) {
-      AABBNode n = load_aabb_node(tree + uint64_t(k) * MC_AABB_NODE_BYTES);
-      if (n.is_leaf()) visit(pns_leaf_block(n, h), pns_leaf_count(n), n.min, n.max);
-    }
-    return;
-  }
-  if (h.tree_format == MC_TREE_AABBTREE || h.tree_format == MC_TREE_AABBTREESPLITAXIS) {
-    return for_each_leaf(blob, [&](uint32_t block, uint32_t count) {
-      AABBNode n = load_aabb_node(tree + block - MC_AABB_NODE_BYTES);
-      visit(block, count, n.min, n.max);
-    });
-  }
-  bool half = h.tree_format == MC_TREE_QUADTREEHALFFLOAT;
-  uint32_t props_at = half ? QuadBoundsHalf::kPropertiesAt : QuadBoundsFloat::kPropertiesAt;
-  std::vector<uint32_t> stack{h.root};
-  if (quad_count(h.root)) {  // a root leaf has no box above it
-    const float lo[3] = {-INFINITY, -INFINITY, -INFINITY}, hi[3] = {INFINITY, INFINITY, INFINITY};
-    return visit(quad_offset(h.root), quad_count(h.root), lo, hi);
-  }
-  while (!stack.empty()) {
-    const uint8_t* node = tree + quad_offset(stack.back());
-    stack.pop_back();
-    for (int k = 0; k < 4; ++k) {
-      uint32_t c = quad_child_properties(node, props_at, k);
-      if (!c) continue;
-      if (!quad_count(c)) {
-        stack.push_back(c);
-        continue;
-      }
-      float lo[3], hi[3];
-      if (half) QuadBoundsHalf::decode(node, h, k, lo, hi);
-      else QuadBoundsFloat::decode(node, h, k, lo, hi);
-      visit(quad_offset(c), quad_count(c), lo, hi);
-    }
-  }
+void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint32_t)>& visit) {
+  for_each_leaf_path(blob, [&](uint32_t block, uint32_t count, const std::vector<PathBox>&) { visit(block, count); });
 }
 
 void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]) {

@@ -1,20 +1,28 @@
 // Visits every leaf of a validated blob: (tree-section offset of its block,
-// triangle count). For tools and tests that read a blob back (the stored
-// triangles, statistics); the walkers do not use it.
+// triangle count), with the boxes the walker decodes on the way down from
+// the root to it. For tools and tests that read a blob back (the stored
+// triangles, statistics, "every node's box contains what lies below it");
+// the walkers do not use it.
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 namespace meshcast::layout {
 
-void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t block, uint32_t count)>& visit);
+struct PathBox {
+  float min[3], max[3];
+};
 
-// The same, with the leaf's box as the walker decodes it from the tree (the
-// AABBTree leaf node, the QuadTree parent's child bounds; BruteForce has no
-// boxes: infinite), for checking that bounds contain what they bound.
-void for_each_leaf_box(const uint8_t* blob,
-                       const std::function<void(uint32_t block, uint32_t count, const float min[3],
-                                                const float max[3])>& visit);
+// `path` holds the decoded box of every node from the root down to the leaf
+// itself, as the walker would use it (QuadTree: each child's box in its
+// parent; SKDTree: the root box cut by each plane; AABBTreeCompressed: each
+// box decoded from its parent's). A format with no box above a leaf
+// (BruteForce; a QuadTree whose root is a leaf) gives an empty path.
+using LeafPathVisitor = std::function<void(uint32_t block, uint32_t count, const std::vector<PathBox>& path)>;
+void for_each_leaf_path(const uint8_t* blob, const LeafPathVisitor& visit);
+
+void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t block, uint32_t count)>& visit);
 
 // The corners of triangle `i` of the block at blob offset `block`, decoded
 // by the blob's triangle format (the scalar decoders of layout/).

@@ -198,7 +198,7 @@ TEST(Build, SixteenBitIndicesRefuseMeshesBeyondTheirReach) {
 TEST(Build, LayoutNamesAreCaseInsensitiveAndUnknownOnesListTheValid) {
   EXPECT_EQ(parse_layout("quadtreehalffloat/indexed8bitpacksoa4").tree_format, MC_TREE_QUADTREEHALFFLOAT);
   try {
-    parse_layout("SKDTree/Float3");
+    parse_layout("OctTree/Float3");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("AABBTree/Float3"), std::string::npos);

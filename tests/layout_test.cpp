@@ -290,6 +290,68 @@ TEST(GoldenBytes, AABBTreePNSIsSeed53And002) {
   EXPECT_EQ(192 + 3 * 28 + 4 * (second & 0x3FFFFFFu), 192 + 3 * 28 + 36u);
 }
 
+// The three trees below use the two triangles 10 apart along x, one a leaf.
+std::vector<uint8_t> two_apart(const char* layout) {
+  Mesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {10, 0, 0}, {11, 0, 0}, {10, 1, 0}};
+  m.triangles = {{0, 1, 2}, {3, 4, 5}};
+  BuildOptions o = parse_layout(layout);
+  o.leaf_size = 1;
+  return build_blob(m, o, layout);
+}
+
+TEST(GoldenBytes, AABBTreeCompressedIsSeed54) {
+  std::vector<uint8_t> b = two_apart("AABBTreeCompressed/Float3");
+  const size_t tree = 192;
+  // Header: RootBoundsMin, RootBoundsMax, RootTriangleCount (0: a node follows).
+  EXPECT_EQ(at<float>(b, tree + 0), 0.0f);
+  EXPECT_EQ(at<float>(b, tree + 12), 11.0f);
+  EXPECT_EQ(at<float>(b, tree + 16), 1.0f);
+  EXPECT_EQ(at<uint32_t>(b, tree + 24), 0u);
+  // Min word: x codes the right child's 10 in [0, 11]: floor(10 * 127 / 11) =
+  // 115; y and z inherit 0 on the left and code 0 on the right (side bits
+  // 1); left count 1 on top.
+  EXPECT_EQ(at<uint32_t>(b, tree + 28), 115u | 7u << 21 | 1u << 24);
+  // Max word: x codes the left child's 1: ceil(127 / 11) = 12 (side 0); y
+  // codes the right child's 1 in [0, 1]: 127; z 0; right count 1.
+  EXPECT_EQ(at<uint32_t>(b, tree + 32), 12u | 127u << 7 | 6u << 21 | 1u << 24);
+  // The left block (36 bytes of Float3) follows the node; the right after it.
+  EXPECT_EQ(at<uint32_t>(b, tree + 36), 28u + 12u + 36u);
+  EXPECT_EQ(at<float>(b, tree + 40), 0.0f);   // first corner of the left triangle
+  EXPECT_EQ(at<float>(b, tree + 76), 10.0f);  // and of the right one
+}
+
+TEST(GoldenBytes, SKDTreeIsSeed55) {
+  std::vector<uint8_t> b = two_apart("SKDTree/Float3");
+  const size_t tree = 192;
+  // Root: axis x (0) in the top 2 bits, right child's offset below; the planes
+  // are the left child's max x and the right child's min x.
+  EXPECT_EQ(at<uint32_t>(b, tree + 0), 12u + 4u + 36u);
+  EXPECT_EQ(at<float>(b, tree + 4), 1.0f);
+  EXPECT_EQ(at<float>(b, tree + 8), 10.0f);
+  // Leaves: axis 3, count 1, block right behind.
+  EXPECT_EQ(at<uint32_t>(b, tree + 12), 0xC0000001u);
+  EXPECT_EQ(at<float>(b, tree + 16), 0.0f);
+  EXPECT_EQ(at<uint32_t>(b, tree + 52), 0xC0000001u);
+  EXPECT_EQ(at<float>(b, tree + 56), 10.0f);
+}
+
+TEST(GoldenBytes, StacklessLBVHIsSeed001) {
+  std::vector<uint8_t> b = two_apart("StacklessLBVH/Float3");
+  const size_t tree = 192;
+  // Heap of depth 1: nodes 1, 2, 3 at 32 (n - 1); min, max, count, position.
+  EXPECT_EQ(at<float>(b, tree + 12), 11.0f);
+  EXPECT_EQ(at<int32_t>(b, tree + 24), -2);       // interior: minus the triangles below
+  EXPECT_EQ(at<uint32_t>(b, tree + 28), 0xF0u);   // seed 002 bits: x-negative octants go right first
+  EXPECT_EQ(at<float>(b, tree + 32 + 12), 1.0f);  // node 2 (left): the triangle at x 0..1
+  EXPECT_EQ(at<int32_t>(b, tree + 32 + 24), 1);
+  EXPECT_EQ(at<uint32_t>(b, tree + 32 + 28), 96u);  // its block right after the 3 nodes
+  EXPECT_EQ(at<float>(b, tree + 64 + 0), 10.0f);
+  EXPECT_EQ(at<uint32_t>(b, tree + 64 + 28), 96u + 36u);
+  BuildOptions o = parse_layout("StacklessLBVH/Float3");
+  EXPECT_EQ(o.splitter, Splitter::Morton);  // the seed's Morton-code middle split
+}
+
 // Hand-made structural faults, re-sealed so only the structure is judged.
 std::string corrupt(std::vector<uint8_t> b, size_t offset, uint32_t value) {
   std::memcpy(b.data() + offset, &value, 4);
@@ -308,6 +370,18 @@ TEST(Corruption, ChildBeforeItsParentIsRefused) {
               why.find("leaves hold") != std::string::npos) << why;
   // The second node's first child pointing back at the second node itself.
   EXPECT_NE(corrupt(q, 192 + 112 + 96, 112u).find("after its parent"), std::string::npos);
+}
+
+TEST(Corruption, NewTreesRefuseBrokenLinks) {
+  const size_t tree = 192;
+  // A right child inside its left sibling.
+  EXPECT_NE(corrupt(two_apart("AABBTreeCompressed/Float3"), tree + 36, 40), "");
+  EXPECT_NE(corrupt(two_apart("SKDTree/Float3"), tree + 0, 8), "");
+  // A hole where an interior node's child must be.
+  std::string why = corrupt(two_apart("StacklessLBVH/Float3"), tree + 64 + 24, 0);
+  EXPECT_NE(why.find("hole"), std::string::npos) << why;
+  // An interior node whose children lie past the node array.
+  EXPECT_NE(corrupt(two_apart("StacklessLBVH/Float3"), tree + 32 + 24, uint32_t(-1)), "");
 }
 
 TEST(Corruption, VertexIndexOutsideTheVertexSectionIsRefused) {

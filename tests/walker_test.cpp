@@ -91,9 +91,10 @@ TEST(WalkerVsOracleLarge, Terrain1M) {
     check_layout(name, true);
 }
 
-// Every leaf's bounds, as the walker decodes them (half floats included),
-// contain every corner its triangle format decodes, for every layout.
-TEST(LeafBoundsContainDecodedCorners, EveryLayoutEveryMesh) {
+// Every node's box, as the walker decodes it (half floats, 7-bit codes,
+// SKD regions included), contains every corner its triangle format decodes
+// below it, for every layout.
+TEST(NodeBoundsContainDecodedCorners, EveryLayoutEveryMesh) {
   for (const NamedMesh& m : test_meshes(false))
     for (const std::string& name : layout_names()) {
       if (m.name == "armadillo" || m.name == "refined_elephant") continue;  // bunny00 and the dragon suffice
@@ -101,13 +102,16 @@ TEST(LeafBoundsContainDecodedCorners, EveryLayoutEveryMesh) {
       std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
       const layout::BlobHeader& h = layout::header_of(blob.data());
       size_t corners = 0;
-      layout::for_each_leaf_box(blob.data(), [&](uint32_t block, uint32_t count, const float lo[3], const float hi[3]) {
+      layout::for_each_leaf_path(blob.data(), [&](uint32_t block, uint32_t count, const std::vector<layout::PathBox>& path) {
+        ASSERT_FALSE(path.empty()) << name << " on " << m.name << ": a leaf with no box above it";
         for (uint32_t i = 0; i < count; ++i) {
           float v[3][3];
           layout::decode_triangle(blob.data(), h.tree_offset + block, i, v);
           for (int c = 0; c < 3; ++c, ++corners)
-            for (int a = 0; a < 3; ++a)
-              ASSERT_TRUE(lo[a] <= v[c][a] && v[c][a] <= hi[a]) << name << " on " << m.name << ": corner outside its leaf box";
+            for (const layout::PathBox& b : path)
+              for (int a = 0; a < 3; ++a)
+                ASSERT_TRUE(b.min[a] <= v[c][a] && v[c][a] <= b.max[a])
+                    << name << " on " << m.name << ": corner outside a box above it (depth " << (&b - path.data()) << ")";
         }
       });
       EXPECT_EQ(corners, 3 * m.mesh->triangles.size()) << name;

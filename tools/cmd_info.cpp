@@ -12,7 +12,7 @@ namespace meshcast::tools {
 
 void add_info(CLI::App& app) {
   struct Args {
-    std::string input, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter = "Binning";
+    std::string input, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter;  // empty: the layout's default
     uint32_t leaf = 8;
     bool json = false;
   };

@@ -11,7 +11,7 @@ namespace meshcast::tools {
 
 void add_trace(CLI::App& app) {
   struct Args {
-    std::string input, rays, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter = "Binning";
+    std::string input, rays, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter;  // empty: the layout's default
     uint32_t leaf = 8, repeat = 5;
     bool json = false;
   };
@@ -60,7 +60,7 @@ void add_trace(CLI::App& app) {
 
 void add_build(CLI::App& app) {
   struct Args {
-    std::string input, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter = "Binning";
+    std::string input, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter;  // empty: the layout's default
     uint32_t leaf = 8;
   };
   auto args = std::make_shared<Args>();

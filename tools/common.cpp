@@ -34,7 +34,7 @@ Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options) {
 BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter) {
   BuildOptions o = parse_layout(layout);
   o.leaf_size = leaf;
-  o.splitter = parse_splitter(splitter);
+  if (!splitter.empty()) o.splitter = parse_splitter(splitter);  // else the layout's (Morton for StacklessLBVH)
   return o;
 }
 

@@ -23,7 +23,7 @@ struct Loaded {
 Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options);
 
 // Options of --layout and --leaf, with the defaults of the foundation issue.
-BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter = "Binning");
+BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter = "");
 
 inline double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

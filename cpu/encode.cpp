@@ -279,13 +279,15 @@ void fill_pns(Writer& w, const PnsPlan& p) {
 
 // QuadTree (§5.6): every binary node that stays a node takes up to four
 // children, found by opening its largest interior descendant until four are
-// reached. Nodes are written depth first, triangle blocks after all nodes
-// ("triangles last", §4.3), which keeps 64-byte half-float nodes cache aligned.
+// reached. Nodes and triangle blocks are then laid out in one of the four
+// node orders of §4.3 (quad_sequence); DepthFirstTrianglesLast, the
+// default, keeps 64-byte half-float nodes cache aligned.
 struct QuadPlan {
   std::vector<std::array<int64_t, 4>> children;  // binary node index or -1
   std::vector<uint32_t> binary_of;               // quad node -> binary node
   std::vector<uint32_t> leaves;                  // binary leaves, in write order
   std::vector<uint32_t> leaf_offset;             // per binary node (leaves)
+  std::vector<uint32_t> node_offset;             // per quad node
   std::vector<uint32_t> quad_index;              // per binary node (quad nodes)
   uint32_t depth = 0;
 };
@@ -295,10 +297,7 @@ QuadPlan plan_quadtree(const BuildTree& t) {
   p.leaf_offset.assign(t.nodes.size(), 0);
   p.quad_index.assign(t.nodes.size(), 0);
   std::function<void(uint32_t, uint32_t)> visit = [&](uint32_t n, uint32_t depth) {
-    if (t.nodes[n].leaf()) {
-      p.leaves.push_back(n);
-      return;
-    }
+    if (t.nodes[n].leaf()) return;
     p.depth = std::max(p.depth, depth);
     std::vector<uint32_t> list{t.nodes[n].left, t.nodes[n].right};
     while (list.size() < 4) {
@@ -323,33 +322,72 @@ QuadPlan plan_quadtree(const BuildTree& t) {
   return p;
 }
 
+// The write order of §4.3: quad nodes (true, quad index) and leaf blocks
+// (false, binary node) depth or breadth first, each node's leaf blocks
+// right behind it or all blocks after all nodes.
+std::vector<std::pair<bool, uint32_t>> quad_sequence(const BuildTree& t, const QuadPlan& p, NodeOrder order) {
+  std::vector<std::pair<bool, uint32_t>> seq, blocks;
+  if (p.binary_of.empty()) return {{false, 0}};  // the root is a leaf
+  const bool last = order == NodeOrder::DepthFirstTrianglesLast || order == NodeOrder::BreadthFirstTrianglesLast;
+  auto emit = [&](uint32_t q, std::vector<uint32_t>& next) {
+    seq.push_back({true, q});
+    for (int64_t c : p.children[q]) {
+      if (c < 0) continue;
+      if (t.nodes[size_t(c)].leaf()) (last ? blocks : seq).push_back({false, uint32_t(c)});
+      else next.push_back(p.quad_index[size_t(c)]);
+    }
+  };
+  if (order == NodeOrder::BreadthFirst || order == NodeOrder::BreadthFirstTrianglesLast) {
+    std::vector<uint32_t> level{0};
+    while (!level.empty()) {
+      std::vector<uint32_t> next;
+      for (uint32_t q : level) emit(q, next);
+      level.swap(next);
+    }
+  } else {
+    std::function<void(uint32_t)> visit = [&](uint32_t q) {
+      std::vector<uint32_t> next;
+      emit(q, next);
+      for (uint32_t c : next) visit(c);
+    };
+    visit(0);
+  }
+  seq.insert(seq.end(), blocks.begin(), blocks.end());
+  return seq;
+}
+
 template <class Bounds>
-void write_quadtree(Writer& w, const QuadPlan& p) {
-  uint64_t nodes = uint64_t(p.binary_of.size()) * Bounds::kNodeBytes;
-  uint64_t end = nodes;
-  for (uint32_t leaf : p.leaves) end += w.leaf_bytes[leaf];
-  if (end > MC_QUAD_OFFSET_MASK)
+void write_quadtree(Writer& w, QuadPlan& p, NodeOrder order) {
+  uint64_t at = 0, nodes = uint64_t(p.binary_of.size()) * Bounds::kNodeBytes;
+  p.node_offset.assign(p.binary_of.size(), 0);
+  for (auto [is_node, id] : quad_sequence(w.tree, p, order)) {
+    if (is_node) {
+      p.node_offset[id] = uint32_t(std::min<uint64_t>(at, MC_QUAD_OFFSET_MASK));
+      at += Bounds::kNodeBytes;
+    } else {
+      p.leaves.push_back(id);
+      p.leaf_offset[id] = uint32_t(std::min<uint64_t>(at, MC_QUAD_OFFSET_MASK));
+      at += w.leaf_bytes[id];
+    }
+  }
+  if (at > MC_QUAD_OFFSET_MASK)
     throw InputError("the " + std::string(layout::tree_format_name(Bounds::kFormat)) + " section of " +
-                     std::to_string(end) + " bytes exceeds its 27-bit child offsets (seed 000 5.6)");
-  w.h.tree_size = uint32_t(end);
+                     std::to_string(at) + " bytes exceeds its 27-bit child offsets (seed 000 5.6)");
+  const bool last = order == NodeOrder::DepthFirstTrianglesLast || order == NodeOrder::BreadthFirstTrianglesLast;
+  w.h.tree_size = uint32_t(at);
   w.h.node_bytes = uint32_t(nodes);
   w.h.node_count = uint32_t(p.binary_of.size());
-  w.h.triangle_base = uint32_t(nodes);
+  w.h.triangle_base = last ? uint32_t(nodes) : 0;  // interleaved blocks: slots count from the section start
 }
 
 template <class Bounds>
 void fill_quadtree(Writer& w, QuadPlan& p) {
   const BuildTree& t = w.tree;
-  uint32_t at = w.h.triangle_base;
-  for (uint32_t leaf : p.leaves) {
-    p.leaf_offset[leaf] = at;
-    w.write_leaf(leaf, at);
-    at += w.leaf_bytes[leaf];
-  }
+  for (uint32_t leaf : p.leaves) w.write_leaf(leaf, p.leaf_offset[leaf]);
   w.refit();
   auto props = [&](uint32_t n) {
     return t.nodes[n].leaf() ? layout::quad_properties(t.nodes[n].count, p.leaf_offset[n])
-                             : layout::quad_properties(0, p.quad_index[n] * Bounds::kNodeBytes);
+                             : layout::quad_properties(0, p.node_offset[p.quad_index[n]]);
   };
   for (size_t q = 0; q < p.binary_of.size(); ++q) {
     layout::QuadChild c[4];
@@ -359,7 +397,7 @@ void fill_quadtree(Writer& w, QuadPlan& p) {
       for (int a = 0; a < 3; ++a) c[k].min[a] = t.nodes[n].box.min[a], c[k].max[a] = t.nodes[n].box.max[a];
       c[k].properties = props(n);
     }
-    uint8_t* out = w.bytes.data() + w.h.tree_offset + q * Bounds::kNodeBytes;
+    uint8_t* out = w.bytes.data() + w.h.tree_offset + p.node_offset[q];
     Bounds::encode(c, w.h, out);
     for (int k = 0; k < 4; ++k) std::memcpy(out + Bounds::kPropertiesAt + 4 * k, &c[k].properties, 4);
   }
@@ -367,6 +405,19 @@ void fill_quadtree(Writer& w, QuadPlan& p) {
 }
 
 }  // namespace
+
+std::string node_order_refusal(uint32_t tree, NodeOrder order) {
+  if (order == NodeOrder::Default || tree == MC_TREE_QUADTREE || tree == MC_TREE_QUADTREEHALFFLOAT) return "";
+  // What each other format's bits fix (seed 000 5.1-5.5, seed 001).
+  NodeOrder fixed = NodeOrder::DepthFirst;
+  const char* why = "its first child and its leaves' blocks sit right behind their node";
+  if (tree == MC_TREE_AABBTREEPNS) fixed = NodeOrder::DepthFirstTrianglesLast, why = "it addresses nodes by depth-first index";
+  if (tree == MC_TREE_STACKLESSLBVH) fixed = NodeOrder::BreadthFirstTrianglesLast, why = "its nodes are a heap";
+  if (tree == MC_TREE_BRUTEFORCE) return "BruteForce has no tree, so no node order";
+  if (order == fixed) return "";
+  return std::string(layout::tree_format_name(tree)) + " is always " + node_order_name(fixed) + ": " + why +
+         " (seed 000 4.3 orders apply where a format allows them)";
+}
 
 void quantization_bound(const float offset[3], const float scale[3], float bound[3]) {
   for (int a = 0; a < 3; ++a) {
@@ -385,6 +436,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
                      std::to_string(MC_QUAD_MAX_COUNT) + " (5-bit triangle counts, seed 000 5.6)");
   if (layout::tree_format_name(o.tree_format).empty()) throw InputError(name + ": unknown tree format");
   CodecOps codec = codec_ops(o.triangle_format);
+  if (std::string why = node_order_refusal(o.tree_format, o.node_order); !why.empty())
+    throw InputError(name + ": " + why);
 
   BlobHeader h{};
   h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
@@ -479,8 +532,9 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   } else {
     plan = plan_quadtree(tree);
     depth = plan.depth;
-    if (o.tree_format == MC_TREE_QUADTREE) write_quadtree<layout::QuadBoundsFloat>(writer, plan);
-    else write_quadtree<layout::QuadBoundsHalf>(writer, plan);
+    NodeOrder order = o.node_order == NodeOrder::Default ? NodeOrder::DepthFirstTrianglesLast : o.node_order;
+    if (o.tree_format == MC_TREE_QUADTREE) write_quadtree<layout::QuadBoundsFloat>(writer, plan, order);
+    else write_quadtree<layout::QuadBoundsHalf>(writer, plan, order);
   }
   if (depth > MC_MAX_DEPTH)
     throw InputError(name + ": the tree is " + std::to_string(depth) + " levels deep, beyond the walkers' limit of " +
@@ -594,6 +648,38 @@ BuildOptions parse_layout(const std::string& text) {
   std::string valid;
   for (const std::string& n : layout_names()) valid += "\n  " + n;
   throw InputError("unknown layout '" + text + "'; valid layouts (TREE/TRIANGLES):" + valid);
+}
+
+}  // namespace meshcast
+
+namespace meshcast {
+
+std::vector<NodeOrder> all_node_orders() {
+  return {NodeOrder::DepthFirst, NodeOrder::DepthFirstTrianglesLast, NodeOrder::BreadthFirst,
+          NodeOrder::BreadthFirstTrianglesLast};
+}
+
+const char* node_order_name(NodeOrder order) {
+  switch (order) {
+    case NodeOrder::Default: return "Default";
+    case NodeOrder::DepthFirst: return "DepthFirst";
+    case NodeOrder::DepthFirstTrianglesLast: return "DepthFirstTrianglesLast";
+    case NodeOrder::BreadthFirst: return "BreadthFirst";
+    case NodeOrder::BreadthFirstTrianglesLast: return "BreadthFirstTrianglesLast";
+  }
+  return "";
+}
+
+NodeOrder parse_node_order(const std::string& name) {
+  std::string valid;
+  for (NodeOrder o : all_node_orders()) {
+    std::string n = node_order_name(o);
+    if (n.size() == name.size() &&
+        std::equal(n.begin(), n.end(), name.begin(), [](char a, char b) { return std::tolower(a) == std::tolower(b); }))
+      return o;
+    valid += " " + n;
+  }
+  throw InputError("unknown node order '" + name + "'; valid orders:" + valid);
 }
 
 }  // namespace meshcast

@@ -12,6 +12,15 @@
 namespace meshcast {
 
 
+// Node orders of seed 000 §4.3; Default is the format's own. Only the quad
+// trees, whose nodes address every child and block by offset, take all four.
+enum class NodeOrder { Default, DepthFirst, DepthFirstTrianglesLast, BreadthFirst, BreadthFirstTrianglesLast };
+const char* node_order_name(NodeOrder order);
+NodeOrder parse_node_order(const std::string& name);  // throws InputError listing the valid names
+std::vector<NodeOrder> all_node_orders();             // the four of §4.3
+// "" when the tree format can be written in that order, else why not.
+std::string node_order_refusal(uint32_t tree_format, NodeOrder order);
+
 struct BuildOptions {
   uint32_t tree_format = 3;      // MC_TREE_*
   uint32_t triangle_format = 3;  // MC_TRI_*
@@ -23,6 +32,7 @@ struct BuildOptions {
   // nearer child first (false: left first, as the seed).
   uint32_t lbvh_depth = 0;
   bool lbvh_near_first = true;
+  NodeOrder node_order = NodeOrder::Default;
 };
 
 struct BuildReport {

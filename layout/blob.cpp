@@ -153,9 +153,12 @@ std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
       return "node at tree offset " + num(offset) + " does not lie after its parent at " + num(it.parent);
     root = false;
     if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(offset)); !e.empty()) return e;
-    if (offset % 4 != 0 || uint64_t(offset) + Bounds::kNodeBytes > h.node_bytes)
-      return "node at tree offset " + num(offset) + " is misaligned or outside the node area (" +
-             num(h.node_bytes) + " bytes)";
+    // Nodes lie before the triangle area, or anywhere in the section when
+    // blocks sit among them (the §4.3 orders without "triangles last").
+    const uint64_t node_area = h.triangle_base > 0 ? h.triangle_base : h.tree_size;
+    if (offset % 4 != 0 || uint64_t(offset) + Bounds::kNodeBytes > node_area)
+      return "node at tree offset " + num(offset) + " is misaligned or outside the node area (" + num(node_area) +
+             " bytes)";
     const uint8_t* node = blob + h.tree_offset + offset;
     for (int k = 0; k < 4; ++k) {
       uint32_t p = quad_child_properties(node, Bounds::kPropertiesAt, k);

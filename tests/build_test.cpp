@@ -195,6 +195,25 @@ TEST(Build, SixteenBitIndicesRefuseMeshesBeyondTheirReach) {
   EXPECT_EQ(layout::validate(build_blob(big, parse_layout("QuadTree/Indexed32"), "grid300")), "");
 }
 
+TEST(Build, NodeOrdersAFormatCannotHoldAreRefusedWithTheReason) {
+  Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
+  BuildOptions o = parse_layout("AABBTree/Float3");
+  o.node_order = NodeOrder::BreadthFirst;
+  try {
+    build_blob(m, o, "sphere");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("right behind"), std::string::npos) << e.what();
+  }
+  o.node_order = NodeOrder::DepthFirst;  // what AABBTree is anyway
+  EXPECT_NO_THROW(build_blob(m, o, "sphere"));
+  o = parse_layout("StacklessLBVH/Float3");
+  o.lbvh_depth = 2;  // 31 triangles a leaf, 2 leaves: far too few for the sphere
+  EXPECT_THROW(build_blob(m, o, "sphere"), InputError);
+  EXPECT_EQ(parse_node_order("breadthfirsttriangleslast"), NodeOrder::BreadthFirstTrianglesLast);
+  EXPECT_THROW(parse_node_order("Random"), InputError);
+}
+
 TEST(Build, LayoutNamesAreCaseInsensitiveAndUnknownOnesListTheValid) {
   EXPECT_EQ(parse_layout("quadtreehalffloat/indexed8bitpacksoa4").tree_format, MC_TREE_QUADTREEHALFFLOAT);
   try {

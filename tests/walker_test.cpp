@@ -2,6 +2,7 @@
 // and the public ones, 10,000 rays of each kind.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 
@@ -67,6 +68,54 @@ TEST(WalkerVsOracleSplitters, EverySplitterOnTheFoundationLayouts) {
         EXPECT_EQ(a.wrong + a.t_errors, 0u) << splitter_name(s) << " " << name << " on " << m.name << ": " << a.first_problem;
       }
     }
+}
+
+// The four node orders of seed 000 §4.3 on the quad trees: same answers, and
+// the blocks where each order puts them.
+TEST(WalkerVsOracleNodeOrders, EveryOrderOnTheQuadTrees) {
+  for (NodeOrder order : all_node_orders())
+    for (const NamedMesh& m : test_meshes(false)) {
+      if (m.name != "sphere" && m.name != "terrain_64k" && m.name != "bunny00") continue;
+      for (const char* name : {"QuadTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
+        BuildOptions o = parse_layout(name);
+        o.node_order = order;
+        std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name);
+        ASSERT_EQ(layout::validate(blob), "") << name << " " << node_order_name(order);
+        const layout::BlobHeader& h = layout::header_of(blob.data());
+        const bool last = order == NodeOrder::DepthFirstTrianglesLast || order == NodeOrder::BreadthFirstTrianglesLast;
+        uint32_t lowest_block = ~0u;
+        layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t) { lowest_block = std::min(lowest_block, block); });
+        if (last) EXPECT_EQ(lowest_block, h.node_bytes) << name << " " << node_order_name(order);
+        else EXPECT_LT(lowest_block, h.node_bytes) << name << " " << node_order_name(order);
+        NamedMesh reference = m;
+        if (moves_vertices(o.triangle_format))
+          reference = {m.name + "#" + name + "#" + node_order_name(order), std::make_shared<const Mesh>(stored_mesh(blob))};
+        const std::vector<Ray>& rays = test_rays(m, RayKind::Long, 2000);
+        Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, RayKind::Long, rays),
+                              1e-5 * m.mesh->bounds().diagonal());
+        EXPECT_EQ(a.wrong + a.t_errors, 0u) << node_order_name(order) << " " << name << " on " << m.name << ": " << a.first_problem;
+      }
+    }
+}
+
+// StacklessLBVH walked left first (the seed) and nearer first give the same
+// answers; so does a tight depth limit, which forces median splits.
+TEST(WalkerVsOracleLBVH, LeftFirstNearFirstAndDepthLimits) {
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (m.name != "sphere" && m.name != "bunny00") continue;
+    for (int variant = 0; variant < 3; ++variant) {
+      BuildOptions o = parse_layout("StacklessLBVH/Float3");
+      o.lbvh_near_first = variant != 1;
+      if (variant == 2) o.lbvh_depth = uint32_t(std::bit_width(m.mesh->triangles.size() / 31)) + 1;
+      std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name);
+      ASSERT_EQ(layout::validate(blob), "");
+      if (variant == 2) EXPECT_LT(layout::header_of(blob.data()).max_depth, o.lbvh_depth);
+      const std::vector<Ray>& rays = test_rays(m, RayKind::Radial, 3000);
+      Agreement a = compare(*m.mesh, rays, trace_all(blob, rays), oracle_answers(m, RayKind::Radial, rays),
+                            1e-5 * m.mesh->bounds().diagonal());
+      EXPECT_EQ(a.wrong + a.t_errors, 0u) << "variant " << variant << " on " << m.name << ": " << a.first_problem;
+    }
+  }
 }
 
 // CTest points MESHCAST_DATA at data/ (scripts/setup.sh fills it): there the

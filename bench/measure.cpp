@@ -6,6 +6,7 @@
 #include "cpu/agreement.h"
 #include "cpu/trace.h"
 #include "layout/blob.h"
+#include "layout/lbvh.h"
 
 namespace meshcast::bench {
 
@@ -40,7 +41,13 @@ Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& op
     a = compare(mesh, rays, hits, oracle, tolerance);
   }
   double tree_bytes = double(h.node_bytes) / h.triangle_count, walked = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
-  return {ms.front(), ms[ms.size() / 2], bytes, a.wrong + a.t_errors, report.build_ms, tree_bytes, walked, report.sah_cost};
+  Timing t{ms.front(), ms[ms.size() / 2], bytes, a.wrong + a.t_errors, report.build_ms, tree_bytes, walked, report.sah_cost};
+  if (h.tree_format == MC_TREE_STACKLESSLBVH) {
+    uint64_t holes = 0;
+    for (uint32_t n = 1; n <= h.node_count; ++n) holes += layout::load_lbvh_node(blob.data() + h.tree_offset, n).count == 0;
+    t.hole_bytes = double(holes * MC_LBVH_NODE_BYTES) / h.triangle_count;
+  }
+  return t;
 }
 
 }  // namespace meshcast::bench

@@ -17,6 +17,7 @@ struct Timing {
   double tree_bytes;         // nodes, per triangle
   double walked_bytes;       // everything a walk reads, per triangle
   double sah_cost;
+  double hole_bytes = 0;     // StacklessLBVH: node slots no walk reaches, per triangle
 };
 
 Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,

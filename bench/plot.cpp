@@ -6,19 +6,23 @@
 namespace meshcast::bench {
 
 std::string plot_scatter(const std::string& png, const std::string& title, const std::string& xlabel,
-                         const std::string& ylabel, const std::vector<Series>& series, bool log_y) {
+                         const std::string& ylabel, const std::vector<Series>& series, bool log_y, bool log_x) {
   std::string script = png + ".gp";
   std::ofstream gp(script);
-  gp << "set terminal pngcairo size 1100,750 font 'sans,10'\n"
+  size_t points = 0;
+  for (const Series& s : series) points += s.points.size();
+  // Many labelled points (one per tree and encoding) need room.
+  gp << (points > 40 ? "set terminal pngcairo size 1800,1200 font 'sans,10'\n" : "set terminal pngcairo size 1100,750 font 'sans,10'\n")
      << "set output '" << png << "'\n"
      << "set title '" << title << "'\n"
      << "set xlabel '" << xlabel << "'\nset ylabel '" << ylabel << "'\n"
      << "set grid\nset key top right\nset offsets graph 0.02, graph 0.15, graph 0.05, graph 0.05\n"
-     << (log_y ? "set logscale y\n" : "") << "plot ";
+     << (log_y ? "set logscale y\n" : "") << (log_x ? "set logscale x\n" : "")
+     << (log_x || log_y ? "set autoscale fix\n" : "") << "plot ";
   for (size_t s = 0; s < series.size(); ++s) {
     if (s) gp << ", ";
-    gp << "'-' using 1:2 with points pt 7 ps 1.2 title '" << series[s].title << "', '-' using 1:2:3 with labels "
-       << "offset 0.8,0.4 left font 'sans,8' notitle";
+    gp << "'-' using 1:2 with points pt 7 ps 1.2 lc " << s + 1 << " title '" << series[s].title
+       << "', '-' using 1:2:3 with labels offset 0.8,0.4 left font 'sans,7' tc lt " << s + 1 << " notitle";
   }
   gp << "\n";
   for (const Series& s : series)

@@ -17,6 +17,6 @@ struct Series {
 // Writes `png` (and the data and script beside it, `png` + ".gp"). Returns ""
 // or why no picture was drawn (gnuplot missing or failing).
 std::string plot_scatter(const std::string& png, const std::string& title, const std::string& xlabel,
-                         const std::string& ylabel, const std::vector<Series>& series, bool log_y);
+                         const std::string& ylabel, const std::vector<Series>& series, bool log_y, bool log_x = false);
 
 }  // namespace meshcast::bench

@@ -6,11 +6,22 @@
 #include "bench/encodings.h"
 #include "bench/plot.h"
 #include "bench/trees.h"
+#include "io/generate.h"
 #include "io/read_mesh.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 
 namespace meshcast::tools {
+
+namespace {
+
+// A mesh file, or "terrain_2M": the generated 2,097,152-triangle terrain.
+Mesh bench_mesh(const std::string& input) {
+  if (input == "terrain_2M") return make_terrain(1024, 1024, 5);
+  return read_mesh(input);
+}
+
+}  // namespace
 
 void add_bench(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "reproduce the source documents' tables");
@@ -29,7 +40,7 @@ void add_bench(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--out-dir", args->out_dir, "where encodings.csv and encodings.png go");
   cmd->callback([args] {
-    Mesh mesh = read_mesh(args->input);
+    Mesh mesh = bench_mesh(args->input);
     std::filesystem::create_directories(args->out_dir);
     std::fprintf(stderr, "%s: %zu triangles, %zu long rays, %u passes\n", args->input.c_str(), mesh.triangles.size(),
                  args->rays, args->repeat);
@@ -64,49 +75,91 @@ void add_bench(CLI::App& app) {
     std::printf("\ncsv: %s\nplot: %s\n", csv_path.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
 
-  // §4.1 and §4.2: the same columns, one table each.
-  for (const char* which : {"splitters", "leafsize", "trees"}) {
+  // §4.1, §4.2, §4.3 and §6: the same columns, one table each, a CSV and a
+  // plot of time per ray against walked bytes per triangle.
+  struct Table { const char* name; const char* what; };
+  const Table tables[] = {
+      {"splitters", "seed 000 4.1: every splitter, AABBTree with Float3 and Float3SOA4, leaf 8"},
+      {"leafsize", "seed 000 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning"},
+      {"order", "seed 000 4.3: the four node orders, QuadTree and QuadTreeHalfFloat with Float3"},
+      {"trees", "seed 000 6: every tree format with Float3, Binning, leaf 8"},
+      {"combos", "seed 000 6: every tree with every CPU triangle encoding"}};
+  for (const Table& table : tables) {
     auto targs = std::make_shared<ArgsT>();
-    std::string what = std::string(which) == "splitters" ? "seed 000 4.1: every splitter, AABBTree with Float3 and Float3SOA4, leaf 8"
-                       : std::string(which) == "leafsize" ? "seed 000 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning"
-                                                          : "seed 000 6: every tree format with Float3, Binning, leaf 8";
-    CLI::App* sub = bench->add_subcommand(which, what);
-    sub->add_option("mesh", targs->input, "mesh file (default data/bunny00.off)");
+    CLI::App* sub = bench->add_subcommand(table.name, table.what);
+    sub->add_option("mesh", targs->input, "mesh file, or terrain_2M for the generated 2M-triangle terrain (default data/bunny00.off)");
     sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
     sub->add_option("--repeat", targs->repeat, "passes; minimum and median reported")->check(CLI::Range(1, 1000));
-    sub->add_option("--out-dir", targs->out_dir, "where the CSV goes");
-    std::string kind = which;
+    sub->add_option("--out-dir", targs->out_dir, "where the CSV and the plot go");
+    std::string kind = table.name;
     sub->callback([targs, kind] {
-      Mesh mesh = read_mesh(targs->input);
+      Mesh mesh = bench_mesh(targs->input);
       std::filesystem::create_directories(targs->out_dir);
       std::vector<bench::TreeRow> rows =
           kind == "splitters" ? bench::bench_splitters(mesh, targs->input, targs->rays, targs->repeat)
           : kind == "leafsize" ? bench::bench_leafsize(mesh, targs->input, targs->rays, targs->repeat)
+          : kind == "order"    ? bench::bench_order(mesh, targs->input, targs->rays, targs->repeat)
+          : kind == "combos"   ? bench::bench_combos(mesh, targs->input, targs->rays, targs->repeat)
                                : bench::bench_trees(mesh, targs->input, targs->rays, targs->repeat);
       double scale = 1024.0 / double(targs->rays);
       std::printf("\n%s, %zu triangles, %zu long rays, one thread; ms for 1024 rays (minimum of %u passes, median "
                   "beside it); seed column: seed 000 (i7-7700HQ, 2019)\n\n",
                   targs->input.c_str(), mesh.triangles.size(), targs->rays, targs->repeat);
+      const char* label = kind == "splitters" ? "splitter" : kind == "leafsize" ? "leaf size" : kind == "order" ? "order" : "tree";
       std::printf("| %s | layout | ms (min) | median | seed | build ms | SAH cost | tree bytes (seed) | tree B/tri | "
-                  "walked B/tri | disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
-                  kind == "splitters" ? "splitter" : kind == "leafsize" ? "leaf size" : "tree");
-      std::ofstream csv(targs->out_dir + "/" + kind + ".csv");
-      csv << "label,layout,min_ms_1024,median_ms_1024,seed,build_ms,sah_cost,tree_bytes_per_tri,walked_bytes_per_tri,"
-             "disagreements\n";
+                  "walked B/tri (seed) | holes B/tri | disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+                  label);
+      std::string stem = targs->out_dir + "/" + kind + (targs->input == "terrain_2M" ? "_terrain_2M" : "");
+      std::ofstream csv(stem + ".csv");
+      csv << "label,layout,min_ms_1024,median_ms_1024,seed_ms_1024,build_ms,sah_cost,tree_bytes_per_tri,"
+             "walked_bytes_per_tri,seed_bytes_per_tri,hole_bytes_per_tri,disagreements\n";
+      // One series (colour) per tree format, each point labelled.
+      std::vector<bench::Series> series;
       for (const bench::TreeRow& r : rows) {
         const bench::Timing& t = r.timing;
         std::string seed_bytes = r.seed_tree_bytes > 0 ? " (" + std::to_string(uint64_t(r.seed_tree_bytes)) + ")" : "";
-        std::printf("| %s | %s | %.3f | %.3f | %.2f | %.0f | %.1f | %.0f%s | %.2f | %.2f | %llu |\n", r.label.c_str(),
-                    r.layout.c_str(), t.min_ms * scale, t.median_ms * scale, r.seed_ms, t.build_ms, t.sah_cost,
+        char seed_walked[32] = "", seed_ms[32] = "-";
+        if (r.seed_bytes_per_tri > 0) std::snprintf(seed_walked, sizeof seed_walked, " (%.1f)", r.seed_bytes_per_tri);
+        if (r.seed_ms > 0) std::snprintf(seed_ms, sizeof seed_ms, "%g", r.seed_ms);
+        std::printf("| %s | %s | %.3f | %.3f | %s | %.0f | %.1f | %.0f%s | %.2f | %.2f%s | %.2f | %llu |\n", r.label.c_str(),
+                    r.layout.c_str(), t.min_ms * scale, t.median_ms * scale, seed_ms, t.build_ms, t.sah_cost,
                     t.tree_bytes * double(mesh.triangles.size()), seed_bytes.c_str(), t.tree_bytes, t.walked_bytes,
-                    (unsigned long long)t.disagreements);
+                    seed_walked, t.hole_bytes, (unsigned long long)t.disagreements);
         csv << r.label << "," << r.layout << "," << t.min_ms * scale << "," << t.median_ms * scale << "," << r.seed_ms
             << "," << t.build_ms << "," << t.sah_cost << "," << t.tree_bytes << "," << t.walked_bytes << ","
-            << t.disagreements << "\n";
+            << r.seed_bytes_per_tri << "," << t.hole_bytes << "," << t.disagreements << "\n";
+        std::string tree = r.layout.substr(0, r.layout.find('/'));
+        std::string point = kind == "combos" ? r.layout.substr(r.layout.find('/') + 1) : r.label;
+        if (series.empty() || series.back().title != tree) series.push_back({tree, {}});
+        series.back().points.push_back({t.walked_bytes, t.min_ms * 1000.0 / double(targs->rays), point});
       }
-      std::printf("\ncsv: %s/%s.csv\n", targs->out_dir.c_str(), kind.c_str());
+      std::string png = stem + ".png";
+      std::string why = bench::plot_scatter(png, std::string(kind) + " on " + targs->input + " (minimum of passes)",
+                                            "bytes per triangle walked (nodes, blocks, vertices)", "microseconds per ray",
+                                            series, kind == "combos", kind == "combos" || kind == "trees");
+      std::printf("\ncsv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
     });
   }
+
+  // Issue 4's offset test for the half-float tree.
+  auto oargs = std::make_shared<ArgsT>();
+  CLI::App* off = bench->add_subcommand("offset", "QuadTreeHalfFloat far from the origin: 0.15 units at 1000, 150 at 30000");
+  off->add_option("mesh", oargs->input, "mesh file (default data/bunny00.off), scaled to each case's size");
+  off->add_option("--rays", oargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
+  off->add_option("--repeat", oargs->repeat, "passes a measurement (3 measurements each, interleaved)")->check(CLI::Range(1, 1000));
+  off->callback([oargs] {
+    Mesh mesh = bench_mesh(oargs->input);
+    std::vector<bench::OffsetRow> rows = bench::bench_offset(mesh, oargs->input, oargs->rays, oargs->repeat);
+    double scale = 1024.0 / double(oargs->rays);
+    std::printf("\n%s scaled and moved, %zu long rays; ms for 1024 rays, minimum over 3 interleaved measurements of %u "
+                "passes each, in this one run\n\n| layout | mesh | at the origin | moved | ratio | disagreements |\n"
+                "|---|---|---:|---:|---:|---:|\n",
+                oargs->input.c_str(), oargs->rays, oargs->repeat);
+    for (const bench::OffsetRow& r : rows)
+      std::printf("| %s | %s | %.3f | %.3f | %.2f | %llu |\n", r.layout.c_str(), r.mesh.c_str(), r.origin.min_ms * scale,
+                  r.offset.min_ms * scale, r.offset.min_ms / r.origin.min_ms,
+                  (unsigned long long)(r.origin.disagreements + r.offset.disagreements));
+  });
 }
 
 }  // namespace meshcast::tools

@@ -122,9 +122,13 @@ std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, siz
       continue;
     std::fprintf(stderr, "  %s\n", layout.c_str());
     auto it = seed.find(layout);
-    TreeRow row{layout.substr(0, layout.find('/')), layout, it == seed.end() ? 0.0 : it->second.first,
-                measure(mesh, name, o, s.rays, s.oracle, repeat)};
+    TreeRow row{layout.substr(0, layout.find('/')), layout, it == seed.end() ? 0.0 : it->second.first, {}};
     row.seed_bytes_per_tri = it == seed.end() ? 0.0 : it->second.second;
+    try {
+      row.timing = measure(mesh, name, o, s.rays, s.oracle, repeat);
+    } catch (const InputError& e) {  // a format limit this mesh exceeds (16-bit indices, offsets)
+      row.refused = e.what();
+    }
     rows.push_back(row);
   }
   return rows;

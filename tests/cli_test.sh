@@ -45,6 +45,10 @@ fi
 check bench-encodings 0 "csv: .*encodings.csv" -- "$meshcast" bench encodings "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check bench-trees 0 "AABBTreePNS/Float3" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check bench-splitters 0 "FixedLeafSize" -- "$meshcast" bench splitters "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-trees-all 0 "StacklessLBVH left first" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-order 0 "BreadthFirstTrianglesLast" -- "$meshcast" bench order "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$mesh" --rays 8 --repeat 1
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout SKDTree/Float3

@@ -117,6 +117,11 @@ void add_bench(CLI::App& app) {
       std::vector<bench::Series> series;
       for (const bench::TreeRow& r : rows) {
         const bench::Timing& t = r.timing;
+        if (!r.refused.empty()) {
+          std::printf("| %s | %s | refused: %s |\n", r.label.c_str(), r.layout.c_str(), r.refused.c_str());
+          csv << r.label << "," << r.layout << ",,,,,,,,,,refused\n";
+          continue;
+        }
         std::string seed_bytes = r.seed_tree_bytes > 0 ? " (" + std::to_string(uint64_t(r.seed_tree_bytes)) + ")" : "";
         char seed_walked[32] = "", seed_ms[32] = "-";
         if (r.seed_bytes_per_tri > 0) std::snprintf(seed_walked, sizeof seed_walked, " (%.1f)", r.seed_bytes_per_tri);

@@ -1,6 +1,8 @@
 // The binary AABB tree every layout is written from. Builders see only
 // triangle boxes and centres, so one builder serves every format.
 #pragma once
+#include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,6 +38,22 @@ enum class Splitter { Binning, LongestAxis, Mean, Morton, FixedLeafSize };
 BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit = ~0u);
 BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size,
                      uint32_t depth_limit = ~0u);
+
+// The option value among `all` whose name_of() matches `name`,
+// case-insensitive; else InputError naming `what` and listing the valid ones.
+template <class E>
+E parse_named(const std::string& name, const std::vector<E>& all, const char* (*name_of)(E), const char* what) {
+  std::string valid;
+  for (E e : all) {
+    std::string n = name_of(e);
+    if (n.size() == name.size() && std::equal(n.begin(), n.end(), name.begin(), [](char a, char b) {
+          return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+        }))
+      return e;
+    valid += " " + n;
+  }
+  throw InputError("unknown " + std::string(what) + " '" + name + "'; valid " + what + "s:" + valid);
+}
 
 // "Binning", "LongestAxis", ... case-insensitive; throws InputError listing
 // the valid names.

@@ -165,16 +165,6 @@ const char* splitter_name(Splitter s) {
   return "";
 }
 
-Splitter parse_splitter(const std::string& name) {
-  std::string valid;
-  for (Splitter s : all_splitters()) {
-    std::string n = splitter_name(s);
-    if (n.size() == name.size() &&
-        std::equal(n.begin(), n.end(), name.begin(), [](char a, char b) { return std::tolower(a) == std::tolower(b); }))
-      return s;
-    valid += " " + n;
-  }
-  throw InputError("unknown splitter '" + name + "'; valid splitters:" + valid);
-}
+Splitter parse_splitter(const std::string& name) { return parse_named(name, all_splitters(), splitter_name, "splitter"); }
 
 }  // namespace meshcast

@@ -671,15 +671,7 @@ const char* node_order_name(NodeOrder order) {
 }
 
 NodeOrder parse_node_order(const std::string& name) {
-  std::string valid;
-  for (NodeOrder o : all_node_orders()) {
-    std::string n = node_order_name(o);
-    if (n.size() == name.size() &&
-        std::equal(n.begin(), n.end(), name.begin(), [](char a, char b) { return std::tolower(a) == std::tolower(b); }))
-      return o;
-    valid += " " + n;
-  }
-  throw InputError("unknown node order '" + name + "'; valid orders:" + valid);
+  return parse_named(name, all_node_orders(), node_order_name, "node order");
 }
 
 }  // namespace meshcast

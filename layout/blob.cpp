@@ -101,36 +101,44 @@ std::string reach(uint64_t* visited, uint32_t depth, const BlobHeader& h, const 
   return "";
 }
 
-template <class Codec>
-std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  struct Item { uint32_t offset, depth; };
-  std::vector<Item> stack{{0, 0}};
+// The depth-first walk every binary tree's validation shares: from `root`,
+// each reached node (an offset or index, named `noun` in messages) is
+// reach()-checked, then visit(at, push) checks it and push()es its children.
+template <class Visit>
+std::string walk_nodes(const BlobHeader& h, uint32_t root, const char* noun, Visit&& visit) {
+  struct Item { uint32_t at, depth; };
+  std::vector<Item> stack{{root, 0}};
   uint64_t visited = 0;
   while (!stack.empty()) {
-    Item it = stack.back();
+    const Item it = stack.back();
     stack.pop_back();
-    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(it.offset)); !e.empty()) return e;
-    if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_AABB_NODE_BYTES > h.tree_size)
-      return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
-    AABBNode n = load_aabb_node(blob + h.tree_offset + it.offset);
-    uint32_t next = it.offset + MC_AABB_NODE_BYTES;
-    const bool split_axis = h.tree_format == MC_TREE_AABBTREESPLITAXIS;
-    if (n.is_leaf()) {
-      std::string e = check_leaf<Codec>(blob, h, next, n.value());
-      if (!e.empty()) return e;
-      *triangles += n.value();
-    } else {
-      uint32_t second = aabb_second_child(n, split_axis);
-      if (second <= next)
-        return "node at tree offset " + num(it.offset) + " has its second child at " + num(second) +
-               ", not after its first child";
-      if (split_axis && aabb_split_axis(n) > 2)
-        return "node at tree offset " + num(it.offset) + " names split axis " + num(aabb_split_axis(n)) + " (0..2)";
-      stack.push_back({next, it.depth + 1});
-      stack.push_back({second, it.depth + 1});
-    }
+    if (std::string e = reach(&visited, it.depth, h, noun + num(it.at)); !e.empty()) return e;
+    auto push = [&](uint32_t child) { stack.push_back({child, it.depth + 1}); };
+    if (std::string e = visit(it.at, push); !e.empty()) return e;
   }
   return "";
+}
+
+template <class Codec>
+std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  const bool split_axis = h.tree_format == MC_TREE_AABBTREESPLITAXIS;
+  return walk_nodes(h, 0, "node at tree offset ", [&](uint32_t at, auto push) -> std::string {
+    if (at % 4 != 0 || uint64_t(at) + MC_AABB_NODE_BYTES > h.tree_size)
+      return "node at tree offset " + num(at) + " is misaligned or past the tree section";
+    AABBNode n = load_aabb_node(blob + h.tree_offset + at);
+    uint32_t next = at + MC_AABB_NODE_BYTES;
+    if (n.is_leaf()) {
+      *triangles += n.value();
+      return check_leaf<Codec>(blob, h, next, n.value());
+    }
+    uint32_t second = aabb_second_child(n, split_axis);
+    if (second <= next)
+      return "node at tree offset " + num(at) + " has its second child at " + num(second) + ", not after its first child";
+    if (split_axis && aabb_split_axis(n) > 2)
+      return "node at tree offset " + num(at) + " names split axis " + num(aabb_split_axis(n)) + " (0..2)";
+    push(next), push(second);
+    return "";
+  });
 }
 
 template <class Bounds, class Codec>
@@ -172,31 +180,22 @@ std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
 // AABBTreePNS: nodes by index, each child after its parent.
 template <class Codec>
 std::string walk_pns(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  struct Item { uint32_t index, depth; };
-  std::vector<Item> stack{{0, 0}};
-  uint64_t visited = 0;
   if (h.node_count == 0 || uint64_t(h.node_count) * MC_AABB_NODE_BYTES != h.triangle_base)
     return "AABBTreePNS: the triangle base must follow the " + num(h.node_count) + " nodes";
-  while (!stack.empty()) {
-    Item it = stack.back();
-    stack.pop_back();
-    if (std::string e = reach(&visited, it.depth, h, "node " + num(it.index)); !e.empty()) return e;
-    if (it.index >= h.node_count) return "node index " + num(it.index) + " past the " + num(h.node_count) + " nodes";
-    AABBNode n = load_aabb_node(blob + h.tree_offset + uint64_t(it.index) * MC_AABB_NODE_BYTES);
+  return walk_nodes(h, 0, "node ", [&](uint32_t index, auto push) -> std::string {
+    if (index >= h.node_count) return "node index " + num(index) + " past the " + num(h.node_count) + " nodes";
+    AABBNode n = load_aabb_node(blob + h.tree_offset + uint64_t(index) * MC_AABB_NODE_BYTES);
     if (n.is_leaf()) {
       uint64_t block = uint64_t(h.triangle_base) + 4ull * (n.properties & MC_PNS_BLOCK_MASK);
-      if (block > h.tree_size) return "leaf " + num(it.index) + " points past the tree section";
-      std::string e = check_leaf<Codec>(blob, h, uint32_t(block), pns_leaf_count(n));
-      if (!e.empty()) return e;
+      if (block > h.tree_size) return "leaf " + num(index) + " points past the tree section";
       *triangles += pns_leaf_count(n);
-      continue;
+      return check_leaf<Codec>(blob, h, uint32_t(block), pns_leaf_count(n));
     }
     uint32_t second = pns_second_index(n);
-    if (second <= it.index + 1) return "node " + num(it.index) + " has its second child at " + num(second) + ", not after its first";
-    stack.push_back({it.index + 1, it.depth + 1});
-    stack.push_back({second, it.depth + 1});
-  }
-  return "";
+    if (second <= index + 1) return "node " + num(index) + " has its second child at " + num(second) + ", not after its first";
+    push(index + 1), push(second);
+    return "";
+  });
 }
 
 // AABBTreeCompressed: the section header, then nodes and blocks, each
@@ -214,31 +213,24 @@ std::string walk_compressed(const uint8_t* blob, const BlobHeader& h, uint64_t* 
     *triangles += count;
     return e;
   }
-  struct Item { uint32_t offset, depth; };
-  std::vector<Item> stack{{MC_COMPRESSED_HEADER_BYTES, 0}};
-  uint64_t visited = 0;
-  while (!stack.empty()) {
-    Item it = stack.back();
-    stack.pop_back();
-    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(it.offset)); !e.empty()) return e;
-    if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_COMPRESSED_NODE_BYTES > h.tree_size)
-      return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
-    CompressedNode n = load<CompressedNode>(tree + it.offset);
-    uint32_t left = it.offset + MC_COMPRESSED_NODE_BYTES;
+  return walk_nodes(h, MC_COMPRESSED_HEADER_BYTES, "node at tree offset ", [&](uint32_t at, auto push) -> std::string {
+    if (at % 4 != 0 || uint64_t(at) + MC_COMPRESSED_NODE_BYTES > h.tree_size)
+      return "node at tree offset " + num(at) + " is misaligned or past the tree section";
+    CompressedNode n = load<CompressedNode>(tree + at);
+    uint32_t left = at + MC_COMPRESSED_NODE_BYTES;
     if (n.right <= left)
-      return "node at tree offset " + num(it.offset) + " has its right child at " + num(n.right) + ", not after its left";
+      return "node at tree offset " + num(at) + " has its right child at " + num(n.right) + ", not after its left";
     const uint32_t child[2] = {left, n.right}, count[2] = {n.left_count(), n.right_count()};
     for (int k = 0; k < 2; ++k) {
       if (count[k] == 0) {
-        stack.push_back({child[k], it.depth + 1});
+        push(child[k]);
         continue;
       }
-      std::string e = check_leaf<Codec>(blob, h, child[k], count[k]);
-      if (!e.empty()) return e;
+      if (std::string e = check_leaf<Codec>(blob, h, child[k], count[k]); !e.empty()) return e;
       *triangles += count[k];
     }
-  }
-  return "";
+    return "";
+  });
 }
 
 // SKDTree: interior nodes and leaves of two sizes, each right child after
@@ -249,31 +241,22 @@ std::string walk_skd(const uint8_t* blob, const BlobHeader& h, uint64_t* triangl
   for (int a = 0; a < 3; ++a)
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
       return "SKDTree: the root box in the header is empty or not finite";
-  struct Item { uint32_t offset, depth; };
-  std::vector<Item> stack{{0, 0}};
-  uint64_t visited = 0;
-  while (!stack.empty()) {
-    Item it = stack.back();
-    stack.pop_back();
-    if (std::string e = reach(&visited, it.depth, h, "node at tree offset " + num(it.offset)); !e.empty()) return e;
-    if (it.offset % 4 != 0 || uint64_t(it.offset) + MC_SKD_LEAF_BYTES > h.tree_size)
-      return "node at tree offset " + num(it.offset) + " is misaligned or past the tree section";
-    uint32_t p = load<uint32_t>(tree + it.offset);
+  return walk_nodes(h, 0, "node at tree offset ", [&](uint32_t at, auto push) -> std::string {
+    if (at % 4 != 0 || uint64_t(at) + MC_SKD_LEAF_BYTES > h.tree_size)
+      return "node at tree offset " + num(at) + " is misaligned or past the tree section";
+    uint32_t p = load<uint32_t>(tree + at);
     if (skd_is_leaf(p)) {
-      std::string e = check_leaf<Codec>(blob, h, it.offset + MC_SKD_LEAF_BYTES, skd_value(p));
-      if (!e.empty()) return e;
       *triangles += skd_value(p);
-      continue;
+      return check_leaf<Codec>(blob, h, at + MC_SKD_LEAF_BYTES, skd_value(p));
     }
-    uint32_t left = it.offset + MC_SKD_INTERIOR_BYTES;
+    uint32_t left = at + MC_SKD_INTERIOR_BYTES;
     if (uint64_t(left) > h.tree_size || skd_value(p) <= left)
-      return "node at tree offset " + num(it.offset) + " has its right child at " + num(skd_value(p)) + ", not after its left";
-    if (!std::isfinite(skd_left_plane(tree + it.offset)) || !std::isfinite(skd_right_plane(tree + it.offset)))
-      return "node at tree offset " + num(it.offset) + " has a plane that is not finite";
-    stack.push_back({left, it.depth + 1});
-    stack.push_back({skd_value(p), it.depth + 1});
-  }
-  return "";
+      return "node at tree offset " + num(at) + " has its right child at " + num(skd_value(p)) + ", not after its left";
+    if (!std::isfinite(skd_left_plane(tree + at)) || !std::isfinite(skd_right_plane(tree + at)))
+      return "node at tree offset " + num(at) + " has a plane that is not finite";
+    push(left), push(skd_value(p));
+    return "";
+  });
 }
 
 // StacklessLBVH: every node a walk reaches is a leaf or has both children
@@ -284,27 +267,18 @@ std::string walk_lbvh(const uint8_t* blob, const BlobHeader& h, uint64_t* triang
   if (h.node_count == 0 || h.node_count > (1u << (MC_LBVH_MAX_DEPTH + 1)) - 1 ||
       uint64_t(h.node_count) * MC_LBVH_NODE_BYTES != h.triangle_base)
     return "StacklessLBVH: " + num(h.node_count) + " node slots do not fit its heap or its triangle base";
-  struct Item { uint32_t index, depth; };
-  std::vector<Item> stack{{1, 0}};
-  uint64_t visited = 0;
-  while (!stack.empty()) {
-    Item it = stack.back();
-    stack.pop_back();
-    if (std::string e = reach(&visited, it.depth, h, "node " + num(it.index)); !e.empty()) return e;
-    LBVHNode n = load_lbvh_node(tree, it.index);
-    if (n.count == 0) return "node " + num(it.index) + " is a hole but its parent is an interior node";
+  return walk_nodes(h, 1, "node ", [&](uint32_t index, auto push) -> std::string {
+    LBVHNode n = load_lbvh_node(tree, index);
+    if (n.count == 0) return "node " + num(index) + " is a hole but its parent is an interior node";
     if (n.count > 0) {
-      std::string e = check_leaf<Codec>(blob, h, n.position, uint32_t(n.count));
-      if (!e.empty()) return e;
       *triangles += uint32_t(n.count);
-      continue;
+      return check_leaf<Codec>(blob, h, n.position, uint32_t(n.count));
     }
-    if (uint64_t(it.index) * 2 + 1 > h.node_count)
-      return "node " + num(it.index) + " has children past the " + num(h.node_count) + " node slots";
-    stack.push_back({2 * it.index, it.depth + 1});
-    stack.push_back({2 * it.index + 1, it.depth + 1});
-  }
-  return "";
+    if (uint64_t(index) * 2 + 1 > h.node_count)
+      return "node " + num(index) + " has children past the " + num(h.node_count) + " node slots";
+    push(2 * index), push(2 * index + 1);
+    return "";
+  });
 }
 
 // BruteForce: the records must tile the tree section exactly.

@@ -56,13 +56,17 @@ uint32_t spread(uint32_t v) {
 }
 
 std::vector<uint32_t> morton_codes(const std::vector<Vec3>& centres) {
+  // One scale for all three axes (the largest extent): scaling each axis to
+  // its own extent would give a flat mesh's thin axis as many bits as the
+  // others, and its top bit would split a terrain into two interleaved
+  // height bands spread over the whole plane.
   Box3 box;
   for (const Vec3& c : centres) box.grow(c);
+  const double e = std::max({double(box.max.x) - box.min.x, double(box.max.y) - box.min.y, double(box.max.z) - box.min.z});
   std::vector<uint32_t> codes(centres.size());
   for (size_t i = 0; i < centres.size(); ++i) {
     uint32_t q[3];
     for (int a = 0; a < 3; ++a) {
-      double e = double(box.max[a]) - box.min[a];
       double f = e > 0 ? (double(centres[i][a]) - box.min[a]) / e : 0.0;
       q[a] = uint32_t(std::clamp(f * 1023.0, 0.0, 1023.0));
     }

@@ -51,7 +51,11 @@ check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mes
 check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$mesh" --rays 8 --repeat 1
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
-check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout SKDTree/Float3
+check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
+check order 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout quadtreehalffloat/float3 --order breadthfirst --rays "$work/r.rays" --out "$work/h4.hits"
+check order-refused 2 "AABBTree is always DepthFirst" -- "$meshcast" info "$mesh" --layout AABBTree/Float3 --order BreadthFirst
+check unknown-order 2 "valid node orders" -- "$meshcast" info "$mesh" --layout QuadTree/Float3 --order Random
+check lbvh 0 "StacklessLBVH/Float3" -- "$meshcast" info "$mesh" --layout StacklessLBVH/Float3 --lbvh-depth 20 --lbvh-left-first
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
 printf 'OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n' >"$work/nan.off"
 check nan-mesh 2 "nan.off.*(NaN|nan)" -- "$meshcast" info "$work/nan.off"

@@ -12,19 +12,17 @@ namespace meshcast::tools {
 
 void add_info(CLI::App& app) {
   struct Args {
-    std::string input, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter;  // empty: the layout's default
-    uint32_t leaf = 8;
+    std::string input;
+    LayoutArgs layout;
     bool json = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("info", "describe a mesh's blob: counts, bounds, bytes per section");
   cmd->add_option("input", args->input, "mesh file or blob")->required();
-  cmd->add_option("--layout", args->layout, "TREE/TRIANGLES when building from a mesh");
-  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
-  cmd->add_option("--splitter", args->splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
+  add_layout_options(cmd, args->layout);
   cmd->add_flag("--json", args->json, "print the same as one JSON object");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf, args->splitter));
+    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
     const layout::BlobHeader& h = layout::header_of(in.blob.data());
     SectionBytes s = section_bytes(in.blob);
     double n = h.triangle_count;

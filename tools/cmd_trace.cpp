@@ -11,8 +11,9 @@ namespace meshcast::tools {
 
 void add_trace(CLI::App& app) {
   struct Args {
-    std::string input, rays, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter;  // empty: the layout's default
-    uint32_t leaf = 8, repeat = 5;
+    std::string input, rays, out;
+    LayoutArgs layout;
+    uint32_t repeat = 5;
     bool json = false;
   };
   auto args = std::make_shared<Args>();
@@ -20,13 +21,11 @@ void add_trace(CLI::App& app) {
   cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL) or blob")->required();
   cmd->add_option("--rays", args->rays, "rays file")->required();
   cmd->add_option("--out", args->out, "hits file to write")->required();
-  cmd->add_option("--layout", args->layout, "TREE/TRIANGLES when building from a mesh");
-  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
-  cmd->add_option("--splitter", args->splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
+  add_layout_options(cmd, args->layout);
   cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf, args->splitter));
+    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
     std::vector<Ray> rays = read_rays(args->rays);
     BlobView view(in.blob, args->input);
     std::vector<Hit> hits(rays.size());
@@ -60,18 +59,16 @@ void add_trace(CLI::App& app) {
 
 void add_build(CLI::App& app) {
   struct Args {
-    std::string input, out, layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4", splitter;  // empty: the layout's default
-    uint32_t leaf = 8;
+    std::string input, out;
+    LayoutArgs layout;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("build", "build a mesh into a blob file");
   cmd->add_option("input", args->input, "mesh file")->required();
   cmd->add_option("--out", args->out, "blob file to write")->required();
-  cmd->add_option("--layout", args->layout, "TREE/TRIANGLES");
-  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
-  cmd->add_option("--splitter", args->splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
+  add_layout_options(cmd, args->layout);
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, layout_options(args->layout, args->leaf, args->splitter));
+    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
     if (!in.mesh) throw InputError(args->input + ": is already a blob; give a mesh file");
     write_file(args->out, in.blob.data(), in.blob.size());
     std::printf("%s: %zu triangles -> %s (%zu bytes, %.2f bytes/triangle), build %.1f ms\n", args->input.c_str(),

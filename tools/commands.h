@@ -1,6 +1,9 @@
 // Subcommands of the meshcast program; each adds itself to the parser.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <string>
+
+#include "cpu/encode.h"
 
 namespace meshcast::tools {
 
@@ -10,5 +13,16 @@ void add_info(CLI::App& app);
 void add_rays(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_bench(CLI::App& app);
+
+// The layout options trace, build and info share: --layout, --leaf,
+// --splitter, --order, --lbvh-depth, --lbvh-left-first.
+struct LayoutArgs {
+  std::string layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+  std::string splitter, order;  // empty: the layout's own
+  uint32_t leaf = 8, lbvh_depth = 0;
+  bool lbvh_left_first = false;
+};
+void add_layout_options(CLI::App* cmd, LayoutArgs& args);
+BuildOptions build_options(const LayoutArgs& args);  // throws InputError for bad names
 
 }  // namespace meshcast::tools

@@ -1,5 +1,7 @@
 #include "tools/common.h"
 
+#include "tools/commands.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -35,6 +37,26 @@ BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std:
   BuildOptions o = parse_layout(layout);
   o.leaf_size = leaf;
   if (!splitter.empty()) o.splitter = parse_splitter(splitter);  // else the layout's (Morton for StacklessLBVH)
+  return o;
+}
+
+void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
+  cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh");
+  cmd->add_option("--leaf", a.leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--splitter", a.splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
+  cmd->add_option("--order", a.order,
+                  "node order (seed 000 4.3): DepthFirst, DepthFirstTrianglesLast, BreadthFirst or "
+                  "BreadthFirstTrianglesLast; the quad trees take all four");
+  cmd->add_option("--lbvh-depth", a.lbvh_depth, "StacklessLBVH depth limit D (0: bit_width(triangles) + 1)")
+      ->check(CLI::Range(0u, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
+  cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
+}
+
+BuildOptions build_options(const LayoutArgs& a) {
+  BuildOptions o = layout_options(a.layout, a.leaf, a.splitter);
+  if (!a.order.empty()) o.node_order = parse_node_order(a.order);
+  o.lbvh_depth = a.lbvh_depth;
+  o.lbvh_near_first = !a.lbvh_left_first;
   return o;
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "io/generate.h"
 #include "layout/blob.h"
 #include "layout/leaves.h"
 #include "tests/testing.h"
@@ -134,10 +135,28 @@ INSTANTIATE_TEST_SUITE_P(Layouts, WalkerVsOracle, ::testing::ValuesIn(layout_nam
                            return n;
                          });
 
-// The three layouts of the foundation issue on the 1M-triangle terrain.
+// The layouts of the foundation issue and every tree with Float3 on the
+// 1M-triangle terrain.
 TEST(WalkerVsOracleLarge, Terrain1M) {
-  for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4"})
+  for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4",
+                           "AABBTreeSplitAxis/Float3", "AABBTreePNS/Float3", "AABBTreeCompressed/Float3",
+                           "SKDTree/Float3", "StacklessLBVH/Float3"})
     check_layout(name, true);
+}
+
+// Seed 000 6: the source's AABBTreePNS ran out of offset bits on its
+// 2,264,303-triangle scene. This one holds a larger terrain and walks it.
+TEST(WalkerVsOracleLarge, PNSHoldsTheSourcesLargestScene) {
+  Mesh terrain = make_terrain(1088, 1056, 13);  // 2,297,856 triangles
+  ASSERT_GT(terrain.triangles.size(), 2264303u);
+  std::vector<uint8_t> blob = build_blob(terrain, parse_layout("AABBTreePNS/Float3"), "terrain_2.3M");
+  ASSERT_EQ(layout::validate(blob), "");
+  std::vector<Ray> rays = make_rays(terrain, RayKind::Long, 2000, 5);
+  OracleTree oracle(terrain);
+  std::vector<OracleHit> answers;
+  for (const Ray& r : rays) answers.push_back(oracle.closest(r));
+  Agreement a = compare(terrain, rays, trace_all(blob, rays), answers, 1e-5 * terrain.bounds().diagonal());
+  EXPECT_EQ(a.wrong + a.t_errors, 0u) << a.first_problem;
 }
 
 // Every node's box, as the walker decodes it (half floats, 7-bit codes,

@@ -77,48 +77,6 @@ std::vector<uint32_t> triangle_formats() {
   return ids;
 }
 
-// AABBTree (§5.1), depth first: first child right behind its parent, the
-// leaf's triangle block right behind the leaf node.
-void write_aabbtree(Writer& w) {
-  const BuildTree& t = w.tree;
-  // Every node, and behind each leaf its block.
-  uint64_t tree_size = uint64_t(t.nodes.size()) * MC_AABB_NODE_BYTES;
-  for (uint32_t bytes : w.leaf_bytes) tree_size += bytes;
-  if (tree_size > MC_AABB_VALUE_MASK)
-    throw InputError("the AABBTree section of " + std::to_string(tree_size) +
-                     " bytes exceeds its 31-bit child offsets");
-  w.h.tree_size = uint32_t(tree_size);
-  w.h.node_bytes = uint32_t(t.nodes.size() * MC_AABB_NODE_BYTES);
-  w.h.node_count = uint32_t(t.nodes.size());
-  w.h.triangle_base = 0;
-  w.h.root = 0;
-}
-
-// Places every node (pre-order), encodes the leaves, refits, then writes
-// the nodes with the refitted boxes.
-void fill_aabbtree(Writer& w, bool split_axis, const std::vector<uint8_t>& axis) {
-  const BuildTree& t = w.tree;
-  std::vector<uint32_t> offset(t.nodes.size());
-  std::function<uint32_t(uint32_t, uint32_t)> place = [&](uint32_t n, uint32_t at) -> uint32_t {
-    offset[n] = at;
-    const BuildNode& b = t.nodes[n];
-    if (b.leaf()) return at + MC_AABB_NODE_BYTES + w.leaf_bytes[n];
-    return place(b.right, place(b.left, at + MC_AABB_NODE_BYTES));
-  };
-  place(0, 0);
-  for (uint32_t n = 0; n < t.nodes.size(); ++n)
-    if (t.nodes[n].leaf()) w.write_leaf(n, offset[n] + MC_AABB_NODE_BYTES);
-  w.refit();
-  for (uint32_t n = 0; n < t.nodes.size(); ++n) {
-    const BuildNode& b = t.nodes[n];
-    layout::AABBNode node{};
-    for (int a = 0; a < 3; ++a) node.min[a] = b.box.min[a], node.max[a] = b.box.max[a];
-    node.properties = b.leaf() ? (MC_AABB_LEAF_BIT | b.count) : offset[b.right];
-    if (split_axis && !b.leaf()) node.properties |= uint32_t(axis[n]) << MC_SPLITAXIS_SHIFT;
-    std::memcpy(w.bytes.data() + w.h.tree_offset + offset[n], &node, sizeof node);
-  }
-}
-
 // kGridPowerOfTwo formats (BitPackSOA, layout/soa.h): blocks of `lanes`
 // consecutive triangles of each leaf; every position goes to the coarsest
 // block lattice among the blocks that use it, repeated until no block needs
@@ -186,225 +144,21 @@ BuildTree chunk_tree(const std::vector<Box3>& boxes, uint32_t chunk) {
   return t;
 }
 
-void write_bruteforce(Writer& w) {
-  uint64_t size = 0;
-  for (size_t n = 1; n < w.tree.nodes.size(); ++n)
-    size += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
-  if (size > 0x7FFFFFFFu) throw InputError("the BruteForce section of " + std::to_string(size) + " bytes exceeds 2 GiB");
-  w.h.tree_size = uint32_t(size);
-  w.h.node_count = uint32_t(w.tree.nodes.size() - 1);
-  w.h.node_bytes = w.h.node_count * MC_BRUTE_RECORD_BYTES;  // the count words
-  w.h.triangle_base = 0;
-  w.h.root = 0;
-}
-
-void fill_bruteforce(Writer& w) {
-  uint32_t at = 0;
-  Box3 all;
-  for (size_t n = 1; n < w.tree.nodes.size(); ++n) {
-    const BuildNode& leaf = w.tree.nodes[n];
-    std::memcpy(w.bytes.data() + w.h.tree_offset + at, &leaf.count, 4);
-    w.write_leaf(uint32_t(n), at + MC_BRUTE_RECORD_BYTES);
-    all.grow(leaf.box);
-    at += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
-  }
-  w.frame(all);
-}
-
-// AABBTreeSplitAxis (§5.2): each interior node's axis is the one along which
-// its children's centres lie farthest apart, and its children are ordered
-// lower first along it. (The builders do not record the axis they split on;
-// this one is the axis that separates the two children most.)
-std::vector<uint8_t> order_by_split_axis(BuildTree& t) {
-  std::vector<uint8_t> axis(t.nodes.size(), 0);
-  for (size_t n = 0; n < t.nodes.size(); ++n) {
-    BuildNode& b = t.nodes[n];
-    if (b.leaf()) continue;
-    Vec3 l = t.nodes[b.left].box.centre(), r = t.nodes[b.right].box.centre();
-    float d[3] = {std::fabs(l.x - r.x), std::fabs(l.y - r.y), std::fabs(l.z - r.z)};
-    int a = d[0] >= d[1] && d[0] >= d[2] ? 0 : (d[1] >= d[2] ? 1 : 2);
-    axis[n] = uint8_t(a);
-    if (l[a] > r[a]) std::swap(b.left, b.right);
-  }
-  return axis;
-}
-
-// AABBTreePNS (§5.3, seed 002): nodes depth first by index, then the blocks.
-struct PnsPlan {
-  std::vector<uint32_t> index;  // per binary node: its node index
-  std::vector<uint32_t> block;  // per binary leaf: tree-section offset of its block
-  std::vector<uint32_t> leaves; // leaves in block order
-};
-
-PnsPlan plan_pns(Writer& w) {
-  const BuildTree& t = w.tree;
-  PnsPlan p{std::vector<uint32_t>(t.nodes.size()), std::vector<uint32_t>(t.nodes.size()), {}};
-  uint32_t next = 0;
-  std::function<void(uint32_t)> visit = [&](uint32_t n) {
-    p.index[n] = next++;
-    if (t.nodes[n].leaf()) return p.leaves.push_back(n);
-    visit(t.nodes[n].left);
-    visit(t.nodes[n].right);
-  };
-  visit(0);
-  uint64_t base = uint64_t(next) * MC_AABB_NODE_BYTES, at = base;
-  for (uint32_t leaf : p.leaves) {
-    p.block[leaf] = uint32_t(at);
-    if ((at - base) / 4 > MC_PNS_BLOCK_MASK) throw InputError("AABBTreePNS: triangle blocks beyond its 26-bit offsets (256 MiB)");
-    at += w.leaf_bytes[leaf];
-  }
-  if (next > MC_PNS_INDEX_MASK) throw InputError("AABBTreePNS: more than 2^23 nodes");
-  if (at > 0x7FFFFFFFu) throw InputError("AABBTreePNS: the tree section exceeds 2 GiB");
-  w.h.node_count = next;
-  w.h.node_bytes = uint32_t(base);
-  w.h.triangle_base = uint32_t(base);
-  w.h.tree_size = uint32_t(at);
-  w.h.root = 0;
-  return p;
-}
-
-void fill_pns(Writer& w, const PnsPlan& p) {
-  const BuildTree& t = w.tree;
-  for (uint32_t leaf : p.leaves) w.write_leaf(leaf, p.block[leaf]);
-  w.refit();
-  for (uint32_t n = 0; n < t.nodes.size(); ++n) {
-    const BuildNode& b = t.nodes[n];
-    layout::AABBNode node{};
-    for (int a = 0; a < 3; ++a) node.min[a] = b.box.min[a], node.max[a] = b.box.max[a];
-    node.properties = b.leaf() ? MC_AABB_LEAF_BIT | b.count << MC_PNS_COUNT_SHIFT | (p.block[n] - w.h.triangle_base) / 4
-                               : pns_code(t.nodes[b.left].box, t.nodes[b.right].box) << MC_PNS_SHIFT | p.index[b.right];
-    std::memcpy(w.bytes.data() + w.h.tree_offset + uint64_t(p.index[n]) * MC_AABB_NODE_BYTES, &node, sizeof node);
-  }
-}
-
-// QuadTree (§5.6): every binary node that stays a node takes up to four
-// children, found by opening its largest interior descendant until four are
-// reached. Nodes and triangle blocks are then laid out in one of the four
-// node orders of §4.3 (quad_sequence); DepthFirstTrianglesLast, the
-// default, keeps 64-byte half-float nodes cache aligned.
-struct QuadPlan {
-  std::vector<std::array<int64_t, 4>> children;  // binary node index or -1
-  std::vector<uint32_t> binary_of;               // quad node -> binary node
-  std::vector<uint32_t> leaves;                  // binary leaves, in write order
-  std::vector<uint32_t> leaf_offset;             // per binary node (leaves)
-  std::vector<uint32_t> node_offset;             // per quad node
-  std::vector<uint32_t> quad_index;              // per binary node (quad nodes)
-  uint32_t depth = 0;
-};
-
-QuadPlan plan_quadtree(const BuildTree& t) {
-  QuadPlan p;
-  p.leaf_offset.assign(t.nodes.size(), 0);
-  p.quad_index.assign(t.nodes.size(), 0);
-  std::function<void(uint32_t, uint32_t)> visit = [&](uint32_t n, uint32_t depth) {
-    if (t.nodes[n].leaf()) return;
-    p.depth = std::max(p.depth, depth);
-    std::vector<uint32_t> list{t.nodes[n].left, t.nodes[n].right};
-    while (list.size() < 4) {
-      int open = -1;
-      for (size_t i = 0; i < list.size(); ++i)
-        if (!t.nodes[list[i]].leaf() &&
-            (open < 0 || t.nodes[list[i]].box.half_area() > t.nodes[list[size_t(open)]].box.half_area()))
-          open = int(i);
-      if (open < 0) break;
-      uint32_t m = list[size_t(open)];
-      list.erase(list.begin() + open);
-      list.insert(list.begin() + open, {t.nodes[m].left, t.nodes[m].right});
-    }
-    p.quad_index[n] = uint32_t(p.binary_of.size());
-    p.binary_of.push_back(n);
-    std::array<int64_t, 4> c{-1, -1, -1, -1};
-    for (size_t i = 0; i < list.size(); ++i) c[i] = list[i];
-    p.children.push_back(c);
-    for (uint32_t m : list) visit(m, depth + 1);
-  };
-  visit(0, 0);
-  return p;
-}
-
-// The write order of §4.3: quad nodes (true, quad index) and leaf blocks
-// (false, binary node) depth or breadth first, each node's leaf blocks
-// right behind it or all blocks after all nodes.
-std::vector<std::pair<bool, uint32_t>> quad_sequence(const BuildTree& t, const QuadPlan& p, NodeOrder order) {
-  std::vector<std::pair<bool, uint32_t>> seq, blocks;
-  if (p.binary_of.empty()) return {{false, 0}};  // the root is a leaf
-  const bool last = order == NodeOrder::DepthFirstTrianglesLast || order == NodeOrder::BreadthFirstTrianglesLast;
-  auto emit = [&](uint32_t q, std::vector<uint32_t>& next) {
-    seq.push_back({true, q});
-    for (int64_t c : p.children[q]) {
-      if (c < 0) continue;
-      if (t.nodes[size_t(c)].leaf()) (last ? blocks : seq).push_back({false, uint32_t(c)});
-      else next.push_back(p.quad_index[size_t(c)]);
-    }
-  };
-  if (order == NodeOrder::BreadthFirst || order == NodeOrder::BreadthFirstTrianglesLast) {
-    std::vector<uint32_t> level{0};
-    while (!level.empty()) {
-      std::vector<uint32_t> next;
-      for (uint32_t q : level) emit(q, next);
-      level.swap(next);
-    }
-  } else {
-    std::function<void(uint32_t)> visit = [&](uint32_t q) {
-      std::vector<uint32_t> next;
-      emit(q, next);
-      for (uint32_t c : next) visit(c);
-    };
-    visit(0);
-  }
-  seq.insert(seq.end(), blocks.begin(), blocks.end());
-  return seq;
-}
-
-template <class Bounds>
-void write_quadtree(Writer& w, QuadPlan& p, NodeOrder order) {
-  uint64_t at = 0, nodes = uint64_t(p.binary_of.size()) * Bounds::kNodeBytes;
-  p.node_offset.assign(p.binary_of.size(), 0);
-  for (auto [is_node, id] : quad_sequence(w.tree, p, order)) {
-    if (is_node) {
-      p.node_offset[id] = uint32_t(std::min<uint64_t>(at, MC_QUAD_OFFSET_MASK));
-      at += Bounds::kNodeBytes;
-    } else {
-      p.leaves.push_back(id);
-      p.leaf_offset[id] = uint32_t(std::min<uint64_t>(at, MC_QUAD_OFFSET_MASK));
-      at += w.leaf_bytes[id];
-    }
-  }
-  if (at > MC_QUAD_OFFSET_MASK)
-    throw InputError("the " + std::string(layout::tree_format_name(Bounds::kFormat)) + " section of " +
-                     std::to_string(at) + " bytes exceeds its 27-bit child offsets (seed 000 5.6)");
-  const bool last = order == NodeOrder::DepthFirstTrianglesLast || order == NodeOrder::BreadthFirstTrianglesLast;
-  w.h.tree_size = uint32_t(at);
-  w.h.node_bytes = uint32_t(nodes);
-  w.h.node_count = uint32_t(p.binary_of.size());
-  w.h.triangle_base = last ? uint32_t(nodes) : 0;  // interleaved blocks: slots count from the section start
-}
-
-template <class Bounds>
-void fill_quadtree(Writer& w, QuadPlan& p) {
-  const BuildTree& t = w.tree;
-  for (uint32_t leaf : p.leaves) w.write_leaf(leaf, p.leaf_offset[leaf]);
-  w.refit();
-  auto props = [&](uint32_t n) {
-    return t.nodes[n].leaf() ? layout::quad_properties(t.nodes[n].count, p.leaf_offset[n])
-                             : layout::quad_properties(0, p.node_offset[p.quad_index[n]]);
-  };
-  for (size_t q = 0; q < p.binary_of.size(); ++q) {
-    layout::QuadChild c[4];
-    for (int k = 0; k < 4; ++k) {
-      if (p.children[q][k] < 0) continue;
-      uint32_t n = uint32_t(p.children[q][k]);
-      for (int a = 0; a < 3; ++a) c[k].min[a] = t.nodes[n].box.min[a], c[k].max[a] = t.nodes[n].box.max[a];
-      c[k].properties = props(n);
-    }
-    uint8_t* out = w.bytes.data() + w.h.tree_offset + p.node_offset[q];
-    Bounds::encode(c, w.h, out);
-    for (int k = 0; k < 4; ++k) std::memcpy(out + Bounds::kPropertiesAt + 4 * k, &c[k].properties, 4);
-  }
-  w.h.root = props(0);
-}
-
 }  // namespace
+
+std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
+  switch (o.tree_format) {
+    case MC_TREE_AABBTREE: return make_aabb_writer(false);
+    case MC_TREE_AABBTREESPLITAXIS: return make_aabb_writer(true);
+    case MC_TREE_AABBTREEPNS: return make_pns_writer();
+    case MC_TREE_AABBTREECOMPRESSED: return make_compressed_writer();
+    case MC_TREE_SKDTREE: return make_skd_writer();
+    case MC_TREE_STACKLESSLBVH: return make_lbvh_writer(o.lbvh_near_first);
+    case MC_TREE_QUADTREE: return make_quad_writer(false, o.node_order);
+    case MC_TREE_QUADTREEHALFFLOAT: return make_quad_writer(true, o.node_order);
+  }
+  return make_bruteforce_writer();
+}
 
 std::string node_order_refusal(uint32_t tree, NodeOrder order) {
   if (order == NodeOrder::Default || tree == MC_TREE_QUADTREE || tree == MC_TREE_QUADTREEHALFFLOAT) return "";
@@ -503,39 +257,18 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(o.tree_format)) + ": " + e.what());
   }
-  std::vector<uint8_t> split_axes;
-  if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) split_axes = order_by_split_axis(tree);
   uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}, {}, {}};
   BlobHeader& hd = writer.h;
   writer.measure_leaves();
 
-  QuadPlan plan;
-  PnsPlan pns_plan;
-  uint32_t depth = tree.depth;
-  std::unique_ptr<TreeWriter> tree_writer;
-  if (o.tree_format == MC_TREE_AABBTREECOMPRESSED) tree_writer = make_compressed_writer();
-  if (o.tree_format == MC_TREE_SKDTREE) tree_writer = make_skd_writer();
-  if (o.tree_format == MC_TREE_STACKLESSLBVH) tree_writer = make_lbvh_writer(o.lbvh_near_first);
-  if (tree_writer) {
+  std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
+  try {
     tree_writer->plan(writer);
-  } else if (o.tree_format == MC_TREE_BRUTEFORCE) {
-    write_bruteforce(writer);
-    depth = 0;
-  } else if (o.tree_format == MC_TREE_AABBTREEPNS) {
-    pns_plan = plan_pns(writer);
-  } else if (o.tree_format == MC_TREE_AABBTREE || o.tree_format == MC_TREE_AABBTREESPLITAXIS) {
-    write_aabbtree(writer);
-    if (o.tree_format == MC_TREE_AABBTREESPLITAXIS && hd.tree_size > MC_SPLITAXIS_OFFSET_MASK)
-      throw InputError(name + ": the AABBTreeSplitAxis section of " + std::to_string(hd.tree_size) +
-                       " bytes exceeds its 29-bit child offsets (seed 000 5.2)");
-  } else {
-    plan = plan_quadtree(tree);
-    depth = plan.depth;
-    NodeOrder order = o.node_order == NodeOrder::Default ? NodeOrder::DepthFirstTrianglesLast : o.node_order;
-    if (o.tree_format == MC_TREE_QUADTREE) write_quadtree<layout::QuadBoundsFloat>(writer, plan, order);
-    else write_quadtree<layout::QuadBoundsHalf>(writer, plan, order);
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + e.what());
   }
+  uint32_t depth = tree_writer->depth(tree);
   if (depth > MC_MAX_DEPTH)
     throw InputError(name + ": the tree is " + std::to_string(depth) + " levels deep, beyond the walkers' limit of " +
                      std::to_string(MC_MAX_DEPTH));
@@ -545,13 +278,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
   writer.bytes.assign(hd.vertex_offset, 0);
   try {
-    if (tree_writer) tree_writer->fill(writer);
-    else if (o.tree_format == MC_TREE_BRUTEFORCE) fill_bruteforce(writer);
-    else if (o.tree_format == MC_TREE_AABBTREE) fill_aabbtree(writer, false, {});
-    else if (o.tree_format == MC_TREE_AABBTREESPLITAXIS) fill_aabbtree(writer, true, split_axes);
-    else if (o.tree_format == MC_TREE_AABBTREEPNS) fill_pns(writer, pns_plan);
-    else if (o.tree_format == MC_TREE_QUADTREE) fill_quadtree<layout::QuadBoundsFloat>(writer, plan);
-    else fill_quadtree<layout::QuadBoundsHalf>(writer, plan);
+    tree_writer->fill(writer);
   } catch (const std::length_error& e) {  // a codec's own limit (index width)
     throw InputError(name + ": " + layout_name(o.tree_format, o.triangle_format) + ": " + e.what());
   }

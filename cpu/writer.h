@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cpu/build.h"
+#include "cpu/encode.h"
 #include "layout/block.h"
 #include "layout/blob.h"
 
@@ -131,7 +132,15 @@ struct TreeWriter {
   virtual ~TreeWriter() = default;
   virtual void plan(Writer& w) = 0;
   virtual void fill(Writer& w) = 0;
+  // Deepest node a walker's stack must hold (the quad trees' is their own).
+  virtual uint32_t depth(const BuildTree& t) const { return t.depth; }
 };
+
+std::unique_ptr<TreeWriter> make_aabb_writer(bool split_axis);  // AABBTree (§5.1), AABBTreeSplitAxis (§5.2)
+std::unique_ptr<TreeWriter> make_pns_writer();                  // AABBTreePNS (§5.3, seed 002)
+std::unique_ptr<TreeWriter> make_quad_writer(bool half, NodeOrder order);  // §5.6-5.7 in a §4.3 order
+std::unique_ptr<TreeWriter> make_bruteforce_writer();           // §3.11
+std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);  // the one for options.tree_format
 
 std::unique_ptr<TreeWriter> make_compressed_writer();  // AABBTreeCompressed (§5.4)
 std::unique_ptr<TreeWriter> make_skd_writer();         // SKDTree (§5.5)

@@ -101,17 +101,18 @@ void add_bench(CLI::App& app) {
           : kind == "order"    ? bench::bench_order(mesh, targs->input, targs->rays, targs->repeat)
           : kind == "combos"   ? bench::bench_combos(mesh, targs->input, targs->rays, targs->repeat)
                                : bench::bench_trees(mesh, targs->input, targs->rays, targs->repeat);
-      double scale = 1024.0 / double(targs->rays);
-      std::printf("\n%s, %zu triangles, %zu long rays, one thread; ms for 1024 rays (minimum of %u passes, median "
+      // Microseconds per ray, the unit of the source's "Time 1024 Rays (us)" columns.
+      double scale = 1000.0 / double(targs->rays);
+      std::printf("\n%s, %zu triangles, %zu long rays, one thread; us per ray (minimum of %u passes, median "
                   "beside it); seed column: seed 000 (i7-7700HQ, 2019)\n\n",
                   targs->input.c_str(), mesh.triangles.size(), targs->rays, targs->repeat);
       const char* label = kind == "splitters" ? "splitter" : kind == "leafsize" ? "leaf size" : kind == "order" ? "order" : "tree";
-      std::printf("| %s | layout | ms (min) | median | seed | build ms | SAH cost | tree bytes (seed) | tree B/tri | "
+      std::printf("| %s | layout | us/ray (min) | median | seed | build ms | SAH cost | tree bytes (seed) | tree B/tri | "
                   "walked B/tri (seed) | holes B/tri | disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
                   label);
       std::string stem = targs->out_dir + "/" + kind + (targs->input == "terrain_2M" ? "_terrain_2M" : "");
       std::ofstream csv(stem + ".csv");
-      csv << "label,layout,min_ms_1024,median_ms_1024,seed_ms_1024,build_ms,sah_cost,tree_bytes_per_tri,"
+      csv << "label,layout,min_us_per_ray,median_us_per_ray,seed_us_per_ray,build_ms,sah_cost,tree_bytes_per_tri,"
              "walked_bytes_per_tri,seed_bytes_per_tri,hole_bytes_per_tri,disagreements\n";
       // One series (colour) per tree format, each point labelled.
       std::vector<bench::Series> series;
@@ -155,8 +156,8 @@ void add_bench(CLI::App& app) {
   off->callback([oargs] {
     Mesh mesh = bench_mesh(oargs->input);
     std::vector<bench::OffsetRow> rows = bench::bench_offset(mesh, oargs->input, oargs->rays, oargs->repeat);
-    double scale = 1024.0 / double(oargs->rays);
-    std::printf("\n%s scaled and moved, %zu long rays; ms for 1024 rays, minimum over 3 interleaved measurements of %u "
+    double scale = 1000.0 / double(oargs->rays);
+    std::printf("\n%s scaled and moved, %zu long rays; us per ray, minimum over 3 interleaved measurements of %u "
                 "passes each, in this one run\n\n| layout | mesh | at the origin | moved | ratio | disagreements |\n"
                 "|---|---|---:|---:|---:|---:|\n",
                 oargs->input.c_str(), oargs->rays, oargs->repeat);

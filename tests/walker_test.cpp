@@ -51,6 +51,21 @@ void check_layout(const std::string& layout_name_, bool large) {
 
 TEST_P(WalkerVsOracle, AllMeshesAllRayKinds) { check_layout(GetParam(), false); }
 
+// Mistakes (wrong triangle or t) of `blob`, built from m with `o`, on
+// `count` rays of `kind`, against the oracle over what the blob stores;
+// `variant` names the build in the oracle's cache.
+uint64_t oracle_mistakes(const std::vector<uint8_t>& blob, const NamedMesh& m, const BuildOptions& o,
+                         const std::string& variant, RayKind kind, size_t count, std::string* problem) {
+  NamedMesh reference = m;
+  if (moves_vertices(o.triangle_format))
+    reference = {m.name + "#" + variant, std::make_shared<const Mesh>(stored_mesh(blob))};
+  const std::vector<Ray>& rays = test_rays(m, kind, count);
+  Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, kind, rays),
+                        1e-5 * m.mesh->bounds().diagonal());
+  *problem = a.first_problem;
+  return a.wrong + a.t_errors;
+}
+
 // Every splitter's trees walk to the oracle's answers.
 TEST(WalkerVsOracleSplitters, EverySplitterOnTheFoundationLayouts) {
   for (Splitter s : all_splitters())
@@ -60,13 +75,8 @@ TEST(WalkerVsOracleSplitters, EverySplitterOnTheFoundationLayouts) {
         BuildOptions o = parse_layout(name);
         o.splitter = s;
         std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name);
-        NamedMesh reference = m;
-        if (moves_vertices(o.triangle_format))
-          reference = {m.name + "#" + name + "#" + splitter_name(s), std::make_shared<const Mesh>(stored_mesh(blob))};
-        const std::vector<Ray>& rays = test_rays(m, RayKind::Long, 2000);
-        Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, RayKind::Long, rays),
-                              1e-5 * m.mesh->bounds().diagonal());
-        EXPECT_EQ(a.wrong + a.t_errors, 0u) << splitter_name(s) << " " << name << " on " << m.name << ": " << a.first_problem;
+        std::string variant = std::string(name) + "#" + splitter_name(s), problem;
+        EXPECT_EQ(oracle_mistakes(blob, m, o, variant, RayKind::Long, 2000, &problem), 0u) << variant << " on " << m.name << ": " << problem;
       }
     }
 }
@@ -88,13 +98,8 @@ TEST(WalkerVsOracleNodeOrders, EveryOrderOnTheQuadTrees) {
         layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t) { lowest_block = std::min(lowest_block, block); });
         if (last) EXPECT_EQ(lowest_block, h.node_bytes) << name << " " << node_order_name(order);
         else EXPECT_LT(lowest_block, h.node_bytes) << name << " " << node_order_name(order);
-        NamedMesh reference = m;
-        if (moves_vertices(o.triangle_format))
-          reference = {m.name + "#" + name + "#" + node_order_name(order), std::make_shared<const Mesh>(stored_mesh(blob))};
-        const std::vector<Ray>& rays = test_rays(m, RayKind::Long, 2000);
-        Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, RayKind::Long, rays),
-                              1e-5 * m.mesh->bounds().diagonal());
-        EXPECT_EQ(a.wrong + a.t_errors, 0u) << node_order_name(order) << " " << name << " on " << m.name << ": " << a.first_problem;
+        std::string variant = std::string(name) + "#" + node_order_name(order), problem;
+        EXPECT_EQ(oracle_mistakes(blob, m, o, variant, RayKind::Long, 2000, &problem), 0u) << variant << " on " << m.name << ": " << problem;
       }
     }
 }
@@ -111,10 +116,9 @@ TEST(WalkerVsOracleLBVH, LeftFirstNearFirstAndDepthLimits) {
       std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name);
       ASSERT_EQ(layout::validate(blob), "");
       if (variant == 2) EXPECT_LT(layout::header_of(blob.data()).max_depth, o.lbvh_depth);
-      const std::vector<Ray>& rays = test_rays(m, RayKind::Radial, 3000);
-      Agreement a = compare(*m.mesh, rays, trace_all(blob, rays), oracle_answers(m, RayKind::Radial, rays),
-                            1e-5 * m.mesh->bounds().diagonal());
-      EXPECT_EQ(a.wrong + a.t_errors, 0u) << "variant " << variant << " on " << m.name << ": " << a.first_problem;
+      std::string problem;
+      EXPECT_EQ(oracle_mistakes(blob, m, o, "lbvh", RayKind::Radial, 3000, &problem), 0u)
+          << "variant " << variant << " on " << m.name << ": " << problem;
     }
   }
 }

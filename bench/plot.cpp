@@ -12,7 +12,7 @@ std::string plot_scatter(const std::string& png, const std::string& title, const
   size_t points = 0;
   for (const Series& s : series) points += s.points.size();
   // Many labelled points (one per tree and encoding) need room.
-  gp << (points > 40 ? "set terminal pngcairo size 1800,1200 font 'sans,10'\n" : "set terminal pngcairo size 1100,750 font 'sans,10'\n")
+  gp << (points > 40 ? "set terminal pngcairo noenhanced size 1800,1200 font 'sans,10'\n" : "set terminal pngcairo noenhanced size 1100,750 font 'sans,10'\n")
      << "set output '" << png << "'\n"
      << "set title '" << title << "'\n"
      << "set xlabel '" << xlabel << "'\nset ylabel '" << ylabel << "'\n"

@@ -21,8 +21,9 @@ struct TreeRow {
 std::vector<TreeRow> bench_splitters(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat);
 // §4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning.
 std::vector<TreeRow> bench_leafsize(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat);
-// §6, first table: every tree format with Float3, Binning, leaf 8, and
-// StacklessLBVH walked left first as seed 001 does.
+// §6, first table: every tree format with Float3, leaf 8, Binning (Morton for
+// StacklessLBVH, its seed's builder), and StacklessLBVH walked left first as
+// seed 001 does.
 std::vector<TreeRow> bench_trees(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat);
 // §4.3: the four node orders, on the quad trees (the formats that take them).
 std::vector<TreeRow> bench_order(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat);

@@ -83,6 +83,7 @@ std::vector<uint32_t> morton_order(const std::vector<uint32_t>& codes) {
 }
 
 struct MortonSplit {
+  static constexpr bool kSorted = true;  // cuts ranges of the presorted order, keeps it
   const std::vector<uint32_t>& codes;
   uint32_t operator()(uint32_t* begin, uint32_t* end, const Box3&) const {
     uint32_t first = codes[*begin], last = codes[*(end - 1)];
@@ -104,7 +105,10 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
   for (size_t i = 0; i < order.size(); ++i) group_boxes[i / kGroup].grow(boxes[order[i]]);
   std::vector<Vec3> group_centres = box_centres(group_boxes);
   BinningSplit split{group_boxes, group_centres};
-  BuildTree g = TopDown<BinningSplit>{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}, depth_limit}.run();
+  TopDown<BinningSplit> group_top{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}, depth_limit};
+  group_top.leaf_capacity = MC_QUAD_MAX_COUNT / kGroup;  // whole groups, at most 31 triangles
+  group_top.primitives = "groups of 4 triangles";
+  BuildTree g = group_top.run();
   // Back to triangles: each group position expands to its members.
   std::vector<uint32_t> start(groups + 1, 0);
   BuildTree t;

@@ -30,6 +30,8 @@ struct TopDown {
   Split& split;
   BuildTree tree;
   uint32_t depth_limit = ~0u;
+  uint32_t leaf_capacity = MC_QUAD_MAX_COUNT;  // most primitives a leaf at the depth limit may take
+  const char* primitives = "triangles";
 
   uint32_t build(uint32_t first, uint32_t count, uint32_t depth) {
     uint32_t index = uint32_t(tree.nodes.size());
@@ -40,7 +42,7 @@ struct TopDown {
     tree.nodes[index].box = box;
     if (count > capacity(depth))
       throw InputError("depth limit " + std::to_string(depth_limit + 1) + " holds at most " +
-                       std::to_string(capacity(depth)) + " triangles (" + std::to_string(MC_QUAD_MAX_COUNT) +
+                       std::to_string(capacity(depth)) + " " + primitives + " (" + std::to_string(leaf_capacity) +
                        " a leaf), not " + std::to_string(count) + "; raise the depth limit");
     if (count <= leaf_size || depth >= depth_limit) {
       tree.nodes[index].first = first, tree.nodes[index].count = count;
@@ -49,9 +51,19 @@ struct TopDown {
     uint32_t* begin = tree.order.data() + first;
     uint32_t left = depth < kSplitterDepth ? split(begin, begin + count, cbox) : 0;
     // Under a depth limit a side must still fit the levels left below it
-    // (halving each level, MC_QUAD_MAX_COUNT a leaf); a split that would
-    // overfill one becomes a median split, which always fits.
-    if (left == 0 || left >= count || std::max(left, count - left) > capacity(depth + 1)) left = median(begin, count, cbox);
+    // (halving each level, leaf_capacity a leaf); a split that would
+    // overfill one is evened out, which always fits: a splitter whose range
+    // stays sorted (Morton) moves its cut within that order, the others
+    // split at the median.
+    const uint64_t fits = capacity(depth + 1);
+    if (left == 0 || left >= count) {
+      left = median(begin, count, cbox);  // (Morton: all codes equal, any order stays sorted)
+    } else if (std::max(left, count - left) > fits) {
+      if constexpr (requires { Split::kSorted; })
+        left = uint32_t(std::clamp<uint64_t>(left, count > fits ? count - fits : 1, std::min<uint64_t>(fits, count - 1)));
+      else
+        left = median(begin, count, cbox);
+    }
     uint32_t l = build(first, left, depth + 1);
     uint32_t r = build(first + left, count - left, depth + 1);
     tree.nodes[index].left = l, tree.nodes[index].right = r;
@@ -61,7 +73,7 @@ struct TopDown {
   // Most triangles a subtree rooted at `depth` can hold under depth_limit.
   uint64_t capacity(uint32_t depth) const {
     if (depth_limit >= 40) return ~0ull;
-    return uint64_t(MC_QUAD_MAX_COUNT) << (depth_limit - std::min(depth, depth_limit));
+    return uint64_t(leaf_capacity) << (depth_limit - std::min(depth, depth_limit));
   }
 
   uint32_t median(uint32_t* begin, uint32_t count, const Box3& cbox) {

@@ -244,7 +244,10 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
   uint32_t depth_limit = ~0u;
   if (o.tree_format == MC_TREE_STACKLESSLBVH) {
-    uint32_t d = o.lbvh_depth ? o.lbvh_depth : uint32_t(std::bit_width(mesh.triangles.size())) + 1;
+    // The seed's choice, within the heap's reach (the capacity check then
+    // says when a mesh is too large for it).
+    uint32_t d = o.lbvh_depth ? o.lbvh_depth
+                              : std::min(uint32_t(std::bit_width(mesh.triangles.size())) + 1, MC_LBVH_MAX_DEPTH + 1);
     if (d > MC_LBVH_MAX_DEPTH + 1)
       throw InputError(name + ": StacklessLBVH depth limit " + std::to_string(d) + " exceeds " +
                        std::to_string(MC_LBVH_MAX_DEPTH + 1) + " (2^26 node slots)");

@@ -2,12 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <functional>
 #include <set>
 
 #include "cpu/build.h"
 #include "io/generate.h"
 #include "layout/blob.h"
+#include "layout/leaves.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -193,6 +195,26 @@ TEST(Build, SixteenBitIndicesRefuseMeshesBeyondTheirReach) {
   }
   // 32-bit indices take the same mesh.
   EXPECT_EQ(layout::validate(build_blob(big, parse_layout("QuadTree/Indexed32"), "grid300")), "");
+}
+
+// A tight StacklessLBVH depth limit with every splitter: the build evens out
+// splits that would overfill the levels left, so it fits, keeps leaves at 31
+// triangles or fewer, and stays within the limit.
+TEST(Build, TightDepthLimitsFitWithEverySplitter) {
+  Mesh m = make_sphere(24, 48, 1, {0, 0, 0});  // 2,208 triangles
+  const uint32_t n = uint32_t(m.triangles.size());
+  for (Splitter s : all_splitters()) {
+    BuildOptions o = parse_layout("StacklessLBVH/Float3");
+    o.splitter = s;
+    o.lbvh_depth = uint32_t(std::bit_width(n / 28)) + 1;  // 28: FixedLeafSize's 7 groups of 4 a leaf
+    std::vector<uint8_t> blob = build_blob(m, o, "sphere");
+    ASSERT_EQ(layout::validate(blob), "") << splitter_name(s);
+    EXPECT_LT(layout::header_of(blob.data()).max_depth, o.lbvh_depth) << splitter_name(s);
+    uint32_t largest = 0, total = 0;
+    layout::for_each_leaf(blob.data(), [&](uint32_t, uint32_t count) { largest = std::max(largest, count), total += count; });
+    EXPECT_LE(largest, 31u) << splitter_name(s);
+    EXPECT_EQ(total, n) << splitter_name(s);
+  }
 }
 
 TEST(Build, NodeOrdersAFormatCannotHoldAreRefusedWithTheReason) {

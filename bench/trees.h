@@ -14,7 +14,7 @@ struct TreeRow {
   Timing timing;
   double seed_tree_bytes = 0;
   double seed_bytes_per_tri = 0;  // §6 combinations: the source's bytes a triangle
-  std::string refused;            // why the layout cannot hold this mesh (no timing then)
+  std::string refused{};          // why the layout cannot hold this mesh (no timing then)
 };
 
 // §4.1: every splitter, AABBTree/Float3 and AABBTree/Float3SOA4, leaf 8.

@@ -49,6 +49,26 @@ struct BlobHeader {
   uint32_t max_block_shift; // BitPackSOA: largest m of a block step grid * 2^m (soa.h)
 };
 static_assert(sizeof(BlobHeader) == MC_BLOB_HEADER_BYTES);
+// The word indices of formats.h (what the shaders read) name these fields.
+static_assert(offsetof(BlobHeader, tree_format) == 4 * MC_HDR_TREE_FORMAT);
+static_assert(offsetof(BlobHeader, triangle_format) == 4 * MC_HDR_TRIANGLE_FORMAT);
+static_assert(offsetof(BlobHeader, triangle_count) == 4 * MC_HDR_TRIANGLE_COUNT);
+static_assert(offsetof(BlobHeader, node_count) == 4 * MC_HDR_NODE_COUNT);
+static_assert(offsetof(BlobHeader, root) == 4 * MC_HDR_ROOT);
+static_assert(offsetof(BlobHeader, bounds_min) == 4 * MC_HDR_BOUNDS_MIN);
+static_assert(offsetof(BlobHeader, bounds_max) == 4 * MC_HDR_BOUNDS_MAX);
+static_assert(offsetof(BlobHeader, quant_offset) == 4 * MC_HDR_QUANT_OFFSET);
+static_assert(offsetof(BlobHeader, quant_scale) == 4 * MC_HDR_QUANT_SCALE);
+static_assert(offsetof(BlobHeader, node_origin) == 4 * MC_HDR_NODE_ORIGIN);
+static_assert(offsetof(BlobHeader, node_scale) == 4 * MC_HDR_NODE_SCALE);
+static_assert(offsetof(BlobHeader, tree_offset) == 4 * MC_HDR_TREE_OFFSET);
+static_assert(offsetof(BlobHeader, tree_size) == 4 * MC_HDR_TREE_SIZE);
+static_assert(offsetof(BlobHeader, triangle_base) == 4 * MC_HDR_TRIANGLE_BASE);
+static_assert(offsetof(BlobHeader, slot_divisor) == 4 * MC_HDR_SLOT_DIVISOR);
+static_assert(offsetof(BlobHeader, vertex_offset) == 4 * MC_HDR_VERTEX_OFFSET);
+static_assert(offsetof(BlobHeader, remap_offset) == 4 * MC_HDR_REMAP_OFFSET);
+static_assert(offsetof(BlobHeader, remap_bits) == 4 * MC_HDR_REMAP_BITS);
+static_assert(offsetof(BlobHeader, remap_slots) == 4 * MC_HDR_REMAP_SLOTS);
 
 // FNV-1a, 32 bits: cheap, and enough to catch accidental damage. Validation
 // does not rely on it: every structural fact is checked on its own.

@@ -10,6 +10,28 @@
 #define MC_BLOB_VERSION 1u
 #define MC_BLOB_HEADER_BYTES 160u
 
+// Header fields as 32-bit word indices, for readers that see the blob as a
+// uint array (the shaders); layout/blob.h checks them against BlobHeader.
+#define MC_HDR_TREE_FORMAT 2u
+#define MC_HDR_TRIANGLE_FORMAT 3u
+#define MC_HDR_TRIANGLE_COUNT 4u
+#define MC_HDR_NODE_COUNT 5u
+#define MC_HDR_ROOT 9u
+#define MC_HDR_BOUNDS_MIN 10u
+#define MC_HDR_BOUNDS_MAX 13u
+#define MC_HDR_QUANT_OFFSET 16u
+#define MC_HDR_QUANT_SCALE 19u
+#define MC_HDR_NODE_ORIGIN 22u
+#define MC_HDR_NODE_SCALE 25u
+#define MC_HDR_TREE_OFFSET 26u
+#define MC_HDR_TREE_SIZE 27u
+#define MC_HDR_TRIANGLE_BASE 29u
+#define MC_HDR_SLOT_DIVISOR 30u
+#define MC_HDR_VERTEX_OFFSET 31u
+#define MC_HDR_REMAP_OFFSET 33u
+#define MC_HDR_REMAP_BITS 35u
+#define MC_HDR_REMAP_SLOTS 36u
+
 // Tree formats (seed 000 §5).
 #define MC_TREE_AABBTREE 1u            // §5.1
 #define MC_TREE_QUADTREE 2u            // §5.6

@@ -56,6 +56,14 @@ check order 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout quadtreehalffloat/f
 check order-refused 2 "AABBTree is always DepthFirst" -- "$meshcast" info "$mesh" --layout AABBTree/Float3 --order BreadthFirst
 check unknown-order 2 "valid node orders" -- "$meshcast" info "$mesh" --layout QuadTree/Float3 --order Random
 check lbvh 0 "StacklessLBVH/Float3" -- "$meshcast" info "$mesh" --layout StacklessLBVH/Float3 --lbvh-depth 20 --lbvh-left-first
+check trace-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --method bruteforce --rays "$work/r.rays" --out "$work/hv.hits" --repeat 1
+# The GPU's hits name the same triangles as the CPU's (AABBTree/Float3 above).
+if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/hv.hits" | awk '{print $2}') \
+            <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then
+  echo "FAIL vulkan hits differ from the CPU's"; failures=$((failures + 1))
+fi
+check vulkan-wrong-layout 2 "reads BruteForce/Float3SOA128" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
+check vulkan-no-device 3 "no device matches" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --device nonesuch --rays "$work/r.rays" --out "$work/hx.hits"
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
 printf 'OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n' >"$work/nan.off"
 check nan-mesh 2 "nan.off.*(NaN|nan)" -- "$meshcast" info "$work/nan.off"

@@ -115,7 +115,9 @@ TEST(WalkerVsOracleLBVH, LeftFirstNearFirstAndDepthLimits) {
       if (variant == 2) o.lbvh_depth = uint32_t(std::bit_width(m.mesh->triangles.size() / 31)) + 1;
       std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name);
       ASSERT_EQ(layout::validate(blob), "");
-      if (variant == 2) EXPECT_LT(layout::header_of(blob.data()).max_depth, o.lbvh_depth);
+      if (variant == 2) {
+        EXPECT_LT(layout::header_of(blob.data()).max_depth, o.lbvh_depth);
+      }
       std::string problem;
       EXPECT_EQ(oracle_mistakes(blob, m, o, "lbvh", RayKind::Radial, 3000, &problem), 0u)
           << "variant " << variant << " on " << m.name << ": " << problem;

@@ -4,6 +4,7 @@
 
 #include "cpu/rays.h"
 #include "cpu/trace.h"
+#include "gpu/method.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 
@@ -15,6 +16,7 @@ void add_trace(CLI::App& app) {
     LayoutArgs layout;
     uint32_t repeat = 5;
     bool json = false;
+    std::string backend = "cpu", method = "bruteforce", device;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh or blob, write a hits file");
@@ -24,17 +26,33 @@ void add_trace(CLI::App& app) {
   add_layout_options(cmd, args->layout);
   cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
+  cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
+  cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128)");
+  cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
+                                            "else the first discrete GPU)");
   cmd->callback([args] {
     Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
     std::vector<Ray> rays = read_rays(args->rays);
-    BlobView view(in.blob, args->input);
     std::vector<Hit> hits(rays.size());
-    std::vector<double> pass_ms;
+    std::vector<double> pass_ms, device_ms;
     uint64_t skipped = 0;
-    for (uint32_t r = 0; r < args->repeat; ++r) {
-      auto t0 = std::chrono::steady_clock::now();
-      skipped = view.trace(rays, hits);
-      pass_ms.push_back(ms_since(t0));
+    std::string device = "CPU, one thread";
+    if (args->backend == "vulkan") {
+      gpu::Context ctx(gpu::DeviceChoice{args->device, false});
+      device = ctx.device_name();
+      std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input);
+      for (uint32_t r = 0; r < args->repeat; ++r) {
+        gpu::GpuTiming timing;
+        skipped = method->trace(rays, hits, &timing);
+        pass_ms.push_back(timing.wall_ms), device_ms.push_back(timing.device_ms);
+      }
+    } else {
+      BlobView view(in.blob, args->input);
+      for (uint32_t r = 0; r < args->repeat; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        skipped = view.trace(rays, hits);
+        pass_ms.push_back(ms_since(t0));
+      }
     }
     write_hits(args->out, hits);
     size_t hit_count = 0;
@@ -42,17 +60,22 @@ void add_trace(CLI::App& app) {
     const layout::BlobHeader& h = layout::header_of(in.blob.data());
     double ns = rays.empty() ? 0 : median(pass_ms) * 1e6 / double(rays.size());
     std::string layout = layout_name(h.tree_format, h.triangle_format);
+    double device_ns = rays.empty() || device_ms.empty() ? 0 : median(device_ms) * 1e6 / double(rays.size());
     if (args->json) {
-      std::printf("{\"input\":\"%s\",\"layout\":\"%s\",\"load_ms\":%.3f,\"build_ms\":%.3f,\"rays\":%zu,"
-                  "\"hits\":%zu,\"invalid_rays\":%llu,\"repeat\":%u,\"ns_per_ray\":%.2f}\n",
-                  args->input.c_str(), layout.c_str(), in.load_ms, in.build_ms, rays.size(), hit_count,
-                  (unsigned long long)skipped, args->repeat, ns);
+      std::printf("{\"input\":\"%s\",\"layout\":\"%s\",\"device\":\"%s\",\"load_ms\":%.3f,\"build_ms\":%.3f,"
+                  "\"rays\":%zu,\"hits\":%zu,\"invalid_rays\":%llu,\"repeat\":%u,\"ns_per_ray\":%.2f,"
+                  "\"device_ns_per_ray\":%.2f}\n",
+                  args->input.c_str(), layout.c_str(), device.c_str(), in.load_ms, in.build_ms, rays.size(), hit_count,
+                  (unsigned long long)skipped, args->repeat, ns, device_ns);
     } else {
       std::printf("%s: %s, load %.1f ms, build %.1f ms\n", args->input.c_str(), layout.c_str(), in.load_ms,
                   in.build_ms);
       std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", rays.size(), hit_count,
                   (unsigned long long)skipped);
-      std::printf("cast: %.1f ns/ray (median of %u passes, one thread)\n", ns, args->repeat);
+      std::printf("device: %s\n", device.c_str());
+      std::printf("cast: %.1f ns/ray (median of %u passes%s)\n", ns, args->repeat,
+                  device_ms.empty() ? ", one thread" : ", submission to read-back");
+      if (!device_ms.empty()) std::printf("device time: %.1f ns/ray (GPU timestamps)\n", device_ns);
     }
   });
 }

@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "cpu/mesh.h"
+#include "gpu/vulkan.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
@@ -20,6 +21,9 @@ int main(int argc, char** argv) {
   } catch (const meshcast::InputError& e) {
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return 2;
+  } catch (const meshcast::gpu::GpuError& e) {  // no Vulkan, no such device: the CPU path still works
+    std::fprintf(stderr, "meshcast: %s\n", e.what());
+    return 3;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return 1;

@@ -1,0 +1,33 @@
+// The GPU methods of seed 000 §7, each reading a blob exactly as uploaded.
+// A method is made once per mesh (pipelines, descriptor sets and the blob's
+// buffer), then traces any number of ray batches.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "cpu/ray.h"
+#include "gpu/vulkan.h"
+
+namespace meshcast::gpu {
+
+struct GpuTiming {
+  double device_ms = 0;  // between the batch's first and last GPU timestamps (0 without timestamps)
+  double wall_ms = 0;    // packing, submission, waiting and reading back
+};
+
+class Method {
+ public:
+  virtual ~Method() = default;
+  // Hits for `rays` (hits.size() >= rays.size()); returns the unwalkable
+  // rays, answered as misses as on the CPU.
+  virtual uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
+};
+
+// "bruteforce" (BruteForce over Float3SOA128 blocks). Throws GpuError or
+// InputError (the blob's layout does not fit the method, naming both).
+std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
+                                    const std::string& name);
+
+}  // namespace meshcast::gpu

@@ -1,0 +1,293 @@
+#include "gpu/vulkan.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+
+namespace meshcast::gpu {
+
+namespace {
+
+const char* result_name(VkResult r) {
+  switch (r) {
+    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_TIMEOUT: return "VK_TIMEOUT";
+    default: return "a VkResult error";
+  }
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool has_layer(const char* name) {
+  uint32_t n = 0;
+  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  std::vector<VkLayerProperties> layers(n);
+  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  for (const VkLayerProperties& l : layers)
+    if (std::strcmp(l.layerName, name) == 0) return true;
+  return false;
+}
+
+}  // namespace
+
+void check(VkResult r, const char* what) {
+  if (r != VK_SUCCESS) throw GpuError(std::string("Vulkan: ") + what + " failed (" + result_name(r) + ")");
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL Context::on_message(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void* self) {
+  auto* ctx = static_cast<Context*>(self);
+  ++ctx->messages_;
+  ctx->last_message_ = data && data->pMessage ? data->pMessage : "";
+  return VK_FALSE;
+}
+
+Context::Context(const DeviceChoice& choice) {
+  if (volkInitialize() != VK_SUCCESS)
+    throw GpuError("Vulkan: no Vulkan loader found (install libvulkan1 and a driver, e.g. mesa-vulkan-drivers)");
+  if (volkGetInstanceVersion() < VK_API_VERSION_1_2)
+    throw GpuError("Vulkan: the loader offers Vulkan " + std::to_string(VK_API_VERSION_MINOR(volkGetInstanceVersion())) +
+                   ".x; meshcast needs 1.2");
+  const char* env_validation = std::getenv("MESHCAST_VK_VALIDATION");
+  bool validation = choice.validation || (env_validation && std::string(env_validation) == "1");
+  if (validation && !has_layer("VK_LAYER_KHRONOS_validation"))
+    throw GpuError("Vulkan: validation asked for, but VK_LAYER_KHRONOS_validation is not installed (vulkan-validationlayers)");
+
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "meshcast";
+  app.apiVersion = VK_API_VERSION_1_2;
+  const char* layer = "VK_LAYER_KHRONOS_validation";
+  const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 1,
+                  ici.ppEnabledExtensionNames = &ext;
+  check(vkCreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
+  volkLoadInstanceOnly(instance_);
+  if (validation) {
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mci.pfnUserCallback = &Context::on_message;
+    mci.pUserData = this;
+    check(vkCreateDebugUtilsMessengerEXT(instance_, &mci, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  }
+
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+  std::vector<VkPhysicalDevice> devices(count);
+  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  if (devices.empty()) throw GpuError("Vulkan: no device found (install mesa-vulkan-drivers for lavapipe)");
+  std::vector<VkPhysicalDeviceProperties> props(count);
+  for (uint32_t i = 0; i < count; ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
+  std::string wanted = choice.device;
+  if (wanted.empty())
+    if (const char* env = std::getenv("MESHCAST_VK_DEVICE")) wanted = env;
+  int pick = -1;
+  if (wanted.empty()) {
+    for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
+      for (uint32_t i = 0; i < count && pick < 0; ++i)
+        if (props[i].deviceType == type) pick = int(i);
+    if (pick < 0) pick = 0;
+  } else if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+    pick = std::stoi(wanted) < int(count) ? std::stoi(wanted) : -1;
+  } else {
+    for (uint32_t i = 0; i < count && pick < 0; ++i)
+      if (lower(props[i].deviceName).find(lower(wanted)) != std::string::npos) pick = int(i);
+  }
+  if (pick < 0) {
+    std::string list;
+    for (uint32_t i = 0; i < count; ++i) list += "\n  " + std::to_string(i) + ": " + props[i].deviceName;
+    throw GpuError("Vulkan: no device matches '" + wanted + "'; devices:" + list);
+  }
+  physical_ = devices[size_t(pick)];
+  name_ = props[size_t(pick)].deviceName;
+  limits_ = props[size_t(pick)].limits;
+  if (props[size_t(pick)].apiVersion < VK_API_VERSION_1_2) throw GpuError("Vulkan: " + name_ + " does not offer Vulkan 1.2");
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+
+  // What the methods need: 64-bit integers and their atomics (the packed
+  // (t, triangle) minimum) and doubles (the watertight test's rare redo).
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+  vkGetPhysicalDeviceFeatures2(physical_, &f2);
+  if (!f2.features.shaderInt64 || !f2.features.shaderFloat64 || !f12.shaderBufferInt64Atomics)
+    throw GpuError("Vulkan: " + name_ + " lacks shaderInt64, shaderFloat64 or shaderBufferInt64Atomics, which the GPU methods use");
+  VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  e12.shaderBufferInt64Atomics = VK_TRUE;
+  VkPhysicalDeviceFeatures2 e2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &e12};
+  e2.features.shaderInt64 = VK_TRUE;
+  e2.features.shaderFloat64 = VK_TRUE;
+
+  uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> qf(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
+  uint32_t family = families;
+  for (uint32_t i = 0; i < families && family == families; ++i)
+    if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) family = i;
+  if (family == families) throw GpuError("Vulkan: " + name_ + " has no compute queue");
+  timestamps_ = qf[family].timestampValidBits > 0 && limits_.timestampPeriod > 0;
+  timestamp_ns_ = limits_.timestampPeriod;
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = family, qci.queueCount = 1, qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &e2};
+  dci.queueCreateInfoCount = 1, dci.pQueueCreateInfos = &qci;
+  check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
+  volkLoadDevice(device_);
+  vkGetDeviceQueue(device_, family, 0, &queue_);
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, pci.queueFamilyIndex = family;
+  check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
+}
+
+Context::~Context() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    vkDestroyFence(device_, fence_, nullptr);
+    vkDestroyCommandPool(device_, pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (messenger_) vkDestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+VkCommandBuffer Context::begin() {
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = pool_, ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, ai.commandBufferCount = 1;
+  VkCommandBuffer cb;
+  check(vkAllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
+  return cb;
+}
+
+void Context::end_and_wait(VkCommandBuffer cb) {
+  check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1, si.pCommandBuffers = &cb;
+  check(vkResetFences(device_, 1, &fence_), "vkResetFences");
+  check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
+  VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, 600ull * 1000 * 1000 * 1000);
+  vkFreeCommandBuffers(device_, pool_, 1, &cb);
+  check(r, "waiting for the GPU");
+}
+
+uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const {
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
+    if ((bits >> i & 1) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+  throw GpuError("Vulkan: " + name_ + " has no host-visible coherent memory for storage buffers");
+}
+
+Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what) : ctx_(ctx), size_(std::max<uint64_t>(bytes, 4)) {
+  if (size_ > ctx.limits().maxStorageBufferRange)
+    throw GpuError("Vulkan: the " + what + " of " + std::to_string(size_) + " bytes exceeds " + ctx.device_name() +
+                   "'s maxStorageBufferRange (" + std::to_string(ctx.limits().maxStorageBufferRange) + " bytes)");
+  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bci.size = size_, bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  check(vkCreateBuffer(ctx.device(), &bci, nullptr, &buffer_), "vkCreateBuffer");
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  VkResult r = vkAllocateMemory(ctx.device(), &mai, nullptr, &memory_);
+  if (r != VK_SUCCESS) {
+    vkDestroyBuffer(ctx.device(), buffer_, nullptr);
+    check(r, ("allocating the " + what).c_str());
+  }
+  check(vkBindBufferMemory(ctx.device(), buffer_, memory_, 0), "vkBindBufferMemory");
+  check(vkMapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+}
+
+Buffer::~Buffer() {
+  vkDestroyBuffer(ctx_.device(), buffer_, nullptr);
+  vkFreeMemory(ctx_.device(), memory_, nullptr);
+}
+
+Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes)
+    : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes) {
+  VkDevice d = ctx.device();
+  std::vector<VkDescriptorSetLayoutBinding> b(bindings);
+  for (uint32_t i = 0; i < bindings; ++i)
+    b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  dl.bindingCount = bindings, dl.pBindings = b.data();
+  check(vkCreateDescriptorSetLayout(d, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1, pl.pSetLayouts = &set_layout_;
+  if (push_bytes) pl.pushConstantRangeCount = 1, pl.pPushConstantRanges = &range;
+  check(vkCreatePipelineLayout(d, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+  VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  sm.codeSize = spirv_bytes, sm.pCode = spirv;
+  VkShaderModule module;
+  check(vkCreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
+  VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", nullptr};
+  cp.layout = layout_;
+  VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
+  vkDestroyShaderModule(d, module, nullptr);
+  check(r, "vkCreateComputePipelines");
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings};
+  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dp.maxSets = 1, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
+  check(vkCreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
+  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  da.descriptorPool = pool_, da.descriptorSetCount = 1, da.pSetLayouts = &set_layout_;
+  check(vkAllocateDescriptorSets(d, &da, &set_), "vkAllocateDescriptorSets");
+}
+
+Pipeline::~Pipeline() {
+  VkDevice d = ctx_.device();
+  vkDestroyDescriptorPool(d, pool_, nullptr);
+  vkDestroyPipeline(d, pipeline_, nullptr);
+  vkDestroyPipelineLayout(d, layout_, nullptr);
+  vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
+}
+
+void Pipeline::bind(const std::vector<const Buffer*>& buffers) {
+  std::vector<VkDescriptorBufferInfo> info(bindings_);
+  std::vector<VkWriteDescriptorSet> writes(bindings_);
+  for (uint32_t i = 0; i < bindings_; ++i) {
+    info[i] = {buffers[i]->handle(), 0, VK_WHOLE_SIZE};
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, set_, i, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                 nullptr, &info[i], nullptr};
+  }
+  vkUpdateDescriptorSets(ctx_.device(), bindings_, writes.data(), 0, nullptr);
+}
+
+void Pipeline::dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+  if (push_bytes_) vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
+  vkCmdDispatch(cb, x, y, z);
+}
+
+void compute_barrier(VkCommandBuffer cb) {
+  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT;
+  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0,
+                       nullptr, 0, nullptr);
+}
+
+}  // namespace meshcast::gpu

@@ -1,0 +1,126 @@
+// The Vulkan context every GPU method shares (Vulkan 1.2 through volk):
+// instance, one device chosen deterministically, its compute queue, and
+// small owners for buffers and compute pipelines. Nothing here knows a blob
+// layout; the methods (gpu/bruteforce.cpp, ...) do.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <volk.h>
+
+namespace meshcast::gpu {
+
+// No Vulkan, no device, or a Vulkan call that failed: the message says which
+// and why. The CPU path never needs the GPU.
+struct GpuError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct DeviceChoice {
+  // "" : $MESHCAST_VK_DEVICE, else the first discrete GPU, else the first
+  // integrated one, else the first device (enumeration order); otherwise a
+  // device index or a case-insensitive part of its name.
+  std::string device;
+  // Validation layers (VK_LAYER_KHRONOS_validation); also turned on by
+  // $MESHCAST_VK_VALIDATION=1. Every message they send is counted.
+  bool validation = false;
+};
+
+class Context {
+ public:
+  explicit Context(const DeviceChoice& choice = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  const std::string& device_name() const { return name_; }
+  VkDevice device() const { return device_; }
+  const VkPhysicalDeviceLimits& limits() const { return limits_; }
+  uint32_t validation_messages() const { return messages_; }
+  const std::string& last_validation_message() const { return last_message_; }
+  double timestamp_period_ns() const { return timestamp_ns_; }
+  bool has_timestamps() const { return timestamps_; }
+
+  // Records `record` into a one-time command buffer, submits it and waits.
+  template <class F>
+  void submit(F&& record) {
+    VkCommandBuffer cb = begin();
+    record(cb);
+    end_and_wait(cb);
+  }
+
+  uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const;
+
+ private:
+  VkCommandBuffer begin();
+  void end_and_wait(VkCommandBuffer cb);
+  static VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT*, void*);
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceLimits limits_{};
+  VkPhysicalDeviceMemoryProperties memory_{};
+  std::string name_, last_message_;
+  uint32_t messages_ = 0;
+  double timestamp_ns_ = 0;
+  bool timestamps_ = false;
+};
+
+// A host-visible storage buffer (coherent, mapped for its whole life).
+class Buffer {
+ public:
+  Buffer(Context& ctx, uint64_t bytes, const std::string& what);
+  ~Buffer();
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+  VkBuffer handle() const { return buffer_; }
+  uint64_t size() const { return size_; }
+  void* data() const { return mapped_; }
+
+ private:
+  Context& ctx_;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  void* mapped_ = nullptr;
+  uint64_t size_ = 0;
+};
+
+// A compute pipeline over one descriptor set of `bindings` storage buffers
+// (binding i = buffer i) and `push_bytes` of push constants.
+class Pipeline {
+ public:
+  Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes);
+  ~Pipeline();
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+  // Points binding i at buffers[i] (whole buffer).
+  void bind(const std::vector<const Buffer*>& buffers);
+  void dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const;
+
+ private:
+  Context& ctx_;
+  uint32_t bindings_, push_bytes_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+};
+
+// A barrier that makes compute-shader writes visible to the next dispatch.
+void compute_barrier(VkCommandBuffer cb);
+
+// Throws GpuError naming `what` when r is not VK_SUCCESS.
+void check(VkResult r, const char* what);
+
+}  // namespace meshcast::gpu

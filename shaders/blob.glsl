@@ -1,0 +1,34 @@
+// The blob as the CPU wrote it, bound as one read-only uint array, and the
+// readers every method shares: header fields, and the remap from a triangle
+// slot to the caller's triangle index (layout/blob.h describes the section).
+#ifndef MESHCAST_BLOB_GLSL
+#define MESHCAST_BLOB_GLSL
+
+#include "layout/formats.h"
+
+layout(std430, set = 0, binding = 0) readonly buffer Blob { uint blob_words[]; };
+
+uint blob_u32(uint byte_offset) { return blob_words[byte_offset >> 2]; }
+float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_words[byte_offset >> 2]); }
+uint header(uint word) { return blob_words[word]; }
+
+// remap_entry of layout/blob.h: the used-slot bitmap (64-bit words), the
+// rank of each word, then the bit-packed entries.
+uint remap_entry(uint slot) {
+  const uint base = header(MC_HDR_REMAP_OFFSET);
+  const uint words = (header(MC_HDR_REMAP_SLOTS) + 63u) / 64u;
+  const uint w = slot >> 6, bit = slot & 63u;
+  const uint lo = blob_u32(base + 8u * w), hi = blob_u32(base + 8u * w + 4u);
+  const uint below = bit < 32u ? bitCount(lo & ((1u << bit) - 1u))
+                               : uint(bitCount(lo)) + bitCount(hi & ((1u << (bit - 32u)) - 1u));
+  const uint index = blob_u32(base + 8u * words + 4u * w) + below;
+  const uint bits = header(MC_HDR_REMAP_BITS);
+  // Entry `index` starts `index * bits` bits into the entries (8-aligned);
+  // it spans at most two 32-bit words.
+  const uint64_t at = uint64_t(base + 12u * words) * 8ul + uint64_t(index) * uint64_t(bits);
+  const uint word = uint(at >> 5), shift = uint(at & 31ul);
+  const uint64_t pair = uint64_t(blob_words[word]) | (uint64_t(blob_words[word + 1u]) << 32);
+  return uint((pair >> shift) & ((1ul << bits) - 1ul));
+}
+
+#endif

@@ -1,0 +1,36 @@
+// Rays as the host prepares them (gpu/rays.cpp): the ray and the per-ray
+// constants of the CPU's RayPre (cpu/ray.h), computed once on the host in
+// correctly rounded arithmetic, so the shear the GPU applies is the CPU's
+// bit for bit. 12 words a ray:
+//   org xyz, dir xyz, tmax, sx, sy, sz, axes (kx | ky << 2 | kz << 4),
+//   walkable (0: answered as a miss, as the CPU does)
+#ifndef MESHCAST_RAY_GLSL
+#define MESHCAST_RAY_GLSL
+
+#define MC_GPU_RAY_WORDS 12u
+
+struct GpuRay {
+  vec3 org, dir;
+  float tmax, sx, sy, sz;
+  uint kx, ky, kz;
+  bool walkable;
+};
+
+layout(std430, set = 0, binding = 1) readonly buffer Rays { uint ray_words[]; };
+
+GpuRay load_ray(uint i) {
+  const uint b = i * MC_GPU_RAY_WORDS;
+  GpuRay r;
+  r.org = vec3(uintBitsToFloat(ray_words[b]), uintBitsToFloat(ray_words[b + 1u]), uintBitsToFloat(ray_words[b + 2u]));
+  r.dir = vec3(uintBitsToFloat(ray_words[b + 3u]), uintBitsToFloat(ray_words[b + 4u]), uintBitsToFloat(ray_words[b + 5u]));
+  r.tmax = uintBitsToFloat(ray_words[b + 6u]);
+  r.sx = uintBitsToFloat(ray_words[b + 7u]);
+  r.sy = uintBitsToFloat(ray_words[b + 8u]);
+  r.sz = uintBitsToFloat(ray_words[b + 9u]);
+  const uint axes = ray_words[b + 10u];
+  r.kx = axes & 3u, r.ky = (axes >> 2) & 3u, r.kz = (axes >> 4) & 3u;
+  r.walkable = ray_words[b + 11u] != 0u;
+  return r;
+}
+
+#endif

@@ -1,0 +1,51 @@
+// The watertight ray/triangle test of cpu/ray.h (Woop, Benthin, Wald 2013),
+// operation for operation: every product and difference is `precise`, so no
+// compiler fuses them into an fma and both triangles of a shared edge get
+// the same roundings; an edge function that rounds to 0 is redone in
+// double, as on the CPU. Two-sided; accepts t in [0, closest].
+#ifndef MESHCAST_WATERTIGHT_GLSL
+#define MESHCAST_WATERTIGHT_GLSL
+
+bool watertight_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
+                       float closest, out float t, out float u, out float v) {
+  precise double U = double(cx) * double(by) - double(cy) * double(bx);
+  precise double V = double(ax) * double(cy) - double(ay) * double(cx);
+  precise double W = double(bx) * double(ay) - double(by) * double(ax);
+  if ((U < 0.0lf || V < 0.0lf || W < 0.0lf) && (U > 0.0lf || V > 0.0lf || W > 0.0lf)) return false;
+  precise double det = U + V + W;
+  if (det == 0.0lf) return false;
+  precise double T = U * double(az) + V * double(bz) + W * double(cz);
+  if (det < 0.0lf) T = -T, U = -U, V = -V, W = -W, det = -det;
+  if (T < 0.0lf) return false;
+  t = float(T / det);
+  if (!(t <= closest)) return false;
+  u = float(V / det), v = float(W / det);
+  return true;
+}
+
+bool watertight(GpuRay r, vec3 a, vec3 b, vec3 c, float closest, out float t, out float u, out float v) {
+  const float ox = r.org[r.kx], oy = r.org[r.ky], oz = r.org[r.kz];
+  precise float ax = a[r.kx] - ox, ay = a[r.ky] - oy, az = a[r.kz] - oz;
+  precise float bx = b[r.kx] - ox, by = b[r.ky] - oy, bz = b[r.kz] - oz;
+  precise float cx = c[r.kx] - ox, cy = c[r.ky] - oy, cz = c[r.kz] - oz;
+  ax = ax - r.sx * az, ay = ay - r.sy * az;
+  bx = bx - r.sx * bz, by = by - r.sy * bz;
+  cx = cx - r.sx * cz, cy = cy - r.sy * cz;
+  precise float U = cx * by - cy * bx;
+  precise float V = ax * cy - ay * cx;
+  precise float W = bx * ay - by * ax;
+  az = r.sz * az, bz = r.sz * bz, cz = r.sz * cz;
+  if (U == 0.0 || V == 0.0 || W == 0.0) return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, closest, t, u, v);
+  if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
+  precise float det = U + V + W;
+  if (det == 0.0) return false;
+  precise float T = U * az + V * bz + W * cz;
+  const float Ts = det < 0.0 ? -T : T, dets = abs(det);
+  if (!(Ts >= 0.0)) return false;
+  t = Ts / dets;
+  if (!(t <= closest)) return false;
+  u = V / det, v = W / det;
+  return true;
+}
+
+#endif

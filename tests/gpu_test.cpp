@@ -1,0 +1,109 @@
+// The Vulkan backend against the CPU walker on the same blob and against the
+// double-precision oracle, on the device the machine has (lavapipe in CI),
+// with the validation layers on.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gpu/method.h"
+#include "io/generate.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+gpu::Context& context() {
+  static gpu::Context ctx(gpu::DeviceChoice{"", true});
+  return ctx;
+}
+
+// Same triangle as the CPU walker for every ray, t within 1e-6 relative; a
+// different triangle only at exactly the same t (a tie the two may break
+// apart, both right).
+void expect_same_as_cpu(const std::vector<Hit>& gpu, const std::vector<Hit>& cpu, const std::string& what) {
+  size_t differ = 0, hits = 0;
+  std::string first;
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    hits += cpu[i].triangle != MC_NO_HIT;
+    bool same = gpu[i].triangle == cpu[i].triangle;
+    bool t_ok = cpu[i].triangle == MC_NO_HIT ? gpu[i].triangle == MC_NO_HIT
+                                             : std::fabs(gpu[i].t - cpu[i].t) <= 1e-6 * std::fabs(cpu[i].t);
+    if (!same && gpu[i].t == cpu[i].t) continue;  // a tie
+    if (!same || !t_ok) {
+      if (differ++ == 0)
+        first = "ray " + std::to_string(i) + ": gpu " + std::to_string(gpu[i].triangle) + " t " + std::to_string(gpu[i].t) +
+                ", cpu " + std::to_string(cpu[i].triangle) + " t " + std::to_string(cpu[i].t);
+    }
+  }
+  EXPECT_EQ(differ, 0u) << what << ": " << first;
+  EXPECT_GT(hits, cpu.size() / 20) << what << ": a ray set that never hits proves nothing";
+}
+
+TEST(Gpu, DeviceIsNamedAndValidationIsOn) {
+  EXPECT_FALSE(context().device_name().empty());
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+
+// The layers are really listening: an invalid call (a buffer of 0 bytes) is
+// reported, so the zero counts of the other tests mean something.
+TEST(Gpu, ValidationLayersReportAnInvalidCall) {
+  gpu::Context ctx(gpu::DeviceChoice{"", true});
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = 0, info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  if (vkCreateBuffer(ctx.device(), &info, nullptr, &buffer) == VK_SUCCESS && buffer) vkDestroyBuffer(ctx.device(), buffer, nullptr);
+  EXPECT_GT(ctx.validation_messages(), 0u);
+}
+
+TEST(Gpu, UnknownDeviceIsRefusedWithTheList) {
+  try {
+    gpu::Context ctx(gpu::DeviceChoice{"no such device", false});
+    FAIL();
+  } catch (const gpu::GpuError& e) {
+    EXPECT_NE(std::string(e.what()).find("devices:"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Gpu, MethodRefusesALayoutItDoesNotRead) {
+  Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  EXPECT_THROW(gpu::make_method(context(), "bruteforce", blob, "sphere"), InputError);
+  EXPECT_THROW(gpu::make_method(context(), "octree", blob, "sphere"), InputError);
+}
+
+// Method 1: BruteForce/Float3SOA128, every ray kind, against the CPU walker
+// on the same blob and against the oracle.
+TEST(Gpu, BruteForceMatchesTheCpuAndTheOracle) {
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (m.name != "sphere" && m.name != "bunny00" && m.name != "terrain_64k") continue;
+    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout("BruteForce/Float3SOA128"), m.name);
+    std::unique_ptr<gpu::Method> method = gpu::make_method(context(), "bruteforce", blob, m.name);
+    for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
+      const size_t count = m.name == "sphere" ? 10000 : 2000;
+      const std::vector<Ray>& rays = test_rays(m, kind, count);
+      std::vector<Hit> gpu(rays.size()), cpu = trace_all(blob, rays);
+      method->trace(rays, gpu);
+      std::string what = m.name + " kind " + std::to_string(int(kind));
+      expect_same_as_cpu(gpu, cpu, what);
+      Agreement a = compare(*m.mesh, rays, gpu, oracle_answers(m, kind, rays), 1e-5 * m.mesh->bounds().diagonal());
+      EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
+    }
+  }
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+
+TEST(Gpu, UnwalkableRaysAreMissesAndCounted) {
+  Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("BruteForce/Float3SOA128"), "sphere");
+  std::unique_ptr<gpu::Method> method = gpu::make_method(context(), "bruteforce", blob, "sphere");
+  std::vector<Ray> rays = {{{0, 0, -5}, {0, 0, 1}, INFINITY}, {{0, 0, -5}, {0, 0, 0}, INFINITY},
+                           {{NAN, 0, -5}, {0, 0, 1}, INFINITY}, {{0, 0, -5}, {0, 0, 1}, NAN}};
+  std::vector<Hit> hits(rays.size());
+  EXPECT_EQ(method->trace(rays, hits), 3u);
+  EXPECT_NE(hits[0].triangle, MC_NO_HIT);
+  for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(hits[i].triangle, MC_NO_HIT) << i;
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+
+}  // namespace
+}  // namespace meshcast::testing

@@ -1,5 +1,6 @@
 // meshcast demo MESH: the main job. Builds the three layouts of the
-// foundation, casts 10,000 rays of each kind, compares every answer with the
+// foundation, casts 10,000 rays of each kind, then the Vulkan brute force
+// on the first 1,000 of each, compares every answer with the
 // double-precision oracle, prints a table and renders a picture.
 #include <cstdio>
 
@@ -8,6 +9,7 @@
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
 #include "cpu/trace.h"
+#include "gpu/method.h"
 #include "io/read_mesh.h"
 #include "layout/blob.h"
 #include "tools/commands.h"
@@ -19,8 +21,9 @@ namespace meshcast::tools {
 void add_demo(CLI::App& app) {
   struct Args {
     std::string input, png = "out/render.png";
-    size_t count = 10000;
+    size_t count = 10000, gpu_count = 1000;
     uint32_t repeat = 5, leaf = 8;
+    std::string device;
     int width = 800, height = 600;
   };
   auto args = std::make_shared<Args>();
@@ -30,6 +33,8 @@ void add_demo(CLI::App& app) {
   cmd->add_option("--repeat", args->repeat, "timed passes; the median is reported")->check(CLI::Range(1, 100));
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
   cmd->add_option("--png", args->png, "picture to write");
+  cmd->add_option("--gpu-count", args->gpu_count, "rays of each kind for the Vulkan brute-force row (0: no GPU row)");
+  cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->add_option("--width", args->width)->check(CLI::Range(16, 8192));
   cmd->add_option("--height", args->height)->check(CLI::Range(16, 8192));
   cmd->callback([args] {
@@ -93,15 +98,54 @@ void add_demo(CLI::App& app) {
       rows.push_back(row);
       picture_blob = std::move(blob);
     }
+    // The GPU: method 1 of seed 000 7 (BruteForce/Float3SOA128) on the
+    // first gpu_count rays of each kind, timed from submission to read-back
+    // (the device's own time beside it), judged by the same oracle.
+    std::string gpu_note;
+    if (args->gpu_count > 0) {
+      try {
+        gpu::Context ctx(gpu::DeviceChoice{args->device, false});
+        BuildReport report;
+        std::vector<uint8_t> blob = build_blob(mesh, layout_options("BruteForce/Float3SOA128", args->leaf), args->input, &report);
+        std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, "bruteforce", blob, args->input);
+        SectionBytes s = section_bytes(blob);
+        Row row{"Vulkan BruteForce/Float3SOA128", report.build_ms, s.walked() / n, s.remap / n, {}, 0};
+        double device_ns[3] = {};
+        for (int k = 0; k < 3; ++k) {
+          size_t m = std::min(args->gpu_count, rays[k].size());
+          std::span<const Ray> subset(rays[k].data(), m);
+          std::vector<Hit> hits(m);
+          std::vector<double> wall, device;
+          for (uint32_t r = 0; r < std::min(args->repeat, 3u); ++r) {
+            gpu::GpuTiming timing;
+            method->trace(subset, hits, &timing);
+            wall.push_back(timing.wall_ms), device.push_back(timing.device_ms);
+          }
+          row.ns[k] = median(wall) * 1e6 / double(m);
+          device_ns[k] = median(device) * 1e6 / double(m);
+          std::vector<OracleHit> answers(oracle[k].begin(), oracle[k].begin() + std::ptrdiff_t(m));
+          Agreement a = compare(mesh, std::vector<Ray>(subset.begin(), subset.end()), hits, answers, tolerance);
+          row.disagreements += a.wrong + a.t_errors;
+        }
+        rows.push_back(row);
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "Vulkan row: %s, %zu rays of each kind, submission to read-back (device time %.0f, %.0f, %.0f ns/ray)",
+                      ctx.device_name().c_str(), std::min(args->gpu_count, rays[0].size()), device_ns[0], device_ns[1], device_ns[2]);
+        gpu_note = buf;
+      } catch (const gpu::GpuError& e) {
+        gpu_note = std::string("no Vulkan row: ") + e.what();
+      }
+    }
     uint64_t disagreements_total = 0;
     for (const Row& r : rows) disagreements_total += r.disagreements;
     // A peer measured in the same run, when meshcast was built with it.
     std::unique_ptr<bench::Peer> peer = bench::make_embree(mesh);
+    Row peer_row{};
     if (peer) {
-      Row row{peer->name() + " (peer)", peer->build_ms(), double(peer->bytes()) / n, 0, {}, 0};
-      time_kinds([&](const std::vector<Ray>& r, std::vector<Hit>& h) { peer->trace(r, h); }, row,
+      peer_row = Row{peer->name() + " (peer)", peer->build_ms(), double(peer->bytes()) / n, 0, {}, 0};
+      time_kinds([&](const std::vector<Ray>& r, std::vector<Hit>& h) { peer->trace(r, h); }, peer_row,
                  [&](int k, const std::vector<Hit>& hits) { return compare(mesh, rays[k], hits, oracle[k], tolerance); });
-      rows.push_back(row);
+      rows.push_back(peer_row);
     }
     std::printf("\n| layout | build ms | bytes/tri walked | remap B/tri | ns/ray long | ns/ray probe | ns/ray radial "
                 "| disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -111,11 +155,13 @@ void add_demo(CLI::App& app) {
     std::printf("\n%zu rays of each kind, one thread, median of %u passes; disagreements = rays whose triangle or t "
                 "differs from the double-precision oracle beyond exact ties (t tolerance %.3g)\n",
                 args->count, args->repeat, tolerance);
+    if (!gpu_note.empty()) std::printf("%s\n", gpu_note.c_str());
     if (peer) {
       std::printf("time / %s time (long, probe, radial):", peer->name().c_str());
-      for (size_t i = 0; i + 1 < rows.size(); ++i)
-        std::printf("  %s %.2f %.2f %.2f;", rows[i].name.c_str(), rows[i].ns[0] / rows.back().ns[0],
-                    rows[i].ns[1] / rows.back().ns[1], rows[i].ns[2] / rows.back().ns[2]);
+      for (size_t i = 0; i < rows.size(); ++i)
+        if (rows[i].name.find("(peer)") == std::string::npos && rows[i].name.find("Vulkan") == std::string::npos)
+          std::printf("  %s %.2f %.2f %.2f;", rows[i].name.c_str(), rows[i].ns[0] / peer_row.ns[0],
+                      rows[i].ns[1] / peer_row.ns[1], rows[i].ns[2] / peer_row.ns[2]);
       std::printf("\n%s bytes/tri: the memory its device reported for the scene (vertices, indices, BVH)\n",
                   peer->name().c_str());
     } else {

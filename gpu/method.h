@@ -6,6 +6,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "cpu/ray.h"
 #include "gpu/vulkan.h"
@@ -25,9 +26,13 @@ class Method {
   virtual uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
 };
 
-// "bruteforce" (BruteForce over Float3SOA128 blocks). Throws GpuError or
-// InputError (the blob's layout does not fit the method, naming both).
+// The methods and the layouts they read so far:
+//   bruteforce  BruteForce/Float3SOA128      aabbtree  AABBTree/Float3
+//   skdtree     SKDTree/Float3               lbvh      StacklessLBVH/Float3
+// Throws GpuError, or InputError (an unknown method, or a blob whose layout
+// the method does not read, naming both).
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
                                     const std::string& name);
+std::vector<std::string> method_names();
 
 }  // namespace meshcast::gpu

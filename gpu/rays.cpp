@@ -18,6 +18,7 @@ uint64_t pack_rays(std::span<const Ray> rays, uint32_t* out) {
     std::memcpy(w, f, sizeof f);
     w[10] = uint32_t(p.axis[0]) | uint32_t(p.axis[1]) << 2 | uint32_t(p.axis[2]) << 4;
     w[11] = 1;
+    std::memcpy(w + 12, p.inv, 12);
   }
   return skipped;
 }

@@ -10,7 +10,7 @@
 
 namespace meshcast::gpu {
 
-constexpr uint32_t kRayWords = 12;  // MC_GPU_RAY_WORDS
+constexpr uint32_t kRayWords = 16;  // MC_GPU_RAY_WORDS
 
 // Packs the rays; returns how many are unwalkable (answered as misses).
 uint64_t pack_rays(std::span<const Ray> rays, uint32_t* out);

@@ -1,16 +1,16 @@
 // Rays as the host prepares them (gpu/rays.cpp): the ray and the per-ray
 // constants of the CPU's RayPre (cpu/ray.h), computed once on the host in
 // correctly rounded arithmetic, so the shear the GPU applies is the CPU's
-// bit for bit. 12 words a ray:
+// bit for bit, and the box test's reciprocals likewise. 16 words a ray:
 //   org xyz, dir xyz, tmax, sx, sy, sz, axes (kx | ky << 2 | kz << 4),
-//   walkable (0: answered as a miss, as the CPU does)
+//   walkable (0: answered as a miss, as the CPU does), inv xyz, 0
 #ifndef MESHCAST_RAY_GLSL
 #define MESHCAST_RAY_GLSL
 
-#define MC_GPU_RAY_WORDS 12u
+#define MC_GPU_RAY_WORDS 16u
 
 struct GpuRay {
-  vec3 org, dir;
+  vec3 org, dir, inv;
   float tmax, sx, sy, sz;
   uint kx, ky, kz;
   bool walkable;
@@ -30,6 +30,7 @@ GpuRay load_ray(uint i) {
   const uint axes = ray_words[b + 10u];
   r.kx = axes & 3u, r.ky = (axes >> 2) & 3u, r.kz = (axes >> 4) & 3u;
   r.walkable = ray_words[b + 11u] != 0u;
+  r.inv = vec3(uintBitsToFloat(ray_words[b + 12u]), uintBitsToFloat(ray_words[b + 13u]), uintBitsToFloat(ray_words[b + 14u]));
   return r;
 }
 

@@ -1,0 +1,63 @@
+// The one-ray-a-thread methods of seed 000 §7: a tree walked per thread
+// (a stack of its own, or none for the StacklessLBVH), one dispatch a batch.
+// Each is a shader and the layout it reads; the host side is the same.
+#include "cpu/mesh.h"
+#include "gpu/batch.h"
+#include "shaders/aabbtree_float3.h"
+#include "shaders/lbvh_float3.h"
+#include "shaders/skdtree_float3.h"
+
+namespace meshcast::gpu {
+
+namespace {
+
+struct Walker {
+  const char* method;
+  uint32_t tree, triangles;
+  const uint32_t* spirv;
+  size_t spirv_bytes;
+};
+
+const Walker kWalkers[] = {
+    {"aabbtree", MC_TREE_AABBTREE, MC_TRI_FLOAT3, aabbtree_float3_spv, sizeof aabbtree_float3_spv},
+    {"skdtree", MC_TREE_SKDTREE, MC_TRI_FLOAT3, skdtree_float3_spv, sizeof skdtree_float3_spv},
+    {"lbvh", MC_TREE_STACKLESSLBVH, MC_TRI_FLOAT3, lbvh_float3_spv, sizeof lbvh_float3_spv},
+};
+
+class WalkMethod : public BatchMethod {
+ public:
+  WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const Walker& w)
+      : BatchMethod(ctx, blob, name, w.method, w.tree, w.triangles), walk_(ctx, w.spirv, w.spirv_bytes, 4, sizeof(Push)) {}
+
+ protected:
+  void bind_all() override { walk_.bind(buffers()); }
+  void record(VkCommandBuffer cb, uint32_t n) override {
+    Push push{0, n, records_};
+    walk_.dispatch(cb, &push, (n + 63) / 64, 1, 1);
+  }
+
+ private:
+  Pipeline walk_;
+};
+
+}  // namespace
+
+std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name);
+
+std::vector<std::string> method_names() {
+  std::vector<std::string> names{"bruteforce"};
+  for (const Walker& w : kWalkers) names.push_back(w.method);
+  return names;
+}
+
+std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
+                                    const std::string& name) {
+  if (method == "bruteforce") return make_bruteforce(ctx, blob, name);
+  for (const Walker& w : kWalkers)
+    if (method == w.method) return std::make_unique<WalkMethod>(ctx, blob, name, w);
+  std::string valid;
+  for (const std::string& n : method_names()) valid += " " + n;
+  throw InputError("unknown GPU method '" + method + "'; implemented:" + valid);
+}
+
+}  // namespace meshcast::gpu

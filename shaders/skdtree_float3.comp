@@ -1,0 +1,76 @@
+// Method 4 of seed 000 §7: SKDTree (§5.5) with Float3 triangles, one ray a
+// thread: the walk of cpu/walk_skdtree.cpp, the ray's [near, far] interval
+// clipped by each node's two planes, the far end widened as in the box test.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#include "shaders/blob.glsl"
+#include "shaders/ray.glsl"
+#include "shaders/watertight.glsl"
+#include "shaders/hits.glsl"
+#include "shaders/walk.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(push_constant) uniform Push { uint ray_base, ray_count, records; } pc;
+
+bool open_interval(float lo, float hi, float closest) {
+  precise float limit = min_keep(hi, closest) * kFarScale;
+  return lo <= limit;
+}
+
+void main() {
+  const uint ray = gl_GlobalInvocationID.x;
+  if (ray >= pc.ray_count) return;
+  const GpuRay r = load_ray(ray);
+  Closest c = Closest(r.tmax, MC_NO_HIT, 0.0, 0.0);
+  const uint tree = header(MC_HDR_TREE_OFFSET);
+  float tn = 0.0, tf = kInfinity;
+  for (int a = 0; a < 3; ++a) {
+    const float lo = uintBitsToFloat(header(MC_HDR_BOUNDS_MIN + uint(a)));
+    const float hi = uintBitsToFloat(header(MC_HDR_BOUNDS_MAX + uint(a)));
+    const bool neg = sign_bit(r.dir[a]);
+    precise float dn = ((neg ? hi : lo) - r.org[a]) * r.inv[a];
+    precise float df = ((neg ? lo : hi) - r.org[a]) * r.inv[a];
+    tn = max_keep(dn, tn), tf = min_keep(df, tf);
+  }
+  if (r.walkable && open_interval(tn, tf, c.t)) {
+    uint stack_node[MC_MAX_DEPTH + 2u];
+    float stack_near[MC_MAX_DEPTH + 2u], stack_far[MC_MAX_DEPTH + 2u];
+    int top = -1;
+    uint at = 0u;
+    for (;;) {
+      const uint props = blob_u32(tree + at);
+      const uint axis = props >> MC_SKD_AXIS_SHIFT;
+      if (axis != MC_SKD_LEAF_AXIS) {
+        precise float tl = (blob_f32(tree + at + 4u) - r.org[axis]) * r.inv[axis];
+        precise float tr = (blob_f32(tree + at + 8u) - r.org[axis]) * r.inv[axis];
+        const uint left = at + MC_SKD_INTERIOR_BYTES, right = props & MC_SKD_VALUE_MASK;
+        float ln = tn, lf = tf, rn = tn, rf = tf;
+        if (sign_bit(r.dir[axis])) ln = max_keep(tl, tn), rf = min_keep(tr, tf);
+        else lf = min_keep(tl, tf), rn = max_keep(tr, tn);
+        const bool lhit = open_interval(ln, lf, c.t), rhit = open_interval(rn, rf, c.t);
+        if (lhit || rhit) {
+          const bool left_first = lhit && (!rhit || ln < rn);
+          if (lhit && rhit) {
+            ++top;
+            stack_node[top] = left_first ? right : left;
+            stack_near[top] = left_first ? rn : ln;
+            stack_far[top] = left_first ? rf : lf;
+          }
+          at = left_first ? left : right, tn = left_first ? ln : rn, tf = left_first ? lf : rf;
+          continue;
+        }
+      } else {
+        const uint block = at + MC_SKD_LEAF_BYTES;
+        test_float3_leaf(r, tree + block, props & MC_SKD_VALUE_MASK, slot_of(block), c);
+      }
+      while (top >= 0 && !open_interval(stack_near[top], stack_far[top], c.t)) --top;
+      if (top < 0) break;
+      at = stack_node[top], tn = stack_near[top], tf = stack_far[top];
+      --top;
+    }
+  }
+  write_closest(ray, c);
+}

@@ -1,0 +1,59 @@
+// What the one-ray-a-thread tree walkers share: the closest hit so far, the
+// conservative box test of cpu/ray.h (Ize 2013) and the Float3 leaf test.
+#ifndef MESHCAST_WALK_GLSL
+#define MESHCAST_WALK_GLSL
+
+// The sign bit, -0 included (std::signbit).
+bool sign_bit(float x) { return (floatBitsToUint(x) >> 31) != 0u; }
+
+// GLSL's min and max are undefined on NaN; these keep their second operand,
+// as max_keep/min_keep do on the CPU (a slab the ray lies in constrains nothing).
+float max_keep(float a, float b) { return a > b ? a : b; }
+float min_keep(float a, float b) { return a < b ? a : b; }
+
+// 1 + 2 gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (cpu/ray.h).
+#define kInfinity uintBitsToFloat(0x7F800000u)
+const float kFarScale = 1.0 + 2.0 * (3.0 * 5.9604644775390625e-8) / (1.0 - 3.0 * 5.9604644775390625e-8);
+
+struct Closest {
+  float t;
+  uint slot;
+  float u, v;
+};
+
+// Entry distance of the box, or +inf for a miss (box_test of cpu/ray.h).
+float box_test(GpuRay r, vec3 mn, vec3 mx, float closest) {
+  float tn = 0.0, tf = uintBitsToFloat(0x7F800000u);
+  for (int a = 0; a < 3; ++a) {
+    const bool neg = sign_bit(r.dir[a]);
+    const float nearp = neg ? mx[a] : mn[a], farp = neg ? mn[a] : mx[a];
+    precise float dn = (nearp - r.org[a]) * r.inv[a];
+    precise float df = (farp - r.org[a]) * r.inv[a];
+    tn = max_keep(dn, tn);
+    tf = min_keep(df, tf);
+  }
+  precise float limit = min_keep(tf, closest) * kFarScale;
+  return tn <= limit ? tn : uintBitsToFloat(0x7F800000u);
+}
+
+// `count` Float3 triangles (9 floats each) at blob offset `block`, slots
+// from slot0.
+void test_float3_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closest c) {
+  for (uint i = 0u; i < count; ++i) {
+    const uint p = block + 36u * i;
+    const vec3 a = vec3(blob_f32(p), blob_f32(p + 4u), blob_f32(p + 8u));
+    const vec3 b = vec3(blob_f32(p + 12u), blob_f32(p + 16u), blob_f32(p + 20u));
+    const vec3 d = vec3(blob_f32(p + 24u), blob_f32(p + 28u), blob_f32(p + 32u));
+    float t, u, v;
+    if (watertight(r, a, b, d, c.t, t, u, v) && t <= c.t) c = Closest(t, slot0 + i, u, v);
+  }
+}
+
+uint slot_of(uint tree_block) { return (tree_block - header(MC_HDR_TRIANGLE_BASE)) / header(MC_HDR_SLOT_DIVISOR); }
+
+void write_closest(uint ray, Closest c) {
+  if (c.slot == MC_NO_HIT) write_miss(ray);
+  else write_hit(ray, c.t, remap_entry(c.slot), c.u, c.v);
+}
+
+#endif

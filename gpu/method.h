@@ -29,6 +29,7 @@ class Method {
 // The methods and the layouts they read so far:
 //   bruteforce  BruteForce/Float3SOA128      aabbtree  AABBTree/Float3
 //   skdtree     SKDTree/Float3               lbvh      StacklessLBVH/Float3
+//   quadtree    QuadTreeHalfFloat/Indexed8BitPackSOA4
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout
 // the method does not read, naming both).
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,

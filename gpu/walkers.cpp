@@ -5,6 +5,7 @@
 #include "gpu/batch.h"
 #include "shaders/aabbtree_float3.h"
 #include "shaders/lbvh_float3.h"
+#include "shaders/quadtree_i8.h"
 #include "shaders/skdtree_float3.h"
 
 namespace meshcast::gpu {
@@ -22,6 +23,7 @@ const Walker kWalkers[] = {
     {"aabbtree", MC_TREE_AABBTREE, MC_TRI_FLOAT3, aabbtree_float3_spv, sizeof aabbtree_float3_spv},
     {"skdtree", MC_TREE_SKDTREE, MC_TRI_FLOAT3, skdtree_float3_spv, sizeof skdtree_float3_spv},
     {"lbvh", MC_TREE_STACKLESSLBVH, MC_TRI_FLOAT3, lbvh_float3_spv, sizeof lbvh_float3_spv},
+    {"quadtree", MC_TREE_QUADTREEHALFFLOAT, MC_TRI_INDEXED8BITPACKSOA4, quadtree_i8_spv, sizeof quadtree_i8_spv},
 };
 
 class WalkMethod : public BatchMethod {

@@ -28,7 +28,8 @@ void add_trace(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
-                                            "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3)");
+                                            "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
+                                            "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {

@@ -1,0 +1,39 @@
+// Arithmetic the CPU does in one rounding that a Vulkan device may not:
+// Vulkan lets fma() round twice, so the CPU's std::fma (the BitPack decode
+// of layout/block.cpp) is rebuilt from double operations, which Vulkan does
+// round correctly: the product of two floats is exact in double, the sum is
+// rounded to odd (TwoSum, then the last bit set when anything was lost), and
+// the one conversion to float then rounds exactly as a fused fma would
+// (Boldo and Melquiond 2008).
+#ifndef MESHCAST_EXACT_GLSL
+#define MESHCAST_EXACT_GLSL
+
+float fma_exact(float a, float b, float c) {
+  precise double p = double(a) * double(b);
+  precise double s = p + double(c);
+  precise double bb = s - p;
+  precise double e = (p - (s - bb)) + (double(c) - bb);
+  if (e != 0.0lf) {
+    uvec2 bits = unpackDouble2x32(s);
+    if ((bits.x & 1u) == 0u) {  // even: step one ulp toward the lost part, making it odd
+      const bool away = (e > 0.0lf) == (s > 0.0lf);
+      uint64_t m = (uint64_t(bits.y) << 32) | uint64_t(bits.x);
+      m = away ? m + 1ul : m - 1ul;
+      s = packDouble2x32(uvec2(uint(m & 0xFFFFFFFFul), uint(m >> 32)));
+    }
+  }
+  return float(s);
+}
+
+// IEEE binary16 to float, exactly (ldexp is exact in Vulkan; subnormal
+// halves are kept, never flushed).
+float half_to_float_exact(uint h) {
+  const uint e = (h >> 10) & 31u, m = h & 1023u;
+  float v;
+  if (e == 0u) v = ldexp(float(m), -24);
+  else if (e == 31u) v = m == 0u ? uintBitsToFloat(0x7F800000u) : uintBitsToFloat(0x7FC00000u);
+  else v = ldexp(float(m + 1024u), int(e) - 25);
+  return (h >> 15) != 0u ? -v : v;
+}
+
+#endif

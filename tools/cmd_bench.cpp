@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "bench/encodings.h"
+#include "bench/gpu.h"
 #include "bench/plot.h"
 #include "bench/trees.h"
 #include "io/generate.h"
@@ -146,6 +147,29 @@ void add_bench(CLI::App& app) {
       std::printf("\ncsv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
     });
   }
+
+  // Seed 000 §7 on this machine's Vulkan device.
+  auto gargs = std::make_shared<ArgsT>();
+  auto gdevice = std::make_shared<std::string>();
+  CLI::App* gsub = bench->add_subcommand("gpu", "seed 000 7: the GPU methods on the Vulkan device, the CPU's best beside them");
+  gsub->add_option("mesh", gargs->input, "mesh file (default data/bunny00.off)");
+  gsub->add_option("--rays", gargs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
+  gsub->add_option("--repeat", gargs->repeat, "passes; the median is reported")->check(CLI::Range(1, 1000));
+  gsub->add_option("--device", *gdevice, "Vulkan device: index or part of its name");
+  gsub->callback([gargs, gdevice] {
+    Mesh mesh = bench_mesh(gargs->input);
+    std::string device;
+    std::vector<bench::GpuRow> rows = bench::bench_gpu(mesh, gargs->input, gargs->rays, gargs->repeat, *gdevice, &device);
+    std::printf("\n%s, %zu triangles, %zu long rays, device: %s; us per ray, median of %u passes (device: GPU "
+                "timestamps; wall: packing, submission and read-back); leaf 4 as the source's GPU table\n\n"
+                "| method | layout | us/ray device | us/ray wall | walked B/tri | seed (GTX 1050, DX11) | disagreements |\n"
+                "|---|---|---:|---:|---:|---|---:|\n",
+                gargs->input.c_str(), mesh.triangles.size(), gargs->rays, device.c_str(), gargs->repeat);
+    for (const bench::GpuRow& r : rows)
+      std::printf("| %s | %s | %s | %.3f | %.2f | %s | %llu |\n", r.method.c_str(), r.layout.c_str(),
+                  r.device_us > 0 ? std::to_string(r.device_us).substr(0, std::to_string(r.device_us).find('.') + 4).c_str() : "-",
+                  r.wall_us, r.bytes, r.seed.empty() ? "-" : r.seed.c_str(), (unsigned long long)r.disagreements);
+  });
 
   // Issue 4's offset test for the half-float tree.
   auto oargs = std::make_shared<ArgsT>();

@@ -1,0 +1,96 @@
+#include "bench/gpu.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "cpu/agreement.h"
+#include "cpu/encode.h"
+#include "cpu/oracle.h"
+#include "cpu/rays.h"
+#include "cpu/trace.h"
+#include "gpu/method.h"
+#include "layout/blob.h"
+
+namespace meshcast::bench {
+
+namespace {
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Oracle answers over what the blob stores (quantized layouts move vertices).
+uint64_t mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
+                  const std::vector<Hit>& hits, const std::vector<OracleHit>& oracle) {
+  const double tolerance = 1e-5 * mesh.bounds().diagonal();
+  if (!moves_vertices(layout::header_of(blob.data()).triangle_format)) {
+    Agreement a = compare(mesh, rays, hits, oracle, tolerance);
+    return a.wrong + a.t_errors;
+  }
+  Mesh stored = stored_mesh(blob);
+  OracleTree tree(stored);
+  std::vector<OracleHit> answers;
+  for (const Ray& r : rays) answers.push_back(tree.closest(r));
+  Agreement a = compare(stored, rays, hits, answers, tolerance);
+  return a.wrong + a.t_errors;
+}
+
+}  // namespace
+
+std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t count, uint32_t repeat,
+                              const std::string& device, std::string* device_name) {
+  gpu::Context ctx(gpu::DeviceChoice{device, false});
+  *device_name = ctx.device_name();
+  std::vector<Ray> rays = make_rays(mesh, RayKind::Long, count, 1);
+  OracleTree oracle_tree(mesh);
+  std::vector<OracleHit> oracle;
+  for (const Ray& r : rays) oracle.push_back(oracle_tree.closest(r));
+  // Seed 000 §7 (GTX 1050, DirectX 11, bunny, 4 triangles a leaf): us per ray, bytes per triangle.
+  struct Case { const char* method; const char* layout; const char* seed; };
+  const Case cases[] = {{"aabbtree", "AABBTree/Float3", "0.34 us, 53.4 B"},
+                        {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4", ""},
+                        {"skdtree", "SKDTree/Float3", "1.15 us, 41.0 B"},
+                        {"lbvh", "StacklessLBVH/Float3", ""},
+                        {"bruteforce", "BruteForce/Float3SOA128", "41.67 us, 36 B"}};
+  std::vector<GpuRow> rows;
+  for (const Case& c : cases) {
+    BuildOptions o = parse_layout(c.layout);
+    o.leaf_size = 4;  // the source's GPU table
+    std::vector<uint8_t> blob = build_blob(mesh, o, name);
+    std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, c.method, blob, name);
+    std::vector<Hit> hits(rays.size());
+    std::vector<double> device_ms, wall_ms;
+    for (uint32_t r = 0; r < repeat; ++r) {
+      gpu::GpuTiming t;
+      method->trace(rays, hits, &t);
+      device_ms.push_back(t.device_ms), wall_ms.push_back(t.wall_ms);
+    }
+    const layout::BlobHeader& h = layout::header_of(blob.data());
+    GpuRow row{c.method, c.layout, c.seed};
+    row.device_us = median_of(device_ms) * 1000.0 / double(rays.size());
+    row.wall_us = median_of(wall_ms) * 1000.0 / double(rays.size());
+    row.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
+    row.disagreements = mistakes(mesh, blob, rays, hits, oracle);
+    rows.push_back(row);
+  }
+  // The CPU's recommended layout, one thread, as the source's yellow row.
+  std::vector<uint8_t> blob = build_blob(mesh, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), name);
+  BlobView view(blob, name);
+  std::vector<Hit> hits(rays.size());
+  std::vector<double> ms;
+  for (uint32_t r = 0; r < repeat; ++r) {
+    auto t0 = std::chrono::steady_clock::now();
+    view.trace(rays, hits);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  GpuRow cpu{"CPU, one thread", "QuadTreeHalfFloat/Indexed8BitPackSOA4 (leaf 8)", "0.47 us, 18.3 B (its QuadTree)"};
+  cpu.wall_us = median_of(ms) * 1000.0 / double(rays.size());
+  cpu.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
+  cpu.disagreements = mistakes(mesh, blob, rays, hits, oracle);
+  rows.push_back(cpu);
+  return rows;
+}
+
+}  // namespace meshcast::bench

@@ -1,13 +1,18 @@
-// Method 1 of seed 000 §7: BruteForce over Float3SOA128 records. Two
-// dispatches a batch: every (record, ray) workgroup tests 128 triangles and
-// folds its hits into the ray's 64-bit key with one atomic minimum
-// (shaders/bruteforce_soa128.comp), then one thread a ray resolves its key
-// into a hit (shaders/bruteforce_resolve.comp).
+// Method 1 of seed 000 §7: BruteForce over Float3SOA128 or BitPackSOA128
+// records. Two dispatches a batch: every (record, ray) workgroup tests 128
+// triangles and folds its hits into the ray's 64-bit key with one atomic
+// minimum (shaders/bruteforce_test.glsl), then one thread a ray resolves its
+// key into a hit (shaders/bruteforce_resolve.glsl); the two codecs differ
+// only in how a lane's corners load (shaders/soa128_*.glsl).
 #include <algorithm>
 
 #include "gpu/batch.h"
-#include "shaders/bruteforce_resolve.h"
-#include "shaders/bruteforce_soa128.h"
+#include "cpu/mesh.h"
+#include "layout/blob.h"
+#include "shaders/bruteforce_bitpack.h"
+#include "shaders/bruteforce_float3.h"
+#include "shaders/resolve_bitpack.h"
+#include "shaders/resolve_float3.h"
 
 namespace meshcast::gpu {
 
@@ -15,10 +20,12 @@ namespace {
 
 class BruteForceMethod : public BatchMethod {
  public:
-  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name)
-      : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, MC_TRI_FLOAT3SOA128),
-        test_(ctx, bruteforce_soa128_spv, sizeof bruteforce_soa128_spv, 4, sizeof(Push)),
-        resolve_(ctx, bruteforce_resolve_spv, sizeof bruteforce_resolve_spv, 4, sizeof(Push)) {}
+  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack)
+      : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128),
+        test_(ctx, bitpack ? bruteforce_bitpack_spv : bruteforce_float3_spv,
+              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push)),
+        resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push)) {}
 
  protected:
   void bind_all() override {
@@ -43,7 +50,10 @@ class BruteForceMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name) {
-  return std::make_unique<BruteForceMethod>(ctx, blob, name);
+  // The codec the blob holds picks the shaders (BatchMethod refuses others).
+  const bool bitpack = blob.size() >= sizeof(layout::BlobHeader) &&
+                       layout::header_of(blob.data()).triangle_format == MC_TRI_BITPACKSOA128;
+  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack);
 }
 
 }  // namespace meshcast::gpu

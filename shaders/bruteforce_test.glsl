@@ -1,18 +1,13 @@
-// Method 1 of seed 000 §7, BruteForce over Float3SOA128 records: a workgroup
+// Method 1 of seed 000 §7, BruteForce over 128-lane records: a workgroup
 // of 128 threads tests one record (128 triangles) against one ray, each
 // thread one lane, and every hit takes part in one 64-bit atomic minimum a
 // ray over (t bits << 32 | triangle position): non-negative floats order as
 // their bits, so the smallest key is the nearest hit, and equal t goes to
 // the lowest position, the same tie rule for every run.
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+// The including file has defined the record's codec (shaders/soa128_*.glsl).
 #extension GL_EXT_shader_atomic_int64 : require
 
-#include "shaders/blob.glsl"
-#include "shaders/ray.glsl"
 #include "shaders/watertight.glsl"
-#include "shaders/bruteforce.glsl"
 
 layout(local_size_x = 128) in;
 

@@ -1,14 +1,8 @@
 // After the brute-force pass: one thread a ray turns its key into a hit.
 // The winning triangle is tested again (the same arithmetic gives the same
 // answer) for its barycentrics, and its slot goes through the remap.
-#version 460
-#extension GL_GOOGLE_include_directive : require
-#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
-
-#include "shaders/blob.glsl"
-#include "shaders/ray.glsl"
+// The including file has defined the record's codec (shaders/soa128_*.glsl).
 #include "shaders/watertight.glsl"
-#include "shaders/bruteforce.glsl"
 #include "shaders/hits.glsl"
 
 layout(local_size_x = 64) in;

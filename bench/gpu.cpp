@@ -49,9 +49,11 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
   // Seed 000 §7 (GTX 1050, DirectX 11, bunny, 4 triangles a leaf): us per ray, bytes per triangle.
   struct Case { const char* method; const char* layout; const char* seed; };
   const Case cases[] = {{"aabbtree", "AABBTree/Float3", "0.34 us, 53.4 B"},
+                        {"aabbtree", "AABBTree/UncompressedStrip", "0.41 us, 37.1 B"},
                         {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4", ""},
                         {"skdtree", "SKDTree/Float3", "1.15 us, 41.0 B"},
                         {"lbvh", "StacklessLBVH/Float3", ""},
+                        {"bruteforce", "BruteForce/BitPackSOA128", "35.01 us, 24 B"},
                         {"bruteforce", "BruteForce/Float3SOA128", "41.67 us, 36 B"}};
   std::vector<GpuRow> rows;
   for (const Case& c : cases) {

@@ -28,7 +28,7 @@ class Method {
 
 // The methods and the layouts they read so far:
 //   bruteforce  BruteForce/Float3SOA128 or BruteForce/BitPackSOA128
-//   aabbtree    AABBTree/Float3
+//   aabbtree    AABBTree/Float3 or AABBTree/UncompressedStrip
 //   skdtree     SKDTree/Float3               lbvh      StacklessLBVH/Float3
 //   quadtree    QuadTreeHalfFloat/Indexed8BitPackSOA4
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout

@@ -1,9 +1,13 @@
 // The one-ray-a-thread methods of seed 000 §7: a tree walked per thread
 // (a stack of its own, or none for the StacklessLBVH), one dispatch a batch.
 // Each is a shader and the layout it reads; the host side is the same.
+#include <algorithm>
+
 #include "cpu/mesh.h"
+#include "layout/blob.h"
 #include "gpu/batch.h"
 #include "shaders/aabbtree_float3.h"
+#include "shaders/aabbtree_strip.h"
 #include "shaders/lbvh_float3.h"
 #include "shaders/quadtree_i8.h"
 #include "shaders/skdtree_float3.h"
@@ -21,6 +25,7 @@ struct Walker {
 
 const Walker kWalkers[] = {
     {"aabbtree", MC_TREE_AABBTREE, MC_TRI_FLOAT3, aabbtree_float3_spv, sizeof aabbtree_float3_spv},
+    {"aabbtree", MC_TREE_AABBTREE, MC_TRI_UNCOMPRESSEDSTRIP, aabbtree_strip_spv, sizeof aabbtree_strip_spv},
     {"skdtree", MC_TREE_SKDTREE, MC_TRI_FLOAT3, skdtree_float3_spv, sizeof skdtree_float3_spv},
     {"lbvh", MC_TREE_STACKLESSLBVH, MC_TRI_FLOAT3, lbvh_float3_spv, sizeof lbvh_float3_spv},
     {"quadtree", MC_TREE_QUADTREEHALFFLOAT, MC_TRI_INDEXED8BITPACKSOA4, quadtree_i8_spv, sizeof quadtree_i8_spv},
@@ -48,15 +53,27 @@ std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> b
 
 std::vector<std::string> method_names() {
   std::vector<std::string> names{"bruteforce"};
-  for (const Walker& w : kWalkers) names.push_back(w.method);
+  for (const Walker& w : kWalkers)
+    if (std::find(names.begin(), names.end(), w.method) == names.end()) names.push_back(w.method);
   return names;
 }
 
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
                                     const std::string& name) {
   if (method == "bruteforce") return make_bruteforce(ctx, blob, name);
-  for (const Walker& w : kWalkers)
-    if (method == w.method) return std::make_unique<WalkMethod>(ctx, blob, name, w);
+  // A method that reads several triangle formats takes the blob's; the
+  // first listed is the one named when the blob fits none.
+  const Walker* pick = nullptr;
+  const uint32_t format = blob.size() >= sizeof(layout::BlobHeader) ? layout::header_of(blob.data()).triangle_format : 0;
+  for (const Walker& w : kWalkers) {
+    if (method != w.method) continue;
+    if (!pick) pick = &w;
+    if (w.triangles == format) {
+      pick = &w;
+      break;
+    }
+  }
+  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick);
   std::string valid;
   for (const std::string& n : method_names()) valid += " " + n;
   throw InputError("unknown GPU method '" + method + "'; implemented:" + valid);

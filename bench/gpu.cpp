@@ -1,8 +1,8 @@
 #include "bench/gpu.h"
 
 #include <algorithm>
-#include <chrono>
 
+#include "bench/measure.h"
 #include "cpu/agreement.h"
 #include "cpu/encode.h"
 #include "cpu/oracle.h"
@@ -77,20 +77,11 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
     rows.push_back(row);
   }
   // The CPU's recommended layout, one thread, as the source's yellow row.
-  std::vector<uint8_t> blob = build_blob(mesh, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), name);
-  BlobView view(blob, name);
-  std::vector<Hit> hits(rays.size());
-  std::vector<double> ms;
-  for (uint32_t r = 0; r < repeat; ++r) {
-    auto t0 = std::chrono::steady_clock::now();
-    view.trace(rays, hits);
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  const layout::BlobHeader& h = layout::header_of(blob.data());
+  Timing t = measure(mesh, name, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), rays, oracle, repeat);
   GpuRow cpu{"CPU, one thread", "QuadTreeHalfFloat/Indexed8BitPackSOA4 (leaf 8)", "0.47 us, 18.3 B (its QuadTree)"};
-  cpu.wall_us = median_of(ms) * 1000.0 / double(rays.size());
-  cpu.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
-  cpu.disagreements = mistakes(mesh, blob, rays, hits, oracle);
+  cpu.wall_us = t.median_ms * 1000.0 / double(rays.size());
+  cpu.bytes = t.walked_bytes;
+  cpu.disagreements = t.disagreements;
   rows.push_back(cpu);
   return rows;
 }

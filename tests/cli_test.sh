@@ -63,6 +63,10 @@ if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/hv.hits" | awk '{print $2}') \
   echo "FAIL vulkan hits differ from the CPU's"; failures=$((failures + 1))
 fi
 check bench-gpu 0 "\\| lbvh \\| StacklessLBVH/Float3" -- "$meshcast" bench gpu "$mesh" --rays 8 --repeat 1
+check render-cpu 0 "device: CPU" -- "$meshcast" render "$mesh" --png "$work/rc.png" --width 160 --height 120
+check render-vulkan 0 "device: " -- "$meshcast" render "$mesh" --backend vulkan --png "$work/rv.png" --width 160 --height 120
+# The same bytes walked on the GPU give the same picture.
+cmp -s "$work/rc.png" "$work/rv.png" || { echo "FAIL the Vulkan picture differs from the CPU's"; failures=$((failures + 1)); }
 check vulkan-wrong-layout 2 "reads BruteForce/Float3SOA128" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
 check vulkan-no-device 3 "no device matches" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --device nonesuch --rays "$work/r.rays" --out "$work/hx.hits"
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"

@@ -7,6 +7,7 @@
 #include "gpu/method.h"
 #include "tools/commands.h"
 #include "tools/common.h"
+#include "tools/render.h"
 
 namespace meshcast::tools {
 
@@ -79,6 +80,43 @@ void add_trace(CLI::App& app) {
                   device_ms.empty() ? ", one thread" : ", submission to read-back");
       if (!device_ms.empty()) std::printf("device time: %.1f ns/ray (GPU timestamps)\n", device_ns);
     }
+  });
+}
+
+void add_render(CLI::App& app) {
+  struct Args {
+    std::string input, png = "out/render.png", backend = "cpu", method = "quadtree", device;
+    LayoutArgs layout;
+    int width = 800, height = 600;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("render", "a depth-shaded picture of a mesh or blob, one primary ray a pixel");
+  cmd->add_option("input", args->input, "mesh file or blob")->required();
+  add_layout_options(cmd, args->layout);
+  cmd->add_option("--png", args->png, "picture to write");
+  cmd->add_option("--width", args->width)->check(CLI::Range(16, 8192));
+  cmd->add_option("--height", args->height)->check(CLI::Range(16, 8192));
+  cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
+  cmd->add_option("--method", args->method, "GPU method for the blob's layout (see trace --help)");
+  cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
+  cmd->callback([args] {
+    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
+    std::string device = "CPU, one thread";
+    Picture p;
+    if (args->backend == "vulkan") {
+      gpu::Context ctx(gpu::DeviceChoice{args->device, false});
+      device = ctx.device_name();
+      std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input);
+      p = render(in.blob, args->width, args->height, {}, {},
+                 [&](std::span<const Ray> rays, std::span<Hit> hits) { method->trace(rays, hits); });
+    } else {
+      p = render(in.blob, args->width, args->height, {}, {});
+    }
+    write_png(args->png, p.width, p.height, p.rgb);
+    const layout::BlobHeader& h = layout::header_of(in.blob.data());
+    std::printf("%s: %s, device: %s, %dx%d, %.0f ns/ray -> %s\n", args->input.c_str(),
+                layout_name(h.tree_format, h.triangle_format).c_str(), device.c_str(), p.width, p.height, p.ns_per_ray,
+                args->png.c_str());
   });
 }
 

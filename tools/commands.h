@@ -13,6 +13,7 @@ void add_info(CLI::App& app);
 void add_rays(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_bench(CLI::App& app);
+void add_render(CLI::App& app);
 
 // The layout options trace, build and info share: --layout, --leaf,
 // --splitter, --order, --lbvh-depth, --lbvh-left-first.

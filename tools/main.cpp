@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   meshcast::tools::add_rays(app);
   meshcast::tools::add_demo(app);
   meshcast::tools::add_bench(app);
+  meshcast::tools::add_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,7 +11,7 @@
 namespace meshcast::tools {
 
 Picture render(const std::vector<uint8_t>& blob, int width, int height, const std::vector<Ray>& markers,
-               const std::vector<Hit>& marker_hits) {
+               const std::vector<Hit>& marker_hits, const CastFn& cast) {
   const layout::BlobHeader& h = layout::header_of(blob.data());
   float c[3], e[3];
   for (int a = 0; a < 3; ++a) c[a] = 0.5f * (h.bounds_min[a] + h.bounds_max[a]), e[a] = h.bounds_max[a] - h.bounds_min[a];
@@ -29,7 +29,8 @@ Picture render(const std::vector<uint8_t>& blob, int width, int height, const st
   BlobView view(blob, "render");
   std::vector<Hit> hits(rays.size());
   auto t0 = std::chrono::steady_clock::now();
-  view.trace(rays, hits);
+  if (cast) cast(rays, hits);
+  else view.trace(rays, hits);
   Picture p{width, height, std::vector<uint8_t>(rays.size() * 3, 0), ms_since(t0) * 1e6 / double(rays.size())};
   // Depth along the view axis, near = bright.
   float near = INFINITY, far = 0;

@@ -1,6 +1,8 @@
 // A depth-shaded picture of a blob, cast one primary ray a pixel, like the
 // figure of seed 000 §2 (hit points of a ray set marked in green).
 #pragma once
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -14,9 +16,13 @@ struct Picture {
   double ns_per_ray = 0;
 };
 
+// Casts a batch: the CPU walker by default, or a GPU method.
+using CastFn = std::function<void(std::span<const Ray>, std::span<Hit>)>;
+
 // Camera in front of the blob's box (looking down -z, y up, as the public
 // meshes are modelled), perspective, 30 degree vertical field of view.
+// `cast` null: the CPU walker on `blob`.
 Picture render(const std::vector<uint8_t>& blob, int width, int height, const std::vector<Ray>& markers,
-               const std::vector<Hit>& marker_hits);
+               const std::vector<Hit>& marker_hits, const CastFn& cast = nullptr);
 
 }  // namespace meshcast::tools

@@ -20,22 +20,6 @@ double median_of(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Oracle answers over what the blob stores (quantized layouts move vertices).
-uint64_t mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
-                  const std::vector<Hit>& hits, const std::vector<OracleHit>& oracle) {
-  const double tolerance = 1e-5 * mesh.bounds().diagonal();
-  if (!moves_vertices(layout::header_of(blob.data()).triangle_format)) {
-    Agreement a = compare(mesh, rays, hits, oracle, tolerance);
-    return a.wrong + a.t_errors;
-  }
-  Mesh stored = stored_mesh(blob);
-  OracleTree tree(stored);
-  std::vector<OracleHit> answers;
-  for (const Ray& r : rays) answers.push_back(tree.closest(r));
-  Agreement a = compare(stored, rays, hits, answers, tolerance);
-  return a.wrong + a.t_errors;
-}
-
 }  // namespace
 
 std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t count, uint32_t repeat,
@@ -73,7 +57,7 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
     row.device_us = median_of(device_ms) * 1000.0 / double(rays.size());
     row.wall_us = median_of(wall_ms) * 1000.0 / double(rays.size());
     row.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
-    row.disagreements = mistakes(mesh, blob, rays, hits, oracle);
+    row.disagreements = oracle_mistakes(mesh, blob, rays, hits, oracle);
     rows.push_back(row);
   }
   // The CPU's recommended layout, one thread, as the source's yellow row.

@@ -12,6 +12,22 @@ namespace meshcast::bench {
 
 
 
+uint64_t oracle_mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
+                         const std::vector<Hit>& hits, const std::vector<OracleHit>& oracle) {
+  const double tolerance = 1e-5 * mesh.bounds().diagonal();
+  Agreement a;
+  if (moves_vertices(layout::header_of(blob.data()).triangle_format)) {
+    Mesh stored = stored_mesh(blob);
+    OracleTree stored_tree(stored);
+    std::vector<OracleHit> answers(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) answers[i] = stored_tree.closest(rays[i]);
+    a = compare(stored, rays, hits, answers, tolerance);
+  } else {
+    a = compare(mesh, rays, hits, oracle, tolerance);
+  }
+  return a.wrong + a.t_errors;
+}
+
 Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
                const std::vector<OracleHit>& oracle, uint32_t repeat) {
   BuildReport report;
@@ -28,20 +44,9 @@ Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& op
   const layout::BlobHeader& h = layout::header_of(blob.data());
   // Bytes of the triangle encoding: its blocks and its shared vertices.
   double bytes = double(h.tree_size - h.node_bytes + h.vertex_size) / h.triangle_count;
-  // Formats that move vertices are judged on the triangles they store.
-  double tolerance = 1e-5 * mesh.bounds().diagonal();
-  Agreement a;
-  if (moves_vertices(h.triangle_format)) {
-    Mesh stored = stored_mesh(blob);
-    OracleTree stored_tree(stored);
-    std::vector<OracleHit> answers(rays.size());
-    for (size_t i = 0; i < rays.size(); ++i) answers[i] = stored_tree.closest(rays[i]);
-    a = compare(stored, rays, hits, answers, tolerance);
-  } else {
-    a = compare(mesh, rays, hits, oracle, tolerance);
-  }
+  const uint64_t disagreements = oracle_mistakes(mesh, blob, rays, hits, oracle);
   double tree_bytes = double(h.node_bytes) / h.triangle_count, walked = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
-  Timing t{ms.front(), ms[ms.size() / 2], bytes, a.wrong + a.t_errors, report.build_ms, tree_bytes, walked, report.sah_cost};
+  Timing t{ms.front(), ms[ms.size() / 2], bytes, disagreements, report.build_ms, tree_bytes, walked, report.sah_cost};
   if (h.tree_format == MC_TREE_STACKLESSLBVH) {
     uint64_t holes = 0;
     for (uint32_t n = 1; n <= h.node_count; ++n) holes += layout::load_lbvh_node(blob.data() + h.tree_offset, n).count == 0;

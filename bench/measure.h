@@ -20,6 +20,11 @@ struct Timing {
   double hole_bytes = 0;     // StacklessLBVH: node slots no walk reaches, per triangle
 };
 
+// Rays whose triangle or t differ from the oracle's (`oracle`: over the
+// input mesh); formats that move vertices are judged on the mesh they store.
+uint64_t oracle_mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
+                         const std::vector<Hit>& hits, const std::vector<OracleHit>& oracle);
+
 Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
                const std::vector<OracleHit>& oracle, uint32_t repeat);
 

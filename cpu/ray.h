@@ -86,19 +86,27 @@ struct RayPre {
 inline float max_keep(float a, float b) { return a > b ? a : b; }
 inline float min_keep(float a, float b) { return a < b ? a : b; }
 
-// Scalar box test; returns the entry distance, or +inf for a miss.
-inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
-  float tn = 0.0f, tf = INFINITY;
+// The ray's interval [tn, tf] inside the box, before the closest-hit cut.
+inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], float* tn, float* tf) {
+  *tn = 0.0f, *tf = INFINITY;
   for (int a = 0; a < 3; ++a) {
     float nearp = r.near_is_max[a] ? mx[a] : mn[a];
     float farp = r.near_is_max[a] ? mn[a] : mx[a];
-    tn = max_keep((nearp - r.org[a]) * r.inv[a], tn);
-    tf = min_keep((farp - r.org[a]) * r.inv[a], tf);
+    *tn = max_keep((nearp - r.org[a]) * r.inv[a], *tn);
+    *tf = min_keep((farp - r.org[a]) * r.inv[a], *tf);
   }
-  // The cut-off at the closest hit is widened too, so a box whose entry
-  // rounds a few ulps past a hit it may still improve on is not dropped.
-  tf = min_keep(tf, closest) * kFarScale;
-  return tn <= tf ? tn : INFINITY;
+}
+
+// Whether [tn, tf] is open before the closest hit. The cut-off is widened
+// too, so a box whose entry rounds a few ulps past a hit it may still
+// improve on is not dropped.
+inline bool interval_open(float tn, float tf, float closest) { return tn <= min_keep(tf, closest) * kFarScale; }
+
+// Scalar box test; returns the entry distance, or +inf for a miss.
+inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
+  float tn, tf;
+  box_interval(r, mn, mx, &tn, &tf);
+  return interval_open(tn, tf, closest) ? tn : INFINITY;
 }
 
 // Four boxes at once; `nearp[a]`/`farp[a]` are the near and far planes of axis a.

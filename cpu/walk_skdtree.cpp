@@ -20,15 +20,10 @@ void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uin
     struct Entry { uint32_t at; float tnear, tfar; };
     Entry stack[MC_MAX_DEPTH + 2];
     int top = -1;
-    float tn = 0.0f, tf = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-      float nearp = r.near_is_max[a] ? h.bounds_max[a] : h.bounds_min[a];
-      float farp = r.near_is_max[a] ? h.bounds_min[a] : h.bounds_max[a];
-      tn = max_keep((nearp - r.org[a]) * r.inv[a], tn);
-      tf = min_keep((farp - r.org[a]) * r.inv[a], tf);
-    }
+    float tn, tf;
+    box_interval(r, h.bounds_min, h.bounds_max, &tn, &tf);
     uint32_t at = 0;
-    auto open = [&](float lo, float hi) { return lo <= min_keep(hi, c.t) * kFarScale; };
+    auto open = [&](float lo, float hi) { return interval_open(lo, hi, c.t); };
     if (!open(tn, tf)) return;
     for (;;) {
       const uint32_t properties = layout::load<uint32_t>(tree + at);

@@ -40,8 +40,7 @@ void test_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closest c) {
     const uint a = flag & 3u, b = (a + 1u + ((flag >> 2) & 1u)) % 3u;
     const vec3 A = p[a], B = p[b];
     p[0] = A, p[1] = B, p[2] = v;
-    float t, u, w;
-    if (watertight(r, p[0], p[1], p[2], c.t, t, u, w) && t <= c.t) c = Closest(t, slot0 + made, u, w);
+    consider(r, p[0], p[1], p[2], slot0 + made, c);
     ++made;
   }
 }

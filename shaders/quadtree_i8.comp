@@ -50,8 +50,7 @@ void test_i8_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closest c)
     const vec3 a = i8_vertex(block, i8_index(block, i, 0u));
     const vec3 b = i8_vertex(block, i8_index(block, i, 1u));
     const vec3 d = i8_vertex(block, i8_index(block, i, 2u));
-    float t, u, v;
-    if (watertight(r, a, b, d, c.t, t, u, v) && t <= c.t) c = Closest(t, slot0 + i, u, v);
+    consider(r, a, b, d, slot0 + i, c);
   }
 }
 

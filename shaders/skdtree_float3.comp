@@ -15,27 +15,19 @@ layout(local_size_x = 64) in;
 
 layout(push_constant) uniform Push { uint ray_base, ray_count, records; } pc;
 
-bool open_interval(float lo, float hi, float closest) {
-  precise float limit = min_keep(hi, closest) * kFarScale;
-  return lo <= limit;
-}
-
 void main() {
   const uint ray = gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
   Closest c = Closest(r.tmax, MC_NO_HIT, 0.0, 0.0);
   const uint tree = header(MC_HDR_TREE_OFFSET);
-  float tn = 0.0, tf = kInfinity;
-  for (int a = 0; a < 3; ++a) {
-    const float lo = uintBitsToFloat(header(MC_HDR_BOUNDS_MIN + uint(a)));
-    const float hi = uintBitsToFloat(header(MC_HDR_BOUNDS_MAX + uint(a)));
-    const bool neg = sign_bit(r.dir[a]);
-    precise float dn = ((neg ? hi : lo) - r.org[a]) * r.inv[a];
-    precise float df = ((neg ? lo : hi) - r.org[a]) * r.inv[a];
-    tn = max_keep(dn, tn), tf = min_keep(df, tf);
-  }
-  if (r.walkable && open_interval(tn, tf, c.t)) {
+  float tn, tf;
+  box_interval(r, vec3(uintBitsToFloat(header(MC_HDR_BOUNDS_MIN)), uintBitsToFloat(header(MC_HDR_BOUNDS_MIN + 1u)),
+                       uintBitsToFloat(header(MC_HDR_BOUNDS_MIN + 2u))),
+               vec3(uintBitsToFloat(header(MC_HDR_BOUNDS_MAX)), uintBitsToFloat(header(MC_HDR_BOUNDS_MAX + 1u)),
+                    uintBitsToFloat(header(MC_HDR_BOUNDS_MAX + 2u))),
+               tn, tf);
+  if (r.walkable && interval_open(tn, tf, c.t)) {
     uint stack_node[MC_MAX_DEPTH + 2u];
     float stack_near[MC_MAX_DEPTH + 2u], stack_far[MC_MAX_DEPTH + 2u];
     int top = -1;
@@ -50,7 +42,7 @@ void main() {
         float ln = tn, lf = tf, rn = tn, rf = tf;
         if (sign_bit(r.dir[axis])) ln = max_keep(tl, tn), rf = min_keep(tr, tf);
         else lf = min_keep(tl, tf), rn = max_keep(tr, tn);
-        const bool lhit = open_interval(ln, lf, c.t), rhit = open_interval(rn, rf, c.t);
+        const bool lhit = interval_open(ln, lf, c.t), rhit = interval_open(rn, rf, c.t);
         if (lhit || rhit) {
           const bool left_first = lhit && (!rhit || ln < rn);
           if (lhit && rhit) {
@@ -66,7 +58,7 @@ void main() {
         const uint block = at + MC_SKD_LEAF_BYTES;
         test_float3_leaf(r, tree + block, props & MC_SKD_VALUE_MASK, slot_of(block), c);
       }
-      while (top >= 0 && !open_interval(stack_near[top], stack_far[top], c.t)) --top;
+      while (top >= 0 && !interval_open(stack_near[top], stack_far[top], c.t)) --top;
       if (top < 0) break;
       at = stack_node[top], tn = stack_near[top], tf = stack_far[top];
       --top;

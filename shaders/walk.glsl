@@ -21,19 +21,36 @@ struct Closest {
   float u, v;
 };
 
-// Entry distance of the box, or +inf for a miss (box_test of cpu/ray.h).
-float box_test(GpuRay r, vec3 mn, vec3 mx, float closest) {
-  float tn = 0.0, tf = uintBitsToFloat(0x7F800000u);
+// The ray's interval [tn, tf] inside the box, each end one rounding of
+// (plane - origin) * 1/d (the slabs of box_interval in cpu/ray.h).
+void box_interval(GpuRay r, vec3 mn, vec3 mx, out float tn, out float tf) {
+  tn = 0.0, tf = kInfinity;
   for (int a = 0; a < 3; ++a) {
     const bool neg = sign_bit(r.dir[a]);
-    const float nearp = neg ? mx[a] : mn[a], farp = neg ? mn[a] : mx[a];
-    precise float dn = (nearp - r.org[a]) * r.inv[a];
-    precise float df = (farp - r.org[a]) * r.inv[a];
+    precise float dn = ((neg ? mx[a] : mn[a]) - r.org[a]) * r.inv[a];
+    precise float df = ((neg ? mn[a] : mx[a]) - r.org[a]) * r.inv[a];
     tn = max_keep(dn, tn);
     tf = min_keep(df, tf);
   }
-  precise float limit = min_keep(tf, closest) * kFarScale;
-  return tn <= limit ? tn : uintBitsToFloat(0x7F800000u);
+}
+
+// Whether [lo, hi] is open before the closest hit, the far end widened.
+bool interval_open(float lo, float hi, float closest) {
+  precise float limit = min_keep(hi, closest) * kFarScale;
+  return lo <= limit;
+}
+
+// Entry distance of the box, or +inf for a miss (box_test of cpu/ray.h).
+float box_test(GpuRay r, vec3 mn, vec3 mx, float closest) {
+  float tn, tf;
+  box_interval(r, mn, mx, tn, tf);
+  return interval_open(tn, tf, closest) ? tn : kInfinity;
+}
+
+// The triangle (a, b, d) of slot `slot` becomes the closest hit if it is one.
+void consider(GpuRay r, vec3 a, vec3 b, vec3 d, uint slot, inout Closest c) {
+  float t, u, v;
+  if (watertight(r, a, b, d, c.t, t, u, v) && t <= c.t) c = Closest(t, slot, u, v);
 }
 
 // `count` Float3 triangles (9 floats each) at blob offset `block`, slots
@@ -44,8 +61,7 @@ void test_float3_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closes
     const vec3 a = vec3(blob_f32(p), blob_f32(p + 4u), blob_f32(p + 8u));
     const vec3 b = vec3(blob_f32(p + 12u), blob_f32(p + 16u), blob_f32(p + 20u));
     const vec3 d = vec3(blob_f32(p + 24u), blob_f32(p + 28u), blob_f32(p + 32u));
-    float t, u, v;
-    if (watertight(r, a, b, d, c.t, t, u, v) && t <= c.t) c = Closest(t, slot0 + i, u, v);
+    consider(r, a, b, d, slot0 + i, c);
   }
 }
 

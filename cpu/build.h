@@ -61,6 +61,23 @@ Splitter parse_splitter(const std::string& name);
 const char* splitter_name(Splitter s);
 std::vector<Splitter> all_splitters();
 
+// The triangles (by their box centres) in Morton order, one scale for all
+// axes: the order the Morton splitter cuts.
+std::vector<uint32_t> morton_sorted(const std::vector<Vec3>& centres);
+
+// AABBList batches (seed 000 §7): how triangles are grouped into batches of
+// MC_LIST_BATCH, each batch later one box.
+//   ClosestCentroid  the seed's greedy: the unused triangle with the lowest
+//                    centre x and the batch - 1 unused triangles whose
+//                    centres lie nearest to its centre
+//   Morton           consecutive runs of the Morton order
+enum class Grouping { ClosestCentroid, Morton };
+// The triangle order, batch after batch (every batch full but the last).
+std::vector<uint32_t> group_batches(const std::vector<Box3>& boxes, uint32_t batch, Grouping grouping);
+Grouping parse_grouping(const std::string& name);
+const char* grouping_name(Grouping g);
+std::vector<Grouping> all_groupings();
+
 // One splitter step (see build_topdown.h for the contract).
 struct BinningSplit {
   const std::vector<Box3>& boxes;

@@ -158,6 +158,8 @@ BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t
   return build_binning(boxes, leaf_size, depth_limit);
 }
 
+std::vector<uint32_t> morton_sorted(const std::vector<Vec3>& centres) { return morton_order(morton_codes(centres)); }
+
 std::vector<Splitter> all_splitters() {
   return {Splitter::Binning, Splitter::LongestAxis, Splitter::Mean, Splitter::Morton, Splitter::FixedLeafSize};
 }

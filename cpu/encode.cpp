@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <numeric>
 #include <unordered_map>
 
 #include "cpu/build.h"
@@ -126,22 +127,37 @@ uint32_t snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& cor
   return largest;
 }
 
-// BruteForce: no tree. The "tree" is node 0 (the whole mesh) followed by one
-// leaf a chunk of brute_chunk() triangles in input order; each becomes a
-// record [count][block].
-BuildTree chunk_tree(const std::vector<Box3>& boxes, uint32_t chunk) {
+// BruteForce and AABBList: no tree. The "tree" is node 0 (the whole mesh)
+// followed by one leaf a chunk of `chunk` triangles of `order` (BruteForce:
+// input order; AABBList: batch after batch, and `chunk` divides the batch);
+// each becomes a record [count][block].
+BuildTree chunk_tree(const std::vector<Box3>& boxes, std::vector<uint32_t> order, uint32_t chunk) {
   BuildTree t;
-  t.order.resize(boxes.size());
+  t.order = std::move(order);
   t.nodes.emplace_back();
-  for (uint32_t i = 0; i < boxes.size(); ++i) t.order[i] = i, t.nodes[0].box.grow(boxes[i]);
-  for (uint32_t first = 0; first < boxes.size(); first += chunk) {
+  for (uint32_t i : t.order) t.nodes[0].box.grow(boxes[i]);
+  for (uint32_t first = 0; first < t.order.size(); first += chunk) {
     BuildNode leaf;
     leaf.first = first;
-    leaf.count = std::min<uint32_t>(chunk, uint32_t(boxes.size()) - first);
-    for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(boxes[i]);
+    leaf.count = std::min<uint32_t>(chunk, uint32_t(t.order.size()) - first);
+    for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(boxes[t.order[i]]);
     t.nodes.push_back(leaf);
   }
   return t;
+}
+
+BuildTree build_for(const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec, uint32_t depth_limit) {
+  const uint32_t chunk = layout::brute_chunk(codec.lanes);
+  if (o.tree_format == MC_TREE_BRUTEFORCE) {
+    std::vector<uint32_t> input(boxes.size());
+    std::iota(input.begin(), input.end(), 0u);
+    return chunk_tree(boxes, std::move(input), chunk);
+  }
+  if (o.tree_format == MC_TREE_AABBLIST) {
+    static_assert(MC_LIST_BATCH % MC_BRUTE_CHUNK == 0 && MC_LIST_BATCH % 128 == 0, "records must tile a batch");
+    return chunk_tree(boxes, group_batches(boxes, MC_LIST_BATCH, o.grouping), chunk);
+  }
+  return build_tree(boxes, o.splitter, o.leaf_size, depth_limit);
 }
 
 }  // namespace
@@ -156,6 +172,7 @@ std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
     case MC_TREE_STACKLESSLBVH: return make_lbvh_writer(o.lbvh_near_first);
     case MC_TREE_QUADTREE: return make_quad_writer(false, o.node_order);
     case MC_TREE_QUADTREEHALFFLOAT: return make_quad_writer(true, o.node_order);
+    case MC_TREE_AABBLIST: return make_aabblist_writer();
   }
   return make_bruteforce_writer();
 }
@@ -168,6 +185,7 @@ std::string node_order_refusal(uint32_t tree, NodeOrder order) {
   if (tree == MC_TREE_AABBTREEPNS) fixed = NodeOrder::DepthFirstTrianglesLast, why = "it addresses nodes by depth-first index";
   if (tree == MC_TREE_STACKLESSLBVH) fixed = NodeOrder::BreadthFirstTrianglesLast, why = "its nodes are a heap";
   if (tree == MC_TREE_BRUTEFORCE) return "BruteForce has no tree, so no node order";
+  if (tree == MC_TREE_AABBLIST) return "AABBList is a list of batches, so no node order";
   if (order == fixed) return "";
   return std::string(layout::tree_format_name(tree)) + " is always " + node_order_name(fixed) + ": " + why +
          " (seed 000 4.3 orders apply where a format allows them)";
@@ -255,8 +273,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   }
   BuildTree tree;
   try {
-    tree = o.tree_format == MC_TREE_BRUTEFORCE ? chunk_tree(boxes, layout::brute_chunk(codec.lanes))
-                                               : build_tree(boxes, o.splitter, o.leaf_size, depth_limit);
+    tree = build_for(o, boxes, codec, depth_limit);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(o.tree_format)) + ": " + e.what());
   }

@@ -33,6 +33,7 @@ struct BuildOptions {
   uint32_t lbvh_depth = 0;
   bool lbvh_near_first = true;
   NodeOrder node_order = NodeOrder::Default;
+  Grouping grouping = Grouping::ClosestCentroid;  // AABBList's batches (seed 000 §7)
 };
 
 struct BuildReport {

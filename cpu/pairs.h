@@ -13,4 +13,5 @@
   X(StacklessLBVH, MC_TREE_STACKLESSLBVH)             \
   X(QuadTree, MC_TREE_QUADTREE)                       \
   X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT)     \
-  X(BruteForce, MC_TREE_BRUTEFORCE)
+  X(BruteForce, MC_TREE_BRUTEFORCE)                   \
+  X(AABBList, MC_TREE_AABBLIST)

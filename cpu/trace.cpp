@@ -28,6 +28,7 @@ constexpr WalkFn walker_for(uint32_t tree) {
     case MC_TREE_AABBTREECOMPRESSED: return &walk_aabbtree_compressed<Codec>;
     case MC_TREE_SKDTREE: return &walk_skdtree<Codec>;
     case MC_TREE_STACKLESSLBVH: return &walk_lbvh<Codec>;
+    case MC_TREE_AABBLIST: return &walk_aabblist<Codec>;
   }
   return nullptr;
 }

@@ -34,6 +34,9 @@ template <class Codec>
 void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
 
 template <class Codec>
+void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+
+template <class Codec>
 void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
 
 // Turns the closest slot into the caller's hit.

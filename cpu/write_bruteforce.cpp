@@ -9,15 +9,9 @@ namespace {
 
 class BruteWriter : public TreeWriter {
  public:
-  void plan(Writer& w) override { write_bruteforce(w); }
-  void fill(Writer& w) override { fill_bruteforce(w); }
-  uint32_t depth(const BuildTree&) const override { return 0; }
-
- private:
-  static void write_bruteforce(Writer& w) {
+  void plan(Writer& w) override {
     uint64_t size = 0;
-    for (size_t n = 1; n < w.tree.nodes.size(); ++n)
-      size += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
+    for (uint32_t n = 1; n < w.tree.nodes.size(); ++n) size += w.record_bytes(n);
     if (size > 0x7FFFFFFFu) throw InputError("the BruteForce section of " + std::to_string(size) + " bytes exceeds 2 GiB");
     w.h.tree_size = uint32_t(size);
     w.h.node_count = uint32_t(w.tree.nodes.size() - 1);
@@ -26,18 +20,17 @@ class BruteWriter : public TreeWriter {
     w.h.root = 0;
   }
 
-  static void fill_bruteforce(Writer& w) {
+  void fill(Writer& w) override {
     uint32_t at = 0;
     Box3 all;
-    for (size_t n = 1; n < w.tree.nodes.size(); ++n) {
-      const BuildNode& leaf = w.tree.nodes[n];
-      std::memcpy(w.bytes.data() + w.h.tree_offset + at, &leaf.count, 4);
-      w.write_leaf(uint32_t(n), at + MC_BRUTE_RECORD_BYTES);
-      all.grow(leaf.box);
-      at += MC_BRUTE_RECORD_BYTES + w.leaf_bytes[n];
+    for (uint32_t n = 1; n < w.tree.nodes.size(); ++n) {
+      at = w.write_record(n, at);
+      all.grow(w.tree.nodes[n].box);
     }
     w.frame(all);
   }
+
+  uint32_t depth(const BuildTree&) const override { return 0; }
 };
 
 }  // namespace

@@ -83,6 +83,15 @@ struct Writer {
     }
   }
 
+  // A BruteForce record [count][block] for leaf n at tree-section offset
+  // `at` (BruteForce, AABBList); returns the offset after it.
+  uint32_t record_bytes(uint32_t n) const { return MC_BRUTE_RECORD_BYTES + leaf_bytes[n]; }
+  uint32_t write_record(uint32_t n, uint32_t at) {
+    std::memcpy(bytes.data() + h.tree_offset + at, &tree.nodes[n].count, 4);
+    write_leaf(n, at + MC_BRUTE_RECORD_BYTES);
+    return at + record_bytes(n);
+  }
+
   // Interior boxes from the refitted leaves (children follow their parent
   // in the builder's node order), then the header's frame from the root.
   void refit() {
@@ -140,6 +149,7 @@ std::unique_ptr<TreeWriter> make_aabb_writer(bool split_axis);  // AABBTree (§5
 std::unique_ptr<TreeWriter> make_pns_writer();                  // AABBTreePNS (§5.3, seed 002)
 std::unique_ptr<TreeWriter> make_quad_writer(bool half, NodeOrder order);  // §5.6-5.7 in a §4.3 order
 std::unique_ptr<TreeWriter> make_bruteforce_writer();           // §3.11
+std::unique_ptr<TreeWriter> make_aabblist_writer();             // §7, method 2
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);  // the one for options.tree_format
 
 std::unique_ptr<TreeWriter> make_compressed_writer();  // AABBTreeCompressed (§5.4)

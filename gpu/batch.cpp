@@ -11,6 +11,10 @@
 
 namespace meshcast::gpu {
 
+uint32_t blob_triangle_format(std::span<const uint8_t> blob) {
+  return blob.size() >= sizeof(layout::BlobHeader) ? layout::header_of(blob.data()).triangle_format : 0;
+}
+
 BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
                          uint32_t tree, uint32_t triangles)
     : ctx_(ctx) {

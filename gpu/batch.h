@@ -17,6 +17,10 @@ struct Push {
   uint32_t ray_base, ray_count, records;
 };
 
+// The blob's triangle format (0 for a buffer too short to say): a method
+// that reads several picks its shaders by it, BatchMethod refuses the rest.
+uint32_t blob_triangle_format(std::span<const uint8_t> blob);
+
 class BatchMethod : public Method {
  public:
   // Validates the blob and requires its layout to be `tree`/`triangles`

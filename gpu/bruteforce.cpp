@@ -51,8 +51,7 @@ class BruteForceMethod : public BatchMethod {
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name) {
   // The codec the blob holds picks the shaders (BatchMethod refuses others).
-  const bool bitpack = blob.size() >= sizeof(layout::BlobHeader) &&
-                       layout::header_of(blob.data()).triangle_format == MC_TRI_BITPACKSOA128;
+  const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
   return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack);
 }
 

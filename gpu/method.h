@@ -28,6 +28,7 @@ class Method {
 
 // The methods and the layouts they read so far:
 //   bruteforce  BruteForce/Float3SOA128 or BruteForce/BitPackSOA128
+//   aabblist    AABBList/Float3SOA128 or AABBList/BitPackSOA128
 //   aabbtree    AABBTree/Float3 or AABBTree/UncompressedStrip
 //   skdtree     SKDTree/Float3               lbvh      StacklessLBVH/Float3
 //   quadtree    QuadTreeHalfFloat/Indexed8BitPackSOA4

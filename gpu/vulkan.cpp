@@ -197,12 +197,13 @@ uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const
   throw GpuError("Vulkan: " + name_ + " has no host-visible coherent memory for storage buffers");
 }
 
-Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what) : ctx_(ctx), size_(std::max<uint64_t>(bytes, 4)) {
+Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage)
+    : ctx_(ctx), size_(std::max<uint64_t>(bytes, 4)) {
   if (size_ > ctx.limits().maxStorageBufferRange)
     throw GpuError("Vulkan: the " + what + " of " + std::to_string(size_) + " bytes exceeds " + ctx.device_name() +
                    "'s maxStorageBufferRange (" + std::to_string(ctx.limits().maxStorageBufferRange) + " bytes)");
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  bci.size = size_, bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  bci.size = size_, bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | usage, bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   check(vkCreateBuffer(ctx.device(), &bci, nullptr, &buffer_), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
@@ -275,19 +276,36 @@ void Pipeline::bind(const std::vector<const Buffer*>& buffers) {
   vkUpdateDescriptorSets(ctx_.device(), bindings_, writes.data(), 0, nullptr);
 }
 
-void Pipeline::dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
+void Pipeline::bind_for(VkCommandBuffer cb, const void* push) const {
   vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
   if (push_bytes_) vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
+}
+
+void Pipeline::dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
+  bind_for(cb, push);
   vkCmdDispatch(cb, x, y, z);
 }
 
-void compute_barrier(VkCommandBuffer cb) {
+void Pipeline::dispatch_indirect(VkCommandBuffer cb, const void* push, const Buffer& args, uint64_t offset) const {
+  bind_for(cb, push);
+  vkCmdDispatchIndirect(cb, args.handle(), offset);
+}
+
+static void barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access) {
   VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT;
-  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0,
-                       nullptr, 0, nullptr);
+  mb.dstAccessMask = dst_access;
+  vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dst_stages, 0, 1, &mb, 0, nullptr, 0, nullptr);
+}
+
+void compute_barrier(VkCommandBuffer cb) {
+  barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+void indirect_barrier(VkCommandBuffer cb) {
+  barrier(cb, VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 }  // namespace meshcast::gpu

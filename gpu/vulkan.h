@@ -76,10 +76,11 @@ class Context {
   bool timestamps_ = false;
 };
 
-// A host-visible storage buffer (coherent, mapped for its whole life).
+// A host-visible storage buffer (coherent, mapped for its whole life);
+// `usage` adds to STORAGE_BUFFER (INDIRECT_BUFFER for dispatch arguments).
 class Buffer {
  public:
-  Buffer(Context& ctx, uint64_t bytes, const std::string& what);
+  Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage = 0);
   ~Buffer();
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
@@ -106,8 +107,11 @@ class Pipeline {
   // Points binding i at buffers[i] (whole buffer).
   void bind(const std::vector<const Buffer*>& buffers);
   void dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const;
+  // The workgroup counts from a VkDispatchIndirectCommand at `offset` of `args`.
+  void dispatch_indirect(VkCommandBuffer cb, const void* push, const Buffer& args, uint64_t offset) const;
 
  private:
+  void bind_for(VkCommandBuffer cb, const void* push) const;
   Context& ctx_;
   uint32_t bindings_, push_bytes_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
@@ -119,6 +123,8 @@ class Pipeline {
 
 // A barrier that makes compute-shader writes visible to the next dispatch.
 void compute_barrier(VkCommandBuffer cb);
+// The same, and visible as the arguments of the next indirect dispatch.
+void indirect_barrier(VkCommandBuffer cb);
 
 // Throws GpuError naming `what` when r is not VK_SUCCESS.
 void check(VkResult r, const char* what);

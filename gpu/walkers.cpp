@@ -50,9 +50,10 @@ class WalkMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name);
+std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name);
 
 std::vector<std::string> method_names() {
-  std::vector<std::string> names{"bruteforce"};
+  std::vector<std::string> names{"bruteforce", "aabblist"};
   for (const Walker& w : kWalkers)
     if (std::find(names.begin(), names.end(), w.method) == names.end()) names.push_back(w.method);
   return names;
@@ -61,10 +62,11 @@ std::vector<std::string> method_names() {
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
                                     const std::string& name) {
   if (method == "bruteforce") return make_bruteforce(ctx, blob, name);
+  if (method == "aabblist") return make_aabblist(ctx, blob, name);
   // A method that reads several triangle formats takes the blob's; the
   // first listed is the one named when the blob fits none.
   const Walker* pick = nullptr;
-  const uint32_t format = blob.size() >= sizeof(layout::BlobHeader) ? layout::header_of(blob.data()).triangle_format : 0;
+  const uint32_t format = blob_triangle_format(blob);
   for (const Walker& w : kWalkers) {
     if (method != w.method) continue;
     if (!pick) pick = &w;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "layout/aabblist.h"
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
 #include "layout/compressed.h"
@@ -48,6 +49,7 @@ std::string_view tree_format_name(uint32_t f) {
     case MC_TREE_AABBTREECOMPRESSED: return "AABBTreeCompressed";
     case MC_TREE_SKDTREE: return "SKDTree";
     case MC_TREE_STACKLESSLBVH: return "StacklessLBVH";
+    case MC_TREE_AABBLIST: return "AABBList";
   }
   return "";
 }
@@ -281,20 +283,57 @@ std::string walk_lbvh(const uint8_t* blob, const BlobHeader& h, uint64_t* triang
   });
 }
 
+// BruteForce records from tree-section offset *at up to `end`: each a
+// valid leaf of at most brute_chunk() triangles, the last ending at `end`.
+template <class Codec>
+std::string check_records(const uint8_t* blob, const BlobHeader& h, uint64_t* at, uint64_t end, uint64_t* triangles,
+                          uint64_t* records) {
+  while (*at < end) {
+    if (*at + MC_BRUTE_RECORD_BYTES > end) return "record at tree offset " + num(*at) + " is cut short";
+    uint32_t count = load<uint32_t>(blob + h.tree_offset + *at);
+    std::string e = check_leaf<Codec>(blob, h, uint32_t(*at + MC_BRUTE_RECORD_BYTES), count, brute_chunk(Codec::kLanes));
+    if (!e.empty()) return e;
+    *triangles += count;
+    *at += MC_BRUTE_RECORD_BYTES + stored_bytes<Codec>(blob, h.tree_offset + uint32_t(*at) + MC_BRUTE_RECORD_BYTES, count, ~0ull);
+    ++*records;
+  }
+  if (*at != end) return "record ending at tree offset " + num(*at) + " runs past " + num(end);
+  return "";
+}
+
 // BruteForce: the records must tile the tree section exactly.
 template <class Codec>
 std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   uint64_t at = 0, records = 0;
-  while (at < h.tree_size) {
-    if (at + MC_BRUTE_RECORD_BYTES > h.tree_size) return "BruteForce record at " + num(at) + " is cut short";
-    uint32_t count = load<uint32_t>(blob + h.tree_offset + at);
-    std::string e = check_leaf<Codec>(blob, h, uint32_t(at + MC_BRUTE_RECORD_BYTES), count, brute_chunk(Codec::kLanes));
-    if (!e.empty()) return e;
-    *triangles += count;
-    at += MC_BRUTE_RECORD_BYTES + stored_bytes<Codec>(blob, h.tree_offset + uint32_t(at) + MC_BRUTE_RECORD_BYTES, count, ~0ull);
-    ++records;
-  }
+  if (std::string e = check_records<Codec>(blob, h, &at, h.tree_size, triangles, &records); !e.empty()) return e;
   if (records != h.node_count) return "BruteForce holds " + num(records) + " records, the header says " + num(h.node_count);
+  return "";
+}
+
+// AABBList: the entries, then the batches' records tiling the rest of the
+// section in batch order, each batch's records holding its count, and every
+// batch but the last full (the shaders find records by arithmetic).
+template <class Codec>
+std::string walk_aabblist(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  const uint8_t* tree = blob + h.tree_offset;
+  if (h.node_count == 0 || h.triangle_base != uint64_t(h.node_count) * MC_LIST_ENTRY_BYTES)
+    return "AABBList of " + num(h.node_count) + " batches does not start its records at tree offset " +
+           num(uint64_t(h.node_count) * MC_LIST_ENTRY_BYTES);
+  uint64_t at = h.triangle_base, records = 0;
+  for (uint32_t b = 0; b < h.node_count; ++b) {
+    const ListEntry e = load_list_entry(tree, b);
+    const std::string batch = "AABBList batch " + num(b);
+    if (e.records != at) return batch + " starts at tree offset " + num(e.records) + ", not " + num(at);
+    if (e.count == 0 || e.count > MC_LIST_BATCH || (b + 1 < h.node_count && e.count != MC_LIST_BATCH))
+      return batch + " holds " + num(e.count) + " triangles (" + num(MC_LIST_BATCH) + " each, the last 1.." +
+             num(MC_LIST_BATCH) + ")";
+    const uint32_t end = list_records_end(tree, h, b);
+    if (end < at || end > h.tree_size) return batch + "'s records end at " + num(end) + ", outside the tree section";
+    uint64_t held = 0;
+    if (std::string why = check_records<Codec>(blob, h, &at, end, &held, &records); !why.empty()) return why;
+    if (held != e.count) return batch + "'s records hold " + num(held) + " triangles, its entry says " + num(e.count);
+    *triangles += held;
+  }
   return "";
 }
 
@@ -302,6 +341,7 @@ template <class Codec>
 std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   switch (h.tree_format) {
     case MC_TREE_BRUTEFORCE: return walk_bruteforce<Codec>(blob, h, triangles);
+    case MC_TREE_AABBLIST: return walk_aabblist<Codec>(blob, h, triangles);
     case MC_TREE_AABBTREEPNS: return walk_pns<Codec>(blob, h, triangles);
     case MC_TREE_AABBTREECOMPRESSED: return walk_compressed<Codec>(blob, h, triangles);
     case MC_TREE_SKDTREE: return walk_skd<Codec>(blob, h, triangles);
@@ -356,6 +396,7 @@ std::string validate(std::span<const uint8_t> blob) {
     case MC_TREE_STACKLESSLBVH: node_size = MC_LBVH_NODE_BYTES; break;
     case MC_TREE_QUADTREE: node_size = MC_QUAD_NODE_BYTES; break;
     case MC_TREE_QUADTREEHALFFLOAT: node_size = MC_QUADHALF_NODE_BYTES; break;
+    case MC_TREE_AABBLIST: node_size = MC_LIST_ENTRY_BYTES; break;
     default: node_size = MC_BRUTE_RECORD_BYTES;
   }
   if (uint64_t(h.node_count) * node_size > h.tree_size)

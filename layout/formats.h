@@ -42,12 +42,27 @@
 #define MC_TREE_AABBTREECOMPRESSED 7u  // §5.4
 #define MC_TREE_SKDTREE 8u             // §5.5
 #define MC_TREE_STACKLESSLBVH 9u       // seed 001
+#define MC_TREE_AABBLIST 10u           // §7: 256-triangle batches, one box each
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
 // (fewer in the last): 16, or the codec's block width when wider (128).
 #define MC_BRUTE_RECORD_BYTES 4u
 #define MC_BRUTE_CHUNK 16u
+
+// AABBList (§7, the GPU's method 2): the tree section opens with node_count
+// batch entries of 32 bytes, BoundingBoxMin, BoundingBoxMax (6 floats),
+// TriangleCount (1..MC_LIST_BATCH) and RecordOffset (tree-section offset of
+// the batch's first record), at triangle_base the batches' records follow,
+// BruteForce records of brute_chunk(lanes) triangles, batch after batch
+// with nothing between them: batch b's records end where batch b + 1's
+// begin. Every batch but the last holds MC_LIST_BATCH triangles, so with the
+// 128-lane codecs every record is one full-size block and record k of the
+// section lies at triangle_base + k * (4 + block bytes).
+#define MC_LIST_BATCH 256u
+#define MC_LIST_ENTRY_BYTES 32u
+#define MC_LIST_COUNT_AT 24u           // TriangleCount's byte in the entry
+#define MC_LIST_RECORDS_AT 28u         // RecordOffset's
 
 // Triangle formats (seed 000 §3).
 #define MC_TRI_FLOAT3 1u               // §3.1

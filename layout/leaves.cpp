@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "layout/aabblist.h"
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
 #include "layout/compressed.h"
@@ -34,8 +35,9 @@ struct Descent {
     if (own) path.pop_back();
   }
 
-  void bruteforce() {
-    for (uint32_t at = 0; at < h.tree_size;) {
+  // BruteForce records from tree-section offset `at` up to `end`.
+  void records(uint32_t at, uint32_t end) {
+    while (at < end) {
       uint32_t count = load<uint32_t>(tree + at);
       leaf(at + MC_BRUTE_RECORD_BYTES, count, nullptr);
       uint64_t bytes = 0;
@@ -44,6 +46,16 @@ struct Descent {
       MC_FOR_EACH_TRIANGLE_CODEC(MC_BYTES)
 #undef MC_BYTES
       at += MC_BRUTE_RECORD_BYTES + uint32_t(bytes);
+    }
+  }
+
+  // AABBList: each batch's box above its records.
+  void aabblist() {
+    for (uint32_t b = 0; b < h.node_count; ++b) {
+      ListEntry e = load_list_entry(tree, b);
+      path.push_back(box_of(e.min, e.max));
+      records(e.records, list_records_end(tree, h, b));
+      path.pop_back();
     }
   }
 
@@ -127,7 +139,8 @@ void for_each_leaf_path(const uint8_t* blob, const LeafPathVisitor& visit) {
   const BlobHeader& h = header_of(blob);
   Descent d{blob, h, blob + h.tree_offset, visit, {}};
   switch (h.tree_format) {
-    case MC_TREE_BRUTEFORCE: return d.bruteforce();
+    case MC_TREE_BRUTEFORCE: return d.records(0, h.tree_size);
+    case MC_TREE_AABBLIST: return d.aabblist();
     case MC_TREE_AABBTREE:
     case MC_TREE_AABBTREESPLITAXIS: return d.aabbtree(0);
     case MC_TREE_AABBTREEPNS: return d.pns(0);

@@ -110,6 +110,8 @@ TEST_P(GpuMethods, MatchTheCpuAndTheOracle) {
 INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods,
                          ::testing::Values(MethodCase{"bruteforce", "BruteForce/Float3SOA128"},
                                            MethodCase{"bruteforce", "BruteForce/BitPackSOA128"},
+                                           MethodCase{"aabblist", "AABBList/Float3SOA128"},
+                                           MethodCase{"aabblist", "AABBList/BitPackSOA128"},
                                            MethodCase{"aabbtree", "AABBTree/Float3"},
                                            MethodCase{"aabbtree", "AABBTree/UncompressedStrip"},
                                            MethodCase{"skdtree", "SKDTree/Float3"},

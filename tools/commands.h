@@ -16,10 +16,10 @@ void add_bench(CLI::App& app);
 void add_render(CLI::App& app);
 
 // The layout options trace, build and info share: --layout, --leaf,
-// --splitter, --order, --lbvh-depth, --lbvh-left-first.
+// --splitter, --order, --lbvh-depth, --lbvh-left-first, --grouping.
 struct LayoutArgs {
   std::string layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
-  std::string splitter, order;  // empty: the layout's own
+  std::string splitter, order, grouping;  // empty: the layout's own
   uint32_t leaf = 8, lbvh_depth = 0;
   bool lbvh_left_first = false;
 };

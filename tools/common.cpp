@@ -50,6 +50,7 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_option("--lbvh-depth", a.lbvh_depth, "StacklessLBVH depth limit D (0: bit_width(triangles) + 1)")
       ->check(CLI::Range(0u, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
   cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
+  cmd->add_option("--grouping", a.grouping, "AABBList batches (seed 000 7): ClosestCentroid (the seed's) or Morton");
 }
 
 BuildOptions build_options(const LayoutArgs& a) {
@@ -57,6 +58,7 @@ BuildOptions build_options(const LayoutArgs& a) {
   if (!a.order.empty()) o.node_order = parse_node_order(a.order);
   o.lbvh_depth = a.lbvh_depth;
   o.lbvh_near_first = !a.lbvh_left_first;
+  if (!a.grouping.empty()) o.grouping = parse_grouping(a.grouping);
   return o;
 }
 

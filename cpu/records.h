@@ -1,0 +1,26 @@
+// BruteForce records [count][block] from tree-section offset `at` to `end`,
+// tested in order through the leaf test every tree uses: the whole of a
+// BruteForce walk, and one batch of an AABBList walk.
+#pragma once
+#include "cpu/pairs.h"
+#include "cpu/walk.h"
+
+namespace meshcast {
+
+template <class Codec>
+inline void test_records(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, uint32_t at,
+                         uint32_t end, Closest& c) {
+  while (at < end) {
+    uint32_t count = layout::load<uint32_t>(blob + h.tree_offset + at);
+    uint32_t block = at + MC_BRUTE_RECORD_BYTES;
+    if constexpr (requires { Codec::kSequential; }) {  // strips: the decode tells the length
+      at = block + uint32_t(test_sequential_leaf<Codec>(blob, r, h.tree_offset + block, count,
+                                                        layout::slot_of(h, block, 0), c));
+    } else {
+      test_leaf<Codec>(blob, r, h.tree_offset + block, count, layout::slot_of(h, block, 0), c);
+      at = block + Codec::block_bytes(count);
+    }
+  }
+}
+
+}  // namespace meshcast

@@ -1,0 +1,83 @@
+// Method 2 of seed 000 §7: AABBList over Float3SOA128 or BitPackSOA128
+// records. Rays go in chunks small enough that every (ray, batch) pair of a
+// chunk fits the pair buffer, so the append can never overflow; a chunk is
+// pass 1 (every ray of the chunk against every batch box, entered boxes
+// appended as pairs), a one-thread pass writing pass 2's indirect dispatch
+// from the count, and pass 2 (each pair's triangles folded into the ray's
+// key). After the last chunk the brute force's resolve pass turns keys into
+// hits: both methods read the same records and keys.
+#include <algorithm>
+#include <cstring>
+
+#include "gpu/batch.h"
+#include "layout/blob.h"
+#include "shaders/aabblist_args.h"
+#include "shaders/aabblist_bitpack.h"
+#include "shaders/aabblist_boxes.h"
+#include "shaders/aabblist_float3.h"
+#include "shaders/resolve_bitpack.h"
+#include "shaders/resolve_float3.h"
+
+namespace meshcast::gpu {
+
+namespace {
+
+// The pair buffer: 2^22 pairs (32 MiB), far below every device's
+// maxStorageBufferRange, and still thousands of rays a chunk on large meshes.
+constexpr uint64_t kPairs = uint64_t(1) << 22;
+
+class AABBListMethod : public BatchMethod {
+ public:
+  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack)
+      : BatchMethod(ctx, blob, name, "aabblist", MC_TREE_AABBLIST, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128),
+        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push)),
+        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push)),
+        test_(ctx, bitpack ? aabblist_bitpack_spv : aabblist_float3_spv,
+              bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push)),
+        resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push)),
+        pairs_(ctx, std::max<uint64_t>(kPairs, records_) * 8, "AABBList pair buffer"),
+        control_(ctx, 5 * 4, "AABBList dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT) {
+    chunk_ = uint32_t(std::clamp<uint64_t>(pairs_.size() / 8 / records_, 1, ctx.limits().maxComputeWorkGroupCount[1]));
+  }
+
+ protected:
+  void bind_all() override {
+    std::vector<const Buffer*> all = buffers();
+    all.push_back(&pairs_), all.push_back(&control_);
+    for (Pipeline* p : {&boxes_, &args_, &test_}) p->bind(all);
+    resolve_.bind(buffers());
+  }
+
+  void record(VkCommandBuffer cb, uint32_t n) override {
+    std::memset(control_.data(), 0, control_.size());  // the append counter starts at 0 (no GPU work is in flight)
+    const VkPhysicalDeviceLimits& limits = ctx_.limits();
+    const uint32_t box_groups = (records_ + 63) / 64;
+    for (uint32_t base = 0; base < n; base += chunk_) {
+      const uint32_t end = std::min(n, base + chunk_);
+      const Push boxes{base, end, records_}, args{0, 0, limits.maxComputeWorkGroupCount[0]}, test{0, n, records_};
+      boxes_.dispatch(cb, &boxes, box_groups, end - base, 1);
+      compute_barrier(cb);
+      args_.dispatch(cb, &args, 1, 1, 1);
+      indirect_barrier(cb);
+      test_.dispatch_indirect(cb, &test, control_, 4);
+      compute_barrier(cb);
+    }
+    const Push resolve{0, n, records_};
+    resolve_.dispatch(cb, &resolve, (n + 63) / 64, 1, 1);
+  }
+
+ private:
+  Pipeline boxes_, args_, test_, resolve_;
+  Buffer pairs_, control_;
+  uint32_t chunk_ = 1;  // rays a chunk: chunk * batches pairs fit the pair buffer
+};
+
+}  // namespace
+
+std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name) {
+  const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
+  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack);
+}
+
+}  // namespace meshcast::gpu

@@ -29,7 +29,8 @@ double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3
 //  - a walker hit against an oracle miss at the ends of the segment (origin
 //    on the surface, surface at t_max), on the hit triangle's edge, or for a
 //    ray lying in the triangle's plane;
-//  - a walker miss against an oracle hit at the ends of the segment.
+//  - a walker miss against an oracle hit at the ends of the segment, or
+//    within a few float ulps of the hit triangle's edge (a grazed silhouette).
 // A walker miss in the middle of a triangle is always wrong; leaks through
 // shared edges are checked by the closed-mesh tests. max_t_error is a
 // distance.

@@ -22,13 +22,9 @@ namespace meshcast::gpu {
 
 namespace {
 
-// The pair buffer: 2^22 pairs (32 MiB), far below every device's
-// maxStorageBufferRange, and still thousands of rays a chunk on large meshes.
-constexpr uint64_t kPairs = uint64_t(1) << 22;
-
 class AABBListMethod : public BatchMethod {
  public:
-  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack)
+  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint64_t pairs)
       : BatchMethod(ctx, blob, name, "aabblist", MC_TREE_AABBLIST, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128),
         boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push)),
         args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push)),
@@ -36,7 +32,7 @@ class AABBListMethod : public BatchMethod {
               bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push)),
         resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
                  bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push)),
-        pairs_(ctx, std::max<uint64_t>(kPairs, records_) * 8, "AABBList pair buffer"),
+        pairs_(ctx, std::max<uint64_t>(pairs, records_) * 8, "AABBList pair buffer"),
         control_(ctx, 5 * 4, "AABBList dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT) {
     chunk_ = uint32_t(std::clamp<uint64_t>(pairs_.size() / 8 / records_, 1, ctx.limits().maxComputeWorkGroupCount[1]));
   }
@@ -75,9 +71,10 @@ class AABBListMethod : public BatchMethod {
 
 }  // namespace
 
-std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name) {
+std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                                      uint64_t pairs) {
   const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack);
+  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack, pairs);
 }
 
 }  // namespace meshcast::gpu

@@ -38,4 +38,10 @@ std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std
                                     const std::string& name);
 std::vector<std::string> method_names();
 
+// AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs: a
+// batch of rays goes in chunks of pairs / batches rays. make_method's uses
+// 2^22 (32 MiB); a test passes a small one to split batches into many chunks.
+std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                                      uint64_t pairs);
+
 }  // namespace meshcast::gpu

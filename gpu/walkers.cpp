@@ -50,7 +50,6 @@ class WalkMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name);
-std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name);
 
 std::vector<std::string> method_names() {
   std::vector<std::string> names{"bruteforce", "aabblist"};
@@ -62,7 +61,9 @@ std::vector<std::string> method_names() {
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
                                     const std::string& name) {
   if (method == "bruteforce") return make_bruteforce(ctx, blob, name);
-  if (method == "aabblist") return make_aabblist(ctx, blob, name);
+  // 2^22 pairs (32 MiB): far below every device's maxStorageBufferRange,
+  // and still thousands of rays a chunk on large meshes.
+  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 22);
   // A method that reads several triangle formats takes the blob's; the
   // first listed is the one named when the blob fits none.
   const Walker* pick = nullptr;

@@ -119,6 +119,60 @@ TEST(Splitters, EveryOneRespectsTheLeafSizeAndCoversEveryTriangleOnce) {
   EXPECT_THROW(parse_splitter("Octree"), InputError);
 }
 
+// The seed's greedy grouping, written the slow obvious way: the unused
+// triangle lowest along the sweep axis (ties: lower index) and the
+// batch - 1 unused ones nearest to its centre (ties: lower along the
+// sweep, then lower index), batch after batch.
+std::vector<std::set<uint32_t>> greedy_batches_by_hand(const std::vector<Box3>& boxes, uint32_t batch) {
+  std::vector<Vec3> c;
+  Box3 all;
+  for (const Box3& b : boxes) c.push_back(b.centre()), all.grow(b.centre());
+  const Vec3 e = all.extent();
+  const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+  auto before = [&](uint32_t a, uint32_t b) { return c[a][axis] < c[b][axis] || (c[a][axis] == c[b][axis] && a < b); };
+  std::vector<bool> used(boxes.size(), false);
+  std::vector<std::set<uint32_t>> out;
+  for (size_t left = boxes.size(); left > 0;) {
+    uint32_t seed = ~0u;
+    for (uint32_t i = 0; i < boxes.size(); ++i)
+      if (!used[i] && (seed == ~0u || before(i, seed))) seed = i;
+    std::vector<uint32_t> rest;
+    for (uint32_t i = 0; i < boxes.size(); ++i)
+      if (!used[i] && i != seed) rest.push_back(i);
+    auto d2 = [&](uint32_t i) {
+      double dx = double(c[i].x) - c[seed].x, dy = double(c[i].y) - c[seed].y, dz = double(c[i].z) - c[seed].z;
+      return dx * dx + dy * dy + dz * dz;
+    };
+    std::sort(rest.begin(), rest.end(), [&](uint32_t a, uint32_t b) { return d2(a) < d2(b) || (d2(a) == d2(b) && before(a, b)); });
+    rest.resize(std::min<size_t>(rest.size(), batch - 1));
+    rest.push_back(seed);
+    for (uint32_t i : rest) used[i] = true;
+    left -= rest.size();
+    out.emplace_back(rest.begin(), rest.end());
+  }
+  return out;
+}
+
+TEST(AABBListGrouping, ClosestCentroidIsTheSeedsGreedyAndMortonCoversAll) {
+  // A terrain (flat: the sweep runs along its long side) and a sphere.
+  for (const Mesh& m : {make_terrain(40, 24, 5), make_sphere(20, 30, 1, {0, 0, 0})}) {
+    std::vector<Box3> boxes = triangle_boxes(m);
+    std::vector<std::set<uint32_t>> expected = greedy_batches_by_hand(boxes, 64);
+    std::vector<uint32_t> order = group_batches(boxes, 64, Grouping::ClosestCentroid);
+    ASSERT_EQ(order.size(), boxes.size());
+    ASSERT_EQ(expected.size(), (boxes.size() + 63) / 64);
+    for (size_t b = 0; b < expected.size(); ++b) {
+      std::set<uint32_t> got(order.begin() + b * 64, order.begin() + std::min(order.size(), b * 64 + 64));
+      EXPECT_EQ(got, expected[b]) << "batch " << b << " of " << m.triangles.size() << " triangles";
+    }
+    std::vector<uint32_t> morton = group_batches(boxes, 64, Grouping::Morton);
+    std::sort(morton.begin(), morton.end());
+    for (uint32_t i = 0; i < morton.size(); ++i) ASSERT_EQ(morton[i], i);
+  }
+  EXPECT_EQ(parse_grouping("morton"), Grouping::Morton);
+  EXPECT_THROW(parse_grouping("Octree"), InputError);
+}
+
 TEST(Binning, CoincidentCentresStillSplit) {
   Mesh m;
   m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};

@@ -124,6 +124,23 @@ INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods,
                            return std::string(info.param.method) + "_" + n;
                          });
 
+// AABBList with a pair buffer of 50,000 pairs: 10,000 rays on the 64k
+// terrain (256 batches) go in chunks of 195 rays, so the counter reset and the dispatch
+// arguments between chunks are exercised, not just one chunk.
+TEST(Gpu, AABBListInManyChunksMatchesTheCpu) {
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (m.name != "terrain_64k") continue;
+    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout("AABBList/Float3SOA128"), m.name);
+    ASSERT_GT(layout::header_of(blob.data()).node_count * 10000ull, 50000ull * 20);
+    std::unique_ptr<gpu::Method> method = gpu::make_aabblist(context(), blob, m.name, 50000);
+    const std::vector<Ray>& rays = test_rays(m, RayKind::Radial, 10000);
+    std::vector<Hit> gpu(rays.size()), cpu = trace_all(blob, rays);
+    method->trace(rays, gpu);
+    expect_same_as_cpu(gpu, cpu, "aabblist in chunks on " + m.name);
+  }
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+
 TEST(Gpu, UnwalkableRaysAreMissesAndCounted) {
   Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
   std::vector<uint8_t> blob = build_blob(m, parse_layout("BruteForce/Float3SOA128"), "sphere");

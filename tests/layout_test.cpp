@@ -384,6 +384,34 @@ TEST(Corruption, NewTreesRefuseBrokenLinks) {
   EXPECT_NE(corrupt(two_apart("StacklessLBVH/Float3"), tree + 32 + 24, uint32_t(-1)), "");
 }
 
+TEST(GoldenBytes, AABBListIsSeed7) {
+  std::vector<uint8_t> b = two_apart("AABBList/Float3");
+  const size_t tree = 192;
+  // One batch entry: BoundingBoxMin, BoundingBoxMax, TriangleCount, RecordOffset.
+  EXPECT_EQ(at<float>(b, tree + 0), 0.0f);
+  EXPECT_EQ(at<float>(b, tree + 12), 11.0f);
+  EXPECT_EQ(at<float>(b, tree + 16), 1.0f);
+  EXPECT_EQ(at<uint32_t>(b, tree + 24), 2u);
+  EXPECT_EQ(at<uint32_t>(b, tree + 28), 32u);
+  // Its one record right after: [count][two Float3 triangles].
+  EXPECT_EQ(at<uint32_t>(b, tree + 32), 2u);
+  EXPECT_EQ(header_of(b.data()).tree_size, 32u + 4u + 72u);
+}
+
+TEST(Corruption, AABBListRecordsMustTileFullBatches) {
+  // 1,200 triangles: four full batches of 256 and a last one of 176.
+  std::vector<uint8_t> b = build_blob(make_sphere(20, 30, 1, {0, 0, 0}), parse_layout("AABBList/Float3SOA128"), "s");
+  const BlobHeader& h = header_of(b.data());
+  ASSERT_EQ(h.node_count, 5u);
+  const size_t entry1 = h.tree_offset + MC_LIST_ENTRY_BYTES;
+  std::string why = corrupt(b, entry1 + MC_LIST_RECORDS_AT, at<uint32_t>(b, entry1 + MC_LIST_RECORDS_AT) + 4);
+  EXPECT_NE(why.find("runs past"), std::string::npos) << why;  // batch 0 now ends short of it
+  why = corrupt(b, h.tree_offset + MC_LIST_COUNT_AT, 255);
+  EXPECT_NE(why.find("batch 0 holds 255"), std::string::npos) << why;
+  why = corrupt(b, h.tree_offset + 4 * MC_LIST_ENTRY_BYTES + MC_LIST_COUNT_AT, 177);
+  EXPECT_NE(why.find("entry says 177"), std::string::npos) << why;
+}
+
 TEST(Corruption, VertexIndexOutsideTheVertexSectionIsRefused) {
   std::vector<uint8_t> b =
       build_blob(make_sphere(8, 16, 1, {0, 0, 0}), parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "s");

@@ -65,6 +65,23 @@ TEST(Oracle, DegenerateTrianglesAreNeverHit) {
   EXPECT_EQ(oracle_brute_force(m, r).triangle, MC_NO_HIT);
 }
 
+// The judge (cpu/agreement.h): a walker's miss where the oracle hits is
+// wrong in the middle of a triangle, a tie only within float rounding of
+// its edge (a grazed silhouette, decided by rounding either way).
+TEST(Agreement, AMissIsWrongUnlessWithinRoundingOfAnEdge) {
+  Mesh m = one_triangle();
+  std::vector<Ray> rays = {{{0.25f, 0.25f, 1.0f}, {0, 0, -1}, INFINITY},   // the middle
+                           {{0.5f, 1e-3f, 1.0f}, {0, 0, -1}, INFINITY},    // near the edge, far beyond rounding
+                           {{0.5f, 1e-9f, 1.0f}, {0, 0, -1}, INFINITY}};   // within rounding of the edge y = 0
+  std::vector<OracleHit> oracle;
+  for (const Ray& r : rays) oracle.push_back(oracle_brute_force(m, r));
+  for (const OracleHit& o : oracle) ASSERT_EQ(o.triangle, 0u);
+  std::vector<Hit> misses(rays.size());
+  Agreement a = compare(m, rays, misses, oracle, 1e-5 * m.bounds().diagonal());
+  EXPECT_EQ(a.wrong, 2u);
+  EXPECT_EQ(a.ties, 1u);
+}
+
 TEST(Oracle, TreeAgreesWithBruteForce) {
   std::vector<NamedMesh> meshes = test_meshes(false);
   for (const NamedMesh& m : meshes) {

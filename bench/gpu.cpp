@@ -35,6 +35,8 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
   const Case cases[] = {{"aabbtree", "AABBTree/Float3", "0.34 us, 53.4 B"},
                         {"aabbtree", "AABBTree/UncompressedStrip", "0.41 us, 37.1 B"},
                         {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4", ""},
+                        {"aabblist", "AABBList/Float3SOA128", "1.06 us, 36.2 B (its Float3SOA256)"},
+                        {"aabblist", "AABBList/BitPackSOA128", ""},
                         {"skdtree", "SKDTree/Float3", "1.15 us, 41.0 B"},
                         {"lbvh", "StacklessLBVH/Float3", ""},
                         {"bruteforce", "BruteForce/BitPackSOA128", "35.01 us, 24 B"},

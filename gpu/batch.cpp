@@ -26,8 +26,8 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
                      std::string(layout::tree_format_name(h.tree_format)) + "/" +
                      std::string(layout::triangle_format_name(h.triangle_format)));
   records_ = h.node_count;
-  blob_.emplace(ctx, blob.size(), "blob of " + name);
-  std::memcpy(blob_->data(), blob.data(), blob.size());
+  blob_.emplace(ctx, blob.size(), "blob of " + name, 0, Memory::DeviceLocal);
+  blob_->upload(blob);
   if (ctx.has_timestamps()) {
     VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     q.queryType = VK_QUERY_TYPE_TIMESTAMP, q.queryCount = 2;

@@ -1,6 +1,6 @@
-// The part every GPU method shares: the blob uploaded once (checked against
-// the layouts the method reads), ray/key/hit buffers that grow with the
-// batch, one submission a batch between two timestamps, and the read-back.
+// The part every GPU method shares: the blob uploaded once into device
+// memory (checked against the layouts the method reads), ray/key/hit
+// buffers that grow with the batch, one submission a batch between two timestamps, and the read-back.
 // A method adds its pipelines and records its dispatches.
 #pragma once
 #include <optional>

@@ -1,6 +1,7 @@
 #include "gpu/vulkan.h"
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
@@ -191,14 +192,17 @@ void Context::end_and_wait(VkCommandBuffer cb) {
   check(r, "waiting for the GPU");
 }
 
-uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const {
+uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required) const {
   for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
     if ((bits >> i & 1) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+  if (!required && bits) return uint32_t(std::countr_zero(bits));
   throw GpuError("Vulkan: " + name_ + " has no host-visible coherent memory for storage buffers");
 }
 
-Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage)
+Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage, Memory memory)
     : ctx_(ctx), size_(std::max<uint64_t>(bytes, 4)) {
+  const bool mapped = memory == Memory::Mapped;
+  if (!mapped) usage |= VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   if (size_ > ctx.limits().maxStorageBufferRange)
     throw GpuError("Vulkan: the " + what + " of " + std::to_string(size_) + " bytes exceeds " + ctx.device_name() +
                    "'s maxStorageBufferRange (" + std::to_string(ctx.limits().maxStorageBufferRange) + " bytes)");
@@ -209,14 +213,30 @@ Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUs
   vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
-  mai.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  mai.memoryTypeIndex = mapped ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
+                               : ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false);
   VkResult r = vkAllocateMemory(ctx.device(), &mai, nullptr, &memory_);
   if (r != VK_SUCCESS) {
     vkDestroyBuffer(ctx.device(), buffer_, nullptr);
     check(r, ("allocating the " + what).c_str());
   }
   check(vkBindBufferMemory(ctx.device(), buffer_, memory_, 0), "vkBindBufferMemory");
-  check(vkMapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+  if (mapped) check(vkMapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+}
+
+void Buffer::upload(std::span<const uint8_t> bytes) {
+  if (bytes.empty()) return;
+  Buffer staging(ctx_, bytes.size(), "staging copy", VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::memcpy(staging.data(), bytes.data(), bytes.size());
+  ctx_.submit([&](VkCommandBuffer cb) {
+    VkBufferCopy region{0, 0, bytes.size()};
+    vkCmdCopyBuffer(cb, staging.handle(), buffer_, 1, &region);
+    // The copy is done before any later submission's shaders read it.
+    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr,
+                         0, nullptr);
+  });
 }
 
 Buffer::~Buffer() {

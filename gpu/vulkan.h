@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,9 @@ class Context {
     end_and_wait(cb);
   }
 
-  uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const;
+  // A memory type among `bits` with all of `wanted`; with `required` false
+  // any of `bits` when none has them, else GpuError.
+  uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required = true) const;
 
  private:
   VkCommandBuffer begin();
@@ -76,17 +79,29 @@ class Context {
   bool timestamps_ = false;
 };
 
-// A host-visible storage buffer (coherent, mapped for its whole life);
-// `usage` adds to STORAGE_BUFFER (INDIRECT_BUFFER for dispatch arguments).
+// A storage buffer; `usage` adds to STORAGE_BUFFER (INDIRECT_BUFFER for
+// dispatch arguments).
+//   Mapped       host-visible and coherent, mapped for its whole life: what
+//                the host writes or reads every batch (rays, hits, keys).
+//   DeviceLocal  the device's own memory where it has any, never mapped,
+//                filled once by upload() through a staging copy: the blob,
+//                which the shaders read over and over (on a discrete GPU
+//                host-visible memory would be read across the bus).
+enum class Memory { Mapped, DeviceLocal };
+
 class Buffer {
  public:
-  Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage = 0);
+  Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage = 0,
+         Memory memory = Memory::Mapped);
   ~Buffer();
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
   VkBuffer handle() const { return buffer_; }
   uint64_t size() const { return size_; }
-  void* data() const { return mapped_; }
+  void* data() const { return mapped_; }  // null for DeviceLocal
+  // Copies `bytes` (at most size()) to the start of a DeviceLocal buffer
+  // through a mapped staging buffer and one transfer; waits for it.
+  void upload(std::span<const uint8_t> bytes);
 
  private:
   Context& ctx_;

@@ -52,6 +52,8 @@ check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$mesh" --
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
+check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
+check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
 check order 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout quadtreehalffloat/float3 --order breadthfirst --rays "$work/r.rays" --out "$work/h4.hits"
 check order-refused 2 "AABBTree is always DepthFirst" -- "$meshcast" info "$mesh" --layout AABBTree/Float3 --order BreadthFirst
 check unknown-order 2 "valid node orders" -- "$meshcast" info "$mesh" --layout QuadTree/Float3 --order Random

@@ -24,57 +24,65 @@ namespace {
 
 class AABBListMethod : public BatchMethod {
  public:
-  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint64_t pairs)
-      : BatchMethod(ctx, blob, name, "aabblist", MC_TREE_AABBLIST, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128),
-        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push)),
-        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push)),
+  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint64_t pairs,
+                 uint32_t slots)
+      : BatchMethod(ctx, blob, name, "aabblist", MC_TREE_AABBLIST, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
+                    slots),
+        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push), slots),
+        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push), slots),
         test_(ctx, bitpack ? aabblist_bitpack_spv : aabblist_float3_spv,
-              bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push)),
+              bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push), slots),
         resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push)),
-        pairs_(ctx, std::max<uint64_t>(pairs, records_) * 8, "AABBList pair buffer"),
-        control_(ctx, 5 * 4, "AABBList dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT) {
-    chunk_ = uint32_t(std::clamp<uint64_t>(pairs_.size() / 8 / records_, 1, ctx.limits().maxComputeWorkGroupCount[1]));
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push), slots) {
+    const uint64_t capacity = std::max<uint64_t>(pairs, records_);
+    for (uint32_t k = 0; k < this->slots(); ++k) {  // every slot in flight has its own pairs and counter
+      pairs_.push_back(std::make_unique<Buffer>(ctx, capacity * 8, "AABBList pair buffer"));
+      control_.push_back(std::make_unique<Buffer>(ctx, 5 * 4, "AABBList dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT));
+    }
+    chunk_ = uint32_t(std::clamp<uint64_t>(capacity / records_, 1, ctx.limits().maxComputeWorkGroupCount[1]));
   }
 
  protected:
-  void bind_all() override {
-    std::vector<const Buffer*> all = buffers();
-    all.push_back(&pairs_), all.push_back(&control_);
-    for (Pipeline* p : {&boxes_, &args_, &test_}) p->bind(all);
-    resolve_.bind(buffers());
+  void bind_all(uint32_t slot) override {
+    std::vector<const Buffer*> all = buffers(slot);
+    all.push_back(pairs_[slot].get()), all.push_back(control_[slot].get());
+    for (Pipeline* p : {&boxes_, &args_, &test_}) p->bind(all, slot);
+    resolve_.bind(buffers(slot), slot);
   }
 
-  void record(VkCommandBuffer cb, uint32_t n) override {
-    std::memset(control_.data(), 0, control_.size());  // the append counter starts at 0 (no GPU work is in flight)
+  // The append counter starts at 0 (the slot's previous batch is finished).
+  void prepare(uint32_t slot, uint32_t) override { std::memset(control_[slot]->data(), 0, control_[slot]->size()); }
+
+  void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
     const VkPhysicalDeviceLimits& limits = ctx_.limits();
     const uint32_t box_groups = (records_ + 63) / 64;
     for (uint32_t base = 0; base < n; base += chunk_) {
       const uint32_t end = std::min(n, base + chunk_);
       const Push boxes{base, end, records_}, args{0, 0, limits.maxComputeWorkGroupCount[0]}, test{0, n, records_};
-      boxes_.dispatch(cb, &boxes, box_groups, end - base, 1);
+      boxes_.dispatch(cb, slot, &boxes, box_groups, end - base, 1);
       compute_barrier(cb);
-      args_.dispatch(cb, &args, 1, 1, 1);
+      args_.dispatch(cb, slot, &args, 1, 1, 1);
       indirect_barrier(cb);
-      test_.dispatch_indirect(cb, &test, control_, 4);
+      test_.dispatch_indirect(cb, slot, &test, *control_[slot], 4);
       compute_barrier(cb);
     }
     const Push resolve{0, n, records_};
-    resolve_.dispatch(cb, &resolve, (n + 63) / 64, 1, 1);
+    resolve_.dispatch(cb, slot, &resolve, (n + 63) / 64, 1, 1);
   }
 
  private:
   Pipeline boxes_, args_, test_, resolve_;
-  Buffer pairs_, control_;
-  uint32_t chunk_ = 1;  // rays a chunk: chunk * batches pairs fit the pair buffer
+  std::vector<std::unique_ptr<Buffer>> pairs_, control_;
+  uint32_t chunk_ = 1;  // rays a chunk: chunk * batches pairs fit a pair buffer
 };
 
 }  // namespace
 
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                      uint64_t pairs) {
+                                      uint64_t pairs, uint32_t slots) {
+  ctx.require_int64_atomics("aabblist");
   const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack, pairs);
+  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack, pairs, slots);
 }
 
 }  // namespace meshcast::gpu

@@ -16,8 +16,8 @@ uint32_t blob_triangle_format(std::span<const uint8_t> blob) {
 }
 
 BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
-                         uint32_t tree, uint32_t triangles)
-    : ctx_(ctx) {
+                         uint32_t tree, uint32_t triangles, uint32_t slots)
+    : ctx_(ctx), slots_(std::max(slots, 1u)) {
   BlobView view(blob, name);  // validates: the shaders trust what validation proved
   const layout::BlobHeader& h = layout::header_of(blob.data());
   if (h.tree_format != tree || h.triangle_format != triangles)
@@ -28,51 +28,106 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
   records_ = h.node_count;
   blob_.emplace(ctx, blob.size(), "blob of " + name, 0, Memory::DeviceLocal);
   blob_->upload(blob);
-  if (ctx.has_timestamps()) {
-    VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-    q.queryType = VK_QUERY_TYPE_TIMESTAMP, q.queryCount = 2;
-    check(vkCreateQueryPool(ctx.device(), &q, nullptr, &queries_), "vkCreateQueryPool");
+  for (Slot& s : slots_) {
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(vkCreateFence(ctx.device(), &fci, nullptr, &s.fence), "vkCreateFence");
+    s.cb = ctx.allocate_command_buffer();
+    if (ctx.has_timestamps()) {
+      VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+      q.queryType = VK_QUERY_TYPE_TIMESTAMP, q.queryCount = 2;
+      check(vkCreateQueryPool(ctx.device(), &q, nullptr, &s.queries), "vkCreateQueryPool");
+    }
   }
 }
 
 BatchMethod::~BatchMethod() {
-  if (queries_) vkDestroyQueryPool(ctx_.device(), queries_, nullptr);
+  for (Slot& s : slots_) {
+    if (s.in_flight) vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000);
+    if (s.queries) vkDestroyQueryPool(ctx_.device(), s.queries, nullptr);
+    if (s.cb) ctx_.free_command_buffer(s.cb);
+    if (s.fence) vkDestroyFence(ctx_.device(), s.fence, nullptr);
+  }
 }
 
-void BatchMethod::reserve(uint32_t n) {
-  if (capacity_ >= n) return;
-  capacity_ = std::max<uint32_t>(n, 1024);
-  rays_.emplace(ctx_, uint64_t(capacity_) * kRayWords * 4, "ray buffer");
-  keys_.emplace(ctx_, uint64_t(capacity_) * 8, "key buffer");
-  hits_.emplace(ctx_, uint64_t(capacity_) * sizeof(Hit), "hit buffer");
-  bind_all();
+std::vector<const Buffer*> BatchMethod::buffers(uint32_t slot) const {
+  const Slot& s = slots_[slot];
+  return {&*blob_, &*s.rays, &*s.keys, &*s.hits};
 }
 
-uint64_t BatchMethod::trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing) {
-  auto t0 = std::chrono::steady_clock::now();
-  const uint32_t n = uint32_t(std::min(rays.size(), hits.size()));
-  if (n == 0) return 0;
-  reserve(n);
-  uint64_t skipped = pack_rays(rays.first(n), static_cast<uint32_t*>(rays_->data()));
-  std::memset(keys_->data(), 0xFF, uint64_t(n) * 8);
-  ctx_.submit([&](VkCommandBuffer cb) {
-    if (queries_) {
-      vkCmdResetQueryPool(cb, queries_, 0, 2);
-      vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, 0);
+void BatchMethod::reserve(uint32_t slot, uint32_t n) {
+  Slot& s = slots_[slot];
+  if (s.capacity >= n) return;
+  s.capacity = std::max<uint32_t>(n, 1024);
+  s.rays.emplace(ctx_, uint64_t(s.capacity) * kRayWords * 4, "ray buffer");
+  s.keys.emplace(ctx_, uint64_t(s.capacity) * 8, "key buffer");
+  s.hits.emplace(ctx_, uint64_t(s.capacity) * sizeof(Hit), "hit buffer");
+  s.recorded = 0;  // the command buffer names the old buffers
+  bind_all(slot);
+}
+
+static double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
+  Slot& s = slots_.at(slot);
+  if (s.in_flight) throw std::logic_error("GPU slot " + std::to_string(slot) + " is still in flight");
+  s.begin_ms = now_ms();
+  s.n = uint32_t(rays.size());
+  if (s.n == 0) return 0;
+  reserve(slot, s.n);
+  uint64_t skipped = pack_rays(rays, static_cast<uint32_t*>(s.rays->data()));
+  std::memset(s.keys->data(), 0xFF, uint64_t(s.n) * 8);
+  prepare(slot, s.n);
+  if (s.recorded != s.n) {  // recorded once a batch size, resubmitted after
+    check(vkResetCommandBuffer(s.cb, 0), "vkResetCommandBuffer");
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    check(vkBeginCommandBuffer(s.cb, &bi), "vkBeginCommandBuffer");
+    if (s.queries) {
+      vkCmdResetQueryPool(s.cb, s.queries, 0, 2);
+      vkCmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
     }
-    record(cb, n);
-    if (queries_) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 1);
-  });
-  std::memcpy(hits.data(), hits_->data(), uint64_t(n) * sizeof(Hit));
+    record(s.cb, slot, s.n);
+    if (s.queries) vkCmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
+    check(vkEndCommandBuffer(s.cb), "vkEndCommandBuffer");
+    s.recorded = s.n;
+  }
+  ctx_.submit_async(s.cb, s.fence);
+  s.in_flight = true;
+  return skipped;
+}
+
+bool BatchMethod::ready(uint32_t slot) {
+  Slot& s = slots_.at(slot);
+  if (!s.in_flight) return true;
+  VkResult r = vkGetFenceStatus(ctx_.device(), s.fence);
+  if (r == VK_NOT_READY) return false;
+  check(r, "waiting for the GPU");
+  return true;
+}
+
+void BatchMethod::wait(uint32_t slot) {
+  Slot& s = slots_.at(slot);
+  if (s.in_flight)
+    check(vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
+}
+
+void BatchMethod::finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) {
+  Slot& s = slots_.at(slot);
+  if (s.in_flight) {
+    s.in_flight = false;
+    check(vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
+  }
+  if (s.n) std::memcpy(hits.data(), s.hits->data(), uint64_t(std::min<size_t>(s.n, hits.size())) * sizeof(Hit));
   if (timing) {
-    timing->wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    timing->wall_ms = now_ms() - s.begin_ms;
     timing->device_ms = 0;
     uint64_t stamps[2];
-    if (queries_ && vkGetQueryPoolResults(ctx_.device(), queries_, 0, 2, sizeof stamps, stamps, 8,
-                                          VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) == VK_SUCCESS)
+    if (s.n && s.queries &&
+        vkGetQueryPoolResults(ctx_.device(), s.queries, 0, 2, sizeof stamps, stamps, 8,
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) == VK_SUCCESS)
       timing->device_ms = double(stamps[1] - stamps[0]) * ctx_.timestamp_period_ns() * 1e-6;
   }
-  return skipped;
 }
 
 }  // namespace meshcast::gpu

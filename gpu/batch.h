@@ -26,25 +26,41 @@ class BatchMethod : public Method {
   // Validates the blob and requires its layout to be `tree`/`triangles`
   // (InputError naming the method and both layouts otherwise).
   BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
-              uint32_t tree, uint32_t triangles);
+              uint32_t tree, uint32_t triangles, uint32_t slots);
   ~BatchMethod() override;
-  uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing) override;
+  uint32_t slots() const override { return uint32_t(slots_.size()); }
+  uint64_t begin(uint32_t slot, std::span<const Ray> rays) override;
+  bool ready(uint32_t slot) override;
+  void wait(uint32_t slot) override;
+  void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) override;
 
  protected:
-  // Points every pipeline at (blob, rays, keys, hits) after the buffers change.
-  virtual void bind_all() = 0;
-  // Records the dispatches for `n` packed rays.
-  virtual void record(VkCommandBuffer cb, uint32_t n) = 0;
-  std::vector<const Buffer*> buffers() const { return {&*blob_, &*rays_, &*keys_, &*hits_}; }
+  // Points every pipeline's set `slot` at (blob, rays, keys, hits, ...)
+  // after the slot's buffers change.
+  virtual void bind_all(uint32_t slot) = 0;
+  // Host-side work before every submission of the slot (the command buffer
+  // is recorded once and resubmitted while the batch size stays the same).
+  virtual void prepare(uint32_t, uint32_t) {}
+  // Records the dispatches for `n` packed rays in `slot`.
+  virtual void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) = 0;
+  std::vector<const Buffer*> buffers(uint32_t slot) const;
 
   Context& ctx_;
   uint32_t records_ = 0;  // the header's node_count (BruteForce: its records)
 
  private:
-  void reserve(uint32_t n);
-  std::optional<Buffer> blob_, rays_, keys_, hits_;
-  uint32_t capacity_ = 0;
-  VkQueryPool queries_ = VK_NULL_HANDLE;
+  struct Slot {
+    std::optional<Buffer> rays, keys, hits;
+    uint32_t capacity = 0, recorded = 0, n = 0;  // recorded: the batch size its command buffer holds
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    bool in_flight = false;
+    double begin_ms = 0;  // steady clock at begin()
+  };
+  void reserve(uint32_t slot, uint32_t n);
+  std::optional<Buffer> blob_;
+  std::vector<Slot> slots_;
 };
 
 }  // namespace meshcast::gpu

@@ -20,27 +20,28 @@ namespace {
 
 class BruteForceMethod : public BatchMethod {
  public:
-  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack)
-      : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128),
+  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint32_t slots)
+      : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
+                    slots),
         test_(ctx, bitpack ? bruteforce_bitpack_spv : bruteforce_float3_spv,
-              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push)),
+              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push), slots),
         resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push)) {}
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push), slots) {}
 
  protected:
-  void bind_all() override {
-    test_.bind(buffers());
-    resolve_.bind(buffers());
+  void bind_all(uint32_t slot) override {
+    test_.bind(buffers(slot), slot);
+    resolve_.bind(buffers(slot), slot);
   }
-  void record(VkCommandBuffer cb, uint32_t n) override {
+  void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
     const uint32_t max_y = ctx_.limits().maxComputeWorkGroupCount[1];
     for (uint32_t base = 0; base < n; base += max_y) {
       Push push{base, n, records_};
-      test_.dispatch(cb, &push, records_, std::min(max_y, n - base), 1);
+      test_.dispatch(cb, slot, &push, records_, std::min(max_y, n - base), 1);
     }
     compute_barrier(cb);
     Push push{0, n, records_};
-    resolve_.dispatch(cb, &push, (n + 63) / 64, 1, 1);
+    resolve_.dispatch(cb, slot, &push, (n + 63) / 64, 1, 1);
   }
 
  private:
@@ -49,10 +50,12 @@ class BruteForceMethod : public BatchMethod {
 
 }  // namespace
 
-std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name) {
+std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                                        uint32_t slots) {
   // The codec the blob holds picks the shaders (BatchMethod refuses others).
+  ctx.require_int64_atomics("bruteforce");
   const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack);
+  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack, slots);
 }
 
 }  // namespace meshcast::gpu

@@ -2,6 +2,7 @@
 // A method is made once per mesh (pipelines, descriptor sets and the blob's
 // buffer), then traces any number of ray batches.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -18,12 +19,34 @@ struct GpuTiming {
   double wall_ms = 0;    // packing, submission, waiting and reading back
 };
 
+// A method runs batches in frame slots: begin() packs a batch into a
+// slot's buffers and submits it without waiting, ready() asks whether it
+// is done, finish() waits for it and copies its hits out. Slots run
+// independently, so a game can keep several frames in flight. A Method is
+// not thread-safe: one caller at a time (host/ serializes its threads).
 class Method {
  public:
   virtual ~Method() = default;
-  // Hits for `rays` (hits.size() >= rays.size()); returns the unwalkable
-  // rays, answered as misses as on the CPU.
-  virtual uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
+  virtual uint32_t slots() const = 0;
+  // Returns the unwalkable rays (answered as misses, as on the CPU). The
+  // slot must be idle (never begun, or finished).
+  virtual uint64_t begin(uint32_t slot, std::span<const Ray> rays) = 0;
+  virtual bool ready(uint32_t slot) = 0;
+  // Blocks until the slot's batch is done. Safe to call from another thread
+  // while the owner begins or finishes other slots (it only waits on the
+  // slot's fence); GpuError when the device is lost.
+  virtual void wait(uint32_t slot) = 0;
+  // Hits of the slot's batch into `hits` (at least the batch's size).
+  virtual void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
+
+  // One batch in slot 0, waited for.
+  uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing = nullptr) {
+    if (rays.empty() || hits.empty()) return 0;
+    const size_t n = std::min(rays.size(), hits.size());
+    uint64_t skipped = begin(0, rays.first(n));
+    finish(0, hits.first(n), timing);
+    return skipped;
+  }
 };
 
 // The methods and the layouts they read so far:
@@ -35,13 +58,14 @@ class Method {
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout
 // the method does not read, naming both).
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
-                                    const std::string& name);
+                                    const std::string& name, uint32_t slots = 1);
 std::vector<std::string> method_names();
 
-// AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs: a
-// batch of rays goes in chunks of pairs / batches rays. make_method's uses
-// 2^22 (32 MiB); a test passes a small one to split batches into many chunks.
+// AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs a
+// slot: a batch of rays goes in chunks of pairs / batches rays. make_method's
+// uses 2^21 (16 MiB); a test passes a small one to split batches into many
+// chunks.
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                      uint64_t pairs);
+                                      uint64_t pairs, uint32_t slots = 1);
 
 }  // namespace meshcast::gpu

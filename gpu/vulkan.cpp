@@ -120,15 +120,19 @@ Context::Context(const DeviceChoice& choice) {
   if (props[size_t(pick)].apiVersion < VK_API_VERSION_1_2) throw GpuError("Vulkan: " + name_ + " does not offer Vulkan 1.2");
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
 
-  // What the methods need: 64-bit integers and their atomics (the packed
-  // (t, triangle) minimum) and doubles (the watertight test's rare redo).
+  // What every method needs: 64-bit integers (remap words, keys) and
+  // doubles (the watertight test's rare redo, the exact BitPack decode).
+  // The 64-bit atomics of the packed (t, triangle) minimum only the
+  // bruteforce and aabblist methods need: enabled when present, and those
+  // two refuse a device without them (require_int64_atomics).
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
   vkGetPhysicalDeviceFeatures2(physical_, &f2);
-  if (!f2.features.shaderInt64 || !f2.features.shaderFloat64 || !f12.shaderBufferInt64Atomics)
-    throw GpuError("Vulkan: " + name_ + " lacks shaderInt64, shaderFloat64 or shaderBufferInt64Atomics, which the GPU methods use");
+  if (!f2.features.shaderInt64 || !f2.features.shaderFloat64)
+    throw GpuError("Vulkan: " + name_ + " lacks shaderInt64 or shaderFloat64, which every GPU method uses");
+  int64_atomics_ = f12.shaderBufferInt64Atomics == VK_TRUE;
   VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  e12.shaderBufferInt64Atomics = VK_TRUE;
+  e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
   VkPhysicalDeviceFeatures2 e2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &e12};
   e2.features.shaderInt64 = VK_TRUE;
   e2.features.shaderFloat64 = VK_TRUE;
@@ -170,11 +174,25 @@ Context::~Context() {
   if (instance_) vkDestroyInstance(instance_, nullptr);
 }
 
-VkCommandBuffer Context::begin() {
+VkCommandBuffer Context::allocate_command_buffer() {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = pool_, ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, ai.commandBufferCount = 1;
   VkCommandBuffer cb;
   check(vkAllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
+  return cb;
+}
+
+void Context::free_command_buffer(VkCommandBuffer cb) { vkFreeCommandBuffers(device_, pool_, 1, &cb); }
+
+void Context::submit_async(VkCommandBuffer cb, VkFence fence) {
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1, si.pCommandBuffers = &cb;
+  check(vkResetFences(device_, 1, &fence), "vkResetFences");
+  check(vkQueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
+}
+
+VkCommandBuffer Context::begin() {
+  VkCommandBuffer cb = allocate_command_buffer();
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
@@ -190,6 +208,12 @@ void Context::end_and_wait(VkCommandBuffer cb) {
   VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, 600ull * 1000 * 1000 * 1000);
   vkFreeCommandBuffers(device_, pool_, 1, &cb);
   check(r, "waiting for the GPU");
+}
+
+void Context::require_int64_atomics(const std::string& method) const {
+  if (!int64_atomics_)
+    throw GpuError("Vulkan: " + name_ + " lacks shaderBufferInt64Atomics, which the " + method +
+                   " method's 64-bit atomic minimum needs");
 }
 
 uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required) const {
@@ -244,7 +268,8 @@ Buffer::~Buffer() {
   vkFreeMemory(ctx_.device(), memory_, nullptr);
 }
 
-Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes)
+Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
+                   uint32_t sets)
     : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes) {
   VkDevice d = ctx.device();
   std::vector<VkDescriptorSetLayoutBinding> b(bindings);
@@ -268,13 +293,15 @@ Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint
   VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
   vkDestroyShaderModule(d, module, nullptr);
   check(r, "vkCreateComputePipelines");
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings};
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings * sets};
   VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dp.maxSets = 1, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
+  dp.maxSets = sets, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
   check(vkCreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
+  std::vector<VkDescriptorSetLayout> layouts(sets, set_layout_);
+  sets_handles_.resize(sets);
   VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  da.descriptorPool = pool_, da.descriptorSetCount = 1, da.pSetLayouts = &set_layout_;
-  check(vkAllocateDescriptorSets(d, &da, &set_), "vkAllocateDescriptorSets");
+  da.descriptorPool = pool_, da.descriptorSetCount = sets, da.pSetLayouts = layouts.data();
+  check(vkAllocateDescriptorSets(d, &da, sets_handles_.data()), "vkAllocateDescriptorSets");
 }
 
 Pipeline::~Pipeline() {
@@ -285,30 +312,31 @@ Pipeline::~Pipeline() {
   vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
 }
 
-void Pipeline::bind(const std::vector<const Buffer*>& buffers) {
+void Pipeline::bind(const std::vector<const Buffer*>& buffers, uint32_t set) {
   std::vector<VkDescriptorBufferInfo> info(bindings_);
   std::vector<VkWriteDescriptorSet> writes(bindings_);
   for (uint32_t i = 0; i < bindings_; ++i) {
     info[i] = {buffers[i]->handle(), 0, VK_WHOLE_SIZE};
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, set_, i, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_handles_[set], i, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                  nullptr, &info[i], nullptr};
   }
   vkUpdateDescriptorSets(ctx_.device(), bindings_, writes.data(), 0, nullptr);
 }
 
-void Pipeline::bind_for(VkCommandBuffer cb, const void* push) const {
+void Pipeline::bind_for(VkCommandBuffer cb, uint32_t set, const void* push) const {
   vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
+  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_handles_[set], 0, nullptr);
   if (push_bytes_) vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
 }
 
-void Pipeline::dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
-  bind_for(cb, push);
+void Pipeline::dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
+  bind_for(cb, set, push);
   vkCmdDispatch(cb, x, y, z);
 }
 
-void Pipeline::dispatch_indirect(VkCommandBuffer cb, const void* push, const Buffer& args, uint64_t offset) const {
-  bind_for(cb, push);
+void Pipeline::dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* push, const Buffer& args,
+                                 uint64_t offset) const {
+  bind_for(cb, set, push);
   vkCmdDispatchIndirect(cb, args.handle(), offset);
 }
 

@@ -44,6 +44,14 @@ class Context {
   const std::string& last_validation_message() const { return last_message_; }
   double timestamp_period_ns() const { return timestamp_ns_; }
   bool has_timestamps() const { return timestamps_; }
+  // GpuError naming `method` when the device lacks 64-bit buffer atomics.
+  void require_int64_atomics(const std::string& method) const;
+
+  // Command buffers kept for resubmission, and their submission without
+  // waiting (the caller's fence signals completion). Not thread-safe.
+  VkCommandBuffer allocate_command_buffer();
+  void free_command_buffer(VkCommandBuffer cb);
+  void submit_async(VkCommandBuffer cb, VkFence fence);
 
   // Records `record` into a one-time command buffer, submits it and waits.
   template <class F>
@@ -77,6 +85,7 @@ class Context {
   uint32_t messages_ = 0;
   double timestamp_ns_ = 0;
   bool timestamps_ = false;
+  bool int64_atomics_ = false;
 };
 
 // A storage buffer; `usage` adds to STORAGE_BUFFER (INDIRECT_BUFFER for
@@ -111,29 +120,31 @@ class Buffer {
   uint64_t size_ = 0;
 };
 
-// A compute pipeline over one descriptor set of `bindings` storage buffers
-// (binding i = buffer i) and `push_bytes` of push constants.
+// A compute pipeline over `sets` descriptor sets (one a frame slot) of
+// `bindings` storage buffers (binding i = buffer i) and `push_bytes` of push
+// constants.
 class Pipeline {
  public:
-  Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes);
+  Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
+           uint32_t sets = 1);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
-  // Points binding i at buffers[i] (whole buffer).
-  void bind(const std::vector<const Buffer*>& buffers);
-  void dispatch(VkCommandBuffer cb, const void* push, uint32_t x, uint32_t y, uint32_t z) const;
+  // Points binding i of descriptor set `set` at buffers[i] (whole buffer).
+  void bind(const std::vector<const Buffer*>& buffers, uint32_t set = 0);
+  void dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z) const;
   // The workgroup counts from a VkDispatchIndirectCommand at `offset` of `args`.
-  void dispatch_indirect(VkCommandBuffer cb, const void* push, const Buffer& args, uint64_t offset) const;
+  void dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* push, const Buffer& args, uint64_t offset) const;
 
  private:
-  void bind_for(VkCommandBuffer cb, const void* push) const;
+  void bind_for(VkCommandBuffer cb, uint32_t set, const void* push) const;
   Context& ctx_;
   uint32_t bindings_, push_bytes_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorSet> sets_handles_;
 };
 
 // A barrier that makes compute-shader writes visible to the next dispatch.

@@ -33,14 +33,15 @@ const Walker kWalkers[] = {
 
 class WalkMethod : public BatchMethod {
  public:
-  WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const Walker& w)
-      : BatchMethod(ctx, blob, name, w.method, w.tree, w.triangles), walk_(ctx, w.spirv, w.spirv_bytes, 4, sizeof(Push)) {}
+  WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const Walker& w, uint32_t slots)
+      : BatchMethod(ctx, blob, name, w.method, w.tree, w.triangles, slots),
+        walk_(ctx, w.spirv, w.spirv_bytes, 4, sizeof(Push), slots) {}
 
  protected:
-  void bind_all() override { walk_.bind(buffers()); }
-  void record(VkCommandBuffer cb, uint32_t n) override {
+  void bind_all(uint32_t slot) override { walk_.bind(buffers(slot), slot); }
+  void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
     Push push{0, n, records_};
-    walk_.dispatch(cb, &push, (n + 63) / 64, 1, 1);
+    walk_.dispatch(cb, slot, &push, (n + 63) / 64, 1, 1);
   }
 
  private:
@@ -49,7 +50,8 @@ class WalkMethod : public BatchMethod {
 
 }  // namespace
 
-std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name);
+std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                                        uint32_t slots);
 
 std::vector<std::string> method_names() {
   std::vector<std::string> names{"bruteforce", "aabblist"};
@@ -59,11 +61,11 @@ std::vector<std::string> method_names() {
 }
 
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
-                                    const std::string& name) {
-  if (method == "bruteforce") return make_bruteforce(ctx, blob, name);
-  // 2^22 pairs (32 MiB): far below every device's maxStorageBufferRange,
-  // and still thousands of rays a chunk on large meshes.
-  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 22);
+                                    const std::string& name, uint32_t slots) {
+  if (method == "bruteforce") return make_bruteforce(ctx, blob, name, slots);
+  // 2^21 pairs (16 MiB a slot): far below every device's
+  // maxStorageBufferRange, and still thousands of rays a chunk on large meshes.
+  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 21, slots);
   // A method that reads several triangle formats takes the blob's; the
   // first listed is the one named when the blob fits none.
   const Walker* pick = nullptr;
@@ -76,7 +78,7 @@ std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std
       break;
     }
   }
-  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick);
+  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick, slots);
   std::string valid;
   for (const std::string& n : method_names()) valid += " " + n;
   throw InputError("unknown GPU method '" + method + "'; implemented:" + valid);

@@ -1,0 +1,391 @@
+#include "host/caster.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "cpu/mesh.h"
+#include "gpu/method.h"
+#include "gpu/vulkan.h"
+#include "layout/blob.h"
+
+namespace meshcast::host {
+
+namespace {
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Records kept for percentiles: a ring, so a long game does not grow it.
+constexpr size_t kRecords = 1 << 16;
+
+}  // namespace
+
+const char* backend_name(Backend b) {
+  switch (b) {
+    case Backend::Cpu: return "CPU";
+    case Backend::Vulkan: return "Vulkan";
+    case Backend::Automatic: return "automatic";
+  }
+  return "";
+}
+
+struct Caster::Slot {
+  enum State { Free, Running, Ready, Collecting };
+  uint32_t index = 0;
+  State state = Free;
+  uint64_t id = 0;
+  uint32_t n = 0;
+  std::vector<Ray> rays;
+  std::vector<Hit> hits;
+  Backend ran_on = Backend::Cpu;
+  double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
+  // CPU batches: `jobs` jobs of `chunk` rays; the last to finish completes.
+  uint32_t jobs = 0, chunk = 0;
+  std::atomic<uint32_t> jobs_left{0};
+  std::atomic<int64_t> cpu_ns{0};
+  std::function<void(uint32_t)> work;  // made once, handed to the job system every batch
+};
+
+Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options)
+    : view_(blob, name), options_(std::move(options)) {
+  options_.frames = std::max(options_.frames, 1u);
+  if (options_.jobs) {
+    jobs_ = options_.jobs;
+  } else {
+    pool_ = std::make_unique<WorkerPool>(options_.threads);
+    jobs_ = pool_.get();
+  }
+  for (uint32_t i = 0; i < options_.frames; ++i) {
+    auto s = std::make_unique<Slot>();
+    s->index = i;
+    Slot* sp = s.get();
+    s->work = [this, sp](uint32_t job) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
+      view_.trace(std::span<const Ray>(sp->rays).subspan(first, count), std::span<Hit>(sp->hits).subspan(first, count));
+      sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
+      if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu, 0);
+    };
+    slots_.push_back(std::move(s));
+  }
+  records_.reserve(kRecords);
+
+  if (options_.backend != Backend::Cpu) {
+    try {
+      gpu_ = std::make_unique<gpu::Context>(gpu::DeviceChoice{options_.device, options_.validation});
+      std::vector<std::string> names = options_.gpu_method.empty() ? gpu::method_names()
+                                                                     : std::vector<std::string>{options_.gpu_method};
+      for (const std::string& m : names) {
+        try {
+          method_ = gpu::make_method(*gpu_, m, blob, name, options_.frames);
+          break;
+        } catch (const InputError&) {
+          if (!options_.gpu_method.empty()) throw;
+        }
+      }
+      if (!method_)
+        throw gpu::GpuError("no GPU method reads " + std::string(layout::tree_format_name(layout::header_of(blob.data()).tree_format)) +
+                            "/" + std::string(layout::triangle_format_name(layout::header_of(blob.data()).triangle_format)));
+      completion_ = std::thread([this] { gpu_completions(); });
+    } catch (const std::exception& e) {  // GpuError, or InputError for a method that does not read the layout
+      method_.reset();
+      gpu_.reset();
+      gpu_error_ = e.what();
+    }
+  }
+  if (options_.backend == Backend::Automatic && gpu_available()) measure_crossover();
+}
+
+Caster::~Caster() {
+  // Collect what is still running, so no job or fence outlives the caster.
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] {
+      return std::none_of(slots_.begin(), slots_.end(), [](const auto& s) { return s->state == Slot::Running; });
+    });
+  }
+  {
+    std::lock_guard<std::mutex> lock(pending_mutex_);
+    stopping_ = true;
+  }
+  pending_changed_.notify_all();
+  if (completion_.joinable()) completion_.join();
+  method_.reset();
+  gpu_.reset();
+}
+
+std::string Caster::device_name() const { return gpu_ ? gpu_->device_name() : "none"; }
+
+uint32_t Caster::validation_messages() const { return gpu_ ? gpu_->validation_messages() : 0; }
+
+Backend Caster::choose(uint32_t rays) const {
+  if (!gpu_available() || options_.backend == Backend::Cpu) return Backend::Cpu;
+  if (options_.backend == Backend::Vulkan) return Backend::Vulkan;
+  return rays >= crossover_ ? Backend::Vulkan : Backend::Cpu;
+}
+
+std::string Caster::why(uint32_t rays) const {
+  const std::string n = std::to_string(rays) + " rays: ";
+  if (options_.backend == Backend::Cpu) return n + "CPU, as the caster was made";
+  if (!gpu_available()) return n + "CPU, the GPU is unavailable (" + gpu_error() + ")";
+  if (options_.backend == Backend::Vulkan) return n + "Vulkan on " + device_name() + ", as the caster was made";
+  if (crossover_ == ~0u) return n + "CPU, the GPU finished no batch size first (" + crossover_note_ + ")";
+  return n + (rays >= crossover_ ? "Vulkan on " + device_name() + ", at or above" : "CPU, below") +
+         " the crossover of " + std::to_string(crossover_) + " rays (" + crossover_note_ + ")";
+}
+
+Ticket Caster::submit(std::span<const Ray> rays) {
+  Slot* s = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& slot : slots_)
+      if (slot->state == Slot::Free) {
+        s = slot.get();
+        break;
+      }
+    if (!s)
+      throw std::runtime_error("all " + std::to_string(slots_.size()) +
+                               " frames hold batches not yet collected; wait() for one before submitting more");
+    s->state = Slot::Running;
+    s->id = next_id_++;
+  }
+  s->submit_ms = now_ms();
+  s->n = uint32_t(rays.size());
+  s->rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+  s->hits.resize(s->n);
+  const Ticket t{s->id, s->index};
+  if (choose(s->n) == Backend::Vulkan && s->n > 0) {
+    try {
+      start_gpu(*s);
+      return t;
+    } catch (const gpu::GpuError& e) {
+      gpu_failed(e.what());
+    }
+  }
+  start_cpu(*s);
+  return t;
+}
+
+void Caster::start_cpu(Slot& s) {
+  s.ran_on = Backend::Cpu;
+  s.cpu_ns = 0;
+  if (s.n == 0) return complete(s, Backend::Cpu, 0);
+  // About four jobs a thread, so uneven rays even out; at least 64 rays a job.
+  const uint32_t per = std::max<uint32_t>(64, (s.n + 4 * jobs_->threads() - 1) / (4 * jobs_->threads()));
+  s.chunk = per, s.jobs = (s.n + per - 1) / per;
+  s.jobs_left = s.jobs;
+  jobs_->run(s.jobs, s.work);
+}
+
+void Caster::start_gpu(Slot& s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    std::lock_guard<std::mutex> lock(gpu_mutex_);
+    if (options_.before_gpu_submit) options_.before_gpu_submit();
+    method_->begin(s.index, s.rays);
+  }
+  s.ran_on = Backend::Vulkan;
+  s.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  {
+    std::lock_guard<std::mutex> lock(pending_mutex_);
+    pending_.push_back(&s);
+  }
+  pending_changed_.notify_one();
+}
+
+// The one thread that waits for GPU batches, in submission order, so each
+// batch's ready time is taken when its fence signals, not when the game
+// happens to ask. A failed wait (a lost device) moves the batch, and every
+// later one, to the CPU.
+void Caster::gpu_completions() {
+  for (;;) {
+    Slot* s = nullptr;
+    {
+      std::unique_lock<std::mutex> lock(pending_mutex_);
+      pending_changed_.wait(lock, [this] { return stopping_ || !pending_.empty(); });
+      if (pending_.empty()) return;
+      s = pending_.front();
+      pending_.pop_front();
+    }
+    try {
+      if (gpu_failed_) throw gpu::GpuError(gpu_error());
+      method_->wait(s->index);
+      complete(*s, Backend::Vulkan, 0);
+    } catch (const gpu::GpuError& e) {
+      gpu_failed(e.what());
+      start_cpu(*s);
+    }
+  }
+}
+
+void Caster::gpu_failed(const std::string& why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!gpu_failed_.exchange(true)) gpu_error_ = why;
+}
+
+void Caster::complete(Slot& s, Backend ran_on, double) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.ready_ms = now_ms();
+    s.ran_on = ran_on;
+    if (ran_on == Backend::Cpu) s.cpu_ms = double(s.cpu_ns.load()) * 1e-6;
+    s.state = Slot::Ready;
+    changed_.notify_all();  // under the lock: the waiter may destroy the caster once it is released
+  }
+}
+
+bool Caster::poll(const Ticket& t) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Slot& s = *slots_.at(t.slot);
+  if (s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting)
+    throw std::invalid_argument("ticket " + std::to_string(t.id) + " is unknown or already collected");
+  return s.state == Slot::Ready;
+}
+
+BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
+  Slot& s = *slots_.at(t.slot);
+  BatchRecord r;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting)
+      throw std::invalid_argument("ticket " + std::to_string(t.id) + " is unknown or already collected");
+    changed_.wait(lock, [&] { return s.state == Slot::Ready; });
+    s.state = Slot::Collecting;
+    r = {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
+  }
+  if (hits.size() < s.n)
+    throw std::invalid_argument("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
+  if (r.ran_on == Backend::Vulkan) {
+    std::lock_guard<std::mutex> lock(gpu_mutex_);
+    gpu::GpuTiming timing;
+    method_->finish(s.index, hits.first(s.n), &timing);  // straight from the mapped buffer
+    r.device_ms = timing.device_ms;
+  } else if (s.n) {
+    std::memcpy(hits.data(), s.hits.data(), s.n * sizeof(Hit));
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (records_.size() < kRecords) records_.push_back(r);
+    else records_[recorded_ % kRecords] = r;
+    ++recorded_;
+    s.state = Slot::Free;
+    changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
+  }
+  return r;
+}
+
+void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits) const { view_.trace(rays, hits); }
+
+std::vector<BatchRecord> Caster::records() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return records_;
+}
+
+void Caster::clear_records() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  records_.clear();
+  recorded_ = 0;
+}
+
+std::string Caster::gpu_error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return gpu_error_;
+}
+
+Percentiles Caster::percentiles(Backend b, uint32_t rays) const {
+  std::vector<double> latency;
+  double total_ms = 0, total_rays = 0;
+  for (const BatchRecord& r : records()) {
+    if (r.ran_on != b || (rays && r.rays != rays)) continue;
+    latency.push_back(r.latency_ms);
+    total_ms += r.latency_ms, total_rays += r.rays;
+  }
+  Percentiles p;
+  p.batches = latency.size();
+  if (latency.empty()) return p;
+  std::sort(latency.begin(), latency.end());
+  p.p50_ms = latency[(latency.size() - 1) / 2];
+  p.p99_ms = latency[std::min(latency.size() - 1, size_t(std::ceil(0.99 * double(latency.size()))) - 1)];
+  p.rays_per_second = total_ms > 0 ? total_rays / (total_ms * 1e-3) : 0;
+  return p;
+}
+
+// The crossover: the smallest measured batch size from which on the GPU
+// returned every size first (median of 3 batches a size and backend),
+// measured on rays aimed at the blob's box from around it; or read from
+// options.profile when that file names this device and blob.
+void Caster::measure_crossover() {
+  const layout::BlobHeader& h = layout::header_of(view_.bytes().data());
+  const std::string key = device_name() + " | " + std::string(layout::tree_format_name(h.tree_format)) + "/" +
+                          std::string(layout::triangle_format_name(h.triangle_format)) + " | " +
+                          std::to_string(h.triangle_count) + " triangles | " + std::to_string(h.checksum);
+  if (!options_.profile.empty()) {
+    std::ifstream in(options_.profile);
+    std::string magic, saved_key, note;
+    uint32_t crossover = 0;
+    if (std::getline(in, magic) && magic == "meshcast-profile 1" && std::getline(in, saved_key) && saved_key == key &&
+        in >> crossover && std::getline(in >> std::ws, note)) {
+      crossover_ = crossover;
+      crossover_note_ = note + ", loaded from " + options_.profile;
+      return;
+    }
+  }
+  std::vector<Ray> rays(16384);
+  uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto uniform = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return float(double(state >> 40) / double(1ull << 24));
+  };
+  float centre[3], extent = 0;
+  for (int a = 0; a < 3; ++a)
+    centre[a] = 0.5f * (h.bounds_min[a] + h.bounds_max[a]), extent = std::max(extent, h.bounds_max[a] - h.bounds_min[a]);
+  for (Ray& r : rays) {
+    for (int a = 0; a < 3; ++a) {
+      r.org[a] = centre[a] + extent * (2 * uniform() - 1);
+      r.dir[a] = h.bounds_min[a] + (h.bounds_max[a] - h.bounds_min[a]) * uniform() - r.org[a];
+    }
+    r.tmax = INFINITY;
+  }
+  std::vector<Hit> hits(rays.size());
+  const Backend chosen = options_.backend;
+  std::vector<uint32_t> sizes;
+  std::vector<double> cpu, gpu;
+  for (uint32_t n = 1; n <= rays.size(); n *= 4) {
+    sizes.push_back(n);
+    for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+      options_.backend = b;
+      std::vector<double> ms;
+      for (int k = 0; k < 3; ++k) ms.push_back(wait(submit(std::span<const Ray>(rays).first(n)), hits).latency_ms);
+      std::sort(ms.begin(), ms.end());
+      (b == Backend::Cpu ? cpu : gpu).push_back(ms[1]);
+    }
+  }
+  options_.backend = chosen;
+  clear_records();
+  if (!gpu_available()) return;
+  size_t first = sizes.size();
+  while (first > 0 && gpu[first - 1] < cpu[first - 1]) --first;
+  std::ostringstream note;
+  if (first < sizes.size()) {
+    crossover_ = sizes[first];
+    note << "at " << sizes[first] << " rays " << device_name() << " took " << gpu[first] << " ms, " << cpu_threads()
+         << " CPU threads " << cpu[first] << " ms";
+  } else {
+    note << "at " << sizes.back() << " rays " << device_name() << " took " << gpu.back() << " ms, " << cpu_threads()
+         << " CPU threads " << cpu.back() << " ms";
+  }
+  note << "; measured at start-up";
+  crossover_note_ = note.str();
+  if (!options_.profile.empty()) {
+    std::ofstream out(options_.profile);
+    out << "meshcast-profile 1\n" << key << "\n" << crossover_ << "\n" << crossover_note_ << "\n";
+  }
+}
+
+}  // namespace meshcast::host

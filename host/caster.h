@@ -1,0 +1,152 @@
+// The API a game calls (issue 6): ray batches submitted during one frame
+// and collected in a later one, from the CPU or the GPU, with the latency of
+// each batch measured, and answers right away for the few rays that cannot
+// wait.
+//
+//   Caster caster(blob, "level", {});           // automatic backend
+//   Ticket t = caster.submit(rays);             // returns at once
+//   ... a frame later ...
+//   caster.wait(t, hits);                       // or poll(t) first
+//   caster.trace_now(one_ray, one_hit);         // synchronous, this thread
+//
+// A caster owns a ring of `frames` slots; each submitted batch holds one
+// until it is collected with wait(). Slot buffers (rays, hits, the GPU's
+// mapped buffers, the recorded command buffers) are reused, so after the
+// first batches of a size nothing is allocated per frame. Every method may
+// be called from several threads at once; the blob is only ever read.
+#pragma once
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cpu/ray.h"
+#include "cpu/trace.h"
+#include "host/jobs.h"
+
+namespace meshcast::gpu {
+class Context;
+class Method;
+}
+
+namespace meshcast::host {
+
+enum class Backend { Cpu, Vulkan, Automatic };
+const char* backend_name(Backend b);
+
+struct Ticket {
+  uint64_t id = 0;
+  uint32_t slot = 0;
+};
+
+// What one batch cost. latency: submit() to the moment the hits were ready
+// (for the GPU, the fence; for the CPU, the last job's end). device: the
+// GPU's own time between its timestamps. cpu: the CPU time the batch took,
+// the workers' summed time for a CPU batch, packing and submitting for a GPU
+// batch.
+struct BatchRecord {
+  Backend ran_on = Backend::Cpu;
+  uint32_t rays = 0;
+  double latency_ms = 0, device_ms = 0, cpu_ms = 0;
+};
+
+struct Percentiles {
+  size_t batches = 0;
+  double p50_ms = 0, p99_ms = 0, rays_per_second = 0;
+};
+
+struct CasterOptions {
+  Backend backend = Backend::Automatic;
+  uint32_t frames = 4;          // batches in flight at most
+  uint32_t threads = 0;         // CPU workers (0: every core), unless `jobs` is given
+  JobSystem* jobs = nullptr;    // an engine's job system (not owned) instead of meshcast's pool
+  std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
+  std::string gpu_method;       // "" : the one that reads the blob's layout
+  bool validation = false;      // Vulkan validation layers
+  std::string profile;          // file with a saved crossover; measured and written when absent
+  // Test hook: called before every GPU submission; throwing GpuError there
+  // acts as a lost device.
+  std::function<void()> before_gpu_submit;
+};
+
+class Caster {
+ public:
+  // Validates the blob (InputError naming `name`); the caster reads the
+  // caller's bytes, which must outlive it. With Backend::Vulkan or
+  // Automatic, a device that is missing or fails leaves the caster on the
+  // CPU, and gpu_error() says why.
+  Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options = {});
+  ~Caster();
+  Caster(const Caster&) = delete;
+  Caster& operator=(const Caster&) = delete;
+
+  // Copies the rays and starts the batch; returns at once. Throws
+  // std::runtime_error when all `frames` slots hold uncollected batches.
+  Ticket submit(std::span<const Ray> rays);
+  bool poll(const Ticket& t);
+  // Blocks until ready, copies the hits into `hits` (at least the batch's
+  // size) and frees the slot; returns that batch's record.
+  BatchRecord wait(const Ticket& t, std::span<Hit> hits);
+  // The calling thread walks the rays now (the CPU walker, no pool).
+  void trace_now(std::span<const Ray> rays, std::span<Hit> hits) const;
+
+  // Where a batch of `rays` would go now, and why in a sentence.
+  Backend choose(uint32_t rays) const;
+  std::string why(uint32_t rays) const;
+  uint32_t crossover() const { return crossover_; }  // GPU from this batch size on (~0u: never)
+  bool gpu_available() const { return method_ != nullptr && !gpu_failed_.load(); }
+  std::string gpu_error() const;
+  std::string device_name() const;
+  // Messages from the Vulkan validation layers so far (options.validation).
+  uint32_t validation_messages() const;
+  uint32_t cpu_threads() const { return jobs_->threads(); }
+
+  // Latency percentiles and throughput of the collected batches of one
+  // backend (all sizes together), or of one batch size.
+  Percentiles percentiles(Backend b, uint32_t rays = 0) const;
+  std::vector<BatchRecord> records() const;
+  void clear_records();
+
+ private:
+  struct Slot;
+  void start_cpu(Slot& s);
+  void start_gpu(Slot& s);
+  void complete(Slot& s, Backend ran_on, double device_ms);
+  void gpu_completions();
+  void gpu_failed(const std::string& why);
+  void measure_crossover();
+
+  BlobView view_;  // the caller's blob, which must outlive the caster
+  CasterOptions options_;
+  std::unique_ptr<WorkerPool> pool_;
+  JobSystem* jobs_ = nullptr;
+  std::unique_ptr<gpu::Context> gpu_;
+  std::unique_ptr<gpu::Method> method_;
+  std::string gpu_error_;
+  std::atomic<bool> gpu_failed_{false};
+  uint32_t crossover_ = ~0u;
+  std::string crossover_note_;
+
+  mutable std::mutex mutex_;            // slots and records
+  std::mutex gpu_mutex_;                // the GPU method's begin and finish
+  std::condition_variable changed_;     // a slot became ready
+  std::vector<std::unique_ptr<Slot>> slots_;
+  uint64_t next_id_ = 1;
+  std::vector<BatchRecord> records_;
+  uint64_t recorded_ = 0;
+
+  std::mutex pending_mutex_;            // GPU batches waiting for their fence, in order
+  std::condition_variable pending_changed_;
+  std::deque<Slot*> pending_;
+  bool stopping_ = false;
+  std::thread completion_;
+};
+
+}  // namespace meshcast::host

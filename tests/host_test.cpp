@@ -1,0 +1,249 @@
+// The host layer (host/): batches submitted now and collected later agree
+// with the synchronous CPU walk on every layout the GPU reads, frames in
+// flight never mix, a missing or lost device leaves the CPU answering, and
+// several threads submitting at once get their own answers (this suite also
+// runs under ThreadSanitizer in scripts/test.sh).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "gpu/vulkan.h"
+#include "host/caster.h"
+#include "io/generate.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+using host::Backend;
+using host::Caster;
+using host::CasterOptions;
+
+// $MESHCAST_HOST_CPU_ONLY=1 (the ThreadSanitizer job) keeps Vulkan out:
+// the software device's own threads are not instrumented.
+bool cpu_only() { return std::getenv("MESHCAST_HOST_CPU_ONLY") != nullptr; }
+
+CasterOptions options(Backend b, uint32_t frames = 4) {
+  CasterOptions o;
+  o.backend = b, o.frames = frames, o.validation = true;
+  return o;
+}
+
+// Same triangle as the synchronous CPU walk, t within 1e-6 relative; a
+// different triangle only at exactly the same t.
+void expect_same(const std::vector<Hit>& got, const std::vector<Hit>& cpu, const std::string& what) {
+  size_t differ = 0, hits = 0;
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    hits += cpu[i].triangle != MC_NO_HIT;
+    if (got[i].triangle != cpu[i].triangle && got[i].t == cpu[i].t) continue;
+    bool t_ok = cpu[i].triangle == MC_NO_HIT || std::fabs(got[i].t - cpu[i].t) <= 1e-6 * std::fabs(cpu[i].t);
+    if (got[i].triangle != cpu[i].triangle || !t_ok) ++differ;
+  }
+  EXPECT_EQ(differ, 0u) << what;
+  EXPECT_GT(hits, cpu.size() / 20) << what << ": a ray set that never hits proves nothing";
+}
+
+std::vector<Hit> sync_cpu(const Caster& c, const std::vector<Ray>& rays) {
+  std::vector<Hit> hits(rays.size());
+  c.trace_now(rays, hits);
+  return hits;
+}
+
+const char* const kGpuLayouts[] = {"BruteForce/Float3SOA128", "AABBList/BitPackSOA128", "AABBTree/Float3",
+                                   "AABBTree/UncompressedStrip", "SKDTree/Float3", "StacklessLBVH/Float3",
+                                   "QuadTreeHalfFloat/Indexed8BitPackSOA4"};
+
+TEST(Host, SubmitWaitEqualsTheSynchronousCpuOnEveryGpuLayout) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  Mesh m = make_terrain(96, 64, 3);
+  NamedMesh named{"terrain_12k", std::make_shared<const Mesh>(m)};
+  for (const char* layout : kGpuLayouts) {
+    std::vector<uint8_t> blob = build_blob(m, parse_layout(layout), "terrain");
+    for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+      Caster caster(blob, "terrain", options(b));
+      ASSERT_TRUE(b == Backend::Cpu || caster.gpu_available()) << caster.gpu_error();
+      std::vector<host::Ticket> tickets;
+      std::vector<const std::vector<Ray>*> sets;
+      for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
+        sets.push_back(&test_rays(named, kind, 2000));
+        tickets.push_back(caster.submit(*sets.back()));  // three frames in flight
+      }
+      for (size_t k = 0; k < tickets.size(); ++k) {
+        std::vector<Hit> hits(sets[k]->size());
+        host::BatchRecord r = caster.wait(tickets[k], hits);
+        EXPECT_EQ(r.ran_on, b);
+        EXPECT_EQ(r.rays, sets[k]->size());
+        EXPECT_GT(r.latency_ms, 0.0);
+        expect_same(hits, sync_cpu(caster, *sets[k]), std::string(layout) + " on " + host::backend_name(b));
+      }
+      // Again, now that the command buffers are recorded: resubmitted as they are.
+      for (size_t k = 0; k < sets.size(); ++k) tickets[k] = caster.submit(*sets[k]);
+      for (size_t k = 0; k < sets.size(); ++k) {
+        std::vector<Hit> hits(sets[k]->size());
+        caster.wait(tickets[k], hits);
+        expect_same(hits, sync_cpu(caster, *sets[k]), std::string(layout) + " resubmitted");
+      }
+      EXPECT_EQ(caster.validation_messages(), 0u);
+    }
+  }
+}
+
+// Eight frames of different sizes and rays, collected in reverse order.
+TEST(Host, FramesInFlightNeverMix) {
+  Mesh m = make_sphere(24, 48, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
+  for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+    if (b == Backend::Vulkan && cpu_only()) continue;
+    Caster caster(blob, "sphere", options(b, 8));
+    std::vector<std::vector<Ray>> frames;
+    std::vector<host::Ticket> tickets;
+    for (uint32_t f = 0; f < 8; ++f) {
+      frames.push_back(make_rays(m, f % 2 ? RayKind::Radial : RayKind::Long, 100 + 300 * f, 40 + f));
+      tickets.push_back(caster.submit(frames.back()));
+    }
+    EXPECT_THROW(caster.submit(frames[0]), std::runtime_error);  // all eight frames are taken
+    for (uint32_t f = 8; f-- > 0;) {
+      std::vector<Hit> hits(frames[f].size());
+      caster.wait(tickets[f], hits);
+      expect_same(hits, sync_cpu(caster, frames[f]), "frame " + std::to_string(f));
+      EXPECT_THROW(caster.wait(tickets[f], hits), std::invalid_argument);  // collected once
+    }
+    EXPECT_EQ(caster.validation_messages(), 0u);
+  }
+}
+
+TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
+  Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  CasterOptions o = options(Backend::Vulkan);
+  o.device = "no such device";
+  Caster caster(blob, "sphere", o);
+  EXPECT_FALSE(caster.gpu_available());
+  EXPECT_NE(caster.gpu_error().find("no such device"), std::string::npos) << caster.gpu_error();
+  EXPECT_NE(caster.why(100).find("unavailable"), std::string::npos) << caster.why(100);
+  std::vector<Ray> rays = make_rays(m, RayKind::Long, 500, 3);
+  std::vector<Hit> hits(rays.size());
+  EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
+  expect_same(hits, sync_cpu(caster, rays), "after a missing device");
+}
+
+TEST(Host, ALostDeviceMovesTheBatchesToTheCpu) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  CasterOptions o = options(Backend::Vulkan);
+  int submissions = 0;
+  o.before_gpu_submit = [&] {
+    if (++submissions > 1) throw gpu::GpuError("Vulkan: device lost (injected by the test)");
+  };
+  Caster caster(blob, "sphere", o);
+  std::vector<Ray> rays = make_rays(m, RayKind::Radial, 500, 5);
+  std::vector<Hit> hits(rays.size());
+  EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Vulkan);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
+    expect_same(hits, sync_cpu(caster, rays), "after a lost device");
+  }
+  EXPECT_FALSE(caster.gpu_available());
+  EXPECT_NE(caster.gpu_error().find("device lost"), std::string::npos) << caster.gpu_error();
+}
+
+// Four threads, each with rays of its own, submitting and collecting at once.
+TEST(Host, ThreadsSubmittingAtOnceGetTheirOwnAnswers) {
+  Mesh m = make_terrain(64, 64, 9);
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "terrain");
+  for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+    if (b == Backend::Vulkan && cpu_only()) continue;
+    Caster caster(blob, "terrain", options(b, 8));
+    std::vector<std::vector<Ray>> rays;
+    std::vector<std::vector<Hit>> expected;
+    for (uint32_t t = 0; t < 4; ++t) {
+      rays.push_back(make_rays(m, RayKind::Radial, 300 + 100 * t, 100 + t));
+      expected.push_back(sync_cpu(caster, rays.back()));
+    }
+    std::vector<size_t> wrong(4, 0);
+    std::vector<std::thread> threads;
+    for (uint32_t t = 0; t < 4; ++t)
+      threads.emplace_back([&, t] {
+        std::vector<Hit> hits(rays[t].size());
+        for (int k = 0; k < 20; ++k) {
+          host::Ticket ticket = caster.submit(rays[t]);
+          caster.wait(ticket, hits);
+          for (size_t i = 0; i < hits.size(); ++i) wrong[t] += hits[i].triangle != expected[t][i].triangle && hits[i].t != expected[t][i].t;
+        }
+      });
+    for (std::thread& th : threads) th.join();
+    for (uint32_t t = 0; t < 4; ++t) EXPECT_EQ(wrong[t], 0u) << host::backend_name(b) << " thread " << t;
+    EXPECT_EQ(caster.percentiles(b).batches, 80u);
+  }
+}
+
+// An engine's job system: here every run goes to a thread of its own, and
+// the calls are counted.
+class CountingJobs : public host::JobSystem {
+ public:
+  void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
+    runs += 1;
+    threads_.emplace_back([count, &work] {
+      for (uint32_t i = 0; i < count; ++i) work(i);
+    });
+  }
+  uint32_t threads() const override { return 3; }
+  ~CountingJobs() override {
+    for (std::thread& t : threads_) t.join();
+  }
+  std::atomic<int> runs{0};
+
+ private:
+  std::vector<std::thread> threads_;
+};
+
+TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
+  Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3SOA4"), "sphere");
+  CountingJobs jobs;
+  CasterOptions o = options(Backend::Cpu);
+  o.jobs = &jobs;
+  {
+    Caster caster(blob, "sphere", o);
+    EXPECT_EQ(caster.cpu_threads(), 3u);
+    std::vector<Ray> rays = make_rays(m, RayKind::Long, 3000, 8);
+    std::vector<Hit> hits(rays.size());
+    caster.wait(caster.submit(rays), hits);
+    expect_same(hits, sync_cpu(caster, rays), "on the engine's jobs");
+  }
+  EXPECT_EQ(jobs.runs.load(), 1);
+}
+
+// The automatic backend measures the crossover once, writes it to the
+// profile, and the next caster on the same device and blob reads it back.
+TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  Mesh m = make_sphere(24, 48, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
+  const std::string profile = (std::filesystem::temp_directory_path() / "meshcast_host_test.profile").string();
+  std::filesystem::remove(profile);
+  CasterOptions o = options(Backend::Automatic);
+  o.profile = profile;
+  uint32_t crossover;
+  {
+    Caster caster(blob, "sphere", o);
+    ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    crossover = caster.crossover();
+    EXPECT_NE(caster.why(1).find("measured at start-up"), std::string::npos) << caster.why(1);
+    for (uint32_t n : {1u, 64u, 4096u, 1u << 20})
+      EXPECT_EQ(caster.choose(n), n >= crossover ? Backend::Vulkan : Backend::Cpu) << n;
+    EXPECT_TRUE(caster.records().empty());  // the measurement's batches are not the game's
+  }
+  ASSERT_TRUE(std::filesystem::exists(profile));
+  Caster again(blob, "sphere", o);
+  EXPECT_EQ(again.crossover(), crossover);
+  EXPECT_NE(again.why(1).find("loaded from"), std::string::npos) << again.why(1);
+  std::filesystem::remove(profile);
+}
+
+}  // namespace
+}  // namespace meshcast::testing

@@ -6,7 +6,8 @@
 namespace meshcast::bench {
 
 std::string plot_scatter(const std::string& png, const std::string& title, const std::string& xlabel,
-                         const std::string& ylabel, const std::vector<Series>& series, bool log_y, bool log_x) {
+                         const std::string& ylabel, const std::vector<Series>& series, bool log_y, bool log_x,
+                         bool lines) {
   std::string script = png + ".gp";
   std::ofstream gp(script);
   size_t points = 0;
@@ -21,7 +22,7 @@ std::string plot_scatter(const std::string& png, const std::string& title, const
      << (log_x || log_y ? "set autoscale fix\n" : "") << "plot ";
   for (size_t s = 0; s < series.size(); ++s) {
     if (s) gp << ", ";
-    gp << "'-' using 1:2 with points pt 7 ps 1.2 lc " << s + 1 << " title '" << series[s].title
+    gp << "'-' using 1:2 with " << (lines ? "linespoints" : "points") << " pt 7 ps 1.2 lc " << s + 1 << " title '" << series[s].title
        << "', '-' using 1:2:3 with labels offset 0.8,0.4 left font 'sans,7' tc lt " << s + 1 << " notitle";
   }
   gp << "\n";

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: the Release build, then the corrupted-blob and
-# robustness suites under AddressSanitizer/UBSan, then the portable scalar
-# build (MESHCAST_SCALAR) through the same tests.
+# robustness suites under AddressSanitizer/UBSan, the host layer under
+# ThreadSanitizer, then the portable scalar build (MESHCAST_SCALAR) through
+# the same tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -14,6 +15,13 @@ echo "== AddressSanitizer + UBSan: corrupted blobs, robustness corpus"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$jobs" --target layout_test robustness_test
 ctest --test-dir build-asan --output-on-failure -j"$jobs" --timeout 900 -R "Blob|Robustness|Half|BitPack|Corruption"
+
+echo "== ThreadSanitizer: the host layer, several threads submitting at once (CPU backend)"
+# Vulkan stays out ($MESHCAST_HOST_CPU_ONLY): lavapipe's own threads are not
+# instrumented, so TSan could not see their synchronisation.
+cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_TSAN=ON >/dev/null
+cmake --build build-tsan -j"$jobs" --target host_test
+MESHCAST_HOST_CPU_ONLY=1 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 
 echo "== Portable scalar path"
 cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON >/dev/null

@@ -5,6 +5,7 @@
 
 #include "bench/encodings.h"
 #include "bench/gpu.h"
+#include "bench/latency.h"
 #include "bench/plot.h"
 #include "bench/trees.h"
 #include "io/generate.h"
@@ -169,6 +170,54 @@ void add_bench(CLI::App& app) {
       std::printf("| %s | %s | %s | %.3f | %.2f | %s | %llu |\n", r.method.c_str(), r.layout.c_str(),
                   r.device_us > 0 ? std::to_string(r.device_us).substr(0, std::to_string(r.device_us).find('.') + 4).c_str() : "-",
                   r.wall_us, r.bytes, r.seed.empty() ? "-" : r.seed.c_str(), (unsigned long long)r.disagreements);
+  });
+
+  // Issue 6: the host layer's latency against batch size, CPU and Vulkan.
+  auto largs = std::make_shared<ArgsT>();
+  auto lopts = std::make_shared<std::pair<std::string, double>>("", 16.7);  // device, frame ms
+  CLI::App* lat = bench->add_subcommand("latency", "the host layer: batch latency from 1 to 65,536 rays, CPU and Vulkan");
+  lat->add_option("mesh", largs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
+  lat->add_option("--device", lopts->first, "Vulkan device: index or part of its name");
+  lat->add_option("--frame-ms", lopts->second, "the frame of other work in the frame-ahead columns")->check(CLI::Range(0.0, 1000.0));
+  lat->add_option("--out-dir", largs->out_dir, "where the CSV and the plot go");
+  lat->callback([largs, lopts] {
+    Mesh mesh = bench_mesh(largs->input);
+    bench::LatencyResult res = bench::bench_latency(mesh, largs->input, lopts->second, lopts->first);
+    std::printf("\n%s, %zu triangles, %s, long rays; Vulkan device: %s%s; CPU: %u threads\n"
+                "latency: submit() until the hits are ready, back to back; frame ahead: submit, %.1f ms of other work "
+                "on the submitting thread, collect (10 frames)\n\n"
+                "| backend | batch | batches | p50 ms | p99 ms | rays/s | GPU device ms | frame ahead: ready | frame ahead rays/s |\n"
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+                largs->input.c_str(), mesh.triangles.size(), res.layout.c_str(), res.device.c_str(),
+                res.gpu_error.empty() ? "" : (" (" + res.gpu_error + ")").c_str(), res.threads, lopts->second);
+    std::filesystem::create_directories(largs->out_dir);
+    std::string stem = largs->out_dir + "/latency" + (largs->input == "terrain_2M" ? "_terrain_2M" : "");
+    std::ofstream csv(stem + ".csv");
+    csv << "backend,batch,batches,p50_ms,p99_ms,rays_per_second,device_ms,frame_ahead_ready,frame_ahead_rays_per_second\n";
+    std::vector<bench::Series> series;
+    double lo = 1e30, hi = 0;
+    for (const bench::LatencyRow& r : res.rows) {
+      std::printf("| %s | %u | %u | %.3f | %.3f | %.3g | %s | %.0f%% | %.3g |\n", r.backend.c_str(), r.batch, r.batches,
+                  r.p50_ms, r.p99_ms, r.rays_per_second, r.device_ms > 0 ? std::to_string(r.device_ms).substr(0, 6).c_str() : "-",
+                  100 * r.ready_share, r.ahead_rays_per_second);
+      csv << r.backend << "," << r.batch << "," << r.batches << "," << r.p50_ms << "," << r.p99_ms << "," << r.rays_per_second
+          << "," << r.device_ms << "," << r.ready_share << "," << r.ahead_rays_per_second << "\n";
+      if (series.empty() || series.back().title != r.backend) series.push_back({r.backend, {}});
+      series.back().points.push_back({double(r.batch), r.p50_ms, ""});
+      lo = std::min(lo, r.p50_ms), hi = std::max(hi, r.p99_ms);
+    }
+    std::printf("\ncrossover (automatic backend, measured at its start-up): %s\n  %s\n  %s\n",
+                res.crossover == ~0u ? "none, the CPU finished every size first" : (std::to_string(res.crossover) + " rays").c_str(),
+                res.why_small.c_str(), res.why_large.c_str());
+    if (res.crossover != ~0u)
+      series.push_back({"crossover (" + std::to_string(res.crossover) + " rays)",
+                        {{double(res.crossover), lo, "crossover"}, {double(res.crossover), hi, ""}}});
+    std::string png = stem + ".png";
+    const std::string title = "batch latency (p50) on " + largs->input + ", Vulkan device: " + res.device +
+                              (res.crossover == ~0u ? " (no crossover: the CPU first at every size)" : "");
+    std::string why = bench::plot_scatter(png, title,
+                                          "rays in the batch", "milliseconds, submit to ready", series, true, true, true);
+    std::printf("csv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
 
   // Issue 4's offset test for the half-float tree.

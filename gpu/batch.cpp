@@ -51,16 +51,20 @@ BatchMethod::~BatchMethod() {
 
 std::vector<const Buffer*> BatchMethod::buffers(uint32_t slot) const {
   const Slot& s = slots_[slot];
-  return {&*blob_, &*s.rays, &*s.keys, &*s.hits};
+  return {&*blob_, s.rays.get(), s.keys.get(), s.hits.get()};
 }
 
 void BatchMethod::reserve(uint32_t slot, uint32_t n) {
   Slot& s = slots_[slot];
   if (s.capacity >= n) return;
-  s.capacity = std::max<uint32_t>(n, 1024);
-  s.rays.emplace(ctx_, uint64_t(s.capacity) * kRayWords * 4, "ray buffer");
-  s.keys.emplace(ctx_, uint64_t(s.capacity) * 8, "key buffer");
-  s.hits.emplace(ctx_, uint64_t(s.capacity) * sizeof(Hit), "hit buffer");
+  // All three made before any is replaced: a refusal (a limit, memory)
+  // leaves the slot as it was.
+  const uint32_t capacity = std::max<uint32_t>(n, 1024);
+  auto rays = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * kRayWords * 4, "ray buffer");
+  auto keys = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * 8, "key buffer");
+  auto hits = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * sizeof(Hit), "hit buffer");
+  s.rays = std::move(rays), s.keys = std::move(keys), s.hits = std::move(hits);
+  s.capacity = capacity;
   s.recorded = 0;  // the command buffer names the old buffers
   bind_all(slot);
 }
@@ -88,6 +92,11 @@ uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
       vkCmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
     }
     record(s.cb, slot, s.n);
+    // The hits (mapped memory) made visible to the host that reads them after the fence.
+    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(s.cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr,
+                         0, nullptr);
     if (s.queries) vkCmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
     check(vkEndCommandBuffer(s.cb), "vkEndCommandBuffer");
     s.recorded = s.n;
@@ -115,8 +124,8 @@ void BatchMethod::wait(uint32_t slot) {
 void BatchMethod::finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) {
   Slot& s = slots_.at(slot);
   if (s.in_flight) {
-    s.in_flight = false;
     check(vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
+    s.in_flight = false;  // only once done: a failed wait leaves the destructor to wait again
   }
   if (s.n) std::memcpy(hits.data(), s.hits->data(), uint64_t(std::min<size_t>(s.n, hits.size())) * sizeof(Hit));
   if (timing) {

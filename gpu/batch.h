@@ -50,7 +50,7 @@ class BatchMethod : public Method {
 
  private:
   struct Slot {
-    std::optional<Buffer> rays, keys, hits;
+    std::unique_ptr<Buffer> rays, keys, hits;
     uint32_t capacity = 0, recorded = 0, n = 0;  // recorded: the batch size its command buffer holds
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;

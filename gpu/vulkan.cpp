@@ -43,7 +43,8 @@ bool has_layer(const char* name) {
 }  // namespace
 
 void check(VkResult r, const char* what) {
-  if (r != VK_SUCCESS) throw GpuError(std::string("Vulkan: ") + what + " failed (" + result_name(r) + ")");
+  if (r != VK_SUCCESS)
+    throw GpuError(std::string("Vulkan: ") + what + " failed (" + result_name(r) + ")", r == VK_ERROR_DEVICE_LOST);
 }
 
 VKAPI_ATTR VkBool32 VKAPI_CALL Context::on_message(VkDebugUtilsMessageSeverityFlagBitsEXT,

@@ -16,8 +16,11 @@ namespace meshcast::gpu {
 
 // No Vulkan, no device, or a Vulkan call that failed: the message says which
 // and why. The CPU path never needs the GPU.
+// lost: the device is gone (VK_ERROR_DEVICE_LOST); other errors (a
+// buffer beyond a limit, memory) concern one request and leave it usable.
 struct GpuError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit GpuError(const std::string& what, bool lost = false) : std::runtime_error(what), lost(lost) {}
+  bool lost;
 };
 
 struct DeviceChoice {

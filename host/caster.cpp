@@ -99,7 +99,14 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
       gpu_error_ = e.what();
     }
   }
-  if (options_.backend == Backend::Automatic && gpu_available()) measure_crossover();
+  if (options_.backend == Backend::Automatic && gpu_available()) {
+    try {
+      measure_crossover();
+    } catch (const std::exception& e) {  // the GPU failed while measured: the CPU it is
+      options_.backend = Backend::Automatic;
+      gpu_failed(std::string("measuring the crossover: ") + e.what());
+    }
+  }
 }
 
 Caster::~Caster() {
@@ -155,20 +162,29 @@ Ticket Caster::submit(std::span<const Ray> rays) {
     s->state = Slot::Running;
     s->id = next_id_++;
   }
-  s->submit_ms = now_ms();
-  s->n = uint32_t(rays.size());
-  s->rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-  s->hits.resize(s->n);
   const Ticket t{s->id, s->index};
-  if (choose(s->n) == Backend::Vulkan && s->n > 0) {
-    try {
-      start_gpu(*s);
-      return t;
-    } catch (const gpu::GpuError& e) {
-      gpu_failed(e.what());
+  try {
+    s->submit_ms = now_ms();
+    s->n = uint32_t(rays.size());
+    s->rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+    s->hits.resize(s->n);
+    if (choose(s->n) == Backend::Vulkan && s->n > 0) {
+      try {
+        start_gpu(*s);
+        return t;
+      } catch (const gpu::GpuError& e) {
+        // A lost device is given up; any other refusal (a batch beyond a
+        // buffer limit, memory) sends just this batch to the CPU.
+        if (e.lost) gpu_failed(e.what());
+      }
     }
+    start_cpu(*s);
+  } catch (...) {  // nothing started: the slot is free again
+    std::lock_guard<std::mutex> lock(mutex_);
+    s->state = Slot::Free;
+    changed_.notify_all();
+    throw;
   }
-  start_cpu(*s);
   return t;
 }
 
@@ -217,7 +233,7 @@ void Caster::gpu_completions() {
       if (gpu_failed_) throw gpu::GpuError(gpu_error());
       method_->wait(s->index);
       complete(*s, Backend::Vulkan, 0);
-    } catch (const gpu::GpuError& e) {
+    } catch (const gpu::GpuError& e) {  // waiting failed: the device is lost
       gpu_failed(e.what());
       start_cpu(*s);
     }
@@ -253,20 +269,32 @@ BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
   BatchRecord r;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    if (s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting)
-      throw std::invalid_argument("ticket " + std::to_string(t.id) + " is unknown or already collected");
-    changed_.wait(lock, [&] { return s.state == Slot::Ready; });
+    auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
+    if (gone()) throw std::invalid_argument("ticket " + std::to_string(t.id) + " is unknown or already collected");
+    if (hits.size() < s.n)
+      throw std::invalid_argument("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
+    // Another thread may collect the same ticket first: then this one throws.
+    changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
+    if (gone()) throw std::invalid_argument("ticket " + std::to_string(t.id) + " was collected by another thread");
     s.state = Slot::Collecting;
     r = {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
   }
-  if (hits.size() < s.n)
-    throw std::invalid_argument("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
+  bool copied = false;
   if (r.ran_on == Backend::Vulkan) {
-    std::lock_guard<std::mutex> lock(gpu_mutex_);
-    gpu::GpuTiming timing;
-    method_->finish(s.index, hits.first(s.n), &timing);  // straight from the mapped buffer
-    r.device_ms = timing.device_ms;
-  } else if (s.n) {
+    try {
+      std::lock_guard<std::mutex> lock(gpu_mutex_);
+      gpu::GpuTiming timing;
+      method_->finish(s.index, hits.first(s.n), &timing);  // straight from the mapped buffer
+      r.device_ms = timing.device_ms;
+      copied = true;
+    } catch (const gpu::GpuError& e) {  // the device went while reading back: the CPU answers
+      gpu_failed(e.what());
+      view_.trace(s.rays, hits.first(s.n));
+      r.ran_on = Backend::Cpu;
+      copied = true;
+    }
+  }
+  if (!copied && s.n) {
     std::memcpy(hits.data(), s.hits.data(), s.n * sizeof(Hit));
   }
   {

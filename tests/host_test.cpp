@@ -130,6 +130,27 @@ TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
   expect_same(hits, sync_cpu(caster, rays), "after a missing device");
 }
 
+// A refusal that is not a lost device (a batch beyond a buffer limit,
+// memory) sends that one batch to the CPU and keeps the GPU.
+TEST(Host, ARefusedBatchGoesToTheCpuAndTheGpuStays) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  CasterOptions o = options(Backend::Vulkan);
+  int submissions = 0;
+  o.before_gpu_submit = [&] {
+    if (++submissions == 2) throw gpu::GpuError("Vulkan: the ray buffer exceeds a limit (injected by the test)");
+  };
+  Caster caster(blob, "sphere", o);
+  std::vector<Ray> rays = make_rays(m, RayKind::Radial, 500, 5);
+  std::vector<Hit> hits(rays.size());
+  EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Vulkan);
+  EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
+  expect_same(hits, sync_cpu(caster, rays), "the refused batch");
+  EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Vulkan);
+  EXPECT_TRUE(caster.gpu_available());
+}
+
 TEST(Host, ALostDeviceMovesTheBatchesToTheCpu) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
   Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
@@ -137,7 +158,7 @@ TEST(Host, ALostDeviceMovesTheBatchesToTheCpu) {
   CasterOptions o = options(Backend::Vulkan);
   int submissions = 0;
   o.before_gpu_submit = [&] {
-    if (++submissions > 1) throw gpu::GpuError("Vulkan: device lost (injected by the test)");
+    if (++submissions > 1) throw gpu::GpuError("Vulkan: device lost (injected by the test)", true);
   };
   Caster caster(blob, "sphere", o);
   std::vector<Ray> rays = make_rays(m, RayKind::Radial, 500, 5);

@@ -22,8 +22,8 @@ using host::Backend;
 using host::Caster;
 using host::CasterOptions;
 
-// $MESHCAST_HOST_CPU_ONLY=1 (the ThreadSanitizer job) keeps Vulkan out:
-// the software device's own threads are not instrumented.
+// $MESHCAST_HOST_CPU_ONLY=1 keeps Vulkan out (for a ThreadSanitizer run
+// on a driver whose own threads make it report what it cannot see).
 bool cpu_only() { return std::getenv("MESHCAST_HOST_CPU_ONLY") != nullptr; }
 
 CasterOptions options(Backend b, uint32_t frames = 4) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cpu/mesh.h"
+#include "layout/formats.h"
 
 namespace meshcast {
 
@@ -34,10 +35,18 @@ enum class Splitter { Binning, LongestAxis, Mean, Morton, FixedLeafSize };
 // SAH over 32 binned centres per axis (Günther et al. 2007).
 // `depth_limit`: nodes at that depth become leaves whatever their count
 // (StacklessLBVH's D - 1); InputError when such a leaf would exceed
-// MC_QUAD_MAX_COUNT triangles.
-BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit = ~0u);
+// `leaf_capacity` primitives (MC_QUAD_MAX_COUNT triangles; fewer when a
+// primitive is a group of triangles, as a pair of seed 003).
+BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit = ~0u,
+                        uint32_t leaf_capacity = MC_QUAD_MAX_COUNT);
 BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size,
-                     uint32_t depth_limit = ~0u);
+                     uint32_t depth_limit = ~0u, uint32_t leaf_capacity = MC_QUAD_MAX_COUNT);
+
+// A tree built over groups of triangles (FixedLeafSize's runs of 4, seed
+// 003's pairs) back to triangles: group k is members[start[k] .. start[k+1]),
+// each position of g.order expands to its group's members, so a group stays
+// whole in one leaf.
+BuildTree expand_groups(const BuildTree& g, const std::vector<uint32_t>& members, const std::vector<uint32_t>& start);
 
 // The option value among `all` whose name_of() matches `name`,
 // case-insensitive; else InputError naming `what` and listing the valid ones.

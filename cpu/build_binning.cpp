@@ -73,10 +73,10 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
   return uint32_t(mid - begin);
 }
 
-BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit) {
+BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit, uint32_t leaf_capacity) {
   std::vector<Vec3> centres = box_centres(boxes);
   BinningSplit split{boxes, centres};
-  return TopDown<BinningSplit>{boxes, centres, std::max(1u, leaf_size), split, {}, depth_limit}.run();
+  return TopDown<BinningSplit>{boxes, centres, std::max(1u, leaf_size), split, {}, depth_limit, leaf_capacity}.run();
 }
 
 }  // namespace meshcast

@@ -94,68 +94,71 @@ struct MortonSplit {
   }
 };
 
-// FixedLeafSize: groups of 4 consecutive triangles in Morton order become
+// FixedLeafSize: groups of 4 consecutive primitives in Morton order become
 // the primitives of a Binning build with leaves of leaf_size / 4 groups.
 BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vector<Vec3>& centres, uint32_t leaf,
-                                uint32_t depth_limit) {
+                                uint32_t depth_limit, uint32_t leaf_capacity) {
   constexpr uint32_t kGroup = 4;
-  std::vector<uint32_t> order = morton_order(morton_codes(centres));
-  size_t groups = (order.size() + kGroup - 1) / kGroup;
+  std::vector<uint32_t> members = morton_order(morton_codes(centres));
+  const uint32_t groups = uint32_t((members.size() + kGroup - 1) / kGroup);
+  std::vector<uint32_t> start(groups + 1);
   std::vector<Box3> group_boxes(groups);
-  for (size_t i = 0; i < order.size(); ++i) group_boxes[i / kGroup].grow(boxes[order[i]]);
+  for (uint32_t k = 0; k <= groups; ++k) start[k] = std::min<uint32_t>(k * kGroup, uint32_t(members.size()));
+  for (size_t i = 0; i < members.size(); ++i) group_boxes[i / kGroup].grow(boxes[members[i]]);
   std::vector<Vec3> group_centres = box_centres(group_boxes);
   BinningSplit split{group_boxes, group_centres};
   TopDown<BinningSplit> group_top{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}, depth_limit};
-  group_top.leaf_capacity = MC_QUAD_MAX_COUNT / kGroup;  // whole groups, at most 31 triangles
-  group_top.primitives = "groups of 4 triangles";
-  BuildTree g = group_top.run();
-  // Back to triangles: each group position expands to its members.
-  std::vector<uint32_t> start(groups + 1, 0);
-  BuildTree t;
-  for (size_t p = 0; p < groups; ++p) {
-    uint32_t group = g.order[p];
-    start[p] = uint32_t(t.order.size());
-    for (size_t i = group * kGroup; i < std::min(order.size(), size_t(group + 1) * kGroup); ++i) t.order.push_back(order[i]);
-  }
-  start[groups] = uint32_t(t.order.size());
-  t.nodes = g.nodes;
-  for (BuildNode& n : t.nodes)
-    if (n.leaf()) {
-      uint32_t first = start[n.first], end = start[n.first + n.count];
-      n.first = first, n.count = end - first;
-    }
-  for (const BuildNode& n : t.nodes)
-    if (n.leaf() && n.count > MC_QUAD_MAX_COUNT)
-      throw InputError("depth limit " + std::to_string(depth_limit + 1) + " leaves " + std::to_string(n.count) +
-                       " triangles in one leaf, more than " + std::to_string(MC_QUAD_MAX_COUNT) + "; raise the depth limit");
-  t.depth = g.depth;
-  t.sah_cost = sah_cost(t);
-  return t;
+  group_top.leaf_capacity = std::max(1u, leaf_capacity / kGroup);  // whole groups within the leaf capacity
+  group_top.primitives = "groups of 4";
+  return expand_groups(group_top.run(), members, start);
 }
 
 }  // namespace
 
-BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size, uint32_t depth_limit) {
+BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size, uint32_t depth_limit,
+                     uint32_t leaf_capacity) {
   leaf_size = std::max(1u, leaf_size);
   std::vector<Vec3> centres = box_centres(boxes);
   switch (splitter) {
-    case Splitter::Binning: return build_binning(boxes, leaf_size, depth_limit);
+    case Splitter::Binning: return build_binning(boxes, leaf_size, depth_limit, leaf_capacity);
     case Splitter::LongestAxis: {
       LongestAxisSplit s{centres};
-      return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}, depth_limit}.run();
+      return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity}.run();
     }
     case Splitter::Mean: {
       MeanSplit s{centres};
-      return TopDown<MeanSplit>{boxes, centres, leaf_size, s, {}, depth_limit}.run();
+      return TopDown<MeanSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity}.run();
     }
     case Splitter::Morton: {
       std::vector<uint32_t> codes = morton_codes(centres);
       MortonSplit s{codes};
-      return TopDown<MortonSplit>{boxes, centres, leaf_size, s, {}, depth_limit}.run(morton_order(codes));
+      return TopDown<MortonSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity}.run(morton_order(codes));
     }
-    case Splitter::FixedLeafSize: return build_fixed_leaf_size(boxes, centres, leaf_size, depth_limit);
+    case Splitter::FixedLeafSize: return build_fixed_leaf_size(boxes, centres, leaf_size, depth_limit, leaf_capacity);
   }
-  return build_binning(boxes, leaf_size, depth_limit);
+  return build_binning(boxes, leaf_size, depth_limit, leaf_capacity);
+}
+
+BuildTree expand_groups(const BuildTree& g, const std::vector<uint32_t>& members, const std::vector<uint32_t>& start) {
+  // position p of g.order -> its first triangle position in t.order
+  std::vector<uint32_t> at(g.order.size() + 1, 0);
+  BuildTree t;
+  t.order.reserve(members.size());
+  for (size_t p = 0; p < g.order.size(); ++p) {
+    const uint32_t group = g.order[p];
+    at[p] = uint32_t(t.order.size());
+    t.order.insert(t.order.end(), members.begin() + start[group], members.begin() + start[group + 1]);
+  }
+  at[g.order.size()] = uint32_t(t.order.size());
+  t.nodes = g.nodes;
+  for (BuildNode& n : t.nodes)
+    if (n.leaf()) {
+      const uint32_t first = at[n.first], end = at[n.first + n.count];
+      n.first = first, n.count = end - first;
+    }
+  t.depth = g.depth;
+  t.sah_cost = sah_cost(t);
+  return t;
 }
 
 std::vector<uint32_t> morton_sorted(const std::vector<Vec3>& centres) { return morton_order(morton_codes(centres)); }

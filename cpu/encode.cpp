@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "cpu/build.h"
+#include "cpu/pairing.h"
 #include "cpu/pairs.h"
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
@@ -146,8 +147,37 @@ BuildTree chunk_tree(const std::vector<Box3>& boxes, std::vector<uint32_t> order
   return t;
 }
 
-BuildTree build_for(const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec, uint32_t depth_limit) {
+// Seed 003: the tree over pairs (and the triangles left single), each
+// expanded back to its triangles side by side.
+BuildTree build_paired(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, uint32_t depth_limit,
+                       BuildReport* report) {
+  if (o.leaf_size < 2) throw InputError("pairing needs leaves of at least 2 triangles (leaf size " + std::to_string(o.leaf_size) + ")");
+  Pairing p = pair_triangles(mesh);
+  std::vector<uint32_t> members, start{0};
+  std::vector<Box3> unit_boxes;
+  for (uint32_t t = 0; t < p.partner.size(); ++t) {
+    const uint32_t q = p.partner[t];
+    if (q != MC_NO_HIT && q < t) continue;  // already in its partner's unit
+    Box3 box = boxes[t];
+    members.push_back(t);
+    if (q != MC_NO_HIT) members.push_back(q), box.grow(boxes[q]);
+    start.push_back(uint32_t(members.size()));
+    unit_boxes.push_back(box);
+  }
+  if (report) report->pairing = p.decision, report->paired_ratio = p.paired_ratio;
+  // A leaf of leaf_size / 2 units holds at most leaf_size triangles; at the
+  // depth limit half the 5-bit count's 31.
+  BuildTree units = build_tree(unit_boxes, o.splitter, o.leaf_size / 2, depth_limit, MC_QUAD_MAX_COUNT / 2);
+  return expand_groups(units, members, start);
+}
+
+BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec,
+                    uint32_t depth_limit, BuildReport* report) {
   const uint32_t chunk = layout::brute_chunk(codec.lanes);
+  if (o.pairing && (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST))
+    throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(o.tree_format)) +
+                     " keeps its own triangle order");
+  if (o.pairing) return build_paired(mesh, o, boxes, depth_limit, report);
   if (o.tree_format == MC_TREE_BRUTEFORCE) {
     std::vector<uint32_t> input(boxes.size());
     std::iota(input.begin(), input.end(), 0u);
@@ -273,7 +303,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   }
   BuildTree tree;
   try {
-    tree = build_for(o, boxes, codec, depth_limit);
+    tree = build_for(mesh, o, boxes, codec, depth_limit, report);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(o.tree_format)) + ": " + e.what());
   }

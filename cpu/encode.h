@@ -34,11 +34,17 @@ struct BuildOptions {
   bool lbvh_near_first = true;
   NodeOrder node_order = NodeOrder::Default;
   Grouping grouping = Grouping::ClosestCentroid;  // AABBList's batches (seed 000 §7)
+  // Seed 003: triangles paired across shared edges (cpu/pairing.h) become
+  // the builder's primitives, so every leaf holds whole pairs, each pair's
+  // two triangles side by side (at most leaf_size triangles a leaf).
+  bool pairing = false;
 };
 
 struct BuildReport {
   double sah_cost = 0;
   double build_ms = 0;
+  std::string pairing;      // the pairing pass's decision ("" without pairing)
+  double paired_ratio = 0;  // share of triangles in a pair
 };
 
 // Throws InputError (naming `name`) for a mesh the layout cannot hold.

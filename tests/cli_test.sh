@@ -54,6 +54,8 @@ check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitte
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
 check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
 check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
+check pairing 0 "of triangles paired" -- "$meshcast" info "$mesh" --layout AABBTree/Float3SOA4 --pairing
+check pairing-bruteforce 2 "keeps its own triangle order" -- "$meshcast" info "$mesh" --layout BruteForce/Float3 --pairing
 check order 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout quadtreehalffloat/float3 --order breadthfirst --rays "$work/r.rays" --out "$work/h4.hits"
 check order-refused 2 "AABBTree is always DepthFirst" -- "$meshcast" info "$mesh" --layout AABBTree/Float3 --order BreadthFirst
 check unknown-order 2 "valid node orders" -- "$meshcast" info "$mesh" --layout QuadTree/Float3 --order Random

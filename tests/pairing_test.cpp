@@ -8,6 +8,8 @@
 
 #include "cpu/pairing.h"
 #include "io/generate.h"
+#include "layout/blob.h"
+#include "layout/leaves.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -106,6 +108,59 @@ TEST(Pairing, CompressedPositionKeysPairAnUnweldedMesh) {
       }
     EXPECT_GE(shared, 2) << t << " and " << q;
   }
+}
+
+// Pairs as the builder's unit: every tree built from pairs keeps each
+// pair in one leaf, leaves within the leaf size, and the oracle's answers.
+TEST(PairedTrees, LeavesHoldWholePairsAndWalkersAgreeWithTheOracle) {
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (m.name != "sphere" && m.name != "bunny00" && m.name != "terrain_64k") continue;
+    const Pairing pairs = pair_triangles(*m.mesh);
+    for (const std::string& name : layout_names()) {
+      BuildOptions o = parse_layout(name);
+      if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST) continue;
+      if (o.triangle_format != MC_TRI_FLOAT3 && o.triangle_format != MC_TRI_FLOAT3SOA4 &&
+          o.triangle_format != MC_TRI_INDEXED8BITPACKSOA4)
+        continue;
+      o.pairing = true;
+      BuildReport report;
+      std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name, &report);
+      EXPECT_FALSE(report.pairing.empty());
+      const layout::BlobHeader& h = layout::header_of(blob.data());
+      std::vector<uint32_t> leaf_of(m.mesh->triangles.size(), ~0u);
+      uint32_t leaf = 0, split = 0;
+      layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t count) {
+        EXPECT_LE(count, o.tree_format == MC_TREE_STACKLESSLBVH ? MC_QUAD_MAX_COUNT - 1 : o.leaf_size) << name;
+        for (uint32_t i = 0; i < count; ++i) leaf_of[layout::remap_entry(blob.data(), h, layout::slot_of(h, block, i))] = leaf;
+        ++leaf;
+      });
+      for (uint32_t t = 0; t < pairs.partner.size(); ++t)
+        split += pairs.partner[t] != MC_NO_HIT && leaf_of[t] != leaf_of[pairs.partner[t]];
+      EXPECT_EQ(split, 0u) << name << " on " << m.name << ": pairs split across leaves";
+      NamedMesh reference = m;
+      if (moves_vertices(o.triangle_format))
+        reference = {m.name + "#paired#" + name, std::make_shared<const Mesh>(stored_mesh(blob))};
+      const std::vector<Ray>& rays = test_rays(m, RayKind::Radial, 3000);
+      Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, RayKind::Radial, rays),
+                            1e-5 * m.mesh->bounds().diagonal());
+      EXPECT_EQ(a.wrong + a.t_errors, 0u) << name << " on " << m.name << ": " << a.first_problem;
+    }
+  }
+}
+
+TEST(PairedTrees, WhatCannotPairIsRefusedWithTheReason) {
+  Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  BuildOptions o = parse_layout("BruteForce/Float3");
+  o.pairing = true;
+  try {
+    build_blob(m, o, "sphere");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("keeps its own triangle order"), std::string::npos) << e.what();
+  }
+  o = parse_layout("AABBTree/Float3");
+  o.pairing = true, o.leaf_size = 1;
+  EXPECT_THROW(build_blob(m, o, "sphere"), InputError);
 }
 
 }  // namespace

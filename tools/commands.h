@@ -16,12 +16,13 @@ void add_bench(CLI::App& app);
 void add_render(CLI::App& app);
 
 // The layout options trace, build and info share: --layout, --leaf,
-// --splitter, --order, --lbvh-depth, --lbvh-left-first, --grouping.
+// --splitter, --order, --lbvh-depth, --lbvh-left-first, --grouping, --pairing.
 struct LayoutArgs {
   std::string layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
   std::string splitter, order, grouping;  // empty: the layout's own
   uint32_t leaf = 8, lbvh_depth = 0;
   bool lbvh_left_first = false;
+  bool pairing = false;
 };
 void add_layout_options(CLI::App* cmd, LayoutArgs& args);
 BuildOptions build_options(const LayoutArgs& args);  // throws InputError for bad names

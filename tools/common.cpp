@@ -51,6 +51,7 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
       ->check(CLI::Range(0u, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
   cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
   cmd->add_option("--grouping", a.grouping, "AABBList batches (seed 000 7): ClosestCentroid (the seed's) or Morton");
+  cmd->add_flag("--pairing", a.pairing, "pair triangles across shared edges first (seed 003); leaves hold whole pairs");
 }
 
 BuildOptions build_options(const LayoutArgs& a) {
@@ -59,6 +60,7 @@ BuildOptions build_options(const LayoutArgs& a) {
   o.lbvh_depth = a.lbvh_depth;
   o.lbvh_near_first = !a.lbvh_left_first;
   if (!a.grouping.empty()) o.grouping = parse_grouping(a.grouping);
+  o.pairing = a.pairing;
   return o;
 }
 

@@ -6,6 +6,7 @@
 #include "bench/encodings.h"
 #include "bench/gpu.h"
 #include "bench/latency.h"
+#include "bench/pairing.h"
 #include "bench/plot.h"
 #include "bench/trees.h"
 #include "io/generate.h"
@@ -218,6 +219,42 @@ void add_bench(CLI::App& app) {
     std::string why = bench::plot_scatter(png, title,
                                           "rays in the batch", "milliseconds, submit to ready", series, true, true, true);
     std::printf("csv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
+  });
+
+  // Issue 7: seed 003's results table.
+  auto pargs = std::make_shared<ArgsT>();
+  auto pdata = std::make_shared<std::string>("data");
+  CLI::App* pair = bench->add_subcommand("pairing", "seed 003: triangle pairing, before and after, as the builder's unit");
+  pair->add_option("--data", *pdata, "folder of the public meshes (bunny00, armadillo, refined_elephant, ChineseDragon-10kv)");
+  pair->add_option("--rays", pargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
+  pair->add_option("--repeat", pargs->repeat, "passes; the minimum and the median are kept")->check(CLI::Range(1, 1000));
+  pair->add_option("--out-dir", pargs->out_dir, "where the CSV goes");
+  pair->callback([pargs, pdata] {
+    std::vector<bench::PairingRow> rows = bench::bench_pairing(*pdata, pargs->rays, pargs->repeat);
+    const double scale = 1000.0 / double(pargs->rays);
+    std::printf("\n%zu long rays, one thread, leaf 8; us per ray, minimum of %u passes; paired: before = input order "
+                "(window N = 2), after = the pass (or the input's pairs when the pre-scan skips it)\n\n"
+                "| mesh | triangles | pairing ms | paired before | after | layout | us/ray | paired | change | walked B/tri | "
+                "paired | disagreements |\n|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n",
+                pargs->rays, pargs->repeat);
+    std::filesystem::create_directories(pargs->out_dir);
+    std::ofstream csv(pargs->out_dir + "/pairing.csv");
+    csv << "mesh,triangles,pairing_ms,paired_before,paired_after,decision,layout,us_per_ray,us_per_ray_paired,"
+           "walked_bytes,walked_bytes_paired,disagreements\n";
+    for (const bench::PairingRow& r : rows) {
+      const double plain = r.plain.min_ms * scale, paired = r.paired.min_ms * scale;
+      const uint64_t wrong = r.plain.disagreements + r.paired.disagreements;
+      std::printf("| %s | %zu | %.1f | %.1f%% | %.1f%% | %s | %.3f | %.3f | %+.1f%% | %.2f | %.2f | %llu |\n", r.mesh.c_str(),
+                  r.triangles, r.pairing_ms, 100 * r.before, 100 * r.after, r.layout.c_str(), plain, paired,
+                  100 * (paired / plain - 1), r.plain.walked_bytes, r.paired.walked_bytes, (unsigned long long)wrong);
+      csv << r.mesh << "," << r.triangles << "," << r.pairing_ms << "," << r.before << "," << r.after << ",\"" << r.decision
+          << "\"," << r.layout << "," << plain << "," << paired << "," << r.plain.walked_bytes << "," << r.paired.walked_bytes
+          << "," << wrong << "\n";
+    }
+    std::printf("\ndecisions:\n");
+    for (size_t i = 0; i < rows.size(); i += 2) std::printf("  %s: %s\n", rows[i].mesh.c_str(), rows[i].decision.c_str());
+    std::printf("csv: %s/pairing.csv\nnot yet: the seed's box and triangle test counts (the walkers have no counters)\n",
+                pargs->out_dir.c_str());
   });
 
   // Issue 4's offset test for the half-float tree.

@@ -1,0 +1,29 @@
+// `meshcast bench pairing` (issue 7, seed 003's results table): per mesh the
+// pairing pass's time, the paired share before (input order, window N = 2)
+// and after, and what pairs as the builder's unit change in bytes per
+// triangle and time per ray. The seed's box and triangle test counts need
+// counters the walkers do not have yet.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "bench/measure.h"
+#include "cpu/mesh.h"
+
+namespace meshcast::bench {
+
+struct PairingRow {
+  std::string mesh, layout, decision;
+  size_t triangles = 0;
+  double pairing_ms = 0, before = 0, after = 0;
+  Timing plain{}, paired{};
+};
+
+// The cases: each named mesh file that exists, the generated 2M terrain, and
+// two copies of bunny00 made hard: its triangle order shuffled, and rotated
+// 45 degrees with its own pairs baked in as consecutive triangles (the seed's
+// third case: an input that looks paired, with pairs chosen before the
+// rotation).
+std::vector<PairingRow> bench_pairing(const std::string& data_dir, size_t rays, uint32_t repeat);
+
+}  // namespace meshcast::bench

@@ -45,8 +45,8 @@ struct Caster::Slot {
   std::vector<Hit> hits;
   Backend ran_on = Backend::Cpu;
   double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
-  // CPU batches: `jobs` jobs of `chunk` rays; the last to finish completes.
-  uint32_t jobs = 0, chunk = 0;
+  // CPU batches: jobs of `chunk` rays; the last to finish completes.
+  uint32_t chunk = 0;
   std::atomic<uint32_t> jobs_left{0};
   std::atomic<int64_t> cpu_ns{0};
   std::function<void(uint32_t)> work;  // made once, handed to the job system every batch
@@ -70,7 +70,7 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
       const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
       view_.trace(std::span<const Ray>(sp->rays).subspan(first, count), std::span<Hit>(sp->hits).subspan(first, count));
       sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
-      if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu, 0);
+      if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu);
     };
     slots_.push_back(std::move(s));
   }
@@ -191,12 +191,13 @@ Ticket Caster::submit(std::span<const Ray> rays) {
 void Caster::start_cpu(Slot& s) {
   s.ran_on = Backend::Cpu;
   s.cpu_ns = 0;
-  if (s.n == 0) return complete(s, Backend::Cpu, 0);
+  if (s.n == 0) return complete(s, Backend::Cpu);
   // About four jobs a thread, so uneven rays even out; at least 64 rays a job.
   const uint32_t per = std::max<uint32_t>(64, (s.n + 4 * jobs_->threads() - 1) / (4 * jobs_->threads()));
-  s.chunk = per, s.jobs = (s.n + per - 1) / per;
-  s.jobs_left = s.jobs;
-  jobs_->run(s.jobs, s.work);
+  const uint32_t jobs = (s.n + per - 1) / per;
+  s.chunk = per;
+  s.jobs_left = jobs;
+  jobs_->run(jobs, s.work);
 }
 
 void Caster::start_gpu(Slot& s) {
@@ -232,7 +233,7 @@ void Caster::gpu_completions() {
     try {
       if (gpu_failed_) throw gpu::GpuError(gpu_error());
       method_->wait(s->index);
-      complete(*s, Backend::Vulkan, 0);
+      complete(*s, Backend::Vulkan);
     } catch (const gpu::GpuError& e) {  // waiting failed: the device is lost
       gpu_failed(e.what());
       start_cpu(*s);
@@ -245,7 +246,7 @@ void Caster::gpu_failed(const std::string& why) {
   if (!gpu_failed_.exchange(true)) gpu_error_ = why;
 }
 
-void Caster::complete(Slot& s, Backend ran_on, double) {
+void Caster::complete(Slot& s, Backend ran_on) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     s.ready_ms = now_ms();

@@ -118,7 +118,7 @@ class Caster {
   struct Slot;
   void start_cpu(Slot& s);
   void start_gpu(Slot& s);
-  void complete(Slot& s, Backend ran_on, double device_ms);
+  void complete(Slot& s, Backend ran_on);
   void gpu_completions();
   void gpu_failed(const std::string& why);
   void measure_crossover();

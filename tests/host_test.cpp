@@ -147,19 +147,30 @@ TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
   expect_same(hits, sync_cpu(caster, rays), "after a missing device");
 }
 
+// A Vulkan caster on a small sphere whose GPU submissions go through
+// `fault(n)` first (n counts from 1): the fault-injection tests' setup.
+struct FaultySphere {
+  explicit FaultySphere(std::function<void(int)> fault) {
+    CasterOptions o = options(Backend::Vulkan);
+    o.before_gpu_submit = [this, fault] { fault(++submissions); };
+    caster = std::make_unique<Caster>(blob, "sphere", o);
+  }
+  Mesh mesh = make_sphere(12, 24, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(mesh, parse_layout("AABBTree/Float3"), "sphere");
+  std::vector<Ray> rays = make_rays(mesh, RayKind::Radial, 500, 5);
+  int submissions = 0;
+  std::unique_ptr<Caster> caster;
+};
+
 // A refusal that is not a lost device (a batch beyond a buffer limit,
 // memory) sends that one batch to the CPU and keeps the GPU.
 TEST(Host, ARefusedBatchGoesToTheCpuAndTheGpuStays) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
-  Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
-  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
-  CasterOptions o = options(Backend::Vulkan);
-  int submissions = 0;
-  o.before_gpu_submit = [&] {
-    if (++submissions == 2) throw gpu::GpuError("Vulkan: the ray buffer exceeds a limit (injected by the test)");
-  };
-  Caster caster(blob, "sphere", o);
-  std::vector<Ray> rays = make_rays(m, RayKind::Radial, 500, 5);
+  FaultySphere f([](int submission) {
+    if (submission == 2) throw gpu::GpuError("Vulkan: the ray buffer exceeds a limit (injected by the test)");
+  });
+  Caster& caster = *f.caster;
+  const std::vector<Ray>& rays = f.rays;
   std::vector<Hit> hits(rays.size());
   EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Vulkan);
   EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
@@ -170,15 +181,11 @@ TEST(Host, ARefusedBatchGoesToTheCpuAndTheGpuStays) {
 
 TEST(Host, ALostDeviceMovesTheBatchesToTheCpu) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
-  Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
-  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
-  CasterOptions o = options(Backend::Vulkan);
-  int submissions = 0;
-  o.before_gpu_submit = [&] {
-    if (++submissions > 1) throw gpu::GpuError("Vulkan: device lost (injected by the test)", true);
-  };
-  Caster caster(blob, "sphere", o);
-  std::vector<Ray> rays = make_rays(m, RayKind::Radial, 500, 5);
+  FaultySphere f([](int submission) {
+    if (submission > 1) throw gpu::GpuError("Vulkan: device lost (injected by the test)", true);
+  });
+  Caster& caster = *f.caster;
+  const std::vector<Ray>& rays = f.rays;
   std::vector<Hit> hits(rays.size());
   EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Vulkan);
   for (int k = 0; k < 3; ++k) {

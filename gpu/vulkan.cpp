@@ -5,10 +5,35 @@
 #include <cctype>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 
 namespace meshcast::gpu {
 
 namespace {
+
+// volk keeps one global table of function pointers. A context may not load
+// its own instance or device into it: a second context would overwrite the
+// first's pointers (and an instance without VK_EXT_debug_utils would leave
+// the messenger functions null for every other context: a crash at exit on
+// NVIDIA's driver, found on an H100). So the table is filled once, through
+// vkGetInstanceProcAddr of the first instance: for core functions the
+// loader returns its trampolines, which dispatch on the handle passed, so
+// they serve every instance and device of the process. Extension functions
+// each context fetches for itself.
+std::mutex volk_mutex;
+bool volk_loaded = false;
+
+VkResult volk_initialize_once() {
+  std::lock_guard lock(volk_mutex);
+  static VkResult result = volkInitialize();
+  return result;
+}
+
+void volk_load_once(VkInstance instance) {
+  std::lock_guard lock(volk_mutex);
+  if (!volk_loaded) volkLoadInstance(instance);
+  volk_loaded = true;
+}
 
 const char* result_name(VkResult r) {
   switch (r) {
@@ -57,7 +82,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::on_message(VkDebugUtilsMessageSeverityFl
 }
 
 Context::Context(const DeviceChoice& choice) {
-  if (volkInitialize() != VK_SUCCESS)
+  if (volk_initialize_once() != VK_SUCCESS)
     throw GpuError("Vulkan: no Vulkan loader found (install libvulkan1 and a driver, e.g. mesa-vulkan-drivers)");
   if (volkGetInstanceVersion() < VK_API_VERSION_1_2)
     throw GpuError("Vulkan: the loader offers Vulkan " + std::to_string(VK_API_VERSION_MINOR(volkGetInstanceVersion())) +
@@ -77,101 +102,115 @@ Context::Context(const DeviceChoice& choice) {
   if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 1,
                   ici.ppEnabledExtensionNames = &ext;
   check(vkCreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
-  volkLoadInstanceOnly(instance_);
-  if (validation) {
-    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    mci.pfnUserCallback = &Context::on_message;
-    mci.pUserData = this;
-    check(vkCreateDebugUtilsMessengerEXT(instance_, &mci, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
-  }
+  // A throw below (no such device, a missing feature) would skip the
+  // destructor: release what exists so far, then let it go on.
+  try {
+    volk_load_once(instance_);
+    if (validation) {
+      auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+      destroy_messenger_ = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+      if (!create || !destroy_messenger_) throw GpuError("Vulkan: validation asked for, but VK_EXT_debug_utils is missing");
+      VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+      mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+      mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                        VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+      mci.pfnUserCallback = &Context::on_message;
+      mci.pUserData = this;
+      check(create(instance_, &mci, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+    }
 
-  uint32_t count = 0;
-  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
-  std::vector<VkPhysicalDevice> devices(count);
-  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
-  if (devices.empty()) throw GpuError("Vulkan: no device found (install mesa-vulkan-drivers for lavapipe)");
-  std::vector<VkPhysicalDeviceProperties> props(count);
-  for (uint32_t i = 0; i < count; ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
-  std::string wanted = choice.device;
-  if (wanted.empty())
-    if (const char* env = std::getenv("MESHCAST_VK_DEVICE")) wanted = env;
-  int pick = -1;
-  if (wanted.empty()) {
-    for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
+    uint32_t count = 0;
+    vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+    std::vector<VkPhysicalDevice> devices(count);
+    vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+    if (devices.empty()) throw GpuError("Vulkan: no device found (install mesa-vulkan-drivers for lavapipe)");
+    std::vector<VkPhysicalDeviceProperties> props(count);
+    for (uint32_t i = 0; i < count; ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
+    std::string wanted = choice.device;
+    if (wanted.empty())
+      if (const char* env = std::getenv("MESHCAST_VK_DEVICE")) wanted = env;
+    int pick = -1;
+    if (wanted.empty()) {
+      for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
+        for (uint32_t i = 0; i < count && pick < 0; ++i)
+          if (props[i].deviceType == type) pick = int(i);
+      if (pick < 0) pick = 0;
+    } else if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+      pick = std::stoi(wanted) < int(count) ? std::stoi(wanted) : -1;
+    } else {
       for (uint32_t i = 0; i < count && pick < 0; ++i)
-        if (props[i].deviceType == type) pick = int(i);
-    if (pick < 0) pick = 0;
-  } else if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
-    pick = std::stoi(wanted) < int(count) ? std::stoi(wanted) : -1;
-  } else {
-    for (uint32_t i = 0; i < count && pick < 0; ++i)
-      if (lower(props[i].deviceName).find(lower(wanted)) != std::string::npos) pick = int(i);
+        if (lower(props[i].deviceName).find(lower(wanted)) != std::string::npos) pick = int(i);
+    }
+    if (pick < 0) {
+      std::string list;
+      for (uint32_t i = 0; i < count; ++i) list += "\n  " + std::to_string(i) + ": " + props[i].deviceName;
+      throw GpuError("Vulkan: no device matches '" + wanted + "'; devices:" + list);
+    }
+    physical_ = devices[size_t(pick)];
+    name_ = props[size_t(pick)].deviceName;
+    limits_ = props[size_t(pick)].limits;
+    if (props[size_t(pick)].apiVersion < VK_API_VERSION_1_2) throw GpuError("Vulkan: " + name_ + " does not offer Vulkan 1.2");
+    vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+
+    // What every method needs: 64-bit integers (remap words, keys) and
+    // doubles (the watertight test's rare redo, the exact BitPack decode).
+    // The 64-bit atomics of the packed (t, triangle) minimum only the
+    // bruteforce and aabblist methods need: enabled when present, and those
+    // two refuse a device without them (require_int64_atomics).
+    VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+    vkGetPhysicalDeviceFeatures2(physical_, &f2);
+    if (!f2.features.shaderInt64 || !f2.features.shaderFloat64)
+      throw GpuError("Vulkan: " + name_ + " lacks shaderInt64 or shaderFloat64, which every GPU method uses");
+    int64_atomics_ = f12.shaderBufferInt64Atomics == VK_TRUE;
+    VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
+    VkPhysicalDeviceFeatures2 e2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &e12};
+    e2.features.shaderInt64 = VK_TRUE;
+    e2.features.shaderFloat64 = VK_TRUE;
+
+    uint32_t families = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> qf(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
+    uint32_t family = families;
+    for (uint32_t i = 0; i < families && family == families; ++i)
+      if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) family = i;
+    if (family == families) throw GpuError("Vulkan: " + name_ + " has no compute queue");
+    timestamps_ = qf[family].timestampValidBits > 0 && limits_.timestampPeriod > 0;
+    timestamp_ns_ = limits_.timestampPeriod;
+
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    qci.queueFamilyIndex = family, qci.queueCount = 1, qci.pQueuePriorities = &priority;
+    VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &e2};
+    dci.queueCreateInfoCount = 1, dci.pQueueCreateInfos = &qci;
+    check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
+    vkGetDeviceQueue(device_, family, 0, &queue_);
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, pci.queueFamilyIndex = family;
+    check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
+
+  } catch (...) {
+    release();
+    throw;
   }
-  if (pick < 0) {
-    std::string list;
-    for (uint32_t i = 0; i < count; ++i) list += "\n  " + std::to_string(i) + ": " + props[i].deviceName;
-    throw GpuError("Vulkan: no device matches '" + wanted + "'; devices:" + list);
-  }
-  physical_ = devices[size_t(pick)];
-  name_ = props[size_t(pick)].deviceName;
-  limits_ = props[size_t(pick)].limits;
-  if (props[size_t(pick)].apiVersion < VK_API_VERSION_1_2) throw GpuError("Vulkan: " + name_ + " does not offer Vulkan 1.2");
-  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
-
-  // What every method needs: 64-bit integers (remap words, keys) and
-  // doubles (the watertight test's rare redo, the exact BitPack decode).
-  // The 64-bit atomics of the packed (t, triangle) minimum only the
-  // bruteforce and aabblist methods need: enabled when present, and those
-  // two refuse a device without them (require_int64_atomics).
-  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
-  vkGetPhysicalDeviceFeatures2(physical_, &f2);
-  if (!f2.features.shaderInt64 || !f2.features.shaderFloat64)
-    throw GpuError("Vulkan: " + name_ + " lacks shaderInt64 or shaderFloat64, which every GPU method uses");
-  int64_atomics_ = f12.shaderBufferInt64Atomics == VK_TRUE;
-  VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
-  VkPhysicalDeviceFeatures2 e2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &e12};
-  e2.features.shaderInt64 = VK_TRUE;
-  e2.features.shaderFloat64 = VK_TRUE;
-
-  uint32_t families = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
-  std::vector<VkQueueFamilyProperties> qf(families);
-  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
-  uint32_t family = families;
-  for (uint32_t i = 0; i < families && family == families; ++i)
-    if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) family = i;
-  if (family == families) throw GpuError("Vulkan: " + name_ + " has no compute queue");
-  timestamps_ = qf[family].timestampValidBits > 0 && limits_.timestampPeriod > 0;
-  timestamp_ns_ = limits_.timestampPeriod;
-
-  float priority = 1.0f;
-  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  qci.queueFamilyIndex = family, qci.queueCount = 1, qci.pQueuePriorities = &priority;
-  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &e2};
-  dci.queueCreateInfoCount = 1, dci.pQueueCreateInfos = &qci;
-  check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
-  volkLoadDevice(device_);
-  vkGetDeviceQueue(device_, family, 0, &queue_);
-  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, pci.queueFamilyIndex = family;
-  check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
 }
 
-Context::~Context() {
+Context::~Context() { release(); }
+
+void Context::release() {
   if (device_) {
     vkDeviceWaitIdle(device_);
     vkDestroyFence(device_, fence_, nullptr);
     vkDestroyCommandPool(device_, pool_, nullptr);
     vkDestroyDevice(device_, nullptr);
   }
-  if (messenger_) vkDestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
+  if (messenger_) destroy_messenger_(instance_, messenger_, nullptr);
   if (instance_) vkDestroyInstance(instance_, nullptr);
 }
 

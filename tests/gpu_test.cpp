@@ -65,6 +65,27 @@ TEST(Gpu, UnknownDeviceIsRefusedWithTheList) {
   }
 }
 
+// Contexts come and go beside one another: one without validation (so
+// without the debug-utils extension) made and dropped, one refused, then
+// the first context still traces and is destroyed cleanly at exit. On an
+// H100 the shared volk table once held the dropped context's pointers and
+// the process crashed at exit.
+TEST(Gpu, ContextsSideBySideKeepTheirOwnFunctions) {
+  Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  std::unique_ptr<gpu::Method> first = gpu::make_method(context(), "aabbtree", blob, "sphere");
+  {
+    gpu::Context other(gpu::DeviceChoice{"", false});
+    std::unique_ptr<gpu::Method> second = gpu::make_method(other, "aabbtree", blob, "sphere");
+    EXPECT_THROW(gpu::Context(gpu::DeviceChoice{"no such device", false}), gpu::GpuError);
+  }
+  std::vector<Ray> rays = {Ray{{0.1f, 0.2f, -5}, {0, 0, 1}, 100}};
+  std::vector<Hit> hits(1);
+  first->trace(rays, hits);
+  EXPECT_NE(hits[0].triangle, MC_NO_HIT);
+  EXPECT_NEAR(hits[0].t, 4.0f, 0.2f);  // a faceted unit sphere
+}
+
 TEST(Gpu, MethodRefusesALayoutItDoesNotRead) {
   Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
   std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");

@@ -17,6 +17,7 @@
 #include "layout/codecs.h"
 #include "layout/quadtree.h"
 #include "cpu/writer.h"
+#include "cpu/zerobyte.h"
 
 namespace meshcast {
 
@@ -229,10 +230,37 @@ void quantization_bound(const float offset[3], const float scale[3], float bound
   }
 }
 
+// The remap section after the blob's bytes so far: slot -> input triangle
+// (MC_NO_HIT: no triangle), as few bits as the triangle count needs.
+void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector<uint32_t>& remap) {
+  hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
+  hd.remap_slots = uint32_t(remap.size());
+  hd.remap_offset = align(bytes.size(), 8);
+  const uint32_t words = layout::remap_words(hd);
+  hd.remap_size = align(12ull * words + (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8, 8);
+  bytes.resize(uint64_t(hd.remap_offset) + hd.remap_size, 0);
+  uint8_t* used = bytes.data() + hd.remap_offset;
+  uint8_t* rank = used + 8ull * words;
+  uint8_t* entries = rank + 4ull * words;
+  uint32_t index = 0;
+  for (uint32_t s = 0; s < hd.remap_slots; ++s) {
+    if (s % 64 == 0) std::memcpy(rank + 4ull * (s / 64), &index, 4);
+    if (remap[s] == MC_NO_HIT) continue;
+    used[s / 8] |= uint8_t(1u << (s % 8));
+    uint64_t bit = uint64_t(index++) * hd.remap_bits;
+    uint64_t word;
+    std::memcpy(&word, entries + (bit >> 3), 8);
+    word |= uint64_t(remap[s]) << (bit & 7);
+    std::memcpy(entries + (bit >> 3), &word, 8);
+  }
+}
+
 std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
                                 BuildReport* report) {
   auto start = std::chrono::steady_clock::now();
   check_mesh(mesh, name);
+  if (o.tree_format == MC_TREE_ZEROBYTE || o.tree_format == MC_TREE_ZEROBYTEHYBRID)
+    return build_zerobyte_blob(mesh, o, name, report);
   if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
     throw InputError(name + ": leaf size " + std::to_string(o.leaf_size) + " is outside 1.." +
                      std::to_string(MC_QUAD_MAX_COUNT) + " (5-bit triangle counts, seed 000 5.6)");
@@ -341,27 +369,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
   if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
 
-  // Remap: slot -> input triangle, as few bits as the triangle count needs.
-  hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
-  hd.remap_slots = uint32_t(writer.remap.size());
-  hd.remap_offset = align(writer.bytes.size(), 8);
-  const uint32_t words = layout::remap_words(hd);
-  hd.remap_size = align(12ull * words + (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8, 8);
-  writer.bytes.resize(uint64_t(hd.remap_offset) + hd.remap_size, 0);
-  uint8_t* used = writer.bytes.data() + hd.remap_offset;
-  uint8_t* rank = used + 8ull * words;
-  uint8_t* entries = rank + 4ull * words;
-  uint32_t index = 0;
-  for (uint32_t s = 0; s < hd.remap_slots; ++s) {
-    if (s % 64 == 0) std::memcpy(rank + 4ull * (s / 64), &index, 4);
-    if (writer.remap[s] == MC_NO_HIT) continue;
-    used[s / 8] |= uint8_t(1u << (s % 8));
-    uint64_t bit = uint64_t(index++) * hd.remap_bits;
-    uint64_t word;
-    std::memcpy(&word, entries + (bit >> 3), 8);
-    word |= uint64_t(writer.remap[s]) << (bit & 7);
-    std::memcpy(entries + (bit >> 3), &word, 8);
-  }
+  append_remap(writer.bytes, hd, writer.remap);
   hd.total_size = uint32_t(writer.bytes.size());
   std::memcpy(writer.bytes.data(), &hd, sizeof hd);
   layout::seal(writer.bytes);
@@ -375,6 +383,10 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
 
 void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
   const BlobHeader& h = layout::header_of(blob.data());
+  if (h.triangle_format == MC_TRI_INDEXED24) {  // the mesh's own floats
+    for (int a = 0; a < 3; ++a) bound[a] = 0;
+    return;
+  }
   layout::GridKind grid = codec_ops(h.triangle_format).grid;
   if (grid == layout::kGridMeshBox) return quantization_bound(h.quant_offset, h.quant_scale, bound);
   for (int a = 0; a < 3; ++a) {
@@ -392,6 +404,7 @@ void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
 }
 
 bool moves_vertices(uint32_t triangle_format) {
+  if (triangle_format == MC_TRI_INDEXED24) return false;
   CodecOps c = codec_ops(triangle_format);
   return c.grid != layout::kGridNone || c.moves_floats;
 }
@@ -401,6 +414,9 @@ std::vector<std::string> layout_names() {
   for (uint32_t t : tree_formats())
     for (uint32_t c : triangle_formats())
       names.push_back(layout_name(t, c));
+  // Seed 004's trees live in the mesh's own indices: one triangle format.
+  names.push_back(layout_name(MC_TREE_ZEROBYTE, MC_TRI_INDEXED24));
+  names.push_back(layout_name(MC_TREE_ZEROBYTEHYBRID, MC_TRI_INDEXED24));
   return names;
 }
 
@@ -413,8 +429,12 @@ BuildOptions parse_layout(const std::string& text) {
     for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     return s;
   };
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (uint32_t t : tree_formats())
-    for (uint32_t c : triangle_formats())
+    for (uint32_t c : triangle_formats()) pairs.push_back({t, c});
+  pairs.push_back({MC_TREE_ZEROBYTE, MC_TRI_INDEXED24});
+  pairs.push_back({MC_TREE_ZEROBYTEHYBRID, MC_TRI_INDEXED24});
+  for (auto [t, c] : pairs)
       if (lower(layout_name(t, c)) == lower(text)) {
         BuildOptions o;
         o.tree_format = t, o.triangle_format = c;

@@ -38,6 +38,13 @@ struct BuildOptions {
   // the builder's primitives, so every leaf holds whole pairs, each pair's
   // two triangles side by side (at most leaf_size triangles a leaf).
   bool pairing = false;
+  // Zero-byte trees (seed 004): interior nodes bounded by 6 triangles whose
+  // first corners give the 6 extremes where the mesh allows it (a box from
+  // 6 vertices, not 18); the walkers' per-thread box cache; the hybrid's
+  // largest leaf (each leaf one zero-byte tree).
+  bool zbt_shuffle = true;
+  bool zbt_box_cache = true;
+  uint32_t hybrid_leaf = 256;
 };
 
 struct BuildReport {
@@ -45,6 +52,7 @@ struct BuildReport {
   double build_ms = 0;
   std::string pairing;      // the pairing pass's decision ("" without pairing)
   double paired_ratio = 0;  // share of triangles in a pair
+  std::string zerobyte;     // zero-byte trees: nodes, shuffled share, cache ("" otherwise)
 };
 
 // Throws InputError (naming `name`) for a mesh the layout cannot hold.

@@ -6,6 +6,7 @@
 
 #include "cpu/ray.h"
 #include "layout/codecs.h"
+#include "layout/zerobyte.h"
 
 namespace meshcast {
 
@@ -123,6 +124,25 @@ struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
         simd::I4 idx3 = idx + idx + idx;
         for (int j = 0; j < 3; ++j) v[c][j] = simd::gather(reinterpret_cast<const float*>(vertices), idx3 + axis[j]);
       }
+    }
+  }
+};
+
+// Indexed24 (seed 004): 32-bit index words whose top byte belongs to the
+// tree; the triangles of a zero-byte node side by side.
+template <>
+struct Loader<layout::Indexed24> {
+  static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, const int axis[3],
+                   simd::F4 v[3][3]) {
+    const float* vertices = reinterpret_cast<const float*>(blob + layout::header_of(blob).vertex_offset);
+    uint32_t last = count - 1;
+    for (int c = 0; c < 3; ++c) {
+      simd::I4 idx = simd::iconst(int(layout::Indexed24::index(blob, block, first, c)),
+                                  int(layout::Indexed24::index(blob, block, std::min(first + 1, last), c)),
+                                  int(layout::Indexed24::index(blob, block, std::min(first + 2, last), c)),
+                                  int(layout::Indexed24::index(blob, block, std::min(first + 3, last), c)));
+      simd::I4 idx3 = idx + idx + idx;
+      for (int j = 0; j < 3; ++j) v[c][j] = simd::gather(vertices, idx3 + axis[j]);
     }
   }
 };

@@ -44,6 +44,8 @@ std::vector<Entry> make_walkers() {
   MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRIES)
 #undef MC_TREE_ENTRY
 #undef MC_CODEC_ENTRIES
+  entries.push_back({MC_TREE_ZEROBYTE, MC_TRI_INDEXED24, &walk_zerobyte});
+  entries.push_back({MC_TREE_ZEROBYTEHYBRID, MC_TRI_INDEXED24, &walk_zerobyte});
   return entries;
 }
 

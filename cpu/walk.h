@@ -39,6 +39,10 @@ void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 template <class Codec>
 void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
 
+// Both zero-byte formats (Indexed24 triangles), with or without the box
+// cache as the blob's header asks.
+void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+
 // Turns the closest slot into the caller's hit.
 inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Closest& c) {
   Hit hit;

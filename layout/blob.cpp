@@ -1,4 +1,5 @@
 #include "layout/blob.h"
+#include "layout/zerobyte.h"
 
 #include <algorithm>
 #include <cmath>
@@ -50,6 +51,8 @@ std::string_view tree_format_name(uint32_t f) {
     case MC_TREE_SKDTREE: return "SKDTree";
     case MC_TREE_STACKLESSLBVH: return "StacklessLBVH";
     case MC_TREE_AABBLIST: return "AABBList";
+    case MC_TREE_ZEROBYTE: return "ZeroByteTree";
+    case MC_TREE_ZEROBYTEHYBRID: return "ZeroByteHybrid";
   }
   return "";
 }
@@ -59,6 +62,7 @@ std::string_view triangle_format_name(uint32_t f) {
   if (f == Codec::kFormat) return text;
   MC_FOR_EACH_TRIANGLE_CODEC(MC_NAME)
 #undef MC_NAME
+  if (f == MC_TRI_INDEXED24) return "Indexed24";
   return "";
 }
 
@@ -424,6 +428,9 @@ std::string validate(std::span<const uint8_t> blob) {
       !(std::isfinite(h.node_scale) && h.node_scale > 0 && std::isfinite(h.node_origin[0]) &&
         std::isfinite(h.node_origin[1]) && std::isfinite(h.node_origin[2])))
     return "half-float node origin or scale is not finite";
+
+  if (h.tree_format == MC_TREE_ZEROBYTE || h.tree_format == MC_TREE_ZEROBYTEHYBRID) return validate_zerobyte(blob, h);
+  if (h.triangle_format == MC_TRI_INDEXED24) return "Indexed24 triangles belong to the zero-byte trees alone";
 
   uint64_t triangles = 0;
   std::string e;

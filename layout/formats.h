@@ -43,6 +43,8 @@
 #define MC_TREE_SKDTREE 8u             // §5.5
 #define MC_TREE_STACKLESSLBVH 9u       // seed 001
 #define MC_TREE_AABBLIST 10u           // §7: 256-triangle batches, one box each
+#define MC_TREE_ZEROBYTE 11u           // seed 004: the index buffer is the tree
+#define MC_TREE_ZEROBYTEHYBRID 12u     // seed 004's future work: AABBTree nodes over zero-byte leaves
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
@@ -81,6 +83,26 @@
 #define MC_TRI_BITPACK 14u             // §3.4
 #define MC_TRI_UNCOMPRESSEDSTRIP 15u   // §3.10
 #define MC_TRI_COMPRESSEDSTRIP 16u     // §3.10
+#define MC_TRI_INDEXED24 17u           // seed 004: 32-bit index words, 24 bits of vertex index, 8 of tree
+
+// Zero-byte tree (seed 004). Triangle P starts a node when a walk reaches
+// it: the top bytes of its three index words, low byte first, hold the
+// node's 24 bits: the first child's position (21 bits, 0 for a leaf; the
+// second child follows the first child's triangles) and the node's
+// triangle count (3 bits, 1..7). An interior node's triangles define its
+// box (each of the 6 extremes comes from one of them); a leaf's are all
+// the subtree holds. With 2 triangles or more, triangle P + 1 carries the
+// seed 002 sorting byte (top byte of its first word) and the shuffled flag
+// (bit 0 of its second word's top byte): the node has 6 triangles and
+// triangle P + j gives extreme j (min x, y, z, max x, y, z) by its first
+// corner alone. Positions count from the zero-byte tree's root.
+#define MC_ZBT_INDEX_MASK 0x00FFFFFFu
+#define MC_ZBT_CHILD_BITS 21u
+#define MC_ZBT_CHILD_MASK 0x001FFFFFu
+#define MC_ZBT_MAX_TRIANGLES 0x200000u // positions in 21 bits: about 2 million
+#define MC_ZBT_MAX_VERTICES 0x1000000u // vertex indices in 24 bits
+#define MC_ZBT_MAX_COUNT 7u
+#define MC_ZBT_FLAG_BOX_CACHE 1u       // header root word: walk with the per-thread box cache
 
 // AABBTree node (§5.1): BoundingBoxMin (3 floats), BoundingBoxMax (3 floats),
 // Properties (uint32). High bit set: a leaf whose low bits are its triangle

@@ -9,6 +9,7 @@
 #include "layout/lbvh.h"
 #include "layout/quadtree.h"
 #include "layout/skdtree.h"
+#include "layout/zerobyte.h"
 
 namespace meshcast::layout {
 
@@ -66,6 +67,26 @@ struct Descent {
     path.push_back(b);
     aabbtree(at + MC_AABB_NODE_BYTES);
     aabbtree(aabb_second_child(n, h.tree_format == MC_TREE_AABBTREESPLITAXIS));
+    path.pop_back();
+  }
+
+  // Zero-byte trees: every node is a block of its own triangles; a hybrid
+  // leaf's box sits above its zero-byte tree.
+  void zerobyte(uint32_t root) {
+    for_each_zbt_node(blob, root, path, [&](uint32_t p, ZbtNode n, const std::vector<PathBox>& boxes) {
+      visit(root + p * Indexed24::kSlotDivisor, n.count, boxes);
+    });
+  }
+
+  void hybrid(uint32_t at) {
+    AABBNode n = load_aabb_node(tree + at);
+    path.push_back(box_of(n.min, n.max));
+    if (n.is_leaf()) {
+      zerobyte(h.triangle_base + n.value() * Indexed24::kSlotDivisor);
+    } else {
+      hybrid(at + MC_AABB_NODE_BYTES);
+      hybrid(n.value());
+    }
     path.pop_back();
   }
 
@@ -144,6 +165,8 @@ void for_each_leaf_path(const uint8_t* blob, const LeafPathVisitor& visit) {
     case MC_TREE_AABBTREE:
     case MC_TREE_AABBTREESPLITAXIS: return d.aabbtree(0);
     case MC_TREE_AABBTREEPNS: return d.pns(0);
+    case MC_TREE_ZEROBYTE: return d.zerobyte(h.triangle_base);
+    case MC_TREE_ZEROBYTEHYBRID: return d.hybrid(0);
     case MC_TREE_AABBTREECOMPRESSED: {
       CompressedBox root = compressed_root_box(d.tree);
       if (uint32_t count = compressed_root_count(d.tree)) {
@@ -168,6 +191,7 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint3
 
 void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]) {
   const BlobHeader& h = header_of(blob);
+  if (h.triangle_format == MC_TRI_INDEXED24) return Indexed24::decode(blob, block, i, out);
 #define MC_DECODE(Codec, name) \
   if (h.triangle_format == Codec::kFormat) return Codec::decode(blob, block, i, out);
   MC_FOR_EACH_TRIANGLE_CODEC(MC_DECODE)

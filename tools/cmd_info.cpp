@@ -49,6 +49,7 @@ void add_info(CLI::App& app) {
     if (in.mesh) std::printf(", SAH cost %.2f, build %.1f ms", in.report.sah_cost, in.build_ms);
     if (in.mesh && !in.report.pairing.empty())
       std::printf("\n  pairing      %.1f%% of triangles paired; %s", 100 * in.report.paired_ratio, in.report.pairing.c_str());
+    if (!in.report.zerobyte.empty()) std::printf("\n  zero-byte    %s", in.report.zerobyte.c_str());
     std::printf("\n  bounds       (%g, %g, %g) .. (%g, %g, %g)\n", h.bounds_min[0], h.bounds_min[1], h.bounds_min[2],
                 h.bounds_max[0], h.bounds_max[1], h.bounds_max[2]);
     std::printf("  %-10s %12s %10s\n", "section", "bytes", "B/tri");

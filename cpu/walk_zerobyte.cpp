@@ -1,0 +1,113 @@
+// Zero-byte tree walkers (seed 004). A node reached is first bounded: its
+// box is recomputed from the vertices of its triangles (or taken from the
+// thread's box cache), tested conservatively, and only then are its
+// triangles, which the box holds, tested; the children follow in the
+// order of the node's sorting byte (seed 002), the near one on top of the
+// stack. A leaf has no box of its own: its triangles' vertices are the
+// box's, so the triangle test reads them once. ZeroByteHybrid walks its
+// AABBTree nodes as walk_aabbtree does and each leaf's zero-byte tree so.
+#include "cpu/box_cache.h"
+#include "cpu/walk.h"
+#include "layout/aabbtree.h"
+#include "layout/zerobyte.h"
+
+namespace meshcast {
+
+namespace {
+
+// The zero-byte tree whose root triangle is at blob offset `root`, its
+// slots from `slot0`.
+template <bool kCache>
+void walk_zbt(const uint8_t* blob, const layout::BlobHeader& h, uint32_t root, uint32_t slot0, uint32_t octant,
+              const RayPre& r, Closest& c, BoxCache* cache) {
+  const uint8_t* tris = blob + root;
+  const uint8_t* vertices = blob + h.vertex_offset;
+  uint32_t stack[MC_MAX_DEPTH + 2];
+  int top = 0;
+  stack[0] = 0;
+  while (top >= 0) {
+    uint32_t p = stack[top--];
+    layout::ZbtNode n = layout::zbt_node(tris, p);
+    if (n.child) {
+      float mn[3], mx[3];
+      if constexpr (kCache) {
+        if (!cache->find(blob, h.checksum, slot0 + p, mn, mx)) {
+          layout::zbt_box(tris, vertices, p, n, mn, mx);
+          cache->put(blob, h.checksum, slot0 + p, mn, mx);
+        }
+      } else {
+        layout::zbt_box(tris, vertices, p, n, mn, mx);
+      }
+      if (box_test(r, mn, mx, c.t) == INFINITY) continue;
+    }
+    test_leaf<layout::Indexed24>(blob, r, root + p * layout::Indexed24::kSlotDivisor, n.count, slot0 + p, c);
+    if (!n.child) continue;
+    uint32_t children[2] = {n.child, n.child + layout::zbt_node(tris, n.child).count};
+    uint32_t bit = n.count >= 2 ? layout::zbt_pns(tris, p) >> octant & 1 : 0;
+    stack[++top] = children[bit ^ 1];
+    stack[++top] = children[bit];
+  }
+}
+
+template <bool kCache>
+void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
+  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+    walk_zbt<kCache>(blob, h, h.tree_offset + h.triangle_base, 0, layout::pns_octant(r.dir), r, c, cache);
+  });
+}
+
+template <bool kCache>
+void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  const uint8_t* tree = blob + h.tree_offset;
+  BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
+  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+    const uint32_t octant = layout::pns_octant(r.dir);
+    struct Entry { uint32_t node; float tnear; };
+    Entry stack[MC_MAX_DEPTH + 2];
+    int top = -1;
+    layout::AABBNode node = layout::load_aabb_node(tree);
+    uint32_t at = 0;
+    if (box_test(r, node.min, node.max, c.t) == INFINITY) return;
+    for (;;) {
+      if (!node.is_leaf()) {
+        uint32_t left = at + MC_AABB_NODE_BYTES, right = node.value();
+        layout::AABBNode ln = layout::load_aabb_node(tree + left), rn = layout::load_aabb_node(tree + right);
+        float lt = box_test(r, ln.min, ln.max, c.t), rt = box_test(r, rn.min, rn.max, c.t);
+        bool lhit = lt != INFINITY, rhit = rt != INFINITY;
+        if (lhit && rhit) {
+          if (lt <= rt) stack[++top] = {right, rt}, at = left, node = ln;
+          else stack[++top] = {left, lt}, at = right, node = rn;
+          continue;
+        }
+        if (lhit || rhit) {
+          at = lhit ? left : right, node = lhit ? ln : rn;
+          continue;
+        }
+      } else {
+        uint32_t root = h.tree_offset + h.triangle_base + node.value() * layout::Indexed24::kSlotDivisor;
+        walk_zbt<kCache>(blob, h, root, node.value(), octant, r, c, cache);
+      }
+      while (top >= 0 && stack[top].tnear > c.t * kFarScale) --top;
+      if (top < 0) break;
+      at = stack[top--].node;
+      node = layout::load_aabb_node(tree + at);
+    }
+  });
+}
+
+}  // namespace
+
+void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  bool cache = h.root & MC_ZBT_FLAG_BOX_CACHE;
+  if (h.tree_format == MC_TREE_ZEROBYTEHYBRID)
+    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped)
+                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped);
+  return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped)
+               : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped);
+}
+
+}  // namespace meshcast

@@ -93,7 +93,8 @@ std::vector<TreeRow> bench_order(const Mesh& mesh, const std::string& name, size
   return rows;
 }
 
-std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat) {
+std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat,
+                                  const std::string& only) {
   // Seed 000 §6, second table (Stanford Bunny): time for 1024 rays, bytes a triangle.
   const std::map<std::string, std::pair<double, double>> seed = {
       {"QuadTree/Indexed8BitPackSOA4", {0.47, 18.3}}, {"QuadTree/BitPackSOA4", {0.47, 38.2}},
@@ -113,12 +114,36 @@ std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, siz
       {"AABBTreeCompressed/Float3SOA4", {0.89, 45.8}}, {"AABBTreeCompressed/CompressedStrip", {0.92, 13.4}},
       {"AABBTreeCompressed/UncompressedStrip", {0.93, 19.1}}, {"AABBTreeCompressed/Float3", {0.94, 38.0}},
       {"AABBTreeCompressed/BitPack", {0.95, 26.0}}};
+  auto kept = [&](const std::string& layout) {
+    if (only.empty()) return true;
+    for (size_t at = 0; at <= only.size();) {
+      size_t comma = std::min(only.find(',', at), only.size());
+      if (comma > at && layout.find(only.substr(at, comma - at)) != std::string::npos) return true;
+      at = comma + 1;
+    }
+    return false;
+  };
+  // Each layout with its default options, then the zero-byte variants.
+  std::vector<std::pair<std::string, BuildOptions>> cases;
+  for (const std::string& layout : layout_names()) cases.push_back({layout, parse_layout(layout)});
+  for (bool cache : {true, false})
+    for (bool shuffle : {true, false}) {
+      if (cache && shuffle) continue;  // the default, above
+      BuildOptions o = parse_layout("ZeroByteTree/Indexed24");
+      o.zbt_box_cache = cache, o.zbt_shuffle = shuffle;
+      cases.push_back({std::string("ZeroByteTree/Indexed24 (") + (cache ? "cache" : "no cache") + ", " +
+                           (shuffle ? "shuffled" : "not shuffled") + ")", o});
+    }
+  for (uint32_t leaf : {64u, 1024u}) {
+    BuildOptions o = parse_layout("ZeroByteHybrid/Indexed24");
+    o.hybrid_leaf = leaf;
+    cases.push_back({"ZeroByteHybrid/Indexed24 (leaf " + std::to_string(leaf) + ")", o});
+  }
   Setup s = setup(mesh, rays);
   std::vector<TreeRow> rows;
-  for (const std::string& layout : layout_names()) {
-    BuildOptions o = parse_layout(layout);
+  for (const auto& [layout, o] : cases) {
     if (o.tree_format == MC_TREE_BRUTEFORCE || o.triangle_format == MC_TRI_FLOAT3SOA128 ||
-        o.triangle_format == MC_TRI_BITPACKSOA128)
+        o.triangle_format == MC_TRI_BITPACKSOA128 || !kept(layout))
       continue;
     std::fprintf(stderr, "  %s\n", layout.c_str());
     auto it = seed.find(layout);

@@ -29,7 +29,11 @@ std::vector<TreeRow> bench_trees(const Mesh& mesh, const std::string& name, size
 std::vector<TreeRow> bench_order(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat);
 // §6, second table: every tree with every CPU triangle encoding (the
 // 128-lane GPU blocks left out: in a tree each leaf pads to 128 lanes).
-std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat);
+// Then seed 004's zero-byte variants: with and without the box cache and
+// the shuffled bounds, the hybrid with leaves of 64, 256 and 1024.
+// `only`: comma-separated parts of layout names to keep ("" keeps all).
+std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat,
+                                  const std::string& only = "");
 
 // Issue 4's offset test: QuadTreeHalfFloat (and its peers in this format
 // family) on a mesh at the origin and the same mesh moved far away.

@@ -256,6 +256,12 @@ void Context::require_int64_atomics(const std::string& method) const {
                    " method's 64-bit atomic minimum needs");
 }
 
+bool Context::has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const {
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
+    if ((bits >> i & 1) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) return true;
+  return false;
+}
+
 uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required) const {
   for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
     if ((bits >> i & 1) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
@@ -277,8 +283,14 @@ Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUs
   vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
-  mai.memoryTypeIndex = mapped ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
-                               : ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false);
+  // Mapped memory is read back by the host every batch (hits, keys): cached
+  // memory where the device has it, since reading uncached (write-combined)
+  // memory runs at a fraction of the speed; coherent either way.
+  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  mai.memoryTypeIndex = !mapped ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false)
+                        : ctx.has_memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                            ? ctx.memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                            : ctx.memory_type(req.memoryTypeBits, host);
   VkResult r = vkAllocateMemory(ctx.device(), &mai, nullptr, &memory_);
   if (r != VK_SUCCESS) {
     vkDestroyBuffer(ctx.device(), buffer_, nullptr);

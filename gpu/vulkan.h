@@ -67,6 +67,7 @@ class Context {
   // A memory type among `bits` with all of `wanted`; with `required` false
   // any of `bits` when none has them, else GpuError.
   uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required = true) const;
+  bool has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const;
 
  private:
   VkCommandBuffer begin();

@@ -94,8 +94,12 @@
 // the subtree holds. With 2 triangles or more, triangle P + 1 carries the
 // seed 002 sorting byte (top byte of its first word) and the shuffled flag
 // (bit 0 of its second word's top byte): the node has 6 triangles and
-// triangle P + j gives extreme j (min x, y, z, max x, y, z) by its first
-// corner alone. Positions count from the zero-byte tree's root.
+// triangle P + j gives extreme j (min x, y, z, max x, y, z) by one corner,
+// whose number (2 bits each, extreme 0 lowest) fills bits 1..6 of that top
+// byte and bits 0..5 of the third word's. The seed rotates each triangle so
+// its first corner gives the extreme; naming the corner instead keeps the
+// caller's corner order (and so the meaning of u, v). Positions count from
+// the zero-byte tree's root.
 #define MC_ZBT_INDEX_MASK 0x00FFFFFFu
 #define MC_ZBT_CHILD_BITS 21u
 #define MC_ZBT_CHILD_MASK 0x001FFFFFu

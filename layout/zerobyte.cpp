@@ -39,6 +39,8 @@ std::string check_zbt(const uint8_t* blob, const BlobHeader& h, uint32_t base, u
           return at + " names vertex " + num(Indexed24::index(tris, 0, it.p + i, c)) + " of " + num(vertex_count);
     }
     if (n.count == 6 && zbt_shuffled(tris, it.p)) {
+      for (int j = 0; j < 6; ++j)
+        if (zbt_corner(tris, it.p, j) > 2) return at + " names corner 3 for its extreme " + num(j);
       // A shuffled box must be the box of the node's triangles, or rays
       // would be culled wrongly.
       float smn[3], smx[3], fmn[3], fmx[3];
@@ -51,7 +53,7 @@ std::string check_zbt(const uint8_t* blob, const BlobHeader& h, uint32_t base, u
             fmn[a] = std::min(fmn[a], v), fmx[a] = std::max(fmx[a], v);
           }
       for (int a = 0; a < 3; ++a)
-        if (smn[a] != fmn[a] || smx[a] != fmx[a]) return at + " is marked shuffled but its first corners miss its box";
+        if (smn[a] != fmn[a] || smx[a] != fmx[a]) return at + " is marked shuffled but its named corners miss its box";
     }
     if (n.child == 0) continue;
     if (n.child < it.p + n.count || n.child >= limit) return at + " names child " + num(n.child) + " outside " + num(it.p + n.count) + ".." + num(limit);

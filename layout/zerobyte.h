@@ -48,15 +48,21 @@ inline ZbtNode zbt_node(const uint8_t* tris, uint32_t p) {
 }
 inline uint32_t zbt_pns(const uint8_t* tris, uint32_t p) { return Indexed24::word(tris, p + 1, 0) >> 24; }
 inline bool zbt_shuffled(const uint8_t* tris, uint32_t p) { return (Indexed24::word(tris, p + 1, 1) >> 24) & 1; }
+// Shuffled node: the corner of triangle P + j that gives extreme j.
+inline uint32_t zbt_corner(const uint8_t* tris, uint32_t p, int j) {
+  uint32_t sel = (Indexed24::word(tris, p + 1, 1) >> 25 & 0x3F) | (Indexed24::word(tris, p + 1, 2) >> 24 & 0x3F) << 6;
+  return sel >> (2 * j) & 3;
+}
 
 // The node's box, from the vertices its triangles name. A shuffled node
-// reads one corner a triangle (6 vertices); any other every corner.
+// reads one named corner a triangle (6 vertices); any other every corner.
 inline void zbt_box(const uint8_t* tris, const uint8_t* vertices, uint32_t p, ZbtNode n, float mn[3], float mx[3]) {
   auto vertex = [&](uint32_t i, int c) {
     return reinterpret_cast<const float*>(vertices + uint64_t(Indexed24::word(tris, p + i, c) & MC_ZBT_INDEX_MASK) * 12);
   };
   if (n.count == 6 && zbt_shuffled(tris, p)) {
-    for (int a = 0; a < 3; ++a) mn[a] = vertex(uint32_t(a), 0)[a], mx[a] = vertex(uint32_t(a) + 3, 0)[a];
+    for (int a = 0; a < 3; ++a)
+      mn[a] = vertex(uint32_t(a), int(zbt_corner(tris, p, a)))[a], mx[a] = vertex(uint32_t(a) + 3, int(zbt_corner(tris, p, a + 3)))[a];
     return;
   }
   for (int a = 0; a < 3; ++a) mn[a] = INFINITY, mx[a] = -INFINITY;

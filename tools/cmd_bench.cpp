@@ -33,6 +33,7 @@ void add_bench(CLI::App& app) {
     std::string input = "data/bunny00.off", out_dir = "out";
     size_t rays = 1024;
     uint32_t repeat = 7;
+    std::string only;  // combos: the layouts naming one of these (comma separated)
   };
   auto args = std::make_shared<Args>();
   using ArgsT = Args;
@@ -94,6 +95,8 @@ void add_bench(CLI::App& app) {
     sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
     sub->add_option("--repeat", targs->repeat, "passes; minimum and median reported")->check(CLI::Range(1, 1000));
     sub->add_option("--out-dir", targs->out_dir, "where the CSV and the plot go");
+    if (std::string(table.name) == "combos")
+      sub->add_option("--only", targs->only, "only the layouts whose name contains one of these, comma separated");
     std::string kind = table.name;
     sub->callback([targs, kind] {
       Mesh mesh = bench_mesh(targs->input);
@@ -102,7 +105,7 @@ void add_bench(CLI::App& app) {
           kind == "splitters" ? bench::bench_splitters(mesh, targs->input, targs->rays, targs->repeat)
           : kind == "leafsize" ? bench::bench_leafsize(mesh, targs->input, targs->rays, targs->repeat)
           : kind == "order"    ? bench::bench_order(mesh, targs->input, targs->rays, targs->repeat)
-          : kind == "combos"   ? bench::bench_combos(mesh, targs->input, targs->rays, targs->repeat)
+          : kind == "combos"   ? bench::bench_combos(mesh, targs->input, targs->rays, targs->repeat, targs->only)
                                : bench::bench_trees(mesh, targs->input, targs->rays, targs->repeat);
       // Microseconds per ray, the unit of the source's "Time 1024 Rays (us)" columns.
       double scale = 1000.0 / double(targs->rays);

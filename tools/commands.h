@@ -23,6 +23,8 @@ struct LayoutArgs {
   uint32_t leaf = 8, lbvh_depth = 0;
   bool lbvh_left_first = false;
   bool pairing = false;
+  bool zbt_no_shuffle = false, zbt_no_cache = false;  // zero-byte trees (seed 004)
+  uint32_t hybrid_leaf = 256;
 };
 void add_layout_options(CLI::App* cmd, LayoutArgs& args);
 BuildOptions build_options(const LayoutArgs& args);  // throws InputError for bad names

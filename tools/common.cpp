@@ -52,6 +52,10 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
   cmd->add_option("--grouping", a.grouping, "AABBList batches (seed 000 7): ClosestCentroid (the seed's) or Morton");
   cmd->add_flag("--pairing", a.pairing, "pair triangles across shared edges first (seed 003); leaves hold whole pairs");
+  cmd->add_flag("--no-shuffle", a.zbt_no_shuffle, "zero-byte trees: any bound triangles, not 6 each naming its extreme's corner");
+  cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
+  cmd->add_option("--hybrid-leaf", a.hybrid_leaf, "ZeroByteHybrid: largest leaf, each one zero-byte tree")
+      ->check(CLI::Range(8u, uint32_t(MC_ZBT_MAX_TRIANGLES)));
 }
 
 BuildOptions build_options(const LayoutArgs& a) {
@@ -61,6 +65,7 @@ BuildOptions build_options(const LayoutArgs& a) {
   o.lbvh_near_first = !a.lbvh_left_first;
   if (!a.grouping.empty()) o.grouping = parse_grouping(a.grouping);
   o.pairing = a.pairing;
+  o.zbt_shuffle = !a.zbt_no_shuffle, o.zbt_box_cache = !a.zbt_no_cache, o.hybrid_leaf = a.hybrid_leaf;
   return o;
 }
 

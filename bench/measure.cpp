@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "cpu/agreement.h"
+#include "cpu/counters.h"
 #include "cpu/trace.h"
 #include "layout/blob.h"
 #include "layout/lbvh.h"
@@ -47,6 +48,12 @@ Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& op
   const uint64_t disagreements = oracle_mistakes(mesh, blob, rays, hits, oracle);
   double tree_bytes = double(h.node_bytes) / h.triangle_count, walked = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
   Timing t{ms.front(), ms[ms.size() / 2], bytes, disagreements, report.build_ms, tree_bytes, walked, report.sah_cost};
+  if constexpr (kCountTests) {
+    test_counts = {};
+    view.trace(rays, hits);
+    t.boxes_per_ray = double(test_counts.boxes) / double(rays.size());
+    t.triangles_per_ray = double(test_counts.triangles) / double(rays.size());
+  }
   if (h.tree_format == MC_TREE_STACKLESSLBVH) {
     uint64_t holes = 0;
     for (uint32_t n = 1; n <= h.node_count; ++n) holes += layout::load_lbvh_node(blob.data() + h.tree_offset, n).count == 0;

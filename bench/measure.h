@@ -18,6 +18,9 @@ struct Timing {
   double walked_bytes;       // everything a walk reads, per triangle
   double sah_cost;
   double hole_bytes = 0;     // StacklessLBVH: node slots no walk reaches, per triangle
+  // Box and triangle tests a ray, from one more pass; -1 unless the build
+  // counts them (MESHCAST_COUNT_TESTS, cpu/counters.h).
+  double boxes_per_ray = -1, triangles_per_ray = -1;
 };
 
 // Rays whose triangle or t differ from the oracle's (`oracle`: over the

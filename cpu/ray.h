@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "cpu/counters.h"
 #include "cpu/simd.h"
 #include "layout/formats.h"
 
@@ -104,6 +105,7 @@ inline bool interval_open(float tn, float tf, float closest) { return tn <= min_
 
 // Scalar box test; returns the entry distance, or +inf for a miss.
 inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
+  count_boxes(1);
   float tn, tf;
   box_interval(r, mn, mx, &tn, &tf);
   return interval_open(tn, tf, closest) ? tn : INFINITY;
@@ -111,6 +113,7 @@ inline float box_test(const RayPre& r, const float mn[3], const float mx[3], flo
 
 // Four boxes at once; `nearp[a]`/`farp[a]` are the near and far planes of axis a.
 inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
+  count_boxes(4);
   using simd::F4;
   F4 tn = F4::splat(0.0f), tf = F4::splat(INFINITY);
   for (int a = 0; a < 3; ++a) {
@@ -139,6 +142,7 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
 template <class F4, class M4>
 inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
   constexpr int kW = F4::kLanes;
+  if constexpr (kCountTests) count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(valid)))));
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
   F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;

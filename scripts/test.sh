@@ -23,7 +23,7 @@ cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_TSAN=ON >/
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 
-echo "== Portable scalar path"
-cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON >/dev/null
+echo "== Portable scalar path, with the box and triangle test counters compiled in"
+cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON >/dev/null
 cmake --build build-scalar -j"$jobs"
 ctest --test-dir build-scalar --output-on-failure -j"$jobs" --timeout 900

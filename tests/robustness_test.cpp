@@ -17,7 +17,14 @@ namespace {
 
 class Robustness : public ::testing::TestWithParam<std::string> {
  protected:
-  BuildOptions options() const { return parse_layout(GetParam()); }
+  // "TREE/TRIANGLES", or with "+pairing": seed 003's pairs as the builder's unit.
+  BuildOptions options() const {
+    const std::string& p = GetParam();
+    size_t plus = p.find('+');
+    BuildOptions o = parse_layout(p.substr(0, plus));
+    o.pairing = plus != std::string::npos;
+    return o;
+  }
   bool quantized() const { return moves_vertices(options().triangle_format); }
   // Oracle answers on the mesh as stored (quantized for bit-packed formats).
   void expect_oracle(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
@@ -186,12 +193,29 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
   EXPECT_EQ(hits[4].triangle, MC_NO_HIT);
 }
 
-INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(layout_names()), [](const auto& info) {
+std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
   std::string n = info.param;
   for (char& c : n)
-    if (c == '/') c = '_';
+    if (c == '/' || c == '+') c = '_';
   return n;
-});
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(layout_names()), param_name);
+
+// Paired trees (seed 003): every tree that takes pairs, with a float and a
+// quantized encoding.
+std::vector<std::string> paired_layouts() {
+  std::vector<std::string> names;
+  for (const std::string& n : layout_names()) {
+    BuildOptions o = parse_layout(n);
+    if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST || o.tree_format == MC_TREE_ZEROBYTE ||
+        o.tree_format == MC_TREE_ZEROBYTEHYBRID)
+      continue;
+    if (o.triangle_format == MC_TRI_FLOAT3SOA4 || o.triangle_format == MC_TRI_INDEXED8BITPACKSOA4) names.push_back(n + "+pairing");
+  }
+  return names;
+}
+INSTANTIATE_TEST_SUITE_P(Paired, Robustness, ::testing::ValuesIn(paired_layouts()), param_name);
 
 }  // namespace
 }  // namespace meshcast::testing

@@ -227,3 +227,26 @@ TEST(StoredCornersWithinBound, EveryFormatEveryMesh) {
 
 }  // namespace
 }  // namespace meshcast::testing
+
+// The test counters (cpu/counters.h), in a counting build: the brute force
+// tests every triangle of every ray and no box; a tree tests boxes and far
+// fewer triangles. Skipped in builds without MESHCAST_COUNT_TESTS.
+namespace meshcast::testing {
+namespace {
+TEST(Counters, CountEveryBoxAndTriangleTest) {
+  if constexpr (!kCountTests) GTEST_SKIP() << "built without MESHCAST_COUNT_TESTS";
+  Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  NamedMesh named{"counted_sphere", std::make_shared<const Mesh>(m)};
+  const std::vector<Ray>& rays = test_rays(named, RayKind::Radial, 500);
+  test_counts = {};
+  trace_all(build_blob(m, parse_layout("BruteForce/Float3"), "sphere"), rays);
+  EXPECT_EQ(test_counts.triangles, rays.size() * m.triangles.size());
+  EXPECT_EQ(test_counts.boxes, 0u);
+  test_counts = {};
+  trace_all(build_blob(m, parse_layout("AABBTree/Float3"), "sphere"), rays);
+  EXPECT_GT(test_counts.boxes, rays.size());
+  EXPECT_GT(test_counts.triangles, 0u);
+  EXPECT_LT(test_counts.triangles, rays.size() * m.triangles.size() / 4);
+}
+}  // namespace
+}  // namespace meshcast::testing

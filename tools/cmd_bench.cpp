@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "cpu/counters.h"
 #include "bench/encodings.h"
 #include "bench/gpu.h"
 #include "bench/latency.h"
@@ -238,26 +239,39 @@ void add_bench(CLI::App& app) {
     std::printf("\n%zu long rays, one thread, leaf 8; us per ray, minimum of %u passes; paired: before = input order "
                 "(window N = 2), after = the pass (or the input's pairs when the pre-scan skips it)\n\n"
                 "| mesh | triangles | pairing ms | paired before | after | layout | us/ray | paired | change | walked B/tri | "
-                "paired | disagreements |\n|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n",
+                "paired | box tests/ray | paired | triangle tests/ray | paired | disagreements |\n"
+                "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
                 pargs->rays, pargs->repeat);
     std::filesystem::create_directories(pargs->out_dir);
     std::ofstream csv(pargs->out_dir + "/pairing.csv");
     csv << "mesh,triangles,pairing_ms,paired_before,paired_after,decision,layout,us_per_ray,us_per_ray_paired,"
-           "walked_bytes,walked_bytes_paired,disagreements\n";
+           "walked_bytes,walked_bytes_paired,box_tests,box_tests_paired,triangle_tests,triangle_tests_paired,disagreements\n";
+    // Test counts exist in a counting build alone (MESHCAST_COUNT_TESTS).
+    auto count = [](double v) {
+      char text[32];
+      if (v < 0) return std::string("-");
+      std::snprintf(text, sizeof text, "%.1f", v);
+      return std::string(text);
+    };
     for (const bench::PairingRow& r : rows) {
       const double plain = r.plain.min_ms * scale, paired = r.paired.min_ms * scale;
       const uint64_t wrong = r.plain.disagreements + r.paired.disagreements;
-      std::printf("| %s | %zu | %.1f | %.1f%% | %.1f%% | %s | %.3f | %.3f | %+.1f%% | %.2f | %.2f | %llu |\n", r.mesh.c_str(),
-                  r.triangles, r.pairing_ms, 100 * r.before, 100 * r.after, r.layout.c_str(), plain, paired,
-                  100 * (paired / plain - 1), r.plain.walked_bytes, r.paired.walked_bytes, (unsigned long long)wrong);
+      std::printf("| %s | %zu | %.1f | %.1f%% | %.1f%% | %s | %.3f | %.3f | %+.1f%% | %.2f | %.2f | %s | %s | %s | %s | %llu |\n",
+                  r.mesh.c_str(), r.triangles, r.pairing_ms, 100 * r.before, 100 * r.after, r.layout.c_str(), plain, paired,
+                  100 * (paired / plain - 1), r.plain.walked_bytes, r.paired.walked_bytes,
+                  count(r.plain.boxes_per_ray).c_str(), count(r.paired.boxes_per_ray).c_str(),
+                  count(r.plain.triangles_per_ray).c_str(), count(r.paired.triangles_per_ray).c_str(),
+                  (unsigned long long)wrong);
       csv << r.mesh << "," << r.triangles << "," << r.pairing_ms << "," << r.before << "," << r.after << ",\"" << r.decision
           << "\"," << r.layout << "," << plain << "," << paired << "," << r.plain.walked_bytes << "," << r.paired.walked_bytes
-          << "," << wrong << "\n";
+          << "," << r.plain.boxes_per_ray << "," << r.paired.boxes_per_ray << "," << r.plain.triangles_per_ray << ","
+          << r.paired.triangles_per_ray << "," << wrong << "\n";
     }
     std::printf("\ndecisions:\n");
     for (size_t i = 0; i < rows.size(); i += 2) std::printf("  %s: %s\n", rows[i].mesh.c_str(), rows[i].decision.c_str());
-    std::printf("csv: %s/pairing.csv\nnot yet: the seed's box and triangle test counts (the walkers have no counters)\n",
-                pargs->out_dir.c_str());
+    std::printf("csv: %s/pairing.csv\n%s\n", pargs->out_dir.c_str(),
+                kCountTests ? "test counts: one more pass with the counters (this build counts; its times are not for comparison)"
+                            : "test counts: '-' (build with -DMESHCAST_COUNT_TESTS=ON to count them)");
   });
 
   // Issue 4's offset test for the half-float tree.

@@ -1,0 +1,29 @@
+// Box and triangle tests, counted per thread for the tables that report
+// them (seed 003's pairing table). Compiled in only with the CMake option
+// MESHCAST_COUNT_TESTS (the scalar test build has it), so a timed build
+// does no extra work; elsewhere kCountTests is false and the counts stay 0.
+#pragma once
+#include <cstdint>
+
+namespace meshcast {
+
+struct TestCounts {
+  uint64_t boxes = 0, triangles = 0;
+};
+
+#ifdef MESHCAST_COUNT_TESTS
+inline constexpr bool kCountTests = true;
+inline thread_local TestCounts test_counts;
+#else
+inline constexpr bool kCountTests = false;
+inline TestCounts test_counts;  // never written
+#endif
+
+inline void count_boxes(uint64_t n) {
+  if constexpr (kCountTests) test_counts.boxes += n;
+}
+inline void count_triangles(uint64_t n) {
+  if constexpr (kCountTests) test_counts.triangles += n;
+}
+
+}  // namespace meshcast

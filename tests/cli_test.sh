@@ -57,6 +57,11 @@ check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info 
 check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
 check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
 check pairing 0 "of triangles paired" -- "$meshcast" info "$mesh" --layout AABBTree/Float3SOA4 --pairing
+check zerobyte 0 "nodes +0 +0\.00" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Indexed24
+check zerobyte-stats 0 "shuffled; box cache off" -- "$meshcast" info "$mesh" --layout ZeroByteHybrid/Indexed24 --hybrid-leaf 64 --no-box-cache
+check zerobyte-float3 2 "valid layouts" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Float3
+check zerobyte-trace 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout ZeroByteTree/Indexed24 --rays "$work/r.rays" --out "$work/hz.hits"
+check bench-combos-zerobyte 0 "ZeroByteHybrid/Indexed24 \(leaf 64\)" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --only ZeroByte,QuadTreeHalfFloat/Indexed8 --out-dir "$work"
 check pairing-bruteforce 2 "keeps its own triangle order" -- "$meshcast" info "$mesh" --layout BruteForce/Float3 --pairing
 check order 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout quadtreehalffloat/float3 --order breadthfirst --rays "$work/r.rays" --out "$work/h4.hits"
 check order-refused 2 "AABBTree is always DepthFirst" -- "$meshcast" info "$mesh" --layout AABBTree/Float3 --order BreadthFirst

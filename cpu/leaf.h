@@ -129,21 +129,24 @@ struct Loader<layout::Indexed<IndexT, kBitPack, kSoa, kId>> {
 };
 
 // Indexed24 (seed 004): 32-bit index words whose top byte belongs to the
-// tree; the triangles of a zero-byte node side by side.
+// tree; the 1..7 triangles of a zero-byte node side by side, tested 8 at a
+// time so a node is one test (its corners gathered into rows first).
 template <>
 struct Loader<layout::Indexed24> {
+  static constexpr int kWidth = 8;
   static void load(const uint8_t* blob, uint32_t block, uint32_t first, uint32_t count, const int axis[3],
-                   simd::F4 v[3][3]) {
+                   simd::F8 v[3][3]) {
     const float* vertices = reinterpret_cast<const float*>(blob + layout::header_of(blob).vertex_offset);
-    uint32_t last = count - 1;
-    for (int c = 0; c < 3; ++c) {
-      simd::I4 idx = simd::iconst(int(layout::Indexed24::index(blob, block, first, c)),
-                                  int(layout::Indexed24::index(blob, block, std::min(first + 1, last), c)),
-                                  int(layout::Indexed24::index(blob, block, std::min(first + 2, last), c)),
-                                  int(layout::Indexed24::index(blob, block, std::min(first + 3, last), c)));
-      simd::I4 idx3 = idx + idx + idx;
-      for (int j = 0; j < 3; ++j) v[c][j] = simd::gather(vertices, idx3 + axis[j]);
+    alignas(32) float rows[3][3][8];
+    for (uint32_t i = 0; i < 8; ++i) {
+      uint32_t t = std::min(first + i, count - 1);
+      for (int c = 0; c < 3; ++c) {
+        const float* p = vertices + 3ull * layout::Indexed24::index(blob, block, t, c);
+        for (int j = 0; j < 3; ++j) rows[c][j][i] = p[axis[j]];
+      }
     }
+    for (int c = 0; c < 3; ++c)
+      for (int j = 0; j < 3; ++j) v[c][j] = simd::F8::load(rows[c][j]);
   }
 };
 

@@ -60,7 +60,10 @@ std::vector<PairingRow> bench_pairing(const std::string& data_dir, size_t ray_co
     OracleTree oracle_tree(mesh);
     std::vector<OracleHit> oracle;
     for (const Ray& r : rays) oracle.push_back(oracle_tree.closest(r));
-    for (const char* layout : {"QuadTreeHalfFloat/Indexed8BitPackSOA4", "AABBTree/Float3SOA4"}) {
+    // Float3PairSOA4: the pair as the unit of storage and of the test, beside
+    // Float3SOA4 in the same tree.
+    for (const char* layout : {"QuadTreeHalfFloat/Indexed8BitPackSOA4", "AABBTree/Float3SOA4", "AABBTree/Float3PairSOA4",
+                               "QuadTree/Float3SOA4", "QuadTree/Float3PairSOA4"}) {
       PairingRow row{name, layout, p.decision, mesh.triangles.size(), p.ms, p.prescan_ratio, p.paired_ratio};
       BuildOptions o = parse_layout(layout);
       o.leaf_size = 8;

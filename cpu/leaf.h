@@ -3,6 +3,7 @@
 // triangle format means adding a loader, not another walker.
 #pragma once
 #include <algorithm>
+#include <bit>
 
 #include "cpu/ray.h"
 #include "layout/codecs.h"
@@ -181,11 +182,38 @@ inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint3
   return bytes;
 }
 
+// Pair blocks (layout/pairsoa.h): 4 lanes of pairs a pass, the leaf's
+// triangles numbered lane by lane. Returns the blocks' bytes.
+template <class Codec>
+inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
+                               Closest& c) {
+  uint32_t made = 0;
+  uint64_t at = 0;
+  while (made < count) {
+    const uint8_t* p = blob + block + at;
+    uint32_t header = layout::load<uint32_t>(p), used = header & 15, paired = header >> 4 & 15;
+    simd::F4 v[4][3];
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 3; ++j) v[k][j] = simd::F4::load(p + Codec::row(k, r.axis[j]));
+    PairHit h = pair_test(r, v, simd::lanes_of(used), simd::lanes_of(paired), c.t);
+    if (h.lane >= 0 && h.t <= c.t) {
+      uint32_t below = (1u << h.lane) - 1;
+      uint32_t index = made + uint32_t(std::popcount(used & below) + std::popcount(paired & below)) + h.second;
+      c = {h.t, slot0 + index, h.u, h.v};
+    }
+    made += uint32_t(std::popcount(used) + std::popcount(paired));
+    at += Codec::kBlockBytes;
+  }
+  return at;
+}
+
 template <class Codec>
 inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                       Closest& c) {
   if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
     test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
+  } else if constexpr (requires { Codec::kPairLanes; }) {
+    test_pair_leaf<Codec>(blob, r, block, count, slot0, c);
   } else {
     constexpr int kWidth = width_of<Loader<Codec>>();
     for (uint32_t first = 0; first < count; first += kWidth) {

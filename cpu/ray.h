@@ -200,4 +200,77 @@ inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float 
   return best;
 }
 
+// Seed 003's pair test: 4 lanes of triangle pairs, corners v[0..3] = A, B,
+// C, D (ray's axis order); the first triangle is (A, B, C), the second
+// (B, A, D). The 4 corners are moved into ray space once (8 where two
+// triangles would take 12... 6 moves for 3), and the shared edge's function
+// once: the second's W is minus the first's, exactly the value a separate
+// test would compute for (B, A), so the pair stays watertight along it.
+// `second` lanes hold a pair; the others test their first triangle alone.
+struct PairHit {
+  int lane = -1;
+  bool second = false;
+  float t = 0, u = 0, v = 0;
+};
+
+template <class F4, class M4>
+inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, float closest) {
+  constexpr int kW = F4::kLanes;
+  if constexpr (kCountTests)
+    count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(used))) + __builtin_popcount(unsigned(simd::bits(second)))));
+  const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
+  const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
+  F4 x[4], y[4], z[4];
+  for (int k = 0; k < 4; ++k) {
+    z[k] = v[k][2] - oz;
+    x[k] = (v[k][0] - ox) - sx * z[k], y[k] = (v[k][1] - oy) - sy * z[k];
+    z[k] = sz * z[k];
+  }
+  // Edge functions as triangle_test writes them: E(P, Q) = Q.x P.y - Q.y P.x.
+  auto edge = [&](int p, int q) { return x[q] * y[p] - y[q] * x[p]; };
+  const F4 zero = F4::splat(0.0f);
+  F4 E[2][3] = {{edge(1, 2), edge(2, 0), edge(0, 1)}, {edge(0, 3), edge(3, 1), zero - edge(0, 1)}};
+  const int corner[2][3] = {{0, 1, 2}, {1, 0, 3}};
+  PairHit best;
+  for (int tri = 0; tri < 2; ++tri) {
+    M4 valid = tri == 0 ? used : second;
+    const F4 &U = E[tri][0], &V = E[tri][1], &W = E[tri][2];
+    M4 neg = (U < zero) | (V < zero) | (W < zero);
+    M4 pos = (U > zero) | (V > zero) | (W > zero);
+    M4 inside = simd::andnot(neg & pos, valid);
+    M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
+    F4 det = U + V + W;
+    F4 T = U * z[corner[tri][0]] + V * z[corner[tri][1]] + W * z[corner[tri][2]];
+    F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
+    F4 t = Ts / dets;
+    M4 accept = simd::andnot(edge_zero, inside & (det != zero) & (Ts >= zero) & (t <= F4::splat(closest)));
+    float tl[kW], Ul[kW], Vl[kW], Wl[kW];
+    t.store(tl), U.store(Ul), V.store(Vl), W.store(Wl);
+    for (int m = simd::bits(accept); m; m &= m - 1) {
+      int i = __builtin_ctz(m);
+      if (best.lane < 0 || tl[i] < best.t) {
+        float d = Ul[i] + Vl[i] + Wl[i];
+        best = {i, tri == 1, tl[i], Vl[i] / d, Wl[i] / d};
+      }
+    }
+    // Rare: an edge function of 0 in float; settle those lanes in double.
+    if (int redo = simd::bits(edge_zero & valid)) {
+      float l[9][kW];
+      const int* k = corner[tri];
+      x[k[0]].store(l[0]), y[k[0]].store(l[1]), x[k[1]].store(l[2]), y[k[1]].store(l[3]), x[k[2]].store(l[4]),
+          y[k[2]].store(l[5]), z[k[0]].store(l[6]), z[k[1]].store(l[7]), z[k[2]].store(l[8]);
+      for (int m = redo; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        LaneHit h;
+        float limit = best.lane >= 0 ? best.t : closest;
+        if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i],
+                                   limit, &h) &&
+            (best.lane < 0 || h.t < best.t))
+          best = {i, tri == 1, h.t, h.u, h.v};
+      }
+    }
+  }
+  return best;
+}
+
 }  // namespace meshcast

@@ -56,6 +56,10 @@ inline M4 operator&(M4 a, M4 b) { return {_mm_and_ps(a.v, b.v)}; }
 inline M4 operator|(M4 a, M4 b) { return {_mm_or_ps(a.v, b.v)}; }
 inline M4 andnot(M4 a, M4 b) { return {_mm_andnot_ps(a.v, b.v)}; }  // b & ~a
 inline int bits(M4 m) { return _mm_movemask_ps(m.v); }
+inline M4 lanes_of(uint32_t bits) {  // lane i set when bit i is
+  const __m128i b = _mm_setr_epi32(1, 2, 4, 8);
+  return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(int(bits)), b), b))};
+}
 inline M4 lanes_below(uint32_t n) {  // lanes 0..n-1 set
   return {_mm_castsi128_ps(_mm_cmplt_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32(int(n))))};
 }
@@ -174,6 +178,7 @@ template <int N> inline MN<N> andnot(MN<N> a, MN<N> b) MC_LANES(MN<N>, !a.v[i] &
 template <int N> inline FN<N> select(MN<N> m, FN<N> a, FN<N> b) MC_LANES(FN<N>, m.v[i] ? a.v[i] : b.v[i])
 template <int N> inline int bits(MN<N> m) { int b = 0; for (int i = 0; i < N; ++i) b |= int(m.v[i]) << i; return b; }
 inline M4 lanes_below(uint32_t n) MC_LANES(M4, uint32_t(i) < n)
+inline M4 lanes_of(uint32_t bits) MC_LANES(M4, (bits >> i & 1) != 0)
 inline M8 lanes_below8(uint32_t n) MC_LANES(M8, uint32_t(i) < n)
 inline M4 nonzero(I4 a) MC_LANES(M4, a.v[i] != 0)
 inline F4 from_u16(const uint8_t* p) MC_LANES(F4, float(uint32_t(p[2 * i] | p[2 * i + 1] << 8)))

@@ -7,6 +7,7 @@
 #include "layout/strip.h"
 #include "layout/indexed.h"
 #include "layout/indexed8bitpacksoa4.h"
+#include "layout/pairsoa.h"
 
 // X(codec type in meshcast::layout, its name as the seed writes it)
 #define MC_FOR_EACH_TRIANGLE_CODEC(X)                  \
@@ -25,4 +26,5 @@
   X(BitPackSOA128, "BitPackSOA128")                    \
   X(BitPack, "BitPack")                                \
   X(UncompressedStrip, "UncompressedStrip")            \
-  X(CompressedStrip, "CompressedStrip")
+  X(CompressedStrip, "CompressedStrip")                \
+  X(Float3PairSOA4, "Float3PairSOA4")

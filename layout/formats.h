@@ -83,6 +83,7 @@
 #define MC_TRI_BITPACK 14u             // §3.4
 #define MC_TRI_UNCOMPRESSEDSTRIP 15u   // §3.10
 #define MC_TRI_COMPRESSEDSTRIP 16u     // §3.10
+#define MC_TRI_FLOAT3PAIRSOA4 18u      // seed 003: triangle pairs, the shared edge stored once
 #define MC_TRI_INDEXED24 17u           // seed 004: 32-bit index words, 24 bits of vertex index, 8 of tree
 
 // Zero-byte tree (seed 004). Triangle P starts a node when a walk reaches

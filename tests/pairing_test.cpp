@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <random>
+#include <set>
 
 #include "cpu/pairing.h"
 #include "io/generate.h"
 #include "layout/blob.h"
 #include "layout/leaves.h"
+#include "layout/pairsoa.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -163,5 +166,53 @@ TEST(PairedTrees, WhatCannotPairIsRefusedWithTheReason) {
   EXPECT_THROW(build_blob(m, o, "sphere"), InputError);
 }
 
+}  // namespace
+}  // namespace meshcast::testing
+
+// Float3PairSOA4 (layout/pairsoa.h): a quad's two triangles become one lane
+// of 4 corners, the second stored as (B, A, D) after the first (A, B, C);
+// the header says lane 0 is used and holds a pair; a header with bits no
+// block may hold is refused.
+namespace meshcast::testing {
+namespace {
+TEST(PairBlocks, AQuadIsOneLaneOfFourCorners) {
+  Mesh quad;
+  quad.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  quad.triangles = {Triangle{0, 1, 2}, Triangle{0, 2, 3}};  // shared edge 0-2, met as (2, 0) in the first
+  std::vector<uint8_t> blob = build_blob(quad, parse_layout("AABBTree/Float3PairSOA4"), "quad");
+  uint32_t leaf_block = 0, leaf_count = 0;
+  layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t count) { leaf_block = block, leaf_count = count; });
+  ASSERT_EQ(leaf_count, 2u);
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  const uint8_t* p = blob.data() + h.tree_offset + leaf_block;
+  EXPECT_EQ(layout::load<uint32_t>(p), 0x11u);
+  float first[3][3], second[3][3];
+  layout::decode_triangle(blob.data(), h.tree_offset + leaf_block, 0, first);
+  layout::decode_triangle(blob.data(), h.tree_offset + leaf_block, 1, second);
+  // (A, B, C) and (B, A, D): the shared edge, reversed, then the other corner.
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(second[0][a], first[1][a]);
+    EXPECT_EQ(second[1][a], first[0][a]);
+  }
+  float d[3];
+  for (int a = 0; a < 3; ++a) d[a] = layout::load<float>(p + layout::Float3PairSOA4::row(3, a));
+  EXPECT_EQ(std::memcmp(d, second[2], 12), 0);
+  // The two triangles' shared corners are the quad's diagonal 0-2.
+  std::set<std::pair<float, float>> diagonal = {{first[0][0], first[0][1]}, {first[1][0], first[1][1]}};
+  EXPECT_EQ(diagonal, (std::set<std::pair<float, float>>{{0, 0}, {1, 1}}));
+  // Rays through each triangle hit it, through the diagonal one of them.
+  std::vector<Ray> rays = {Ray{{0.8f, 0.2f, 1}, {0, 0, -1}, 10}, Ray{{0.2f, 0.8f, 1}, {0, 0, -1}, 10},
+                           Ray{{0.5f, 0.5f, 1}, {0, 0, -1}, 10}};
+  std::vector<Hit> hits = trace_all(blob, rays);
+  EXPECT_EQ(hits[0].triangle, 0u);
+  EXPECT_EQ(hits[1].triangle, 1u);
+  EXPECT_NE(hits[2].triangle, MC_NO_HIT);
+
+  std::vector<uint8_t> bad = blob;
+  uint32_t header = 0x111;
+  std::memcpy(bad.data() + h.tree_offset + leaf_block, &header, 4);
+  layout::seal(bad);
+  EXPECT_NE(layout::validate(bad), "");
+}
 }  // namespace
 }  // namespace meshcast::testing

@@ -136,6 +136,21 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
                             const float cy, const float az, const float bz, const float cz, float closest,
                             LaneHit* out);
 
+// The lanes of `redo` settled in double: corners in ray space (x, y of the
+// three corners, then their scaled z) stored, each lane redone by
+// watertight_lane_double against limit(); take(lane, hit) for each hit.
+template <class F4, class Limit, class Take>
+inline void settle_in_double(int redo, const F4 (&p)[9], Limit&& limit, Take&& take) {
+  float l[9][F4::kLanes];
+  for (int k = 0; k < 9; ++k) p[k].store(l[k]);
+  for (int m = redo; m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    LaneHit h;
+    if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i], limit(), &h))
+      take(i, h);
+  }
+}
+
 // Corners come in the ray's axis order, v[corner][j] = axis r.axis[j], so the
 // test indexes registers with constants. One source for every width: F4 (SSE,
 // 4 triangles) and F8 (AVX2, 8 triangles).
@@ -182,21 +197,11 @@ inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float 
     best.u = Vl[best.lane] / d, best.v = Wl[best.lane] / d;
   }
   // Rare: an edge function of 0 in float; settle those lanes in double.
-  int redo = simd::bits(edge_zero & valid);
-  if (redo) {
-    float l[9][kW];
-    ax.store(l[0]), ay.store(l[1]), bx.store(l[2]), by.store(l[3]), cx.store(l[4]), cy.store(l[5]);
-    az.store(l[6]), bz.store(l[7]), cz.store(l[8]);
-    for (int m = redo; m; m &= m - 1) {
-      int i = __builtin_ctz(m);
-      LaneHit h;
-      float limit = best.lane >= 0 ? best.t : closest;
-      if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i],
-                                 limit, &h) &&
-          (best.lane < 0 || h.t < best.t))
-        best = h, best.lane = i;
-    }
-  }
+  if (int redo = simd::bits(edge_zero & valid))
+    settle_in_double(redo, {ax, ay, bx, by, cx, cy, az, bz, cz}, [&] { return best.lane >= 0 ? best.t : closest; },
+                     [&](int i, const LaneHit& h) {
+                       if (best.lane < 0 || h.t < best.t) best = h, best.lane = i;
+                     });
   return best;
 }
 
@@ -254,21 +259,13 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
       }
     }
     // Rare: an edge function of 0 in float; settle those lanes in double.
-    if (int redo = simd::bits(edge_zero & valid)) {
-      float l[9][kW];
-      const int* k = corner[tri];
-      x[k[0]].store(l[0]), y[k[0]].store(l[1]), x[k[1]].store(l[2]), y[k[1]].store(l[3]), x[k[2]].store(l[4]),
-          y[k[2]].store(l[5]), z[k[0]].store(l[6]), z[k[1]].store(l[7]), z[k[2]].store(l[8]);
-      for (int m = redo; m; m &= m - 1) {
-        int i = __builtin_ctz(m);
-        LaneHit h;
-        float limit = best.lane >= 0 ? best.t : closest;
-        if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i],
-                                   limit, &h) &&
-            (best.lane < 0 || h.t < best.t))
-          best = {i, tri == 1, h.t, h.u, h.v};
-      }
-    }
+    const int* k = corner[tri];
+    if (int redo = simd::bits(edge_zero & valid))
+      settle_in_double(redo, {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]], z[k[0]], z[k[1]], z[k[2]]},
+                       [&] { return best.lane >= 0 ? best.t : closest; },
+                       [&](int i, const LaneHit& h) {
+                         if (best.lane < 0 || h.t < best.t) best = {i, tri == 1, h.t, h.u, h.v};
+                       });
   }
   return best;
 }

@@ -1,6 +1,7 @@
 // AABBTree walker (seed 000 §5.1): test both children, descend into the
 // nearer, push the farther with its entry distance, and drop a popped node
 // that can no longer beat the closest hit.
+#include "cpu/aabb_walk.h"
 #include "cpu/pairs.h"
 #include "cpu/walk.h"
 #include "layout/aabbtree.h"
@@ -12,36 +13,10 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
-    struct Entry { uint32_t node; float tnear; };
-    Entry stack[MC_MAX_DEPTH + 2];
-    int top = -1;
-    layout::AABBNode node = layout::load_aabb_node(tree);
-    uint32_t at = 0;
-    if (box_test(r, node.min, node.max, c.t) == INFINITY) return;
-    for (;;) {
-      if (!node.is_leaf()) {
-        uint32_t left = at + MC_AABB_NODE_BYTES, right = node.value();
-        layout::AABBNode ln = layout::load_aabb_node(tree + left), rn = layout::load_aabb_node(tree + right);
-        float lt = box_test(r, ln.min, ln.max, c.t), rt = box_test(r, rn.min, rn.max, c.t);
-        bool lhit = lt != INFINITY, rhit = rt != INFINITY;
-        if (lhit && rhit) {
-          if (lt <= rt) stack[++top] = {right, rt}, at = left, node = ln;
-          else stack[++top] = {left, lt}, at = right, node = rn;
-          continue;
-        }
-        if (lhit || rhit) {
-          at = lhit ? left : right, node = lhit ? ln : rn;
-          continue;
-        }
-      } else {
-        uint32_t block = at + MC_AABB_NODE_BYTES;
-        test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
-      }
-      while (top >= 0 && stack[top].tnear > c.t * kFarScale) --top;
-      if (top < 0) break;
-      at = stack[top--].node;
-      node = layout::load_aabb_node(tree + at);
-    }
+    walk_aabb_nodes(tree, r, c, [&](const layout::AABBNode& node, uint32_t at) {
+      uint32_t block = at + MC_AABB_NODE_BYTES;
+      test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
+    });
   });
 }
 

@@ -6,6 +6,7 @@
 // stack. A leaf has no box of its own: its triangles' vertices are the
 // box's, so the triangle test reads them once. ZeroByteHybrid walks its
 // AABBTree nodes as walk_aabbtree does and each leaf's zero-byte tree so.
+#include "cpu/aabb_walk.h"
 #include "cpu/box_cache.h"
 #include "cpu/walk.h"
 #include "layout/aabbtree.h"
@@ -61,40 +62,13 @@ void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
 template <bool kCache>
 void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
   const layout::BlobHeader& h = layout::header_of(blob);
-  const uint8_t* tree = blob + h.tree_offset;
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
   for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
-    struct Entry { uint32_t node; float tnear; };
-    Entry stack[MC_MAX_DEPTH + 2];
-    int top = -1;
-    layout::AABBNode node = layout::load_aabb_node(tree);
-    uint32_t at = 0;
-    if (box_test(r, node.min, node.max, c.t) == INFINITY) return;
-    for (;;) {
-      if (!node.is_leaf()) {
-        uint32_t left = at + MC_AABB_NODE_BYTES, right = node.value();
-        layout::AABBNode ln = layout::load_aabb_node(tree + left), rn = layout::load_aabb_node(tree + right);
-        float lt = box_test(r, ln.min, ln.max, c.t), rt = box_test(r, rn.min, rn.max, c.t);
-        bool lhit = lt != INFINITY, rhit = rt != INFINITY;
-        if (lhit && rhit) {
-          if (lt <= rt) stack[++top] = {right, rt}, at = left, node = ln;
-          else stack[++top] = {left, lt}, at = right, node = rn;
-          continue;
-        }
-        if (lhit || rhit) {
-          at = lhit ? left : right, node = lhit ? ln : rn;
-          continue;
-        }
-      } else {
-        uint32_t root = h.tree_offset + h.triangle_base + node.value() * layout::Indexed24::kSlotDivisor;
-        walk_zbt<kCache>(blob, h, root, node.value(), octant, r, c, cache);
-      }
-      while (top >= 0 && stack[top].tnear > c.t * kFarScale) --top;
-      if (top < 0) break;
-      at = stack[top--].node;
-      node = layout::load_aabb_node(tree + at);
-    }
+    walk_aabb_nodes(blob + h.tree_offset, r, c, [&](const layout::AABBNode& node, uint32_t) {
+      uint32_t root = h.tree_offset + h.triangle_base + node.value() * layout::Indexed24::kSlotDivisor;
+      walk_zbt<kCache>(blob, h, root, node.value(), octant, r, c, cache);
+    });
   });
 }
 

@@ -4,6 +4,8 @@
 //   kFormat, kSlotDivisor, kLanes, block_bytes(count), encode(...), decode(...)
 #pragma once
 #include <cstdint>
+#include <cstring>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -52,6 +54,22 @@ uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint6
   if constexpr (requires { C::stored_bytes(blob, block, count, limit); }) return C::stored_bytes(blob, block, count, limit);
   else return C::block_bytes(count);
 }
+
+// Formats whose blocks are read front to back (strips, pair blocks): their
+// size and any one triangle come from the format's read(blob, block,
+// count, limit, emit), which also checks the block's grammar.
+template <class C>
+struct ReadBack {
+  static uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit) {
+    return C::read(blob, block, count, limit, [](uint32_t, const float(*)[3]) {});
+  }
+  static void decode(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]) {
+    C::read(blob, block, i + 1, ~0ull, [&](uint32_t k, const float(*p)[3]) {
+      if (k == i) std::memcpy(out, p, 36);
+    });
+  }
+  static bool check(const uint8_t*, uint32_t, uint32_t, std::string*) { return true; }  // read() checks
+};
 
 // Appends a vertex record to the pool; returns its index (record number).
 inline uint32_t pool_append(std::vector<uint8_t>& pool, const void* record, size_t bytes) {

@@ -25,7 +25,7 @@
 
 namespace meshcast::layout {
 
-struct Float3PairSOA4 {
+struct Float3PairSOA4 : ReadBack<Float3PairSOA4> {
   static constexpr uint32_t kFormat = MC_TRI_FLOAT3PAIRSOA4;
   static constexpr uint32_t kLanes = 4;
   static constexpr uint32_t kRowsBytes = 12 * 4 * 4;
@@ -139,15 +139,6 @@ struct Float3PairSOA4 {
     }
     return at;
   }
-  static uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit) {
-    return read(blob, block, count, limit, [](uint32_t, const float(*)[3]) {});
-  }
-  static void decode(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]) {
-    read(blob, block, i + 1, ~0ull, [&](uint32_t k, const float(*p)[3]) {
-      if (k == i) std::memcpy(out, p, 36);
-    });
-  }
-  static bool check(const uint8_t*, uint32_t, uint32_t, std::string*) { return true; }  // read() checks
 };
 
 }  // namespace meshcast::layout

@@ -105,7 +105,7 @@ struct CompressedRecord {
 };
 
 template <class Record, uint32_t kId>
-struct Strip {
+struct Strip : ReadBack<Strip<Record, kId>> {
   static constexpr uint32_t kFormat = kId;
   static constexpr uint32_t kSlotDivisor = Record::kBytes;  // a leaf of n triangles stores >= n + 2 vertices
   static constexpr uint32_t kLanes = 1;
@@ -151,15 +151,6 @@ struct Strip {
     }
     return at;
   }
-  static uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit) {
-    return read(blob, block, count, limit, [](uint32_t, const float(*)[3]) {});
-  }
-  static void decode(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]) {
-    read(blob, block, i + 1, ~0ull, [&](uint32_t k, const float(*p)[3]) {
-      if (k == i) std::memcpy(out, p, 36);
-    });
-  }
-  static bool check(const uint8_t*, uint32_t, uint32_t, std::string*) { return true; }  // read() checks
 };
 
 using UncompressedStrip = Strip<UncompressedRecord, MC_TRI_UNCOMPRESSEDSTRIP>;

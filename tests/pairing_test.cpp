@@ -114,17 +114,19 @@ TEST(Pairing, CompressedPositionKeysPairAnUnweldedMesh) {
 }
 
 // Pairs as the builder's unit: every tree built from pairs keeps each
-// pair in one leaf, leaves within the leaf size, and the oracle's answers.
+// pair in one leaf, leaves within the leaf size, and the oracle's answers,
+// on every test mesh and ray kind, with four encodings (the pair blocks
+// among them).
 TEST(PairedTrees, LeavesHoldWholePairsAndWalkersAgreeWithTheOracle) {
   for (const NamedMesh& m : test_meshes(false)) {
-    if (m.name != "sphere" && m.name != "bunny00" && m.name != "terrain_64k") continue;
     const Pairing pairs = pair_triangles(*m.mesh);
     for (const std::string& name : layout_names()) {
       BuildOptions o = parse_layout(name);
       if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST) continue;
       if (o.triangle_format != MC_TRI_FLOAT3 && o.triangle_format != MC_TRI_FLOAT3SOA4 &&
-          o.triangle_format != MC_TRI_INDEXED8BITPACKSOA4)
+          o.triangle_format != MC_TRI_INDEXED8BITPACKSOA4 && o.triangle_format != MC_TRI_FLOAT3PAIRSOA4)
         continue;
+      if (o.tree_format == MC_TREE_ZEROBYTE || o.tree_format == MC_TREE_ZEROBYTEHYBRID) continue;
       o.pairing = true;
       BuildReport report;
       std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name, &report);
@@ -143,10 +145,12 @@ TEST(PairedTrees, LeavesHoldWholePairsAndWalkersAgreeWithTheOracle) {
       NamedMesh reference = m;
       if (moves_vertices(o.triangle_format))
         reference = {m.name + "#paired#" + name, std::make_shared<const Mesh>(stored_mesh(blob))};
-      const std::vector<Ray>& rays = test_rays(m, RayKind::Radial, 3000);
-      Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, RayKind::Radial, rays),
-                            1e-5 * m.mesh->bounds().diagonal());
-      EXPECT_EQ(a.wrong + a.t_errors, 0u) << name << " on " << m.name << ": " << a.first_problem;
+      for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
+        const std::vector<Ray>& rays = test_rays(m, kind, 2000);
+        Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, kind, rays),
+                              1e-5 * m.mesh->bounds().diagonal());
+        EXPECT_EQ(a.wrong + a.t_errors, 0u) << name << " on " << m.name << " kind " << int(kind) << ": " << a.first_problem;
+      }
     }
   }
 }

@@ -1,8 +1,8 @@
 // `meshcast bench pairing` (issue 7, seed 003's results table): per mesh the
 // pairing pass's time, the paired share before (input order, window N = 2)
 // and after, and what pairs as the builder's unit change in bytes per
-// triangle and time per ray. The seed's box and triangle test counts need
-// counters the walkers do not have yet.
+// triangle, time per ray and (in a counting build, cpu/counters.h) box and
+// triangle tests a ray.
 #pragma once
 #include <string>
 #include <vector>

@@ -10,6 +10,7 @@
 // Both are two-sided and accept t in [0, t_max].
 #pragma once
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 
@@ -151,6 +152,48 @@ inline void settle_in_double(int redo, const F4 (&p)[9], Limit&& limit, Take&& t
   }
 }
 
+// The plain Möller–Trumbore test (1997), kept only so `meshcast bench
+// robustness` can show what the watertight test costs: not watertight (a
+// ray through a shared edge or vertex can fall between the triangles), no
+// double-precision fallback, no epsilon (a triangle with det = 0 is missed,
+// as by the watertight test). Corners in the ray's axis order, as below;
+// the permutation flips both crosses' signs together, so u, v, t do not
+// change. Off unless set_triangle_test() picks it.
+template <class F4, class M4>
+inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
+  constexpr int kW = F4::kLanes;
+  F4 d[3], o[3], e1[3], e2[3], s[3], p[3], q[3];
+  for (int j = 0; j < 3; ++j) {
+    d[j] = F4::splat(r.dir[r.axis[j]]), o[j] = F4::splat(r.org[r.axis[j]]);
+    e1[j] = v[1][j] - v[0][j], e2[j] = v[2][j] - v[0][j], s[j] = o[j] - v[0][j];
+  }
+  auto cross = [](const F4 a[3], const F4 b[3], F4 out[3]) {
+    out[0] = a[1] * b[2] - a[2] * b[1], out[1] = a[2] * b[0] - a[0] * b[2], out[2] = a[0] * b[1] - a[1] * b[0];
+  };
+  auto dot = [](const F4 a[3], const F4 b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  cross(d, e2, p);
+  cross(s, e1, q);
+  const F4 zero = F4::splat(0.0f), one = F4::splat(1.0f);
+  F4 det = dot(e1, p);
+  F4 inv = one / det;
+  F4 u = dot(s, p) * inv, w = dot(d, q) * inv, t = dot(e2, q) * inv;
+  M4 accept = valid & (det != zero) & (u >= zero) & (w >= zero) & (u + w <= one) & (t >= zero) & (t <= F4::splat(closest));
+  LaneHit best;
+  float tl[kW], ul[kW], wl[kW];
+  t.store(tl), u.store(ul), w.store(wl);
+  for (int m = simd::bits(accept); m; m &= m - 1) {
+    int i = __builtin_ctz(m);
+    if (best.lane < 0 || tl[i] < best.t) best = {i, tl[i], ul[i], wl[i]};
+  }
+  return best;
+}
+
+// Which test the walkers run: the watertight one unless a benchmark asks
+// for the plain one (process-wide; set it before tracing, not during).
+enum class TriangleTest { Watertight, MollerTrumbore };
+inline std::atomic<TriangleTest> triangle_test_choice{TriangleTest::Watertight};
+inline void set_triangle_test(TriangleTest t) { triangle_test_choice.store(t, std::memory_order_relaxed); }
+
 // Corners come in the ray's axis order, v[corner][j] = axis r.axis[j], so the
 // test indexes registers with constants. One source for every width: F4 (SSE,
 // 4 triangles) and F8 (AVX2, 8 triangles).
@@ -158,6 +201,8 @@ template <class F4, class M4>
 inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
   constexpr int kW = F4::kLanes;
   if constexpr (kCountTests) count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(valid)))));
+  if (triangle_test_choice.load(std::memory_order_relaxed) == TriangleTest::MollerTrumbore) [[unlikely]]
+    return moller_trumbore_test(r, v, valid, closest);
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
   F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;

@@ -2,6 +2,7 @@
 // and the public ones, 10,000 rays of each kind.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -247,6 +248,31 @@ TEST(Counters, CountEveryBoxAndTriangleTest) {
   EXPECT_GT(test_counts.boxes, rays.size());
   EXPECT_GT(test_counts.triangles, 0u);
   EXPECT_LT(test_counts.triangles, rays.size() * m.triangles.size() / 4);
+}
+}  // namespace
+}  // namespace meshcast::testing
+
+// The plain Möller–Trumbore test is an option for `bench robustness` alone:
+// off by default, and when on it still finds the oracle's hits for rays
+// that pass nowhere near an edge (what it may lose is the edge cases).
+namespace meshcast::testing {
+namespace {
+TEST(TriangleTests, MollerTrumboreIsAnOptionOffByDefault) {
+  EXPECT_EQ(triangle_test_choice.load(), TriangleTest::Watertight);
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (m.name != "sphere" && m.name != "bunny00") continue;
+    const std::vector<Ray>& rays = test_rays(m, RayKind::Long, 2000);
+    for (const char* layout : {"AABBTree/Float3", "AABBTree/Float3SOA8", "QuadTree/Float3SOA4"}) {
+      std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout), m.name);
+      set_triangle_test(TriangleTest::MollerTrumbore);
+      std::vector<Hit> plain = trace_all(blob, rays);
+      set_triangle_test(TriangleTest::Watertight);
+      Agreement a = compare(*m.mesh, rays, plain, oracle_answers(m, RayKind::Long, rays), 1e-5 * m.mesh->bounds().diagonal());
+      EXPECT_LE(a.wrong + a.t_errors, 2u) << layout << " on " << m.name << ": " << a.first_problem;
+      size_t hits = size_t(std::count_if(plain.begin(), plain.end(), [](const Hit& h) { return h.triangle != MC_NO_HIT; }));
+      EXPECT_GT(hits, rays.size() / 10) << layout << " on " << m.name;
+    }
+  }
 }
 }  // namespace
 }  // namespace meshcast::testing

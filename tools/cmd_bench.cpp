@@ -9,6 +9,7 @@
 #include "bench/latency.h"
 #include "bench/pairing.h"
 #include "bench/plot.h"
+#include "bench/robustness.h"
 #include "bench/trees.h"
 #include "io/generate.h"
 #include "io/read_mesh.h"
@@ -226,6 +227,28 @@ void add_bench(CLI::App& app) {
   });
 
   // Issue 7: seed 003's results table.
+  auto rargs = std::make_shared<ArgsT>();
+  CLI::App* rob = bench->add_subcommand("robustness", "issue 8: the watertight test against plain Moller-Trumbore, time and leaks");
+  rob->add_option("mesh", rargs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
+  rob->add_option("--rays", rargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
+  rob->add_option("--repeat", rargs->repeat, "passes; the minimum and the median are kept")->check(CLI::Range(1, 1000));
+  rob->callback([rargs] {
+    Mesh mesh = bench_mesh(rargs->input);
+    std::vector<bench::RobustnessRow> rows = bench::bench_robustness(mesh, rargs->input, rargs->rays, rargs->repeat);
+    const double scale = 1000.0 / double(rargs->rays);
+    std::printf("\n%s, %zu triangles, %zu long rays, one thread; us per ray, minimum of %u passes, both tests in this "
+                "run; leaks: rays from inside a closed sphere (96 rings, 192 segments) aimed at its vertices and edge midpoints "
+                "that miss\n\n| layout | us/ray watertight | us/ray Moller-Trumbore | watertight / plain | disagreements "
+                "(watertight, plain) | leaks watertight | leaks plain |\n|---|---:|---:|---:|---|---:|---:|\n",
+                rargs->input.c_str(), mesh.triangles.size(), rargs->rays, rargs->repeat);
+    for (const bench::RobustnessRow& r : rows)
+      std::printf("| %s | %.3f | %.3f | %.2f | %llu, %llu | %llu of %llu | %llu of %llu |\n", r.layout.c_str(),
+                  r.watertight.min_ms * scale, r.plain.min_ms * scale, r.watertight.min_ms / r.plain.min_ms,
+                  (unsigned long long)r.watertight.disagreements, (unsigned long long)r.plain.disagreements,
+                  (unsigned long long)r.leaks_watertight, (unsigned long long)r.probes,
+                  (unsigned long long)r.leaks_plain, (unsigned long long)r.probes);
+  });
+
   auto pargs = std::make_shared<ArgsT>();
   auto pdata = std::make_shared<std::string>("data");
   CLI::App* pair = bench->add_subcommand("pairing", "seed 003: triangle pairing, before and after, as the builder's unit");

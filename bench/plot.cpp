@@ -18,7 +18,10 @@ std::string plot_scatter(const std::string& png, const std::string& title, const
      << "set title '" << title << "'\n"
      << "set xlabel '" << xlabel << "'\nset ylabel '" << ylabel << "'\n"
      << "set grid\nset key top right\nset offsets graph 0.02, graph 0.15, graph 0.05, graph 0.05\n"
-     << (log_y ? "set logscale y\n" : "") << (log_x ? "set logscale x\n" : "")
+     // Log axes ticked every factor of 2 (gnuplot's default, decades, leaves
+     // data within one decade without a single label).
+     << (log_y ? "set logscale y\nset ytics 2\nset format y '%.1e'\n" : "")
+     << (log_x ? "set logscale x\nset xtics 2\nset format x '%g'\n" : "")
      << (log_x || log_y ? "set autoscale fix\n" : "") << "plot ";
   for (size_t s = 0; s < series.size(); ++s) {
     if (s) gp << ", ";

@@ -51,6 +51,7 @@ check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mes
 check bench-pairing 0 "bunny00 rotated 45, pairs baked|terrain_2M" -- "$meshcast" bench pairing --data "$data" --rays 8 --repeat 1 --out-dir "$work"
 check bench-latency 0 "crossover \\(automatic backend" -- "$meshcast" bench latency "$mesh" --frame-ms 1 --out-dir "$work"
 check bench-robustness 0 "leaks plain" -- "$meshcast" bench robustness "$mesh" --rays 8 --repeat 1
+check bench-error 0 "plots: " -- "$meshcast" bench error "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$mesh" --rays 8 --repeat 1
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree

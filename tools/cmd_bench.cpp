@@ -2,9 +2,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <cmath>
+#include <algorithm>
 
 #include "cpu/counters.h"
 #include "bench/encodings.h"
+#include "bench/error.h"
 #include "bench/gpu.h"
 #include "bench/latency.h"
 #include "bench/pairing.h"
@@ -227,6 +231,72 @@ void add_bench(CLI::App& app) {
   });
 
   // Issue 7: seed 003's results table.
+  auto eargs = std::make_shared<ArgsT>();
+  auto emeshes = std::make_shared<std::vector<std::string>>();
+  auto edevice = std::make_shared<std::string>();
+  CLI::App* err = bench->add_subcommand("error", "issue 8: error against run time and bytes, every tree x encoding (and GPU method)");
+  err->add_option("meshes", *emeshes, "mesh files or terrain_2M (default bunny00, ChineseDragon-10kv, terrain_2M)");
+  err->add_option("--rays", eargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
+  err->add_option("--repeat", eargs->repeat, "passes; the minimum is kept (GPU: the median)")->check(CLI::Range(1, 1000));
+  err->add_option("--device", *edevice, "also the GPU methods on this Vulkan device (any: the default one)");
+  err->add_option("--out-dir", eargs->out_dir, "where the CSV and the plots go");
+  err->callback([eargs, emeshes, edevice] {
+    std::vector<std::string> names = *emeshes;
+    if (names.empty()) names = {"data/bunny00.off", "data/ChineseDragon-10kv.off", "terrain_2M"};
+    std::vector<bench::NamedInput> inputs;
+    for (const std::string& n : names) inputs.push_back({n, bench_mesh(n)});
+    std::vector<bench::ErrorRow> rows = bench::bench_error(inputs, eargs->rays, eargs->repeat, *edevice);
+    std::filesystem::create_directories(eargs->out_dir);
+    std::ofstream csv(eargs->out_dir + "/error.csv");
+    csv << "mesh,backend,layout,us_per_ray,bytes_per_tri,max_dt,mean_dt,max_surface,bound,rays,false_misses,false_hits,"
+           "wrong_triangles\n";
+    std::printf("\n%zu long rays a mesh, one thread (GPU: device time); errors relative to the mesh diagonal against the "
+                "double-precision oracle on the input mesh; bound: the format's stated largest corner move\n\n"
+                "| mesh | backend | layout | us/ray | B/tri | max dt | mean dt | max surface | bound | false misses | false "
+                "hits | wrong triangles |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+                eargs->rays);
+    std::map<std::string, bench::Series> by_time, by_bytes;
+    for (const bench::ErrorRow& r : rows) {
+      std::printf("| %s | %s | %s | %.3f | %.2f | %.2e | %.2e | %.2e | %.2e | %llu | %llu | %llu |\n", r.mesh.c_str(),
+                  r.backend.c_str(), r.layout.c_str(), r.us_per_ray, r.bytes_per_tri, r.max_dt, r.mean_dt, r.max_surface,
+                  r.bound, (unsigned long long)r.false_misses, (unsigned long long)r.false_hits,
+                  (unsigned long long)r.wrong_triangles);
+      csv << r.mesh << "," << r.backend << "," << r.layout << "," << r.us_per_ray << "," << r.bytes_per_tri << ","
+          << r.max_dt << "," << r.mean_dt << "," << r.max_surface << "," << r.bound << "," << r.rays << ","
+          << r.false_misses << "," << r.false_hits << "," << r.wrong_triangles << "\n";
+      // A log axis has no 0: errors below 1e-12 are drawn at 1e-12.
+      double y = std::max(r.max_surface, 1e-12);
+      std::string series = r.mesh + (r.backend.rfind("Vulkan", 0) == 0 ? " (Vulkan)" : "");
+      by_time[series].title = by_bytes[series].title = series;
+      by_time[series].points.push_back({r.us_per_ray, y, ""});
+      by_bytes[series].points.push_back({r.bytes_per_tri, y, ""});
+    }
+    // The Pareto front of each series: no other point both faster (smaller) and more exact.
+    auto with_fronts = [](const std::map<std::string, bench::Series>& all) {
+      std::vector<bench::Series> out;
+      for (const auto& [name, s] : all) {
+        out.push_back(s);
+        std::vector<bench::Point> pts = s.points;
+        std::sort(pts.begin(), pts.end(), [](const bench::Point& a, const bench::Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+        bench::Series front{name + ": Pareto front", {}};
+        double best = INFINITY;
+        for (const bench::Point& p : pts)
+          if (p.y < best) best = p.y, front.points.push_back(p);
+        out.push_back(front);
+      }
+      return out;
+    };
+    std::string png1 = eargs->out_dir + "/error_time.png", png2 = eargs->out_dir + "/error_bytes.png";
+    std::string why1 = bench::plot_scatter(png1, "Error against time a ray", "microseconds per ray (log)",
+                                           "largest distance of a hit from the input surface / diagonal (log)",
+                                           with_fronts(by_time), true, true);
+    std::string why2 = bench::plot_scatter(png2, "Error against bytes a triangle", "bytes per triangle walked (log)",
+                                           "largest distance of a hit from the input surface / diagonal (log)",
+                                           with_fronts(by_bytes), true, true);
+    std::printf("\ncsv: %s/error.csv\nplots: %s, %s\n", eargs->out_dir.c_str(), why1.empty() ? png1.c_str() : why1.c_str(),
+                why2.empty() ? png2.c_str() : why2.c_str());
+  });
+
   auto rargs = std::make_shared<ArgsT>();
   CLI::App* rob = bench->add_subcommand("robustness", "issue 8: the watertight test against plain Moller-Trumbore, time and leaks");
   rob->add_option("mesh", rargs->input, "mesh file, or terrain_2M (default data/bunny00.off)");

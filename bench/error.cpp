@@ -1,0 +1,134 @@
+#include "bench/error.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "cpu/agreement.h"
+#include "cpu/encode.h"
+#include "cpu/oracle.h"
+#include "cpu/rays.h"
+#include "cpu/trace.h"
+#include "gpu/method.h"
+#include "layout/blob.h"
+
+namespace meshcast::bench {
+
+namespace {
+
+// The error columns of one layout's hits against the oracle over `mesh`.
+void judge(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+           const std::vector<OracleHit>& oracle, ErrorRow& row) {
+  const double diag = std::max(1e-30, mesh.bounds().diagonal());
+  double sum_dt = 0;
+  uint64_t both = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    bool ohit = oracle[i].triangle != MC_NO_HIT, whit = hits[i].triangle != MC_NO_HIT;
+    if (ohit && !whit) ++row.false_misses;
+    if (!ohit && whit) ++row.false_hits;
+    if (whit) {  // the hit point against the input triangle it names
+      const Ray& r = rays[i];
+      double p[3];
+      for (int a = 0; a < 3; ++a) p[a] = double(r.org[a]) + double(hits[i].t) * r.dir[a];
+      const Triangle& t = mesh.triangles[hits[i].triangle];
+      row.max_surface = std::max(row.max_surface, point_triangle_distance(p, mesh.vertices[t[0]], mesh.vertices[t[1]],
+                                                                          mesh.vertices[t[2]]) / diag);
+    }
+    if (!ohit || !whit) continue;
+    double len = std::sqrt(double(rays[i].dir[0]) * rays[i].dir[0] + double(rays[i].dir[1]) * rays[i].dir[1] +
+                           double(rays[i].dir[2]) * rays[i].dir[2]);
+    double dt = std::fabs(double(hits[i].t) - oracle[i].t) * len / diag;
+    if (hits[i].triangle != oracle[i].triangle && dt > 1e-5) ++row.wrong_triangles;
+    row.max_dt = std::max(row.max_dt, dt);
+    sum_dt += dt, ++both;
+  }
+  row.mean_dt = both ? sum_dt / double(both) : 0.0;
+  row.rays = rays.size();
+}
+
+double median_ms(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t count, uint32_t repeat,
+                                  const std::string& device) {
+  std::vector<ErrorRow> rows;
+  std::unique_ptr<gpu::Context> ctx;
+  if (!device.empty()) ctx = std::make_unique<gpu::Context>(gpu::DeviceChoice{device == "any" ? "" : device, false});
+  for (const NamedInput& in : meshes) {
+    std::vector<Ray> rays = make_rays(in.mesh, RayKind::Long, count, 1);
+    OracleTree tree(in.mesh);
+    std::vector<OracleHit> oracle;
+    for (const Ray& r : rays) oracle.push_back(tree.closest(r));
+    const double diag = std::max(1e-30, in.mesh.bounds().diagonal());
+    auto finish = [&](ErrorRow row, const std::vector<uint8_t>& blob, const std::vector<Hit>& hits) {
+      const layout::BlobHeader& h = layout::header_of(blob.data());
+      row.mesh = in.name;
+      row.bytes_per_tri = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
+      float bound[3];
+      displacement_bound(blob, bound);
+      row.bound = std::sqrt(double(bound[0]) * bound[0] + double(bound[1]) * bound[1] + double(bound[2]) * bound[2]) / diag;
+      judge(in.mesh, rays, hits, oracle, row);
+      rows.push_back(row);
+    };
+    for (const std::string& layout : layout_names()) {
+      BuildOptions o = parse_layout(layout);
+      if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST) continue;  // the GPU's
+      std::fprintf(stderr, "  %s %s\n", in.name.c_str(), layout.c_str());
+      std::vector<uint8_t> blob;
+      try {
+        blob = build_blob(in.mesh, o, in.name);
+      } catch (const InputError&) {  // a format limit this mesh exceeds
+        continue;
+      }
+      BlobView view(blob, in.name);
+      std::vector<Hit> hits(rays.size());
+      std::vector<double> ms;
+      for (uint32_t r = 0; r < repeat; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        view.trace(rays, hits);
+        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      }
+      ErrorRow row;
+      row.backend = "CPU, one thread", row.layout = layout;
+      row.us_per_ray = *std::min_element(ms.begin(), ms.end()) * 1000.0 / double(rays.size());
+      finish(row, blob, hits);
+    }
+    if (!ctx) continue;
+    struct Case { const char* method; const char* layout; };
+    const Case cases[] = {{"aabbtree", "AABBTree/Float3"},         {"aabbtree", "AABBTree/UncompressedStrip"},
+                          {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}, {"aabblist", "AABBList/Float3SOA128"},
+                          {"aabblist", "AABBList/BitPackSOA128"},  {"skdtree", "SKDTree/Float3"},
+                          {"lbvh", "StacklessLBVH/Float3"},        {"bruteforce", "BruteForce/BitPackSOA128"},
+                          {"bruteforce", "BruteForce/Float3SOA128"}};
+    for (const Case& c : cases) {
+      std::fprintf(stderr, "  %s %s on %s\n", in.name.c_str(), c.layout, ctx->device_name().c_str());
+      std::vector<uint8_t> blob;
+      std::unique_ptr<gpu::Method> method;
+      try {
+        blob = build_blob(in.mesh, parse_layout(c.layout), in.name);
+        method = gpu::make_method(*ctx, c.method, blob, in.name);
+      } catch (const std::exception&) {  // a limit of the format or the device (maxStorageBufferRange)
+        continue;
+      }
+      std::vector<Hit> hits(rays.size());
+      std::vector<double> ms;
+      for (uint32_t r = 0; r < repeat; ++r) {
+        gpu::GpuTiming t;
+        method->trace(rays, hits, &t);
+        ms.push_back(t.device_ms);
+      }
+      ErrorRow row;
+      row.backend = "Vulkan " + std::string(c.method) + " (device time)", row.layout = c.layout;
+      row.us_per_ray = median_ms(ms) * 1000.0 / double(rays.size());
+      finish(row, blob, hits);
+    }
+  }
+  return rows;
+}
+
+}  // namespace meshcast::bench

@@ -4,11 +4,13 @@
 // double-precision oracle over the input mesh:
 //   max and mean |dt| / diagonal   rays where both hit
 //   surface error / diagonal       the walker's hit point from the input
-//                                  triangle it names, the quantity a lossy
-//                                  format's stated bound (displacement_bound)
-//                                  holds: a point of the stored triangle lies
-//                                  within the corners' largest move of the
-//                                  input triangle at the same barycentrics
+//                                  triangle it names, less 4 ulps of t along
+//                                  the ray (float t's own rounding): the
+//                                  quantity a lossy format's stated bound
+//                                  (displacement_bound) holds, since a point
+//                                  of the stored triangle lies within the
+//                                  corners' largest move of the input
+//                                  triangle at the same barycentrics
 //   false misses, false hits       the oracle hits and the walker does not,
 //                                  and the other way round
 //   wrong triangles                both hit, other triangles, |dt| beyond

@@ -293,6 +293,14 @@ void add_bench(CLI::App& app) {
     std::string why2 = bench::plot_scatter(png2, "Error against bytes a triangle", "bytes per triangle walked (log)",
                                            "largest distance of a hit from the input surface / diagonal (log)",
                                            with_fronts(by_bytes), true, true);
+    size_t above = 0;
+    for (const bench::ErrorRow& r : rows)
+      if (r.max_surface > r.bound) {
+        std::printf("above its bound: %s %s %s (%.2e > %.2e)\n", r.mesh.c_str(), r.backend.c_str(), r.layout.c_str(),
+                    r.max_surface, r.bound);
+        ++above;
+      }
+    std::printf("\n%zu of %zu rows within their format's stated bound\n", rows.size() - above, rows.size());
     std::printf("\ncsv: %s/error.csv\nplots: %s, %s\n", eargs->out_dir.c_str(), why1.empty() ? png1.c_str() : why1.c_str(),
                 why2.empty() ? png2.c_str() : why2.c_str());
   });

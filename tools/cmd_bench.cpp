@@ -261,7 +261,7 @@ void add_bench(CLI::App& app) {
                   r.backend.c_str(), r.layout.c_str(), r.us_per_ray, r.bytes_per_tri, r.max_dt, r.mean_dt, r.max_surface,
                   r.bound, (unsigned long long)r.false_misses, (unsigned long long)r.false_hits,
                   (unsigned long long)r.wrong_triangles);
-      csv << r.mesh << "," << r.backend << "," << r.layout << "," << r.us_per_ray << "," << r.bytes_per_tri << ","
+      csv << r.mesh << ",\"" << r.backend << "\"," << r.layout << "," << r.us_per_ray << "," << r.bytes_per_tri << ","
           << r.max_dt << "," << r.mean_dt << "," << r.max_surface << "," << r.bound << "," << r.rays << ","
           << r.false_misses << "," << r.false_hits << "," << r.wrong_triangles << "\n";
       // A log axis has no 0: errors below 1e-12 are drawn at 1e-12.

@@ -1,5 +1,7 @@
 #include "bench/error.h"
 
+#include "bench/measure.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -90,15 +92,10 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
       }
       BlobView view(blob, in.name);
       std::vector<Hit> hits(rays.size());
-      std::vector<double> ms;
-      for (uint32_t r = 0; r < repeat; ++r) {
-        auto t0 = std::chrono::steady_clock::now();
-        view.trace(rays, hits);
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      }
+      std::vector<double> ms = time_passes(view, rays, hits, repeat);
       ErrorRow row;
       row.backend = "CPU, one thread", row.layout = layout;
-      row.us_per_ray = *std::min_element(ms.begin(), ms.end()) * 1000.0 / double(rays.size());
+      row.us_per_ray = ms.front() * 1000.0 / double(rays.size());
       finish(row, blob, hits);
     }
     if (!ctx) continue;

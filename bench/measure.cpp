@@ -29,12 +29,7 @@ uint64_t oracle_mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, con
   return a.wrong + a.t_errors;
 }
 
-Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
-               const std::vector<OracleHit>& oracle, uint32_t repeat) {
-  BuildReport report;
-  std::vector<uint8_t> blob = build_blob(mesh, options, name, &report);
-  BlobView view(blob, name);
-  std::vector<Hit> hits(rays.size());
+std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat) {
   std::vector<double> ms;
   for (uint32_t r = 0; r < repeat; ++r) {
     auto t0 = std::chrono::steady_clock::now();
@@ -42,6 +37,16 @@ Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& op
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
+  return ms;
+}
+
+Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
+               const std::vector<OracleHit>& oracle, uint32_t repeat) {
+  BuildReport report;
+  std::vector<uint8_t> blob = build_blob(mesh, options, name, &report);
+  BlobView view(blob, name);
+  std::vector<Hit> hits(rays.size());
+  std::vector<double> ms = time_passes(view, rays, hits, repeat);
   const layout::BlobHeader& h = layout::header_of(blob.data());
   // Bytes of the triangle encoding: its blocks and its shared vertices.
   double bytes = double(h.tree_size - h.node_bytes + h.vertex_size) / h.triangle_count;

@@ -6,6 +6,7 @@
 
 #include "cpu/encode.h"
 #include "cpu/oracle.h"
+#include "cpu/trace.h"
 
 namespace meshcast::bench {
 
@@ -27,6 +28,10 @@ struct Timing {
 // input mesh); formats that move vertices are judged on the mesh they store.
 uint64_t oracle_mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
                          const std::vector<Hit>& hits, const std::vector<OracleHit>& oracle);
+
+// Traces `rays` `repeat` times through `view` (the hits of the last pass
+// kept); returns each pass's milliseconds, sorted.
+std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat);
 
 Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
                const std::vector<OracleHit>& oracle, uint32_t repeat);

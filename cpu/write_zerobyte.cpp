@@ -308,6 +308,15 @@ std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o
     throw InputError(what + ": " + e.what());
   }
 
+  // Everything the blob holds, counted in 64 bits before any header field
+  // narrows to 32: header, the hybrid's nodes, indices, vertices, and the
+  // remap (at most 8 bytes a triangle with its bitmap and ranks).
+  const uint64_t total = 256 + uint64_t(nodes.size()) + 12ull * mesh.triangles.size() + 12ull * mesh.vertices.size() +
+                         8ull * mesh.triangles.size() + 64;
+  if (total > 0xF0000000ull)
+    throw InputError(what + ": the blob would take about " + std::to_string(total >> 20) +
+                     " MiB, beyond the 4 GiB its 32-bit offsets reach");
+
   BlobHeader h{};
   h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
   h.tree_format = o.tree_format, h.triangle_format = MC_TRI_INDEXED24;

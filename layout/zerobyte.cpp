@@ -116,8 +116,12 @@ std::string validate_zerobyte(std::span<const uint8_t> blob, const BlobHeader& h
       if (std::string e = check_zbt(blob.data(), h, roots[i], end, top_depth, covered, &depth); !e.empty()) return e;
     }
   }
-  for (uint32_t i = 0; i < h.triangle_count; ++i)
+  for (uint32_t i = 0; i < h.triangle_count; ++i) {
     if (!covered[i]) return "triangle " + num(i) + " of the index buffer belongs to no zero-byte node";
+    // Every slot is a triangle: its remap bit must say so, or two slots
+    // could name one triangle.
+    if (!(remap_used(blob.data(), h, i / 64) >> (i % 64) & 1)) return "remap marks slot " + num(i) + " unused";
+  }
   if (depth > MC_MAX_DEPTH) return "tree deeper than " + num(MC_MAX_DEPTH);
   return "";
 }

@@ -58,9 +58,10 @@ TEST(ZeroByte, EveryVariantReturnsTheOraclesAnswers) {
                            m.name + " kind " + std::to_string(int(kind));
         Agreement a = compare(*m.mesh, rays, hits, oracle_answers(m, kind, rays), 1e-5 * m.mesh->bounds().diagonal());
         EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
-        if (&v == &variants[1])  // the cache's twin: the very same answers
+        if (&v == &variants[1]) {  // the cache's twin: the very same answers
           for (size_t i = 0; i < hits.size(); ++i)
             ASSERT_TRUE(hits[i].triangle == first[i].triangle && hits[i].t == first[i].t) << what << " ray " << i;
+        }
         if (&v == &variants[0]) first = hits;
       }
     }
@@ -116,8 +117,9 @@ TEST(ZeroByte, DamagedTreesAreRefused) {
   // A vertex index past the vertex section.
   EXPECT_NE(damaged([&](uint8_t* t) { uint32_t w = 0x00FFFFFFu; std::memcpy(t + 12 * 5, &w, 3); }), "");
   // A named corner changed: the box no longer holds the triangles.
-  if (root.count == 6 && layout::zbt_shuffled(good.data() + tris, 0))
+  if (root.count == 6 && layout::zbt_shuffled(good.data() + tris, 0)) {
     EXPECT_NE(damaged([](uint8_t* t) { t[12 + 7] ^= 0x06; }), "");
+  }
 }
 
 TEST(ZeroByte, TheBoxCacheKnowsItsBlob) {

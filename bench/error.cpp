@@ -3,7 +3,6 @@
 #include "bench/measure.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -99,13 +98,7 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
       finish(row, blob, hits);
     }
     if (!ctx) continue;
-    struct Case { const char* method; const char* layout; };
-    const Case cases[] = {{"aabbtree", "AABBTree/Float3"},         {"aabbtree", "AABBTree/UncompressedStrip"},
-                          {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}, {"aabblist", "AABBList/Float3SOA128"},
-                          {"aabblist", "AABBList/BitPackSOA128"},  {"skdtree", "SKDTree/Float3"},
-                          {"lbvh", "StacklessLBVH/Float3"},        {"bruteforce", "BruteForce/BitPackSOA128"},
-                          {"bruteforce", "BruteForce/Float3SOA128"}};
-    for (const Case& c : cases) {
+    for (const gpu::MethodLayout& c : gpu::method_layouts()) {
       std::fprintf(stderr, "  %s %s on %s\n", in.name.c_str(), c.layout, ctx->device_name().c_str());
       std::vector<uint8_t> blob;
       std::unique_ptr<gpu::Method> method;

@@ -61,6 +61,15 @@ std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std
                                     const std::string& name, uint32_t slots = 1);
 std::vector<std::string> method_names();
 
+// Every (method, layout) pair the GPU reads, in the order of seed 000 §7's
+// table: the tests, the stiff and extreme suite, bench gpu and bench error
+// run this one list.
+struct MethodLayout {
+  const char* method;
+  const char* layout;
+};
+std::span<const MethodLayout> method_layouts();
+
 // AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs a
 // slot: a batch of rays goes in chunks of pairs / batches rays. make_method's
 // uses 2^21 (16 MiB); a test passes a small one to split batches into many

@@ -60,6 +60,19 @@ std::vector<std::string> method_names() {
   return names;
 }
 
+std::span<const MethodLayout> method_layouts() {
+  static const MethodLayout kAll[] = {{"aabbtree", "AABBTree/Float3"},
+                                      {"aabbtree", "AABBTree/UncompressedStrip"},
+                                      {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4"},
+                                      {"aabblist", "AABBList/Float3SOA128"},
+                                      {"aabblist", "AABBList/BitPackSOA128"},
+                                      {"skdtree", "SKDTree/Float3"},
+                                      {"lbvh", "StacklessLBVH/Float3"},
+                                      {"bruteforce", "BruteForce/BitPackSOA128"},
+                                      {"bruteforce", "BruteForce/Float3SOA128"}};
+  return kAll;
+}
+
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
                                     const std::string& name, uint32_t slots) {
   if (method == "bruteforce") return make_bruteforce(ctx, blob, name, slots);

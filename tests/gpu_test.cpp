@@ -97,15 +97,10 @@ TEST(Gpu, MethodRefusesALayoutItDoesNotRead) {
 // walker on the same blob and against the oracle, 10,000 rays of each kind
 // (the brute force too, which tests every triangle for every ray: about a
 // minute a codec on lavapipe).
-struct MethodCase {
-  const char* method;
-  const char* layout;
-};
-
-class GpuMethods : public ::testing::TestWithParam<MethodCase> {};
+class GpuMethods : public ::testing::TestWithParam<gpu::MethodLayout> {};
 
 TEST_P(GpuMethods, MatchTheCpuAndTheOracle) {
-  const MethodCase mc = GetParam();
+  const gpu::MethodLayout mc = GetParam();
   for (const NamedMesh& m : test_meshes(false)) {
     if (m.name != "sphere" && m.name != "bunny00" && m.name != "terrain_64k") continue;
     std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(mc.layout), m.name);
@@ -129,16 +124,7 @@ TEST_P(GpuMethods, MatchTheCpuAndTheOracle) {
   EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods,
-                         ::testing::Values(MethodCase{"bruteforce", "BruteForce/Float3SOA128"},
-                                           MethodCase{"bruteforce", "BruteForce/BitPackSOA128"},
-                                           MethodCase{"aabblist", "AABBList/Float3SOA128"},
-                                           MethodCase{"aabblist", "AABBList/BitPackSOA128"},
-                                           MethodCase{"aabbtree", "AABBTree/Float3"},
-                                           MethodCase{"aabbtree", "AABBTree/UncompressedStrip"},
-                                           MethodCase{"skdtree", "SKDTree/Float3"},
-                                           MethodCase{"lbvh", "StacklessLBVH/Float3"},
-                                           MethodCase{"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}),
+INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods, ::testing::ValuesIn(gpu::method_layouts().begin(), gpu::method_layouts().end()),
                          [](const auto& info) {
                            std::string n = info.param.layout;
                            for (char& ch : n)

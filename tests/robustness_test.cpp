@@ -3,6 +3,11 @@
 // axis-parallel and signed-zero directions, grazing rays, far-from-origin,
 // tiny and huge meshes, slivers and degenerate triangles, NaN and infinite
 // rays, t_max of zero and infinity, origins on the surface.
+//
+// Built twice: robustness_test runs it on the CPU walkers of every layout;
+// gpu_robustness_test (MESHCAST_TEST_GPU) runs the very same probes through
+// every Vulkan method on the layout it reads, on the machine's device
+// (lavapipe in CI) with the validation layers on.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,20 +16,50 @@
 #include "io/generate.h"
 #include "layout/blob.h"
 #include "tests/testing.h"
+#ifdef MESHCAST_TEST_GPU
+#include "gpu/method.h"
+#endif
 
 namespace meshcast::testing {
 namespace {
 
+#ifdef MESHCAST_TEST_GPU
+gpu::Context& context() {
+  static gpu::Context ctx(gpu::DeviceChoice{"", true});
+  return ctx;
+}
+#endif
+
 class Robustness : public ::testing::TestWithParam<std::string> {
  protected:
-  // "TREE/TRIANGLES", or with "+pairing": seed 003's pairs as the builder's unit.
+  // "TREE/TRIANGLES", with "+pairing": seed 003's pairs as the builder's
+  // unit; with "@METHOD": traced by that GPU method instead of the CPU.
+  std::string layout() const { return GetParam().substr(0, GetParam().find_first_of("+@")); }
+  std::string method() const {
+    size_t at = GetParam().find('@');
+    return at == std::string::npos ? "" : GetParam().substr(at + 1);
+  }
   BuildOptions options() const {
-    const std::string& p = GetParam();
-    size_t plus = p.find('+');
-    BuildOptions o = parse_layout(p.substr(0, plus));
-    o.pairing = plus != std::string::npos;
+    BuildOptions o = parse_layout(layout());
+    o.pairing = GetParam().find('+') != std::string::npos;
     return o;
   }
+  std::vector<Hit> trace(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr) {
+#ifdef MESHCAST_TEST_GPU
+    std::unique_ptr<gpu::Method> m = gpu::make_method(context(), method(), blob, GetParam());
+    std::vector<Hit> hits(rays.size());
+    uint64_t unwalkable = m->trace(rays, hits);
+    if (skipped) *skipped = unwalkable;
+    return hits;
+#else
+    return trace_all(blob, rays, skipped);
+#endif
+  }
+#ifdef MESHCAST_TEST_GPU
+  void TearDown() override {
+    EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+  }
+#endif
   bool quantized() const { return moves_vertices(options().triangle_format); }
   // Oracle answers on the mesh as stored (quantized for bit-packed formats).
   void expect_oracle(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
@@ -32,7 +67,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     Mesh stored = quantized() ? stored_mesh(blob) : mesh;
     std::vector<OracleHit> oracle(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) oracle[i] = oracle_brute_force(stored, rays[i]);
-    std::vector<Hit> hits = trace_all(blob, rays);
+    std::vector<Hit> hits = trace(blob, rays);
     Agreement a = compare(stored, rays, hits, oracle, 1e-5 * std::max(1e-30, mesh.bounds().diagonal()));
     EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
   }
@@ -69,7 +104,7 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
       Vec3 mid{0.5f * (a.x + b.x), 0.5f * (a.y + b.y), 0.5f * (a.z + b.z)};
       for (Vec3 p : {a, mid}) rays.push_back({{0.1f, 0.2f, 0.3f}, {p.x - 0.1f, p.y - 0.2f, p.z - 0.3f}, INFINITY});
     }
-  std::vector<Hit> hits = trace_all(blob, rays);
+  std::vector<Hit> hits = trace(blob, rays);
   size_t leaks = 0;
   for (const Hit& h : hits) leaks += h.triangle == MC_NO_HIT;
   EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded");
@@ -88,7 +123,7 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
           for (float dz : {-1.0f, 1.0f})
             rays.push_back({{0.5f * x, 0.5f * y, -dz * 2.0f}, {zx, zy, dz}, INFINITY});
   std::vector<uint8_t> blob = build_blob(g, options(), "grid");
-  std::vector<Hit> hits = trace_all(blob, rays);
+  std::vector<Hit> hits = trace(blob, rays);
   const Mesh stored = stored_mesh(blob);  // u, v follow the stored corner order
   for (size_t i = 0; i < hits.size(); ++i) {
     ASSERT_NE(hits[i].triangle, MC_NO_HIT) << "ray " << i << " leaked";
@@ -166,7 +201,7 @@ TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
       {{1, 1, 1}, {0, 0, -1}, nan},   {{1, 1, 1}, {0, 0, -1}, -1.0f},
   };
   uint64_t skipped = 0;
-  std::vector<Hit> hits = trace_all(blob, rays, &skipped);
+  std::vector<Hit> hits = trace(blob, rays, &skipped);
   EXPECT_EQ(skipped, rays.size());
   for (const Hit& h : hits) {
     EXPECT_EQ(h.triangle, MC_NO_HIT);
@@ -186,7 +221,7 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
       {{2.0f, 2.0f, 0.0f}, {0, 0, 1}, INFINITY},  // on a vertex, leaving
   };
   expect_oracle(g, rays, "t_max");
-  std::vector<Hit> hits = trace_all(build_blob(g, options(), "grid"), rays);
+  std::vector<Hit> hits = trace(build_blob(g, options(), "grid"), rays);
   EXPECT_EQ(hits[0].t, 0.0f);
   EXPECT_EQ(hits[2].triangle, MC_NO_HIT);
   EXPECT_NE(hits[3].triangle, MC_NO_HIT);
@@ -196,10 +231,19 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
   std::string n = info.param;
   for (char& c : n)
-    if (c == '/' || c == '+') c = '_';
+    if (c == '/' || c == '+' || c == '@') c = '_';
   return n;
 }
 
+#ifdef MESHCAST_TEST_GPU
+// Every GPU method on every layout it reads.
+std::vector<std::string> gpu_cases() {
+  std::vector<std::string> names;
+  for (const gpu::MethodLayout& c : gpu::method_layouts()) names.push_back(std::string(c.layout) + "@" + c.method);
+  return names;
+}
+INSTANTIATE_TEST_SUITE_P(Vulkan, Robustness, ::testing::ValuesIn(gpu_cases()), param_name);
+#else
 INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(layout_names()), param_name);
 
 // Paired trees (seed 003): every tree that takes pairs, with a float and a
@@ -216,6 +260,8 @@ std::vector<std::string> paired_layouts() {
   return names;
 }
 INSTANTIATE_TEST_SUITE_P(Paired, Robustness, ::testing::ValuesIn(paired_layouts()), param_name);
+
+#endif
 
 }  // namespace
 }  // namespace meshcast::testing

@@ -258,14 +258,13 @@ std::vector<Vec3> scan_stl_ascii(const std::string& path, std::string_view text)
 }
 
 // PLY: checks the header and that the body holds every record it declares.
-// Assimp 5.2.5 loops forever without `end_header` and reads past the end of a
-// truncated file (garbage indices), so this runs before Assimp sees the file.
+// Assimp 5.2.5 loops forever without `end_header`, reads past the end of a
+// truncated file (garbage indices), and reads past its buffers when a header
+// line is not what it expects (found by fuzz/mesh_fuzz: an unknown keyword,
+// a line ended by another byte than a newline), so this runs before Assimp
+// sees the file and lets through only a header of the PLY grammar in
+// printable ASCII, one statement a line.
 void check_ply_layout(const std::string& path, std::string_view text) {
-  size_t end = text.find("end_header");
-  if (text.substr(0, 3) != "ply" || end == std::string_view::npos)
-    fail(path, "malformed file: no PLY header ending in end_header");
-  end = text.find('\n', end);
-  end = end == std::string_view::npos ? text.size() : end + 1;
   struct Prop { int count_size = 0, size = 0; };  // count_size > 0: a list
   struct Element { size_t n = 0; std::vector<Prop> props; };
   std::vector<Element> elements;
@@ -276,24 +275,42 @@ void check_ply_layout(const std::string& path, std::string_view text) {
     if (t == "double" || t == "float64") return 8;
     return 0;
   };
-  Lines ln{text.substr(0, end)};
+  Lines ln{text};
   std::string_view line, format;
-  while (ln.next(line)) {
+  size_t end = std::string_view::npos;
+  while (end == std::string_view::npos && ln.next(line)) {
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    for (unsigned char c : line)
+      if ((c < 0x20 && c != '\t') || c > 0x7e)
+        fail(path, ln.at() + "malformed file: a byte outside printable ASCII in the PLY header");
     auto t = tokens(line);
+    if (ln.number == 1) {
+      if (t.size() != 1 || t[0] != "ply") fail(path, "malformed file: no PLY header ending in end_header");
+      continue;
+    }
     long long n = 0;
-    if (t.empty()) continue;
-    if (t[0] == "format" && t.size() >= 2) format = t[1];
-    if (t[0] == "element" && (t.size() < 3 || !parse_int(t[2], n) || n < 0))
-      fail(path, ln.at() + "malformed file: bad element line");
-    if (t[0] == "element") elements.push_back({size_t(n), {}});
-    if (t[0] == "property") {
-      bool list = t.size() >= 5 && t[1] == "list";
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "end_header" && t.size() == 1) {
+      end = std::min(ln.pos, text.size());
+    } else if (t[0] == "format") {
+      if (t.size() != 3 || (t[1] != "ascii" && t[1] != "binary_little_endian" && t[1] != "binary_big_endian"))
+        fail(path, ln.at() + "malformed file: bad format line");
+      format = t[1];
+    } else if (t[0] == "element") {
+      if (t.size() != 3 || !parse_int(t[2], n) || n < 0) fail(path, ln.at() + "malformed file: bad element line");
+      elements.push_back({size_t(n), {}});
+    } else if (t[0] == "property") {
+      // `property TYPE NAME` or `property list COUNT_TYPE TYPE NAME`
+      bool list = t.size() == 5 && t[1] == "list";
+      if (elements.empty() || t.size() != (list ? 5u : 3u)) fail(path, ln.at() + "malformed file: bad property line");
       Prop p{list ? type_size(t[2]) : 0, type_size(t[list ? 3 : 1])};
-      if (elements.empty() || p.size == 0 || (list && p.count_size == 0))
-        fail(path, ln.at() + "malformed file: bad property line");
+      if (p.size == 0 || (list && p.count_size == 0)) fail(path, ln.at() + "malformed file: bad property line");
       elements.back().props.push_back(p);
+    } else {
+      fail(path, ln.at() + "malformed file: unknown PLY header line '" + std::string(t[0].substr(0, 32)) + "'");
     }
   }
+  if (end == std::string_view::npos) fail(path, "malformed file: no PLY header ending in end_header");
   size_t records = 0, pos = end;
   for (const Element& e : elements) records += e.n;
   if (format == "ascii") {  // one record per line
@@ -307,7 +324,7 @@ void check_ply_layout(const std::string& path, std::string_view text) {
   const bool big = format == "binary_big_endian";
   if (!big && format != "binary_little_endian") fail(path, "malformed file: unknown PLY format");
   for (const Element& e : elements)
-    for (size_t r = 0; r < e.n; ++r)
+    for (size_t r = 0; r < e.n && !e.props.empty(); ++r)  // an element without properties takes no bytes
       for (const Prop& p : e.props) {
         uint64_t count = 1;
         if (p.count_size) {

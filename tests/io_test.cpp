@@ -146,6 +146,14 @@ TEST(ReadMeshErrors, MissingUnknownMalformed) {
   expect_error(write_file("short.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n"), "truncated");
   std::string bin = binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}});
   expect_error(write_file("short_bin.ply", bin.substr(0, bin.size() - 6)), "truncated");
+  // A header line that is no PLY keyword made Assimp read past its buffers
+  // (found by fuzz/mesh_fuzz).
+  expect_error(write_file("bad_keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\npropertLL float x\nend_header\n"),
+               "unknown PLY header line");
+  expect_error(write_file("short_property.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty\nend_header\n"),
+               "bad property line");
+  expect_error(write_file("header_byte.ply", "ply\nformat ascii 1.0\nelement vertex 3\x8a\nend_header\n"),
+               "printable ASCII");
   expect_error(write_file("garbage.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"), "malformed");
   expect_error(write_file("big_face.off", std::string("OFF\n6 1 0\n") + kVertText + "10 0 1 2 3 4 5 0 1 2 3\n"),
                "corners");

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The whole test suite: the Release build, then the corrupted-blob and
-# robustness suites under AddressSanitizer/UBSan, the host layer under
-# ThreadSanitizer, then the portable scalar build (MESHCAST_SCALAR) through
-# the same tests.
+# The whole test suite: the Release build, then every CPU suite and the fuzz
+# corpora under AddressSanitizer/UBSan, the host layer under ThreadSanitizer,
+# the portable scalar build (MESHCAST_SCALAR) through the same tests, and
+# last the fuzz targets under libFuzzer for a bounded time (scripts/fuzz.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -11,10 +11,15 @@ jobs=$(nproc)
 echo "== Release (AVX2)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900
 
-echo "== AddressSanitizer + UBSan: corrupted blobs, robustness corpus"
+echo "== AddressSanitizer + UBSan: every CPU test suite and the fuzz corpora"
+# The Vulkan suites stay out of this build: lavapipe and the loader are not
+# instrumented (their own allocations would read as leaks); they run in the
+# Release build above and the host layer under TSan below.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_SANITIZE=ON >/dev/null
-cmake --build build-asan -j"$jobs" --target layout_test robustness_test
-ctest --test-dir build-asan --output-on-failure -j"$jobs" --timeout 900 -R "Blob|Robustness|Half|BitPack|Corruption"
+cmake --build build-asan -j"$jobs" --target layout_test oracle_test walker_test build_test robustness_test io_test \
+      pairing_test zerobyte_test limits_test blob_fuzz mesh_fuzz
+LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp" \
+  ctest --test-dir build-asan --output-on-failure -j"$jobs" --timeout 1800 -E "NOT_BUILT|^cli$"
 
 echo "== ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan)"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
@@ -27,3 +32,6 @@ echo "== Portable scalar path, with the box and triangle test counters compiled 
 cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON >/dev/null
 cmake --build build-scalar -j"$jobs"
 ctest --test-dir build-scalar --output-on-failure -j"$jobs" --timeout 900
+
+echo "== libFuzzer: the blob validator + walker and the mesh reader + builder"
+bash scripts/fuzz.sh

@@ -1,0 +1,116 @@
+// Meshes at the edge of each format's limits, and just beyond them: the
+// edge must build, validate and return the oracle's answers; one more must
+// be refused with an error that names the limit. (The zero-byte trees'
+// limits: zerobyte_test; the StacklessLBVH depth limit: build_test.)
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "io/generate.h"
+#include "layout/blob.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+// Every ray of `rays` against the oracle on the mesh the blob stores.
+void expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, const std::string& what) {
+  Mesh stored = moves_vertices(layout::header_of(blob.data()).triangle_format) ? stored_mesh(blob) : mesh;
+  OracleTree tree(stored);  // the double-precision oracle over a tree: these meshes are large
+  std::vector<OracleHit> oracle(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) oracle[i] = tree.closest(rays[i]);
+  std::vector<Hit> hits = trace_all(blob, rays);
+  Agreement a = compare(stored, rays, hits, oracle, 1e-5 * mesh.bounds().diagonal());
+  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
+  size_t hit = 0;
+  for (const Hit& h : hits) hit += h.triangle != MC_NO_HIT;
+  EXPECT_GT(hit, rays.size() / 2) << what << ": rays that miss prove little";
+}
+
+std::string refusal(const Mesh& mesh, const BuildOptions& o, const std::string& name) {
+  try {
+    build_blob(mesh, o, name);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(built)";
+}
+
+// 16-bit indices: a 255 x 255 grid has exactly 65,536 vertices, the most
+// they reach; one vertex more is refused, naming the mesh and the limit.
+TEST(Limits, SixteenBitIndicesTakeExactly65536Vertices) {
+  Mesh edge = make_grid_plane(255, 255);
+  ASSERT_EQ(edge.vertices.size(), 65536u);
+  Mesh beyond = edge;
+  beyond.vertices.push_back({0.5f, 0.25f, 1.0f});
+  beyond.triangles.push_back({0, 1, 65536});
+  std::vector<Ray> rays = make_rays(edge, RayKind::Long, 500, 7);
+  for (int i = 0; i <= 255; i += 15)  // straight down onto shared vertices
+    rays.push_back({{float(i) * 0.5f, float(255 - i) * 0.5f, 3.0f}, {0, 0, -1}, INFINITY});
+  for (const std::string& layout : layout_names()) {
+    BuildOptions o = parse_layout(layout);
+    if (layout.find("Indexed16") == std::string::npos) continue;
+    std::vector<uint8_t> blob = build_blob(edge, o, "grid255");
+    ASSERT_EQ(layout::validate(blob), "") << layout;
+    expect_oracle(edge, blob, rays, layout + " at 65,536 vertices");
+    std::string why = refusal(beyond, o, "grid255+1");
+    EXPECT_NE(why.find("16-bit indices reach 65536 vertices"), std::string::npos) << layout << ": " << why;
+    EXPECT_NE(why.find("grid255+1"), std::string::npos) << why;
+  }
+}
+
+// A chain: triangle k sits at x = 2.05^(k - 96) (from 2^-99 to 2^99, inside
+// the coordinate range), so the LongestAxis splitter (the middle of the
+// centres' box) cuts off one triangle a level: the worst a splitter can do.
+// The builder lets a splitter go kSplitterDepth (40) levels deep and splits
+// at the median below, so no mesh under 2^24 triangles makes a tree deeper
+// than the walkers' MC_MAX_DEPTH (64); a deeper blob is refused by
+// validation (layout_test: DepthBeyondTheLimitIsRefused). Here the longest
+// chain the coordinate range allows (193 triangles) makes the deepest trees
+// a mesh of that size can: 40 levels of chain plus 8 of median splits in a
+// binary tree. Each tree format must walk them right.
+Mesh chain(int n) {
+  Mesh m;
+  for (int k = 0; k < n; ++k) {
+    float x = float(std::pow(2.05, k - 96));
+    uint32_t b = uint32_t(m.vertices.size());
+    m.vertices.push_back({x, 0, 0});
+    m.vertices.push_back({1.1f * x, 0, 0});
+    m.vertices.push_back({x, 0.1f * x, 0});
+    m.triangles.push_back({b, b + 1, b + 2});
+  }
+  return m;
+}
+
+TEST(Limits, TheDeepestTreesTheBuilderMakesWalkRight) {
+  const int n = 193;
+  Mesh m = chain(n);
+  std::vector<Ray> rays;  // down onto every triangle, and along the chain
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    Vec3 a = m.corner(t, 0);
+    rays.push_back({{1.02f * a.x, 0.02f * a.x, 1.0f}, {0, 0, -1}, INFINITY});
+  }
+  rays.push_back({{-1.0f, 1e-30f, 0.0f}, {1, 0, 0}, INFINITY});
+  for (const char* layout : {"AABBTree/Float3", "AABBTreeSplitAxis/Float3", "AABBTreePNS/Float3", "AABBTreeCompressed/Float3",
+                             "SKDTree/Float3", "QuadTree/Float3", "QuadTreeHalfFloat/Float3"}) {
+    BuildOptions o = parse_layout(layout);
+    o.splitter = Splitter::LongestAxis;
+    o.leaf_size = 1;
+    std::vector<uint8_t> blob = build_blob(m, o, "chain");
+    ASSERT_EQ(layout::validate(blob), "") << layout;
+    const uint32_t depth = layout::header_of(blob.data()).max_depth;
+    // The quad trees pull grandchildren up into 4-wide nodes and the
+    // SKDTree places its own planes: shallower, still deep.
+    const bool binary = o.tree_format != MC_TREE_QUADTREE && o.tree_format != MC_TREE_QUADTREEHALFFLOAT &&
+                        o.tree_format != MC_TREE_SKDTREE;
+    if (binary)
+      EXPECT_EQ(depth, 48u) << layout;
+    else
+      EXPECT_GT(depth, 12u) << layout;
+    EXPECT_LE(depth, MC_MAX_DEPTH) << layout;
+    expect_oracle(m, blob, rays, std::string(layout) + " chain of " + std::to_string(n));
+  }
+}
+
+}  // namespace
+}  // namespace meshcast::testing

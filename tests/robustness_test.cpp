@@ -191,6 +191,36 @@ TEST_P(Robustness, SliversAndDegenerateTriangles) {
   expect_oracle(m, rays, "slivers");
 }
 
+// Directions with denormal components (their inverses overflow to
+// infinity in the box tests) and coplanar overlapping triangles (the same
+// plane hit by two or three triangles at once: any of them is right, none
+// may be missed).
+TEST_P(Robustness, DenormalDirectionsAndCoplanarOverlaps) {
+  Mesh g = make_grid_plane(8, 8);
+  uint32_t base = uint32_t(g.vertices.size());
+  for (Vec3 v : {Vec3{0.25f, 0.25f, 0}, Vec3{3.75f, 0.5f, 0}, Vec3{1.0f, 3.5f, 0},   // overlaps the grid
+                 Vec3{0.5f, 0.25f, 0}, Vec3{3.5f, 3.5f, 0}, Vec3{0.25f, 3.0f, 0}})  // and that triangle
+    g.vertices.push_back(v);
+  g.triangles.push_back({base, base + 1, base + 2});
+  g.triangles.push_back({base + 3, base + 4, base + 5});
+  const float d = 1e-40f, e = -3e-42f;  // denormals
+  std::vector<Ray> rays;
+  for (int x = 0; x <= 16; ++x)
+    for (int y = 0; y <= 16; ++y) {
+      float px = 0.25f * float(x), py = 0.25f * float(y);
+      rays.push_back({{px, py, 2.0f}, {d, e, -1}, INFINITY});
+      rays.push_back({{px, py, -2.0f}, {-0.0f, d, 1}, INFINITY});
+      rays.push_back({{px, py, 1e-30f}, {e, 0.0f, -d}, INFINITY});  // crawls down onto the plane
+    }
+  rays.push_back({{-1.0f, 1.5f, 1e-38f}, {1, 0, -d}, INFINITY});  // nearly in the plane
+  std::vector<Hit> hits = trace(build_blob(g, options(), "coplanar"), rays);
+  size_t leaks = 0;
+  for (size_t i = 0; i + 1 < rays.size(); ++i)  // the steep rays from inside the grid's border (on it, -3e-42 in y leaves)
+    leaks += hits[i].triangle == MC_NO_HIT && rays[i].dir[2] * rays[i].dir[2] == 1 && rays[i].org[0] > 0 && rays[i].org[1] > 0;
+  EXPECT_EQ(leaks, 0u);
+  expect_oracle(g, rays, "coplanar, denormal directions");
+}
+
 TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
   Mesh g = make_grid_plane(4, 4);
   std::vector<uint8_t> blob = build_blob(g, options(), "grid");

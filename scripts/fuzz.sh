@@ -8,15 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${MESHCAST_FUZZ_SECONDS:-120}
 
-missing=()
-for p in clang libclang-rt-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "fuzz: installing ${missing[*]}"
-  apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+source scripts/packages.sh
+install_missing clang libclang-rt-14-dev
 
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
       -DMESHCAST_FUZZ=ON >/dev/null
@@ -26,7 +19,14 @@ for target in blob mesh; do
   echo "== fuzz: ${target}_fuzz for ${seconds} s from fuzz/corpus/${target}"
   mkdir -p "build-fuzz/found-${target}"
   # -timeout: an input taking 10 s is a hang; -rss_limit_mb: one needing 2 GiB is a failure too.
-  (cd build-fuzz && UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 LSAN_OPTIONS=suppressions=../fuzz/lsan.supp \
-     "bin/${target}_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
-     -print_final_stats=1 "found-${target}" "../fuzz/corpus/${target}")
+  log="build-fuzz/${target}_fuzz.log"
+  if (cd build-fuzz && UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 LSAN_OPTIONS=suppressions=../fuzz/lsan.supp \
+        "bin/${target}_fuzz" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
+        -print_final_stats=1 "found-${target}" "../fuzz/corpus/${target}") > "$log" 2>&1; then
+    grep -E "^Done|^stat::(number_of_executed_units|new_units_added|peak_rss_mb)" "$log"
+  else
+    tail -80 "$log"
+    echo "fuzz: ${target}_fuzz failed; its input is in build-fuzz/ (crash-*, leak-*, timeout-* or oom-*)" >&2
+    exit 1
+  fi
 done

@@ -9,15 +9,8 @@ PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgte
           libvulkan-dev libvulkan-volk-dev glslang-tools  # the Vulkan backend: headers, loader, volk, glslang
           mesa-vulkan-drivers vulkan-validationlayers      # lavapipe (a Vulkan device on the CPU), the layers the tests run
           libembree-dev gnuplot-nox)  # Embree: a peer measured beside meshcast; gnuplot: bench plots
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
-  apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+source scripts/packages.sh
+install_missing "${PACKAGES[@]}"
 
 # Public meshes: data/meshes/*.off of CGAL's demo data (libcgal-demo).
 if [[ ! -f data/bunny00.off ]]; then

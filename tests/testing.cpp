@@ -15,6 +15,8 @@ std::optional<Mesh> data_mesh(const std::string& name) {
   return read_mesh(path);
 }
 
+bool quick() { return std::getenv("MESHCAST_TEST_QUICK") != nullptr; }
+
 std::vector<NamedMesh> test_meshes(bool large) {
   static std::map<std::string, std::shared_ptr<const Mesh>> cache;
   auto get = [&](const std::string& name, auto make) {
@@ -26,6 +28,7 @@ std::vector<NamedMesh> test_meshes(bool large) {
   out.push_back(get("grid_plane", [] { return make_grid_plane(40, 30); }));
   out.push_back(get("terrain_64k", [] { return make_terrain(256, 128, 7); }));
   for (const char* name : {"bunny00", "armadillo", "refined_elephant", "ChineseDragon-10kv"}) {
+    if (quick() && std::string(name) != "bunny00") continue;
     if (!cache.count(name)) {
       std::optional<Mesh> m = data_mesh(name);
       if (!m) continue;

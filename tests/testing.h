@@ -25,8 +25,11 @@ struct NamedMesh {
   std::shared_ptr<const Mesh> mesh;
 };
 // Generated meshes plus the four public ones when present. `large` adds the
-// 1M+ triangle terrain.
+// 1M+ triangle terrain. Under sanitizers (MESHCAST_TEST_QUICK set, see
+// scripts/test.sh) the three larger public meshes are left out.
 std::vector<NamedMesh> test_meshes(bool large);
+// True when MESHCAST_TEST_QUICK is set: the suites walk fewer rays a set.
+bool quick();
 
 // Oracle answers (tree oracle) for a ray set, cached per (mesh, kind).
 const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays);

@@ -59,6 +59,41 @@ TEST(Limits, SixteenBitIndicesTakeExactly65536Vertices) {
   }
 }
 
+// Offsets at the edge of their field: QuadTree's child offsets have 27 bits
+// (seed 000 5.6), and Float3SOA128 leaves of one triangle each take 4,608
+// bytes, so about 29,000 triangles fill them. A mesh past them is refused
+// naming the field; one that fills 99% of it builds, and rays onto every
+// part of it (the last leaves sit at offsets near 2^27) return the oracle's
+// answers.
+TEST(Limits, QuadTreeOffsetsNearTheirTwentySevenBits) {
+  const Mesh grid = make_grid_plane(130, 130);  // 33,800 triangles
+  auto first = [&](size_t n) {
+    Mesh m = grid;
+    m.triangles.resize(n);
+    return m;
+  };
+  BuildOptions o = parse_layout("QuadTree/Float3SOA128");
+  o.leaf_size = 1;
+  std::string why = refusal(grid, o, "grid130");
+  ASSERT_NE(why.find("exceeds its 27-bit child offsets"), std::string::npos) << why;
+  // The refusal names the bytes the section would take: scale down to just
+  // inside the field.
+  const double bytes = std::stod(why.substr(why.find("section of ") + 11));
+  const size_t n = size_t(double(grid.triangles.size()) * double(MC_QUAD_OFFSET_MASK) / bytes * 0.995);
+  Mesh edge = first(n);
+  std::vector<uint8_t> blob = build_blob(edge, o, "grid130 part");
+  ASSERT_EQ(layout::validate(blob), "");
+  const uint32_t tree_size = layout::header_of(blob.data()).tree_size;
+  EXPECT_GT(tree_size, 0.98 * MC_QUAD_OFFSET_MASK) << n << " triangles";
+  EXPECT_LE(tree_size, MC_QUAD_OFFSET_MASK);
+  std::vector<Ray> rays = make_rays(edge, RayKind::Long, 400, 3);
+  for (size_t t = 0; t < n; t += 97) {  // straight down onto triangles across the whole mesh
+    Vec3 a = edge.corner(t, 0), b = edge.corner(t, 1), c = edge.corner(t, 2);
+    rays.push_back({{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, 1.0f}, {0, 0, -1}, INFINITY});
+  }
+  expect_oracle(edge, blob, rays, "QuadTree/Float3SOA128 near 2^27 bytes");
+}
+
 // A chain: triangle k sits at x = 2.05^(k - 96) (from 2^-99 to 2^99, inside
 // the coordinate range), so the LongestAxis splitter (the middle of the
 // centres' box) cuts off one triangle a level: the worst a splitter can do.

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -24,12 +25,17 @@ namespace {
 // The reader takes a path (it needs the extension, Assimp reads the file):
 // one scratch file per process, in a directory of its own.
 std::string scratch(const char* ext) {
-  static std::string dir = [] {
-    char pattern[] = "/tmp/meshcast_fuzz_XXXXXX";
-    if (!mkdtemp(pattern)) std::abort();
-    return std::string(pattern);
+  static char dir[] = "/tmp/meshcast_fuzz_XXXXXX";  // a plain array: still there when atexit runs
+  static const bool made = [] {
+    if (!mkdtemp(dir)) std::abort();
+    std::atexit([] {
+      std::error_code ec;
+      std::filesystem::remove_all(dir, ec);
+    });
+    return true;
   }();
-  return dir + "/mesh" + ext;
+  (void)made;
+  return std::string(dir) + "/mesh" + ext;
 }
 
 }  // namespace

@@ -280,16 +280,22 @@ void check_ply_layout(const std::string& path, std::string_view text) {
   size_t end = std::string_view::npos;
   while (end == std::string_view::npos && ln.next(line)) {
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    // Comments may carry any text but control bytes (UTF-8 names, paths).
+    const bool comment = line.starts_with("comment") || line.starts_with("obj_info");
     for (unsigned char c : line)
-      if ((c < 0x20 && c != '\t') || c > 0x7e)
+      if ((c < 0x20 && c != '\t') || c == 0x7f || (c > 0x7f && !comment))
         fail(path, ln.at() + "malformed file: a byte outside printable ASCII in the PLY header");
+    // PLY has no '#' comments (tokens() would cut the line there and hide
+    // the rest from this check, not from Assimp).
+    if (!comment && line.find('#') != std::string_view::npos)
+      fail(path, ln.at() + "malformed file: '#' in a PLY header line");
     auto t = tokens(line);
     if (ln.number == 1) {
       if (t.size() != 1 || t[0] != "ply") fail(path, "malformed file: no PLY header ending in end_header");
       continue;
     }
     long long n = 0;
-    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t.empty() || comment) continue;
     if (t[0] == "end_header" && t.size() == 1) {
       end = std::min(ln.pos, text.size());
     } else if (t[0] == "format") {
@@ -297,14 +303,19 @@ void check_ply_layout(const std::string& path, std::string_view text) {
         fail(path, ln.at() + "malformed file: bad format line");
       format = t[1];
     } else if (t[0] == "element") {
-      if (t.size() != 3 || !parse_int(t[2], n) || n < 0) fail(path, ln.at() + "malformed file: bad element line");
+      // Every record takes a byte at least: a count beyond the file's size
+      // is malformed (and would overflow the record total below).
+      if (t.size() != 3 || !parse_int(t[2], n) || n < 0 || uint64_t(n) > text.size())
+        fail(path, ln.at() + "malformed file: bad element line");
       elements.push_back({size_t(n), {}});
     } else if (t[0] == "property") {
       // `property TYPE NAME` or `property list COUNT_TYPE TYPE NAME`
       bool list = t.size() == 5 && t[1] == "list";
       if (elements.empty() || t.size() != (list ? 5u : 3u)) fail(path, ln.at() + "malformed file: bad property line");
       Prop p{list ? type_size(t[2]) : 0, type_size(t[list ? 3 : 1])};
-      if (p.size == 0 || (list && p.count_size == 0)) fail(path, ln.at() + "malformed file: bad property line");
+      const bool integer_count = !list || (t[2] != "float" && t[2] != "float32" && t[2] != "double" && t[2] != "float64");
+      if (p.size == 0 || (list && p.count_size == 0) || !integer_count)
+        fail(path, ln.at() + "malformed file: bad property line");
       elements.back().props.push_back(p);
     } else {
       fail(path, ln.at() + "malformed file: unknown PLY header line '" + std::string(t[0].substr(0, 32)) + "'");

@@ -18,19 +18,17 @@ echo "== AddressSanitizer + UBSan: every CPU test suite and the fuzz corpora"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$jobs" --target layout_test oracle_test walker_test build_test robustness_test io_test \
       pairing_test zerobyte_test limits_test blob_fuzz mesh_fuzz
-# One process a suite, two at a time (CTest's one process a test would load
-# the meshes and compute the oracle's answers again for every test), with
-# MESHCAST_TEST_QUICK: bunny00 and the generated meshes only, fewer rays a
-# set (the Release and scalar runs walk all of them).
-export MESHCAST_DATA="$PWD/data" LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp"
-export MESHCAST_TEST_QUICK=1
+# One process a suite, $jobs at a time (CTest's one process a test would
+# load the meshes and compute the oracle's answers again for every test),
+# with MESHCAST_TEST_QUICK: bunny00 and the generated meshes only, fewer
+# rays a set (the Release and scalar runs walk all of them). A failing suite
+# prints its log; xargs waits for the others and fails the pipeline.
+asan_env=(env MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp")
 printf '%s\n' walker_test robustness_test build_test layout_test oracle_test io_test pairing_test zerobyte_test limits_test |
-  xargs -P"$jobs" -I{} sh -c 'build-asan/bin/{} --gtest_brief=1 > build-asan/{}.log 2>&1 && echo "  {}: passed" ||
-                                { echo "  {}: FAILED"; tail -50 build-asan/{}.log; exit 255; }'
-build-asan/bin/blob_fuzz fuzz/corpus/blob
-build-asan/bin/mesh_fuzz fuzz/corpus/mesh
-
-unset MESHCAST_TEST_QUICK
+  "${asan_env[@]}" xargs -P"$jobs" -I{} sh -c 'build-asan/bin/{} --gtest_brief=1 > build-asan/{}.log 2>&1 && echo "  {}: passed" ||
+                                              { echo "  {}: FAILED"; tail -50 build-asan/{}.log; exit 1; }'
+"${asan_env[@]}" build-asan/bin/blob_fuzz fuzz/corpus/blob
+"${asan_env[@]}" build-asan/bin/mesh_fuzz fuzz/corpus/mesh
 
 echo "== ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan)"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own

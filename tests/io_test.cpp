@@ -96,6 +96,13 @@ TEST(ReadMesh, ObjRestoresSharedVerticesAcrossGroups) {
 TEST(ReadMesh, PlyAscii) {
   std::string p = write_file("a.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n5 0 1 4 5 2\n");
   expect_same(read_mesh(p), kVerts, kFanned);
+  // Windows line ends in the header and a UTF-8 comment are still PLY.
+  std::string header = ply_header("binary_little_endian");
+  std::string crlf;
+  for (char c : header.substr(0, header.size() - 11)) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  crlf += "comment auteur Zo\xc3\xab\r\nend_header\n";
+  std::string bin = binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}});
+  expect_same(read_mesh(write_file("crlf.ply", crlf + bin.substr(header.size()))), kVerts, kFanned);
 }
 
 TEST(ReadMesh, PlyBinary) {
@@ -151,6 +158,12 @@ TEST(ReadMeshErrors, MissingUnknownMalformed) {
   expect_error(write_file("bad_keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\npropertLL float x\nend_header\n"),
                "unknown PLY header line");
   expect_error(write_file("short_property.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty\nend_header\n"),
+               "bad property line");
+  expect_error(write_file("hash.ply", "ply\nformat ascii 1.0\nelement vertex 3\n#propertLL float x\nend_header\n"),
+               "'#' in a PLY header line");
+  expect_error(write_file("huge_element.ply", "ply\nformat binary_little_endian 1.0\nelement foo 4000000000\nend_header\n"),
+               "bad element line");
+  expect_error(write_file("float_count.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list float int v\nend_header\n"),
                "bad property line");
   expect_error(write_file("header_byte.ply", "ply\nformat ascii 1.0\nelement vertex 3\x8a\nend_header\n"),
                "printable ASCII");

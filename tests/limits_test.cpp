@@ -45,11 +45,15 @@ TEST(Limits, SixteenBitIndicesTakeExactly65536Vertices) {
   beyond.vertices.push_back({0.5f, 0.25f, 1.0f});
   beyond.triangles.push_back({0, 1, 65536});
   std::vector<Ray> rays = make_rays(edge, RayKind::Long, 500, 7);
-  for (int i = 0; i <= 255; i += 15)  // straight down onto shared vertices
-    rays.push_back({{float(i) * 0.5f, float(255 - i) * 0.5f, 3.0f}, {0, 0, -1}, INFINITY});
+  for (int i = 0; i <= 255; i += 15)  // straight down onto shared vertices, up to the last one (index 65,535)
+    rays.push_back({{float(i), float(255 - i), 3.0f}, {0, 0, -1}, INFINITY});
+  rays.push_back({{255.0f, 255.0f, 3.0f}, {0, 0, -1}, INFINITY});
+  rays.push_back({{254.5f, 254.75f, 3.0f}, {0, 0, -1}, INFINITY});
+  size_t tested = 0;
   for (const std::string& layout : layout_names()) {
     BuildOptions o = parse_layout(layout);
     if (layout.find("Indexed16") == std::string::npos) continue;
+    ++tested;
     std::vector<uint8_t> blob = build_blob(edge, o, "grid255");
     ASSERT_EQ(layout::validate(blob), "") << layout;
     expect_oracle(edge, blob, rays, layout + " at 65,536 vertices");
@@ -57,6 +61,7 @@ TEST(Limits, SixteenBitIndicesTakeExactly65536Vertices) {
     EXPECT_NE(why.find("16-bit indices reach 65536 vertices"), std::string::npos) << layout << ": " << why;
     EXPECT_NE(why.find("grid255+1"), std::string::npos) << why;
   }
+  EXPECT_GE(tested, 30u) << "every tree with Indexed16, Indexed16SOA4 and Indexed16BitPackSOA4";
 }
 
 // Offsets at the edge of their field: QuadTree's child offsets have 27 bits

@@ -73,9 +73,7 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
       const layout::BlobHeader& h = layout::header_of(blob.data());
       row.mesh = in.name;
       row.bytes_per_tri = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
-      float bound[3];
-      displacement_bound(blob, bound);
-      row.bound = std::sqrt(double(bound[0]) * bound[0] + double(bound[1]) * bound[1] + double(bound[2]) * bound[2]) / diag;
+      row.bound = relative_error_bound(blob, diag);
       judge(in.mesh, rays, hits, oracle, row);
       rows.push_back(row);
     };

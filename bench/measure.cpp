@@ -5,6 +5,7 @@
 
 #include "cpu/agreement.h"
 #include "cpu/counters.h"
+#include "cpu/rays.h"
 #include "cpu/trace.h"
 #include "layout/blob.h"
 #include "layout/lbvh.h"
@@ -27,6 +28,13 @@ uint64_t oracle_mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, con
     a = compare(mesh, rays, hits, oracle, tolerance);
   }
   return a.wrong + a.t_errors;
+}
+
+Setup setup(const Mesh& mesh, size_t count) {
+  Setup s{make_rays(mesh, RayKind::Long, count, 1), {}};
+  OracleTree tree(mesh);
+  for (const Ray& r : s.rays) s.oracle.push_back(tree.closest(r));
+  return s;
 }
 
 std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat) {
@@ -53,6 +61,8 @@ Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& op
   const uint64_t disagreements = oracle_mistakes(mesh, blob, rays, hits, oracle);
   double tree_bytes = double(h.node_bytes) / h.triangle_count, walked = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
   Timing t{ms.front(), ms[ms.size() / 2], bytes, disagreements, report.build_ms, tree_bytes, walked, report.sah_cost};
+  t.total_bytes = double(blob.size()) / h.triangle_count;
+  t.error_bound = relative_error_bound(blob, mesh.bounds().diagonal());
   if constexpr (kCountTests) {
     test_counts = {};
     view.trace(rays, hits);

@@ -19,10 +19,20 @@ struct Timing {
   double walked_bytes;       // everything a walk reads, per triangle
   double sah_cost;
   double hole_bytes = 0;     // StacklessLBVH: node slots no walk reaches, per triangle
+  double total_bytes = 0;    // the whole blob, per triangle
+  double error_bound = 0;    // relative_error_bound: the format's stated error, of the diagonal
   // Box and triangle tests a ray, from one more pass; -1 unless the build
   // counts them (MESHCAST_COUNT_TESTS, cpu/counters.h).
   double boxes_per_ray = -1, triangles_per_ray = -1;
 };
+
+// The tables' ray set: `count` long rays (seed 1) and the oracle's answers
+// over the input mesh.
+struct Setup {
+  std::vector<Ray> rays;
+  std::vector<OracleHit> oracle;
+};
+Setup setup(const Mesh& mesh, size_t count);
 
 // Rays whose triangle or t differ from the oracle's (`oracle`: over the
 // input mesh); formats that move vertices are judged on the mesh they store.

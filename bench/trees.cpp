@@ -8,22 +8,6 @@
 
 namespace meshcast::bench {
 
-namespace {
-
-struct Setup {
-  std::vector<Ray> rays;
-  std::vector<OracleHit> oracle;
-};
-
-Setup setup(const Mesh& mesh, size_t count) {
-  Setup s{make_rays(mesh, RayKind::Long, count, 1), {}};
-  OracleTree tree(mesh);
-  for (const Ray& r : s.rays) s.oracle.push_back(tree.closest(r));
-  return s;
-}
-
-}  // namespace
-
 std::vector<TreeRow> bench_splitters(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat) {
   // Seed 000 §4.1 (time for 1024 rays as printed there; the units of that
   // table read as ms for the 1024 rays).

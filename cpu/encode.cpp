@@ -403,6 +403,12 @@ void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
   }
 }
 
+double relative_error_bound(const std::vector<uint8_t>& blob, double diagonal) {
+  float b[3];
+  displacement_bound(blob, b);
+  return std::sqrt(double(b[0]) * b[0] + double(b[1]) * b[1] + double(b[2]) * b[2]) / std::max(1e-30, diagonal);
+}
+
 bool moves_vertices(uint32_t triangle_format) {
   if (triangle_format == MC_TRI_INDEXED24) return false;
   CodecOps c = codec_ops(triangle_format);

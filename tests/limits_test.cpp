@@ -13,18 +13,9 @@
 namespace meshcast::testing {
 namespace {
 
-// Every ray of `rays` against the oracle on the mesh the blob stores.
-void expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, const std::string& what) {
-  Mesh stored = moves_vertices(layout::header_of(blob.data()).triangle_format) ? stored_mesh(blob) : mesh;
-  OracleTree tree(stored);  // the double-precision oracle over a tree: these meshes are large
-  std::vector<OracleHit> oracle(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) oracle[i] = tree.closest(rays[i]);
-  std::vector<Hit> hits = trace_all(blob, rays);
-  Agreement a = compare(stored, rays, hits, oracle, 1e-5 * mesh.bounds().diagonal());
-  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
-  size_t hit = 0;
-  for (const Hit& h : hits) hit += h.triangle != MC_NO_HIT;
-  EXPECT_GT(hit, rays.size() / 2) << what << ": rays that miss prove little";
+// The oracle's answers, and most rays hitting (misses prove little).
+void expect_answers(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, const std::string& what) {
+  EXPECT_GT(expect_oracle(mesh, blob, rays, trace_all(blob, rays), what), rays.size() / 2) << what << ": rays that miss prove little";
 }
 
 std::string refusal(const Mesh& mesh, const BuildOptions& o, const std::string& name) {
@@ -56,7 +47,7 @@ TEST(Limits, SixteenBitIndicesTakeExactly65536Vertices) {
     ++tested;
     std::vector<uint8_t> blob = build_blob(edge, o, "grid255");
     ASSERT_EQ(layout::validate(blob), "") << layout;
-    expect_oracle(edge, blob, rays, layout + " at 65,536 vertices");
+    expect_answers(edge, blob, rays, layout + " at 65,536 vertices");
     std::string why = refusal(beyond, o, "grid255+1");
     EXPECT_NE(why.find("16-bit indices reach 65536 vertices"), std::string::npos) << layout << ": " << why;
     EXPECT_NE(why.find("grid255+1"), std::string::npos) << why;
@@ -96,7 +87,7 @@ TEST(Limits, QuadTreeOffsetsNearTheirTwentySevenBits) {
     Vec3 a = edge.corner(t, 0), b = edge.corner(t, 1), c = edge.corner(t, 2);
     rays.push_back({{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, 1.0f}, {0, 0, -1}, INFINITY});
   }
-  expect_oracle(edge, blob, rays, "QuadTree/Float3SOA128 near 2^27 bytes");
+  expect_answers(edge, blob, rays, "QuadTree/Float3SOA128 near 2^27 bytes");
 }
 
 // A chain: triangle k sits at x = 2.05^(k - 96) (from 2^-99 to 2^99, inside
@@ -148,7 +139,7 @@ TEST(Limits, TheDeepestTreesTheBuilderMakesWalkRight) {
     else
       EXPECT_GT(depth, 12u) << layout;
     EXPECT_LE(depth, MC_MAX_DEPTH) << layout;
-    expect_oracle(m, blob, rays, std::string(layout) + " chain of " + std::to_string(n));
+    expect_answers(m, blob, rays, std::string(layout) + " chain of " + std::to_string(n));
   }
 }
 

@@ -28,6 +28,15 @@ gpu::Context& context() {
   static gpu::Context ctx(gpu::DeviceChoice{"", true});
   return ctx;
 }
+
+// The first method that reads the blob's layout.
+std::string method_for(const std::vector<uint8_t>& blob) {
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  const std::string name = layout_name(h.tree_format, h.triangle_format);
+  for (const gpu::MethodLayout& c : gpu::method_layouts())
+    if (name == c.layout) return c.method;
+  return "none reads " + name;
+}
 #endif
 
 class Robustness : public ::testing::TestWithParam<std::string> {
@@ -44,9 +53,20 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     o.pairing = GetParam().find('+') != std::string::npos;
     return o;
   }
+  // "auto:SETTING" (testing.h auto_limits) builds the layout the automatic
+  // layout chooses for each probe mesh; anything else the named layout.
+  bool automatic() const { return GetParam().rfind("auto:", 0) == 0; }
+  std::vector<uint8_t> build(const Mesh& mesh, const char* what) const {
+    if (!automatic()) return build_blob(mesh, options(), what);
+    AutoLimits limits = auto_limits(layout().substr(5));
+#ifdef MESHCAST_TEST_GPU
+    for (const gpu::MethodLayout& c : gpu::method_layouts()) limits.readers.push_back(c.layout);
+#endif
+    return choose_layout(mesh, limits, what).blob;
+  }
   std::vector<Hit> trace(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr) {
 #ifdef MESHCAST_TEST_GPU
-    std::unique_ptr<gpu::Method> m = gpu::make_method(context(), method(), blob, GetParam());
+    std::unique_ptr<gpu::Method> m = gpu::make_method(context(), automatic() ? method_for(blob) : method(), blob, GetParam());
     std::vector<Hit> hits(rays.size());
     uint64_t unwalkable = m->trace(rays, hits);
     if (skipped) *skipped = unwalkable;
@@ -64,16 +84,13 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     EXPECT_EQ(context().validation_messages(), messages_before_) << context().last_validation_message();
   }
 #endif
-  bool quantized() const { return moves_vertices(options().triangle_format); }
+  static bool quantized(const std::vector<uint8_t>& blob) {
+    return moves_vertices(layout::header_of(blob.data()).triangle_format);
+  }
   // Oracle answers on the mesh as stored (quantized for bit-packed formats).
-  void expect_oracle(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
-    std::vector<uint8_t> blob = build_blob(mesh, options(), what);
-    Mesh stored = quantized() ? stored_mesh(blob) : mesh;
-    std::vector<OracleHit> oracle(rays.size());
-    for (size_t i = 0; i < rays.size(); ++i) oracle[i] = oracle_brute_force(stored, rays[i]);
-    std::vector<Hit> hits = trace(blob, rays);
-    Agreement a = compare(stored, rays, hits, oracle, 1e-5 * std::max(1e-30, mesh.bounds().diagonal()));
-    EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
+  void expect_answers(const Mesh& mesh, const std::vector<Ray>& rays, const char* what) {
+    std::vector<uint8_t> blob = build(mesh, what);
+    expect_oracle(mesh, blob, rays, trace(blob, rays), what);
   }
 };
 
@@ -95,7 +112,7 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
   for (bool soup : {false, true}) {
   Mesh s = make_sphere(24, 48, 1.0f, {0.1f, 0.2f, 0.3f});
   if (soup) s = unwelded(s);
-  std::vector<uint8_t> blob = build_blob(s, options(), "sphere");
+  std::vector<uint8_t> blob = build(s, "sphere");
   std::vector<Ray> rays;
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> u(-1, 1);
@@ -126,7 +143,7 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
         for (float zy : {0.0f, -0.0f})
           for (float dz : {-1.0f, 1.0f})
             rays.push_back({{0.5f * x, 0.5f * y, -dz * 2.0f}, {zx, zy, dz}, INFINITY});
-  std::vector<uint8_t> blob = build_blob(g, options(), "grid");
+  std::vector<uint8_t> blob = build(g, "grid");
   std::vector<Hit> hits = trace(blob, rays);
   const Mesh stored = stored_mesh(blob);  // u, v follow the stored corner order
   for (size_t i = 0; i < hits.size(); ++i) {
@@ -139,12 +156,12 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
       float p = rays[i].org[a] + h.t * rays[i].dir[a];
       float q = (1 - h.u - h.v) * stored.corner(h.triangle, 0)[a] + h.u * stored.corner(h.triangle, 1)[a] +
                 h.v * stored.corner(h.triangle, 2)[a];
-      EXPECT_NEAR(p, q, quantized() ? 1e-4 : 1e-5) << "ray " << i;
+      EXPECT_NEAR(p, q, quantized(blob) ? 1e-4 : 1e-5) << "ray " << i;
     }
     EXPECT_GE(h.u, -1e-6f);
     EXPECT_GE(h.v, -1e-6f);
   }
-  expect_oracle(g, rays, "grid");
+  expect_answers(g, rays, "grid");
 }
 
 TEST_P(Robustness, AxisParallelGrazingAndInPlane) {
@@ -158,7 +175,7 @@ TEST_P(Robustness, AxisParallelGrazingAndInPlane) {
     rays.push_back({{c, c, 5.0f}, {0, 0, -1}, INFINITY});             // axis-parallel
     rays.push_back({{-1.0f, -1.0f, 1.0f}, {c + 1, c + 1, -1}, INFINITY});
   }
-  expect_oracle(g, rays, "grid in-plane");
+  expect_answers(g, rays, "grid in-plane");
 }
 
 TEST_P(Robustness, FarTinyAndHugeMeshes) {
@@ -169,7 +186,7 @@ TEST_P(Robustness, FarTinyAndHugeMeshes) {
     Mesh s = make_sphere(16, 32, radius, centre);
     std::vector<Ray> rays = make_rays(s, RayKind::Long, 400, rng());
     for (const Ray& r : make_rays(s, RayKind::Radial, 200, rng())) rays.push_back(r);
-    expect_oracle(s, rays, "far/tiny/huge sphere");
+    expect_answers(s, rays, "far/tiny/huge sphere");
   }
 }
 
@@ -192,7 +209,7 @@ TEST_P(Robustness, SliversAndDegenerateTriangles) {
     float c = 1.0f + 0.1f * i;
     rays.push_back({{c, c, 2.0f}, {0, 0, -1}, INFINITY});  // along the sliver
   }
-  expect_oracle(m, rays, "slivers");
+  expect_answers(m, rays, "slivers");
 }
 
 // Directions with denormal components (their inverses overflow to
@@ -217,17 +234,17 @@ TEST_P(Robustness, DenormalDirectionsAndCoplanarOverlaps) {
       rays.push_back({{px, py, 1e-30f}, {e, 0.0f, -d}, INFINITY});  // crawls down onto the plane
     }
   rays.push_back({{-1.0f, 1.5f, 1e-38f}, {1, 0, -d}, INFINITY});  // nearly in the plane
-  std::vector<Hit> hits = trace(build_blob(g, options(), "coplanar"), rays);
+  std::vector<Hit> hits = trace(build(g, "coplanar"), rays);
   size_t leaks = 0;
   for (size_t i = 0; i + 1 < rays.size(); ++i)  // the steep rays from inside the grid's border (on it, -3e-42 in y leaves)
     leaks += hits[i].triangle == MC_NO_HIT && rays[i].dir[2] * rays[i].dir[2] == 1 && rays[i].org[0] > 0 && rays[i].org[1] > 0;
   EXPECT_EQ(leaks, 0u);
-  expect_oracle(g, rays, "coplanar, denormal directions");
+  expect_answers(g, rays, "coplanar, denormal directions");
 }
 
 TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
   Mesh g = make_grid_plane(4, 4);
-  std::vector<uint8_t> blob = build_blob(g, options(), "grid");
+  std::vector<uint8_t> blob = build(g, "grid");
   const float nan = NAN, inf = INFINITY;
   std::vector<Ray> rays = {
       {{nan, 1, 1}, {0, 0, -1}, inf}, {{1, 1, 1}, {0, nan, -1}, inf}, {{inf, 1, 1}, {0, 0, -1}, inf},
@@ -254,8 +271,8 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
       {{1.3f, 1.6f, 1e30f}, {0, 0, -1}, INFINITY},
       {{2.0f, 2.0f, 0.0f}, {0, 0, 1}, INFINITY},  // on a vertex, leaving
   };
-  expect_oracle(g, rays, "t_max");
-  std::vector<Hit> hits = trace(build_blob(g, options(), "grid"), rays);
+  expect_answers(g, rays, "t_max");
+  std::vector<Hit> hits = trace(build(g, "grid"), rays);
   EXPECT_EQ(hits[0].t, 0.0f);
   EXPECT_EQ(hits[2].triangle, MC_NO_HIT);
   EXPECT_NE(hits[3].triangle, MC_NO_HIT);
@@ -265,7 +282,7 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
   std::string n = info.param;
   for (char& c : n)
-    if (c == '/' || c == '+' || c == '@') c = '_';
+    if (c == '/' || c == '+' || c == '@' || c == ':' || c == ',' || c == '-' || c == '.') c = '_';
   return n;
 }
 
@@ -274,11 +291,20 @@ std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
 std::vector<std::string> gpu_cases() {
   std::vector<std::string> names;
   for (const gpu::MethodLayout& c : gpu::method_layouts()) names.push_back(std::string(c.layout) + "@" + c.method);
+  for (const std::string& setting : auto_settings()) names.push_back("auto:" + setting);
   return names;
 }
 INSTANTIATE_TEST_SUITE_P(Vulkan, Robustness, ::testing::ValuesIn(gpu_cases()), param_name);
 #else
 INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(layout_names()), param_name);
+
+// The automatic layout's choice for each probe mesh, under each setting.
+std::vector<std::string> auto_cases() {
+  std::vector<std::string> names;
+  for (const std::string& setting : auto_settings()) names.push_back("auto:" + setting);
+  return names;
+}
+INSTANTIATE_TEST_SUITE_P(Auto, Robustness, ::testing::ValuesIn(auto_cases()), param_name);
 
 // Paired trees (seed 003): every tree that takes pairs, with a float and a
 // quantized encoding.

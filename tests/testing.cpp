@@ -1,10 +1,15 @@
 #include "tests/testing.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
 #include <filesystem>
 
 #include "io/generate.h"
 #include "io/read_mesh.h"
+#include "layout/blob.h"
 
 namespace meshcast::testing {
 
@@ -66,6 +71,35 @@ std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<R
   uint64_t s = view.trace(rays, hits);
   if (skipped) *skipped = s;
   return hits;
+}
+
+size_t expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
+                     const std::vector<Hit>& hits, const std::string& what) {
+  const Mesh stored = moves_vertices(layout::header_of(blob.data()).triangle_format) ? stored_mesh(blob) : mesh;
+  OracleTree tree(stored);
+  std::vector<OracleHit> oracle(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) oracle[i] = tree.closest(rays[i]);
+  Agreement a = compare(stored, rays, hits, oracle, 1e-5 * std::max(1e-30, mesh.bounds().diagonal()));
+  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
+  return size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.triangle != MC_NO_HIT; }));
+}
+
+std::vector<std::string> auto_settings() { return {"speed", "speed,trial", "memory", "memory,error", "speed,bytes"}; }
+
+AutoLimits auto_limits(const std::string& setting) {
+  AutoLimits l;
+  const size_t comma = setting.find(',');
+  l.goal = parse_goal(setting.substr(0, comma));
+  const std::string extra = comma == std::string::npos ? "" : setting.substr(comma + 1);
+  if (extra == "trial")
+    l.trial_rays = 256;
+  else if (extra == "error")
+    l.max_error = 2e-6;
+  else if (extra == "bytes")
+    l.max_bytes_per_triangle = 20;
+  else if (!extra.empty())
+    throw std::invalid_argument("unknown auto setting " + setting);
+  return l;
 }
 
 }  // namespace meshcast::testing

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cpu/agreement.h"
+#include "cpu/auto_layout.h"
 #include "cpu/encode.h"
 #include "cpu/mesh.h"
 #include "cpu/oracle.h"
@@ -36,5 +37,19 @@ const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, c
 const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count = 10000);
 
 std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr);
+
+// `hits` against the double-precision oracle over the mesh `blob` stores
+// (the input mesh, or stored_mesh(blob) for the formats that move
+// vertices): same triangle, t within 1e-5 of the diagonal. A failure names
+// `what` and the first problem. Returns how many rays hit.
+size_t expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
+                     const std::vector<Hit>& hits, const std::string& what);
+
+// The automatic layout's settings the suites run (auto_test, the stiff
+// suite): "speed", "speed,trial" (a 256-ray trial), "memory",
+// "memory,error" (stated error at most 2e-6 of the diagonal) and
+// "speed,bytes" (at most 20 bytes a triangle: past the fast layouts).
+std::vector<std::string> auto_settings();
+AutoLimits auto_limits(const std::string& setting);
 
 }  // namespace meshcast::testing

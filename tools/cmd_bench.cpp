@@ -22,19 +22,16 @@
 
 namespace meshcast::tools {
 
-namespace {
-
-// A mesh file, or "terrain_2M": the generated 2,097,152-triangle terrain.
 Mesh bench_mesh(const std::string& input) {
   if (input == "terrain_2M") return make_terrain(1024, 1024, 5);
+  if (input == "terrain_66k") return make_terrain(256, 256, 5);
   return read_mesh(input);
 }
-
-}  // namespace
 
 void add_bench(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "reproduce the source documents' tables");
   bench->require_subcommand(1);
+  add_bench_auto(bench);
   struct Args {
     std::string input = "data/bunny00.off", out_dir = "out";
     size_t rays = 1024;

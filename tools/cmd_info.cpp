@@ -22,7 +22,7 @@ void add_info(CLI::App& app) {
   add_layout_options(cmd, args->layout);
   cmd->add_flag("--json", args->json, "print the same as one JSON object");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
+    Loaded in = load_input(args->input, args->layout, args->json ? stderr : stdout);
     const layout::BlobHeader& h = layout::header_of(in.blob.data());
     SectionBytes s = section_bytes(in.blob);
     double n = h.triangle_count;

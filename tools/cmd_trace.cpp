@@ -34,7 +34,7 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
+    Loaded in = load_input(args->input, args->layout);
     std::vector<Ray> rays = read_rays(args->rays);
     std::vector<Hit> hits(rays.size());
     std::vector<double> pass_ms, device_ms;
@@ -100,7 +100,7 @@ void add_render(CLI::App& app) {
   cmd->add_option("--method", args->method, "GPU method for the blob's layout (see trace --help)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
+    Loaded in = load_input(args->input, args->layout);
     std::string device = "CPU, one thread";
     Picture p;
     if (args->backend == "vulkan") {
@@ -131,7 +131,7 @@ void add_build(CLI::App& app) {
   cmd->add_option("--out", args->out, "blob file to write")->required();
   add_layout_options(cmd, args->layout);
   cmd->callback([args] {
-    Loaded in = load_mesh_or_blob(args->input, build_options(args->layout));
+    Loaded in = load_input(args->input, args->layout);
     if (!in.mesh) throw InputError(args->input + ": is already a blob; give a mesh file");
     write_file(args->out, in.blob.data(), in.blob.size());
     std::printf("%s: %zu triangles -> %s (%zu bytes, %.2f bytes/triangle), build %.1f ms\n", args->input.c_str(),

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cpu/encode.h"
+#include "tools/common.h"
 
 namespace meshcast::tools {
 
@@ -14,6 +15,12 @@ void add_rays(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_bench(CLI::App& app);
 void add_render(CLI::App& app);
+void add_bench_auto(CLI::App* bench);  // `meshcast bench auto`, under `bench`
+
+// A mesh file, or a generated terrain: "terrain_2M" (2,097,152 triangles,
+// 1,050,625 vertices) or "terrain_66k" (131,072 triangles, 66,049 vertices:
+// just past 16-bit indices).
+Mesh bench_mesh(const std::string& input);
 
 // The layout options trace, build and info share: --layout, --leaf,
 // --splitter, --order, --lbvh-depth, --lbvh-left-first, --grouping, --pairing.
@@ -25,8 +32,16 @@ struct LayoutArgs {
   bool pairing = false;
   bool zbt_no_shuffle = false, zbt_no_cache = false;  // zero-byte trees (seed 004)
   uint32_t hybrid_leaf = 256;
+  // --layout auto (cpu/auto_layout.h): the limits it chooses under.
+  std::string goal = "speed";
+  double max_bytes = 0, max_error = 0;
+  bool gpu = false;
+  uint32_t trial = 0;
 };
 void add_layout_options(CLI::App* cmd, LayoutArgs& args);
 BuildOptions build_options(const LayoutArgs& args);  // throws InputError for bad names
+// load_mesh_or_blob with these options; with --layout auto the layout is
+// chosen for the mesh, and what was chosen and why is printed to `report`.
+Loaded load_input(const std::string& path, const LayoutArgs& args, std::FILE* report = stdout);
 
 }  // namespace meshcast::tools

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cstring>
 
+#include "cpu/auto_layout.h"
 #include "cpu/rays.h"
+#include "gpu/method.h"
 #include "cpu/trace.h"
 #include "io/read_mesh.h"
 #include "layout/blob.h"
@@ -41,7 +43,16 @@ BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std:
 }
 
 void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
-  cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh");
+  cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh, or auto (chosen for the mesh)");
+  cmd->add_option("--goal", a.goal, "auto: speed (fastest) or memory (fewest bytes)");
+  cmd->add_option("--max-bytes", a.max_bytes, "auto: at most this many blob bytes a triangle (0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--max-error", a.max_error,
+                  "auto: stated error bound at most this fraction of the mesh diagonal (0: no limit; bench error)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--gpu", a.gpu, "auto: only layouts a Vulkan method reads as well (CPU and GPU)");
+  cmd->add_option("--trial", a.trial, "auto, speed first: time the candidates on this many rays (0: rules only)")
+      ->check(CLI::Range(0u, 1u << 20));
   cmd->add_option("--leaf", a.leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
   cmd->add_option("--splitter", a.splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
   cmd->add_option("--order", a.order,
@@ -56,6 +67,38 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
   cmd->add_option("--hybrid-leaf", a.hybrid_leaf, "ZeroByteHybrid: largest leaf, each one zero-byte tree")
       ->check(CLI::Range(8u, uint32_t(MC_ZBT_MAX_TRIANGLES)));
+}
+
+namespace {
+bool is_blob_file(const std::string& path) {
+  uint32_t magic = 0;
+  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    if (std::fread(&magic, 4, 1, f) != 1) magic = 0;
+    std::fclose(f);
+  }
+  return magic == MC_BLOB_MAGIC;
+}
+}  // namespace
+
+Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* report) {
+  if (a.layout != "auto" || is_blob_file(path)) return load_mesh_or_blob(path, a.layout == "auto" ? BuildOptions{} : build_options(a));
+  AutoLimits limits;
+  limits.goal = parse_goal(a.goal);
+  limits.max_bytes_per_triangle = a.max_bytes, limits.max_error = a.max_error;
+  if (a.gpu)
+    for (const gpu::MethodLayout& m : gpu::method_layouts()) limits.readers.push_back(m.layout);
+  limits.trial_rays = a.trial;
+  Loaded out;
+  auto t0 = std::chrono::steady_clock::now();
+  out.mesh = read_mesh(path);
+  out.load_ms = ms_since(t0);
+  auto t1 = std::chrono::steady_clock::now();
+  AutoChoice choice = choose_layout(*out.mesh, limits, path);
+  out.build_ms = ms_since(t1);
+  out.blob = std::move(choice.blob);
+  out.report = choice.report;
+  std::fprintf(report, "%s", describe(limits, choice).c_str());
+  return out;
 }
 
 BuildOptions build_options(const LayoutArgs& a) {

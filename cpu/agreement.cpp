@@ -172,8 +172,11 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
 Mesh stored_mesh(const std::vector<uint8_t>& blob) {
   const layout::BlobHeader& h = layout::header_of(blob.data());
   Mesh m;
-  m.vertices.resize(size_t(h.triangle_count) * 3);
-  m.triangles.resize(h.triangle_count);
+  // Without a remap, triangles are numbered by slot: holes become
+  // triangles of one point (zero area), which no ray hits.
+  const size_t count = layout::has_remap(h) ? h.triangle_count : h.remap_slots;
+  m.vertices.resize(count * 3);
+  m.triangles.assign(count, Triangle{0, 0, 0});
   layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t count) {
     for (uint32_t i = 0; i < count; ++i) {
       uint32_t t = layout::remap_entry(blob.data(), h, layout::slot_of(h, block, i));

@@ -39,7 +39,8 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
 
 // The triangles as the blob stores them, decoded by its triangle format and
 // put back in input order: a triangle soup, three vertices a triangle. The
-// exact reference for formats that move vertices.
+// exact reference for formats that move vertices. A blob without a remap
+// numbers its triangles by slot (layout/blob.h has_remap), and so does this.
 Mesh stored_mesh(const std::vector<uint8_t>& blob);
 
 }  // namespace meshcast

@@ -19,10 +19,11 @@ std::string format(const char* fmt, double a, double b) {
   return text;
 }
 
-AutoCandidate candidate(const std::string& layout, uint32_t leaf, std::string why) {
+AutoCandidate candidate(const AutoLimits& l, const std::string& layout, uint32_t leaf, std::string why) {
   AutoCandidate c;
   c.options = parse_layout(layout);
   c.options.leaf_size = leaf;
+  c.options.triangle_ids = l.triangle_ids;
   c.label = leaf == kLeaf ? layout : layout + " (leaf " + std::to_string(leaf) + ")";
   c.why = std::move(why);
   return c;
@@ -85,7 +86,7 @@ double time_rays(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
 std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, std::vector<std::string>& reasons) {
   std::vector<AutoCandidate> out;
   auto add = [&](const std::string& layout, const std::string& why) {
-    if (worth_trying(l, s, layout)) out.push_back(candidate(layout, kLeaf, why));
+    if (worth_trying(l, s, layout)) out.push_back(candidate(l, layout, kLeaf, why));
   };
   const std::string w = s.vertices <= 65536 ? "16" : "32";
   if (!l.readers.empty()) {
@@ -134,7 +135,7 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
 std::vector<AutoCandidate> memory_list(const MeshStats& s, const AutoLimits& l, std::vector<std::string>& reasons) {
   std::vector<AutoCandidate> out;
   auto add = [&](const std::string& layout, const std::string& why) {
-    if (worth_trying(l, s, layout)) out.push_back(candidate(layout, kLeaf, why));
+    if (worth_trying(l, s, layout)) out.push_back(candidate(l, layout, kLeaf, why));
   };
   if (!l.readers.empty()) {
     reasons.push_back("CPU and GPU: every layout a Vulkan method reads (brute force only up to 4096 triangles)");
@@ -230,7 +231,7 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
     const size_t from = out.candidates.size();
     for (size_t a : again) {
       const AutoCandidate& small = out.candidates[a];
-      out.candidates.push_back(candidate(layout_name(small.options.tree_format, small.options.triangle_format), 16,
+      out.candidates.push_back(candidate(limits, layout_name(small.options.tree_format, small.options.triangle_format), 16,
                                          small.why + "; leaves of 16: fewer nodes, fuller blocks"));
     }
     if (!again.empty()) out.reasons.push_back("memory first: the smallest tree layouts once more with leaves of 16");
@@ -251,7 +252,7 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
     auto rank = [&](const std::string& layout) { return std::find(order.begin(), order.end(), tree_of(layout)) - order.begin(); };
     std::stable_sort(rest.begin(), rest.end(), [&](const std::string& a, const std::string& b) { return rank(a) < rank(b); });
     const size_t from = out.candidates.size();
-    for (const std::string& layout : rest) out.candidates.push_back(candidate(layout, kLeaf, "no shortlisted layout fits"));
+    for (const std::string& layout : rest) out.candidates.push_back(candidate(limits, layout, kLeaf, "no shortlisted layout fits"));
     run(from);
   }
   if (pick == kNone) {

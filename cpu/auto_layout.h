@@ -39,6 +39,7 @@ struct AutoLimits {
   // rays, their own seed) and take the fastest; 0: no trial, rule order.
   uint32_t trial_rays = 0;
   uint32_t trial_passes = 3;  // the fastest pass of these counts
+  bool triangle_ids = true;   // BuildOptions::triangle_ids of every candidate
 };
 
 struct AutoCandidate {

@@ -232,9 +232,17 @@ void quantization_bound(const float offset[3], const float scale[3], float bound
 
 // The remap section after the blob's bytes so far: slot -> input triangle
 // (MC_NO_HIT: no triangle), as few bits as the triangle count needs.
-void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector<uint32_t>& remap) {
-  hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
+void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector<uint32_t>& remap, bool keep) {
   hd.remap_slots = uint32_t(remap.size());
+  bool identity = remap.size() == hd.triangle_count;
+  for (uint32_t s = 0; identity && s < hd.remap_slots; ++s) identity = remap[s] == s;
+  if (identity || !keep) {
+    hd.remap_bits = hd.remap_size = 0;
+    hd.remap_offset = align(bytes.size(), 4);
+    bytes.resize(hd.remap_offset, 0);
+    return;
+  }
+  hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
   hd.remap_offset = align(bytes.size(), 8);
   const uint32_t words = layout::remap_words(hd);
   hd.remap_size = align(12ull * words + (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8, 8);
@@ -369,7 +377,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
   if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
 
-  append_remap(writer.bytes, hd, writer.remap);
+  append_remap(writer.bytes, hd, writer.remap, o.triangle_ids);
   hd.total_size = uint32_t(writer.bytes.size());
   std::memcpy(writer.bytes.data(), &hd, sizeof hd);
   layout::seal(writer.bytes);

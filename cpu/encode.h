@@ -45,6 +45,11 @@ struct BuildOptions {
   bool zbt_shuffle = true;
   bool zbt_box_cache = true;
   uint32_t hybrid_leaf = 256;
+  // The remap section, which turns a hit's slot into the caller's triangle
+  // number. false: left out, hits name triangles by slot number (see
+  // layout/blob.h has_remap; stored_mesh gives their corners). Left out
+  // anyway when the build kept the input order.
+  bool triangle_ids = true;
 };
 
 struct BuildReport {

@@ -31,9 +31,12 @@ static_assert(sizeof(Ray) == 28, "Ray is the 7 floats of a rays-file record");
 struct Hit {
   float t = INFINITY;
   uint32_t triangle = MC_NO_HIT;  // index in the caller's mesh
-  float u = 0, v = 0;             // barycentrics of corners 1 and 2 (strips: of a
-                                  // rotation of the triangle's corners, the winding kept)
+  // Only when asked for (MC_HIT_UV): barycentrics of corners 1 and 2
+  // (strips: of a rotation of the triangle's corners, the winding kept).
+  float u = 0, v = 0;
+  float point[3] = {0, 0, 0};     // only when asked for (MC_HIT_POINT): org + t * dir
 };
+static_assert(sizeof(Hit) == 28, "the Vulkan methods' hit record (shaders/hits.glsl) is the same 7 words");
 
 // A ray the walkers may walk: finite origin and direction, a direction that
 // is not zero (nor denormal), t_max not NaN and not negative (infinity allowed). Any other
@@ -62,8 +65,9 @@ struct RayPre {
   // keep the winding), shear constants S.
   int axis[3];  // {kx, ky, kz}: loaders fetch corners in this order
   float sx, sy, sz;
+  uint32_t outputs;  // MC_HIT_* asked for: the triangle tests skip u, v unless asked
 
-  explicit RayPre(const Ray& r) {
+  explicit RayPre(const Ray& r, uint32_t hit_outputs = 0) : outputs(hit_outputs) {
     for (int a = 0; a < 3; ++a) {
       org[a] = r.org[a];
       dir[a] = r.dir[a];
@@ -235,7 +239,7 @@ inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float 
     int i = __builtin_ctz(m);
     if (best.lane < 0 || tl[i] < best.t) best.lane = i, best.t = tl[i];
   }
-  if (best.lane >= 0) {
+  if (best.lane >= 0 && (r.outputs & MC_HIT_UV)) {
     float Ul[kW], Vl[kW], Wl[kW];
     U.store(Ul), V.store(Vl), W.store(Wl);
     float d = Ul[best.lane] + Vl[best.lane] + Wl[best.lane];
@@ -299,8 +303,11 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     for (int m = simd::bits(accept); m; m &= m - 1) {
       int i = __builtin_ctz(m);
       if (best.lane < 0 || tl[i] < best.t) {
-        float d = Ul[i] + Vl[i] + Wl[i];
-        best = {i, tri == 1, tl[i], Vl[i] / d, Wl[i] / d};
+        best = {i, tri == 1, tl[i], 0, 0};
+        if (r.outputs & MC_HIT_UV) {
+          const float d = Ul[i] + Vl[i] + Wl[i];
+          best.u = Vl[i] / d, best.v = Wl[i] / d;
+        }
       }
     }
     // Rare: an edge function of 0 in float; settle those lanes in double.

@@ -80,9 +80,9 @@ BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : by
   if (!walk_) throw InputError(name + ": no walker for this layout");
 }
 
-uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits) const {
+uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, uint32_t outputs) const {
   uint64_t skipped = 0;
-  walk_(bytes_.data(), rays.data(), hits.data(), std::min(rays.size(), hits.size()), &skipped);
+  walk_(bytes_.data(), rays.data(), hits.data(), std::min(rays.size(), hits.size()), &skipped, outputs);
   return skipped;
 }
 

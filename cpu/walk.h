@@ -9,47 +9,50 @@
 namespace meshcast {
 
 // Walks `n` rays through a validated blob. Unwalkable rays (ray_is_walkable)
-// are answered as misses and counted in *skipped.
-using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+// are answered as misses and counted in *skipped. `outputs`: the MC_HIT_*
+// asked for.
+using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Bounds, class Codec>
-void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 template <class Codec>
-void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
 // Both zero-byte formats (Indexed24 triangles), with or without the box
 // cache as the blob's header asks.
-void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped);
+void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
-// Turns the closest slot into the caller's hit.
-inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Closest& c) {
+// Turns the closest slot into the caller's hit, with the outputs asked for.
+inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Closest& c, const RayPre& r) {
   Hit hit;
   if (c.slot == MC_NO_HIT) return hit;
   hit.t = c.t;
   hit.triangle = layout::remap_entry(blob, h, c.slot);
-  hit.u = c.u, hit.v = c.v;
+  if (r.outputs & MC_HIT_UV) hit.u = c.u, hit.v = c.v;
+  if (r.outputs & MC_HIT_POINT)
+    for (int a = 0; a < 3; ++a) hit.point[a] = r.org[a] + c.t * r.dir[a];
   return hit;
 }
 
@@ -57,7 +60,7 @@ inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Cl
 // miss; walk_one(r, c) walks one ray, shortening c on every hit.
 template <class WalkOne>
 inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
-                         WalkOne&& walk_one) {
+                         uint32_t outputs, WalkOne&& walk_one) {
   const layout::BlobHeader& h = layout::header_of(blob);
   for (size_t i = 0; i < n; ++i) {
     if (!ray_is_walkable(rays[i])) {
@@ -65,10 +68,10 @@ inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t
       ++*skipped;
       continue;
     }
-    const RayPre r(rays[i]);
+    const RayPre r(rays[i], outputs);
     Closest c{rays[i].tmax};
     walk_one(r, c);
-    hits[i] = finish_hit(blob, h, c);
+    hits[i] = finish_hit(blob, h, c, r);
   }
 }
 

@@ -8,10 +8,10 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     for (uint32_t b = 0; b < h.node_count; ++b) {
       const layout::ListEntry e = layout::load_list_entry(tree, b);
       if (box_test(r, e.min, e.max, c.t) != INFINITY)
@@ -21,7 +21,7 @@ void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_aabblist<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
+  template void walk_aabblist<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -9,10 +9,10 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     walk_aabb_nodes(tree, r, c, [&](const layout::AABBNode& node, uint32_t at) {
       uint32_t block = at + MC_AABB_NODE_BYTES;
       test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
@@ -25,10 +25,10 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 // side of the split axis (the first child is the lower one) and pushes the
 // other.
 template <class Codec>
-void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     uint32_t stack[MC_MAX_DEPTH + 2];
     int top = -1;
     uint32_t at = 0;
@@ -54,10 +54,10 @@ void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, si
 // AABBTreePNS walker (seed 000 §5.3, seed 002): as AABBTreeSplitAxis, but
 // the near child is one AND away: bit octant(dir) of the node's 8 bits.
 template <class Codec>
-void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
     uint32_t stack[MC_MAX_DEPTH + 2];
     int top = -1;
@@ -82,9 +82,9 @@ void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n
 }
 
 #define MC_INSTANTIATE(Codec, name)                                                                 \
-  template void walk_aabbtree_pns<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*); \
-  template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*); \
-  template void walk_aabbtree_splitaxis<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
+  template void walk_aabbtree_pns<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
+  template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
+  template void walk_aabbtree_splitaxis<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -8,12 +8,12 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   const layout::CompressedBox root = layout::compressed_root_box(tree);
   const uint32_t root_count = layout::compressed_root_count(tree);
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     struct Entry {
       layout::CompressedBox box;
       uint32_t at, count;
@@ -51,7 +51,7 @@ void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, s
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_aabbtree_compressed<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
+  template void walk_aabbtree_compressed<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

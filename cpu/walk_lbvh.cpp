@@ -17,10 +17,10 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
     uint32_t v = 1, o = 0, node_index = 1;
     for (;;) {
@@ -44,7 +44,7 @@ void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_lbvh<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
+  template void walk_lbvh<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -47,10 +47,10 @@ constexpr int kStackSize = 3 * MC_MAX_DEPTH + 8;
 }  // namespace
 
 template <class Bounds, class Codec>
-void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     uint32_t node_stack[kStackSize];
     float fraction_stack[kStackSize];
     node_stack[0] = h.root;
@@ -92,11 +92,11 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   });
 }
 
-#define MC_INSTANTIATE(Codec, name)                                                                                   \
+#define MC_INSTANTIATE(Codec, name)                                                                            \
   template void walk_quadtree<layout::QuadBoundsFloat, layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, \
-                                                                      uint64_t*);                               \
+                                                                      uint64_t*, uint32_t);                     \
   template void walk_quadtree<layout::QuadBoundsHalf, layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t,  \
-                                                                     uint64_t*);
+                                                                     uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -13,10 +13,10 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     struct Entry { uint32_t at; float tnear, tfar; };
     Entry stack[MC_MAX_DEPTH + 2];
     int top = -1;
@@ -57,7 +57,7 @@ void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uin
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_skdtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*);
+  template void walk_skdtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -51,19 +51,19 @@ void walk_zbt(const uint8_t* blob, const layout::BlobHeader& h, uint32_t root, u
 }
 
 template <bool kCache>
-void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     walk_zbt<kCache>(blob, h, h.tree_offset + h.triangle_base, 0, layout::pns_octant(r.dir), r, c, cache);
   });
 }
 
 template <bool kCache>
-void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
-  for_each_ray(blob, rays, hits, n, skipped, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
     walk_aabb_nodes(blob + h.tree_offset, r, c, [&](const layout::AABBNode& node, uint32_t) {
       uint32_t root = h.tree_offset + h.triangle_base + node.value() * layout::Indexed24::kSlotDivisor;
@@ -74,14 +74,14 @@ void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_
 
 }  // namespace
 
-void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped) {
+void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   bool cache = h.root & MC_ZBT_FLAG_BOX_CACHE;
   if (h.tree_format == MC_TREE_ZEROBYTEHYBRID)
-    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped)
-                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped);
-  return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped)
-               : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped);
+    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, outputs)
+                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, outputs);
+  return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, outputs)
+               : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, outputs);
 }
 
 }  // namespace meshcast

@@ -340,7 +340,7 @@ std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o
     float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
     std::memcpy(bytes.data() + h.vertex_offset + 12 * v, p, 12);
   }
-  append_remap(bytes, h, order);
+  append_remap(bytes, h, order, o.triangle_ids);
   h.total_size = uint32_t(bytes.size());
   std::memcpy(bytes.data(), &h, sizeof h);
   layout::seal(bytes);

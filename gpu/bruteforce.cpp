@@ -20,13 +20,14 @@ namespace {
 
 class BruteForceMethod : public BatchMethod {
  public:
-  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint32_t slots)
+  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint32_t slots,
+                   uint32_t outputs)
       : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
                     slots),
         test_(ctx, bitpack ? bruteforce_bitpack_spv : bruteforce_float3_spv,
-              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push), slots),
+              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push), slots, outputs),
         resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push), slots) {}
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push), slots, outputs) {}
 
  protected:
   void bind_all(uint32_t slot) override {
@@ -51,11 +52,11 @@ class BruteForceMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                        uint32_t slots) {
+                                        uint32_t slots, uint32_t outputs) {
   // The codec the blob holds picks the shaders (BatchMethod refuses others).
   ctx.require_int64_atomics("bruteforce");
   const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack, slots);
+  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack, slots, outputs);
 }
 
 }  // namespace meshcast::gpu

@@ -57,8 +57,10 @@ class Method {
 //   quadtree    QuadTreeHalfFloat/Indexed8BitPackSOA4
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout
 // the method does not read, naming both).
+// `outputs`: the per-hit outputs (MC_HIT_UV, MC_HIT_POINT) its shaders
+// compute; the others read 0.
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
-                                    const std::string& name, uint32_t slots = 1);
+                                    const std::string& name, uint32_t slots = 1, uint32_t outputs = 0);
 std::vector<std::string> method_names();
 
 // Every (method, layout) pair the GPU reads, in the order of seed 000 §7's
@@ -75,6 +77,6 @@ std::span<const MethodLayout> method_layouts();
 // uses 2^21 (16 MiB); a test passes a small one to split batches into many
 // chunks.
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                      uint64_t pairs, uint32_t slots = 1);
+                                      uint64_t pairs, uint32_t slots = 1, uint32_t outputs = 0);
 
 }  // namespace meshcast::gpu

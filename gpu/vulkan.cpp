@@ -321,7 +321,7 @@ Buffer::~Buffer() {
 }
 
 Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
-                   uint32_t sets)
+                   uint32_t sets, uint32_t hit_outputs)
     : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes) {
   VkDevice d = ctx.device();
   std::vector<VkDescriptorSetLayoutBinding> b(bindings);
@@ -340,7 +340,11 @@ Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint
   VkShaderModule module;
   check(vkCreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
   VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", nullptr};
+  // A shader that does not declare constant 0 ignores it (Vulkan spec,
+  // VkSpecializationMapEntry).
+  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
+  const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &hit_outputs};
+  cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", &spec};
   cp.layout = layout_;
   VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
   vkDestroyShaderModule(d, module, nullptr);

@@ -128,11 +128,12 @@ class Buffer {
 
 // A compute pipeline over `sets` descriptor sets (one a frame slot) of
 // `bindings` storage buffers (binding i = buffer i) and `push_bytes` of push
-// constants.
+// constants. `hit_outputs` (MC_HIT_*) is specialization constant 0, which
+// shaders/hits.glsl reads: the per-hit outputs are fixed with the pipeline.
 class Pipeline {
  public:
   Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
-           uint32_t sets = 1);
+           uint32_t sets = 1, uint32_t hit_outputs = 0);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;

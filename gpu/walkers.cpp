@@ -33,9 +33,10 @@ const Walker kWalkers[] = {
 
 class WalkMethod : public BatchMethod {
  public:
-  WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const Walker& w, uint32_t slots)
+  WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const Walker& w, uint32_t slots,
+             uint32_t outputs)
       : BatchMethod(ctx, blob, name, w.method, w.tree, w.triangles, slots),
-        walk_(ctx, w.spirv, w.spirv_bytes, 4, sizeof(Push), slots) {}
+        walk_(ctx, w.spirv, w.spirv_bytes, 4, sizeof(Push), slots, outputs) {}
 
  protected:
   void bind_all(uint32_t slot) override { walk_.bind(buffers(slot), slot); }
@@ -51,7 +52,7 @@ class WalkMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                        uint32_t slots);
+                                        uint32_t slots, uint32_t outputs);
 
 std::vector<std::string> method_names() {
   std::vector<std::string> names{"bruteforce", "aabblist"};
@@ -74,11 +75,11 @@ std::span<const MethodLayout> method_layouts() {
 }
 
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
-                                    const std::string& name, uint32_t slots) {
-  if (method == "bruteforce") return make_bruteforce(ctx, blob, name, slots);
+                                    const std::string& name, uint32_t slots, uint32_t outputs) {
+  if (method == "bruteforce") return make_bruteforce(ctx, blob, name, slots, outputs);
   // 2^21 pairs (16 MiB a slot): far below every device's
   // maxStorageBufferRange, and still thousands of rays a chunk on large meshes.
-  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 21, slots);
+  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 21, slots, outputs);
   // A method that reads several triangle formats takes the blob's; the
   // first listed is the one named when the blob fits none.
   const Walker* pick = nullptr;
@@ -91,7 +92,7 @@ std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std
       break;
     }
   }
-  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick, slots);
+  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick, slots, outputs);
   std::string valid;
   for (const std::string& n : method_names()) valid += " " + n;
   throw InputError("unknown GPU method '" + method + "'; implemented:" + valid);

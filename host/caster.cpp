@@ -68,7 +68,8 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
     s->work = [this, sp](uint32_t job) {
       const auto t0 = std::chrono::steady_clock::now();
       const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
-      view_.trace(std::span<const Ray>(sp->rays).subspan(first, count), std::span<Hit>(sp->hits).subspan(first, count));
+      view_.trace(std::span<const Ray>(sp->rays).subspan(first, count), std::span<Hit>(sp->hits).subspan(first, count),
+                  options_.hit_outputs);
       sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
       if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu);
     };
@@ -83,7 +84,7 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
                                                                      : std::vector<std::string>{options_.gpu_method};
       for (const std::string& m : names) {
         try {
-          method_ = gpu::make_method(*gpu_, m, blob, name, options_.frames);
+          method_ = gpu::make_method(*gpu_, m, blob, name, options_.frames, options_.hit_outputs);
           break;
         } catch (const InputError&) {
           if (!options_.gpu_method.empty()) throw;
@@ -290,7 +291,7 @@ BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
       copied = true;
     } catch (const gpu::GpuError& e) {  // the device went while reading back: the CPU answers
       gpu_failed(e.what());
-      view_.trace(s.rays, hits.first(s.n));
+      view_.trace(s.rays, hits.first(s.n), options_.hit_outputs);
       r.ran_on = Backend::Cpu;
       copied = true;
     }
@@ -309,7 +310,7 @@ BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
   return r;
 }
 
-void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits) const { view_.trace(rays, hits); }
+void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits) const { view_.trace(rays, hits, options_.hit_outputs); }
 
 std::vector<BatchRecord> Caster::records() const {
   std::lock_guard<std::mutex> lock(mutex_);

@@ -70,6 +70,7 @@ struct CasterOptions {
   std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
   std::string gpu_method;       // "" : the one that reads the blob's layout
   bool validation = false;      // Vulkan validation layers
+  uint32_t hit_outputs = 0;     // per-hit outputs (MC_HIT_UV, MC_HIT_POINT) on either backend
   std::string profile;          // file with a saved crossover; measured and written when absent
   // Test hook: called before every GPU submission; throwing GpuError there
   // acts as a lost device.

@@ -89,7 +89,7 @@ std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block,
   if (slot0 + count > h.remap_slots)
     return "triangle block at tree offset " + num(block) + " maps past the remap (" + num(h.remap_slots) +
            " slots)";
-  for (uint64_t s = slot0; s < slot0 + count; ++s)
+  for (uint64_t s = slot0; has_remap(h) && s < slot0 + count; ++s)
     if (!(remap_used(blob, h, uint32_t(s >> 6)) >> (s & 63) & 1))
       return "triangle block at tree offset " + num(block) + " uses slot " + num(s) + ", which the remap marks unused";
   std::string why;
@@ -407,23 +407,30 @@ std::string validate(std::span<const uint8_t> blob) {
     return "node count " + num(h.node_count) + " does not fit the tree section";
   if (h.node_bytes > h.tree_size || h.triangle_base > h.tree_size)
     return "node area or triangle base lies past the tree section";
-  if (h.remap_bits == 0 || h.remap_bits > 32 || (uint64_t(1) << h.remap_bits) < h.triangle_count)
-    return "remap entries of " + num(h.remap_bits) + " bits cannot hold " + num(h.triangle_count) + " triangles";
-  if (12ull * remap_words(h) + (uint64_t(h.triangle_count) * h.remap_bits + 7) / 8 + 8 > h.remap_size)
-    return "remap section of " + num(h.remap_size) + " bytes is too small for " + num(h.remap_slots) +
-           " slots and " + num(h.triangle_count) + " entries";
-  uint64_t used = 0;
-  for (uint32_t w = 0; w < remap_words(h); ++w) {
-    if (load<uint32_t>(blob.data() + h.remap_offset + 8ull * remap_words(h) + 4ull * w) != used)
-      return "remap rank of word " + num(w) + " does not count the used slots before it";
-    used += uint64_t(std::popcount(remap_used(blob.data(), h, w)));
+  if (!has_remap(h)) {
+    // Hits name slots: every slot number must stay below MC_NO_HIT.
+    if (h.remap_size != 0) return "remap section of " + num(h.remap_size) + " bytes with 0-bit entries";
+    if (h.remap_slots < h.triangle_count || h.remap_slots == MC_NO_HIT)
+      return "no remap, and " + num(h.remap_slots) + " slot numbers for " + num(h.triangle_count) + " triangles";
+  } else {
+    if (h.remap_bits == 0 || h.remap_bits > 32 || (uint64_t(1) << h.remap_bits) < h.triangle_count)
+      return "remap entries of " + num(h.remap_bits) + " bits cannot hold " + num(h.triangle_count) + " triangles";
+    if (12ull * remap_words(h) + (uint64_t(h.triangle_count) * h.remap_bits + 7) / 8 + 8 > h.remap_size)
+      return "remap section of " + num(h.remap_size) + " bytes is too small for " + num(h.remap_slots) +
+             " slots and " + num(h.triangle_count) + " entries";
+    uint64_t used = 0;
+    for (uint32_t w = 0; w < remap_words(h); ++w) {
+      if (load<uint32_t>(blob.data() + h.remap_offset + 8ull * remap_words(h) + 4ull * w) != used)
+        return "remap rank of word " + num(w) + " does not count the used slots before it";
+      used += uint64_t(std::popcount(remap_used(blob.data(), h, w)));
+    }
+    if (used != h.triangle_count)
+      return "remap marks " + num(used) + " slots used for " + num(h.triangle_count) + " triangles";
+    for (uint32_t i = 0; i < h.triangle_count; ++i)
+      if (remap_packed(blob.data(), h, i) >= h.triangle_count)
+        return "remap entry " + num(i) + " names triangle " + num(remap_packed(blob.data(), h, i)) + " of " +
+               num(h.triangle_count);
   }
-  if (used != h.triangle_count)
-    return "remap marks " + num(used) + " slots used for " + num(h.triangle_count) + " triangles";
-  for (uint32_t i = 0; i < h.triangle_count; ++i)
-    if (remap_packed(blob.data(), h, i) >= h.triangle_count)
-      return "remap entry " + num(i) + " names triangle " + num(remap_packed(blob.data(), h, i)) + " of " +
-             num(h.triangle_count);
   if (h.tree_format == MC_TREE_QUADTREEHALFFLOAT &&
       !(std::isfinite(h.node_scale) && h.node_scale > 0 && std::isfinite(h.node_origin[0]) &&
         std::isfinite(h.node_origin[1]) && std::isfinite(h.node_origin[2])))

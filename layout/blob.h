@@ -113,6 +113,12 @@ inline uint32_t slot_of(const BlobHeader& h, uint32_t block, uint32_t lane) {
 //             order, then 8 bytes of padding so a 64-bit load never leaves it
 // with W = ceil(remap_slots / 64). A slot's entry is number
 // rank[s/64] + popcount(used[s/64] below bit s%64).
+//
+// A blob may have no remap (remap_bits = 0, remap_size = 0): when the build
+// kept the input order (every slot s holds input triangle s) or the caller
+// asked for no input triangle numbers. A hit then names the triangle by its
+// slot number, below remap_slots.
+inline bool has_remap(const BlobHeader& h) { return h.remap_bits != 0; }
 inline uint32_t remap_words(const BlobHeader& h) { return (h.remap_slots + 63) / 64; }
 
 inline uint32_t remap_packed(const uint8_t* blob, const BlobHeader& h, uint32_t index) {
@@ -126,6 +132,7 @@ inline uint64_t remap_used(const uint8_t* blob, const BlobHeader& h, uint32_t wo
 }
 
 inline uint32_t remap_entry(const uint8_t* blob, const BlobHeader& h, uint32_t slot) {
+  if (h.remap_bits == 0) return slot;  // no remap section: see has_remap
   uint32_t w = slot >> 6;
   uint64_t below = remap_used(blob, h, w) & ((uint64_t(1) << (slot & 63)) - 1);
   uint32_t rank = load<uint32_t>(blob + h.remap_offset + 8ull * remap_words(h) + 4ull * w);

@@ -10,6 +10,12 @@
 #define MC_BLOB_VERSION 1u
 #define MC_BLOB_HEADER_BYTES 160u
 
+// Per-hit outputs a trace may ask for beyond t and the triangle (issue 9);
+// what is not asked for is not computed and reads 0. The CPU walkers take
+// them with each batch, the Vulkan methods as specialization constant 0.
+#define MC_HIT_UV 1u     // barycentrics u, v of the hit in its triangle
+#define MC_HIT_POINT 2u  // the hit point: org + t * dir, in float
+
 // Header fields as 32-bit word indices, for readers that see the blob as a
 // uint array (the shaders); layout/blob.h checks them against BlobHeader.
 #define MC_HDR_TREE_FORMAT 2u

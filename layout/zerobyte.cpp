@@ -120,7 +120,7 @@ std::string validate_zerobyte(std::span<const uint8_t> blob, const BlobHeader& h
     if (!covered[i]) return "triangle " + num(i) + " of the index buffer belongs to no zero-byte node";
     // Every slot is a triangle: its remap bit must say so, or two slots
     // could name one triangle.
-    if (!(remap_used(blob.data(), h, i / 64) >> (i % 64) & 1)) return "remap marks slot " + num(i) + " unused";
+    if (has_remap(h) && !(remap_used(blob.data(), h, i / 64) >> (i % 64) & 1)) return "remap marks slot " + num(i) + " unused";
   }
   if (depth > MC_MAX_DEPTH) return "tree deeper than " + num(MC_MAX_DEPTH);
   return "";

@@ -13,8 +13,9 @@ float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_words[byte_offset
 uint header(uint word) { return blob_words[word]; }
 
 // remap_entry of layout/blob.h: the used-slot bitmap (64-bit words), the
-// rank of each word, then the bit-packed entries.
+// rank of each word, then the bit-packed entries; or no remap at all.
 uint remap_entry(uint slot) {
+  if (header(MC_HDR_REMAP_BITS) == 0u) return slot;  // no remap section: hits name slots
   const uint base = header(MC_HDR_REMAP_OFFSET);
   const uint words = (header(MC_HDR_REMAP_SLOTS) + 63u) / 64u;
   const uint w = slot >> 6, bit = slot & 63u;

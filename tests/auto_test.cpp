@@ -113,6 +113,45 @@ TEST(AutoLayout, ImpossibleLimitsAndReaders) {
   }
 }
 
+// Without the remap (BuildOptions::triangle_ids false) every layout walks
+// the same hits, naming triangles by slot: the same t, the same stored
+// corners, the oracle's answers over stored_mesh (numbered by slot too), and
+// the blob is smaller by the remap section. The remap is left out on its
+// own when the build kept the input order.
+TEST(NoRemap, EveryLayoutAnswersBySlot) {
+  const Mesh mesh = make_sphere(24, 48, 1.0f, {0.1f, 0.2f, -0.3f});
+  const std::vector<Ray> rays = make_rays(mesh, RayKind::Long, 1500, 11);
+  for (const std::string& layout : layout_names()) {
+    BuildOptions with = parse_layout(layout), without = with;
+    without.triangle_ids = false;
+    const std::vector<uint8_t> a = build_blob(mesh, with, "sphere"), b = build_blob(mesh, without, "sphere");
+    const layout::BlobHeader &ha = layout::header_of(a.data()), &hb = layout::header_of(b.data());
+    ASSERT_EQ(layout::validate(b), "") << layout;
+    EXPECT_FALSE(layout::has_remap(hb)) << layout;
+    EXPECT_EQ(b.size() + ha.remap_size + (ha.remap_offset - hb.remap_offset), a.size()) << layout;
+    const std::vector<Hit> ha_hits = trace_all(a, rays), hb_hits = trace_all(b, rays);
+    const Mesh sa = stored_mesh(a), sb = stored_mesh(b);
+    std::vector<OracleHit> oracle(rays.size());
+    OracleTree tree(sb);
+    for (size_t i = 0; i < rays.size(); ++i) oracle[i] = tree.closest(rays[i]);
+    Agreement agree = compare(sb, rays, hb_hits, oracle, 1e-5 * mesh.bounds().diagonal());
+    EXPECT_EQ(agree.wrong + agree.t_errors, 0u) << layout << ": " << agree.first_problem;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      ASSERT_EQ(ha_hits[i].t, hb_hits[i].t) << layout << " ray " << i;
+      if (ha_hits[i].triangle == MC_NO_HIT) continue;
+      ASSERT_LT(hb_hits[i].triangle, hb.remap_slots) << layout;
+      for (int k = 0; k < 3; ++k)
+        for (int x = 0; x < 3; ++x)
+          ASSERT_EQ(sa.corner(ha_hits[i].triangle, k)[x], sb.corner(hb_hits[i].triangle, k)[x]) << layout << " ray " << i;
+    }
+    // Kept input order: every slot holds its own input triangle, no remap
+    // needed, and the hits still name the input's triangles.
+    if (!layout::has_remap(ha)) {
+      expect_oracle(mesh, a, rays, ha_hits, layout + " (input order kept)");
+    }
+  }
+}
+
 class AutoChoices : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
 
 // The choice meets its limits and is what its goal says among the

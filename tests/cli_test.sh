@@ -58,6 +58,16 @@ check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitte
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
 check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
 check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
+check auto-speed 0 "chose QuadTree" -- "$meshcast" build "$mesh" --layout auto --out "$work/auto.blob"
+check auto-blob 0 "remap: " -- "$meshcast" info "$work/auto.blob"
+check auto-memory 0 "the fewest bytes that meet the limits" -- "$meshcast" info "$mesh" --layout auto --goal memory --max-error 2e-6
+check auto-trial 0 "fastest in the trial" -- "$meshcast" build "$mesh" --layout auto --trial 64 --out "$work/auto2.blob"
+check auto-gpu 0 "CPU and GPU" -- "$meshcast" info "$mesh" --layout auto --gpu --goal memory
+check auto-json 0 '^\{"input"' -- "$meshcast" info "$mesh" --layout auto --json
+check auto-impossible 2 "no layout meets the limits \(at most 1.00 bytes" -- "$meshcast" info "$mesh" --layout auto --max-bytes 1
+check auto-goal 2 "valid goals: speed memory" -- "$meshcast" info "$mesh" --layout auto --goal fast
+check no-triangle-ids 0 "remap: none" -- "$meshcast" info "$mesh" --layout QuadTree/Float3SOA4 --no-triangle-ids
+check bench-auto 0 "choices more than 10% from the best" -- "$meshcast" bench auto "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check pairing 0 "of triangles paired" -- "$meshcast" info "$mesh" --layout AABBTree/Float3SOA4 --pairing
 check zerobyte 0 "nodes +0 +0\.00" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Indexed24
 check zerobyte-stats 0 "shuffled; box cache off" -- "$meshcast" info "$mesh" --layout ZeroByteHybrid/Indexed24 --hybrid-leaf 64 --no-box-cache

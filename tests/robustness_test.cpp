@@ -64,15 +64,21 @@ class Robustness : public ::testing::TestWithParam<std::string> {
 #endif
     return choose_layout(mesh, limits, what).blob;
   }
-  std::vector<Hit> trace(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr) {
+  // `outputs`: the per-hit outputs asked for (MC_HIT_*).
+  std::vector<Hit> trace(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr,
+                         uint32_t outputs = 0) {
 #ifdef MESHCAST_TEST_GPU
-    std::unique_ptr<gpu::Method> m = gpu::make_method(context(), automatic() ? method_for(blob) : method(), blob, GetParam());
+    std::unique_ptr<gpu::Method> m =
+        gpu::make_method(context(), automatic() ? method_for(blob) : method(), blob, GetParam(), 1, outputs);
     std::vector<Hit> hits(rays.size());
     uint64_t unwalkable = m->trace(rays, hits);
     if (skipped) *skipped = unwalkable;
     return hits;
 #else
-    return trace_all(blob, rays, skipped);
+    std::vector<Hit> hits(rays.size());
+    uint64_t unwalkable = BlobView(blob, GetParam()).trace(rays, hits, outputs);
+    if (skipped) *skipped = unwalkable;
+    return hits;
 #endif
   }
 #ifdef MESHCAST_TEST_GPU
@@ -144,7 +150,7 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
           for (float dz : {-1.0f, 1.0f})
             rays.push_back({{0.5f * x, 0.5f * y, -dz * 2.0f}, {zx, zy, dz}, INFINITY});
   std::vector<uint8_t> blob = build(g, "grid");
-  std::vector<Hit> hits = trace(blob, rays);
+  std::vector<Hit> hits = trace(blob, rays, nullptr, MC_HIT_UV);
   const Mesh stored = stored_mesh(blob);  // u, v follow the stored corner order
   for (size_t i = 0; i < hits.size(); ++i) {
     ASSERT_NE(hits[i].triangle, MC_NO_HIT) << "ray " << i << " leaked";
@@ -162,6 +168,53 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
     EXPECT_GE(h.v, -1e-6f);
   }
   expect_answers(g, rays, "grid");
+}
+
+// Per-hit outputs (issue 9) are computed only when asked: u, v and the
+// point read 0 otherwise, and asking changes neither t nor the triangle.
+// The point is org + t * dir; u, v name that point in the stored triangle.
+TEST_P(Robustness, PerHitOutputsOnlyWhenAsked) {
+  const Mesh s = make_sphere(12, 24, 1.5f, {0.25f, -0.5f, 2.0f});
+  const std::vector<Ray> rays = make_rays(s, RayKind::Long, 256, 5);
+  const std::vector<uint8_t> blob = build(s, "sphere");
+  const Mesh stored = stored_mesh(blob);
+  const std::vector<Hit> plain = trace(blob, rays);
+  const std::vector<Hit> uv = trace(blob, rays, nullptr, MC_HIT_UV);
+  const std::vector<Hit> point = trace(blob, rays, nullptr, MC_HIT_POINT);
+  const std::vector<Hit> both = trace(blob, rays, nullptr, MC_HIT_UV | MC_HIT_POINT);
+  const double tolerance = 1e-5 * s.bounds().diagonal();
+  size_t hit = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    for (const std::vector<Hit>* h : {&uv, &point, &both}) {
+      ASSERT_EQ((*h)[i].triangle, plain[i].triangle) << "ray " << i;
+      ASSERT_EQ((*h)[i].t, plain[i].t) << "ray " << i;
+    }
+    for (const Hit* h : {&plain[i], &point[i]}) {
+      EXPECT_EQ(h->u, 0.0f) << "ray " << i;
+      EXPECT_EQ(h->v, 0.0f) << "ray " << i;
+    }
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(plain[i].point[a], 0.0f) << "ray " << i;
+      EXPECT_EQ(uv[i].point[a], 0.0f) << "ray " << i;
+    }
+    if (plain[i].triangle == MC_NO_HIT) continue;
+    ++hit;
+    const Hit& h = both[i];
+    for (int a = 0; a < 3; ++a) {
+      const double p = double(rays[i].org[a]) + double(h.t) * rays[i].dir[a];
+      const double q = (1.0 - h.u - h.v) * stored.corner(h.triangle, 0)[a] + double(h.u) * stored.corner(h.triangle, 1)[a] +
+                       double(h.v) * stored.corner(h.triangle, 2)[a];
+      EXPECT_NEAR(h.point[a], p, tolerance) << "ray " << i << " axis " << a;
+      EXPECT_EQ(point[i].point[a], h.point[a]) << "ray " << i;
+      EXPECT_NEAR(q, p, tolerance) << "ray " << i << " axis " << a;
+    }
+    EXPECT_EQ(uv[i].u, h.u);
+    EXPECT_EQ(uv[i].v, h.v);
+    EXPECT_GE(h.u, -1e-6f);
+    EXPECT_GE(h.v, -1e-6f);
+    EXPECT_LE(h.u + h.v, 1.0f + 1e-6f);
+  }
+  EXPECT_GT(hit, rays.size() / 2);
 }
 
 TEST_P(Robustness, AxisParallelGrazingAndInPlane) {

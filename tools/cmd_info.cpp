@@ -61,8 +61,13 @@ void add_info(CLI::App& app) {
     row("walked", s.walked());
     row("remap", s.remap);
     row("total", s.total);
-    std::printf("  remap: %u entries of %u bits, %u slot numbers (%.0f%% used)\n", h.triangle_count, h.remap_bits,
-                h.remap_slots, 100.0 * h.triangle_count / std::max(1u, h.remap_slots));
+    if (layout::has_remap(h))
+      std::printf("  remap: %u entries of %u bits, %u slot numbers (%.0f%% used)\n", h.triangle_count, h.remap_bits,
+                  h.remap_slots, 100.0 * h.triangle_count / std::max(1u, h.remap_slots));
+    else
+      std::printf("  remap: none: a hit names its triangle by slot number (below %u), the input's own number when the "
+                  "build kept the input order\n",
+                  h.remap_slots);
   });
 }
 

@@ -30,6 +30,7 @@ struct LayoutArgs {
   uint32_t leaf = 8, lbvh_depth = 0;
   bool lbvh_left_first = false;
   bool pairing = false;
+  bool no_triangle_ids = false;  // BuildOptions::triangle_ids
   bool zbt_no_shuffle = false, zbt_no_cache = false;  // zero-byte trees (seed 004)
   uint32_t hybrid_leaf = 256;
   // --layout auto (cpu/auto_layout.h): the limits it chooses under.

@@ -62,6 +62,8 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
       ->check(CLI::Range(0u, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
   cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
   cmd->add_option("--grouping", a.grouping, "AABBList batches (seed 000 7): ClosestCentroid (the seed's) or Morton");
+  cmd->add_flag("--no-triangle-ids", a.no_triangle_ids,
+                "leave the remap out: hits name triangles by the blob's slot numbers, not the input's");
   cmd->add_flag("--pairing", a.pairing, "pair triangles across shared edges first (seed 003); leaves hold whole pairs");
   cmd->add_flag("--no-shuffle", a.zbt_no_shuffle, "zero-byte trees: any bound triangles, not 6 each naming its extreme's corner");
   cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
@@ -88,6 +90,7 @@ Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* repor
   if (a.gpu)
     for (const gpu::MethodLayout& m : gpu::method_layouts()) limits.readers.push_back(m.layout);
   limits.trial_rays = a.trial;
+  limits.triangle_ids = !a.no_triangle_ids;
   Loaded out;
   auto t0 = std::chrono::steady_clock::now();
   out.mesh = read_mesh(path);
@@ -108,6 +111,7 @@ BuildOptions build_options(const LayoutArgs& a) {
   o.lbvh_near_first = !a.lbvh_left_first;
   if (!a.grouping.empty()) o.grouping = parse_grouping(a.grouping);
   o.pairing = a.pairing;
+  o.triangle_ids = !a.no_triangle_ids;
   o.zbt_shuffle = !a.zbt_no_shuffle, o.zbt_box_cache = !a.zbt_no_cache, o.hybrid_leaf = a.hybrid_leaf;
   return o;
 }

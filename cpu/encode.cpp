@@ -231,21 +231,26 @@ void quantization_bound(const float offset[3], const float scale[3], float bound
 }
 
 // The remap section after the blob's bytes so far: slot -> input triangle
-// (MC_NO_HIT: no triangle), as few bits as the triangle count needs.
+// (MC_NO_HIT: no triangle), as few bits as the triangle count needs; only
+// the used slots and their ranks when the slots keep the input order; none
+// when the caller asked for none (layout/blob.h).
 void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector<uint32_t>& remap, bool keep) {
   hd.remap_slots = uint32_t(remap.size());
-  bool identity = remap.size() == hd.triangle_count;
-  for (uint32_t s = 0; identity && s < hd.remap_slots; ++s) identity = remap[s] == s;
-  if (identity || !keep) {
+  hd.remap_offset = align(bytes.size(), 8);
+  if (!keep) {
     hd.remap_bits = hd.remap_size = 0;
     hd.remap_offset = align(bytes.size(), 4);
     bytes.resize(hd.remap_offset, 0);
     return;
   }
-  hd.remap_bits = std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
-  hd.remap_offset = align(bytes.size(), 8);
+  uint32_t next = 0;  // in order: the used slots name triangles 0, 1, 2, ...
+  for (uint32_t s = 0; s < hd.remap_slots && next != MC_NO_HIT; ++s)
+    if (remap[s] != MC_NO_HIT) next = remap[s] == next ? next + 1 : MC_NO_HIT;
+  const bool in_order = next == hd.triangle_count;
+  hd.remap_bits = in_order ? 0 : std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
   const uint32_t words = layout::remap_words(hd);
-  hd.remap_size = align(12ull * words + (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8, 8);
+  const uint64_t entry_bytes = in_order ? 0 : (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8;
+  hd.remap_size = align(12ull * words + entry_bytes, 8);
   bytes.resize(uint64_t(hd.remap_offset) + hd.remap_size, 0);
   uint8_t* used = bytes.data() + hd.remap_offset;
   uint8_t* rank = used + 8ull * words;
@@ -255,6 +260,10 @@ void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector
     if (s % 64 == 0) std::memcpy(rank + 4ull * (s / 64), &index, 4);
     if (remap[s] == MC_NO_HIT) continue;
     used[s / 8] |= uint8_t(1u << (s % 8));
+    if (in_order) {
+      ++index;
+      continue;
+    }
     uint64_t bit = uint64_t(index++) * hd.remap_bits;
     uint64_t word;
     std::memcpy(&word, entries + (bit >> 3), 8);

@@ -409,13 +409,15 @@ std::string validate(std::span<const uint8_t> blob) {
     return "node area or triangle base lies past the tree section";
   if (!has_remap(h)) {
     // Hits name slots: every slot number must stay below MC_NO_HIT.
-    if (h.remap_size != 0) return "remap section of " + num(h.remap_size) + " bytes with 0-bit entries";
+    if (h.remap_bits != 0) return "no remap section, yet remap entries of " + num(h.remap_bits) + " bits";
     if (h.remap_slots < h.triangle_count || h.remap_slots == MC_NO_HIT)
       return "no remap, and " + num(h.remap_slots) + " slot numbers for " + num(h.triangle_count) + " triangles";
   } else {
-    if (h.remap_bits == 0 || h.remap_bits > 32 || (uint64_t(1) << h.remap_bits) < h.triangle_count)
+    // remap_bits 0: in input order, no entries (layout/blob.h).
+    if (h.remap_bits > 32 || (h.remap_bits != 0 && (uint64_t(1) << h.remap_bits) < h.triangle_count))
       return "remap entries of " + num(h.remap_bits) + " bits cannot hold " + num(h.triangle_count) + " triangles";
-    if (12ull * remap_words(h) + (uint64_t(h.triangle_count) * h.remap_bits + 7) / 8 + 8 > h.remap_size)
+    const uint64_t entry_bytes = h.remap_bits ? (uint64_t(h.triangle_count) * h.remap_bits + 7) / 8 + 8 : 0;
+    if (12ull * remap_words(h) + entry_bytes > h.remap_size)
       return "remap section of " + num(h.remap_size) + " bytes is too small for " + num(h.remap_slots) +
              " slots and " + num(h.triangle_count) + " entries";
     uint64_t used = 0;
@@ -426,7 +428,7 @@ std::string validate(std::span<const uint8_t> blob) {
     }
     if (used != h.triangle_count)
       return "remap marks " + num(used) + " slots used for " + num(h.triangle_count) + " triangles";
-    for (uint32_t i = 0; i < h.triangle_count; ++i)
+    for (uint32_t i = 0; h.remap_bits != 0 && i < h.triangle_count; ++i)
       if (remap_packed(blob.data(), h, i) >= h.triangle_count)
         return "remap entry " + num(i) + " names triangle " + num(remap_packed(blob.data(), h, i)) + " of " +
                num(h.triangle_count);

@@ -42,7 +42,7 @@ struct BlobHeader {
   uint32_t slot_divisor;    // bytes of triangle block per slot number
   uint32_t vertex_offset, vertex_size;
   uint32_t remap_offset, remap_size;
-  uint32_t remap_bits;      // bits per remap entry
+  uint32_t remap_bits;      // bits per remap entry (0: none, see has_remap)
   uint32_t remap_slots;     // slot numbers covered by the remap (used or not)
   uint32_t total_size;
   uint32_t checksum;        // FNV-1a over the header (this field as 0) and the payload
@@ -67,6 +67,7 @@ static_assert(offsetof(BlobHeader, triangle_base) == 4 * MC_HDR_TRIANGLE_BASE);
 static_assert(offsetof(BlobHeader, slot_divisor) == 4 * MC_HDR_SLOT_DIVISOR);
 static_assert(offsetof(BlobHeader, vertex_offset) == 4 * MC_HDR_VERTEX_OFFSET);
 static_assert(offsetof(BlobHeader, remap_offset) == 4 * MC_HDR_REMAP_OFFSET);
+static_assert(offsetof(BlobHeader, remap_size) == 4 * MC_HDR_REMAP_SIZE);
 static_assert(offsetof(BlobHeader, remap_bits) == 4 * MC_HDR_REMAP_BITS);
 static_assert(offsetof(BlobHeader, remap_slots) == 4 * MC_HDR_REMAP_SLOTS);
 
@@ -114,11 +115,14 @@ inline uint32_t slot_of(const BlobHeader& h, uint32_t block, uint32_t lane) {
 // with W = ceil(remap_slots / 64). A slot's entry is number
 // rank[s/64] + popcount(used[s/64] below bit s%64).
 //
-// A blob may have no remap (remap_bits = 0, remap_size = 0): when the build
-// kept the input order (every slot s holds input triangle s) or the caller
-// asked for no input triangle numbers. A hit then names the triangle by its
-// slot number, below remap_slots.
-inline bool has_remap(const BlobHeader& h) { return h.remap_bits != 0; }
+// Two smaller forms:
+//   in order (remap_bits = 0): the build kept the input order, so the n-th
+//             used slot holds input triangle n: only used[] and rank[]
+//             (12 bytes every 64 slot numbers), no entries;
+//   none      (remap_size = 0): the caller asked for no input triangle
+//             numbers; a hit names its triangle by slot number, below
+//             remap_slots.
+inline bool has_remap(const BlobHeader& h) { return h.remap_size != 0; }
 inline uint32_t remap_words(const BlobHeader& h) { return (h.remap_slots + 63) / 64; }
 
 inline uint32_t remap_packed(const uint8_t* blob, const BlobHeader& h, uint32_t index) {
@@ -132,11 +136,12 @@ inline uint64_t remap_used(const uint8_t* blob, const BlobHeader& h, uint32_t wo
 }
 
 inline uint32_t remap_entry(const uint8_t* blob, const BlobHeader& h, uint32_t slot) {
-  if (h.remap_bits == 0) return slot;  // no remap section: see has_remap
+  if (!has_remap(h)) return slot;
   uint32_t w = slot >> 6;
   uint64_t below = remap_used(blob, h, w) & ((uint64_t(1) << (slot & 63)) - 1);
   uint32_t rank = load<uint32_t>(blob + h.remap_offset + 8ull * remap_words(h) + 4ull * w);
-  return remap_packed(blob, h, rank + uint32_t(std::popcount(below)));
+  const uint32_t index = rank + uint32_t(std::popcount(below));
+  return h.remap_bits == 0 ? index : remap_packed(blob, h, index);
 }
 
 }  // namespace meshcast::layout

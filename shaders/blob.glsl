@@ -13,9 +13,10 @@ float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_words[byte_offset
 uint header(uint word) { return blob_words[word]; }
 
 // remap_entry of layout/blob.h: the used-slot bitmap (64-bit words), the
-// rank of each word, then the bit-packed entries; or no remap at all.
+// rank of each word, then the bit-packed entries; or in input order (no
+// entries), or no remap at all.
 uint remap_entry(uint slot) {
-  if (header(MC_HDR_REMAP_BITS) == 0u) return slot;  // no remap section: hits name slots
+  if (header(MC_HDR_REMAP_SIZE) == 0u) return slot;  // no remap section: hits name slots
   const uint base = header(MC_HDR_REMAP_OFFSET);
   const uint words = (header(MC_HDR_REMAP_SLOTS) + 63u) / 64u;
   const uint w = slot >> 6, bit = slot & 63u;
@@ -24,6 +25,7 @@ uint remap_entry(uint slot) {
                                : uint(bitCount(lo)) + bitCount(hi & ((1u << (bit - 32u)) - 1u));
   const uint index = blob_u32(base + 8u * words + 4u * w) + below;
   const uint bits = header(MC_HDR_REMAP_BITS);
+  if (bits == 0u) return index;  // in input order: the n-th used slot is triangle n
   // Entry `index` starts `index * bits` bits into the entries (8-aligned);
   // it spans at most two 32-bit words.
   const uint64_t at = uint64_t(base + 12u * words) * 8ul + uint64_t(index) * uint64_t(bits);

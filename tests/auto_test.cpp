@@ -116,8 +116,8 @@ TEST(AutoLayout, ImpossibleLimitsAndReaders) {
 // Without the remap (BuildOptions::triangle_ids false) every layout walks
 // the same hits, naming triangles by slot: the same t, the same stored
 // corners, the oracle's answers over stored_mesh (numbered by slot too), and
-// the blob is smaller by the remap section. The remap is left out on its
-// own when the build kept the input order.
+// the blob is smaller by the remap section. When the build kept the input
+// order the remap keeps only its bitmap and ranks.
 TEST(NoRemap, EveryLayoutAnswersBySlot) {
   const Mesh mesh = make_sphere(24, 48, 1.0f, {0.1f, 0.2f, -0.3f});
   const std::vector<Ray> rays = make_rays(mesh, RayKind::Long, 1500, 11);
@@ -144,9 +144,11 @@ TEST(NoRemap, EveryLayoutAnswersBySlot) {
         for (int x = 0; x < 3; ++x)
           ASSERT_EQ(sa.corner(ha_hits[i].triangle, k)[x], sb.corner(hb_hits[i].triangle, k)[x]) << layout << " ray " << i;
     }
-    // Kept input order: every slot holds its own input triangle, no remap
-    // needed, and the hits still name the input's triangles.
-    if (!layout::has_remap(ha)) {
+    // Kept input order (brute force): the remap is the used-slot bitmap and
+    // ranks alone, and the hits still name the input's triangles.
+    if (with.tree_format == MC_TREE_BRUTEFORCE) {
+      EXPECT_EQ(ha.remap_bits, 0u) << layout;
+      EXPECT_EQ(ha.remap_size, (12 * layout::remap_words(ha) + 7) / 8 * 8) << layout;
       expect_oracle(mesh, a, rays, ha_hits, layout + " (input order kept)");
     }
   }

@@ -430,25 +430,28 @@ TEST(Corruption, WrongRemapRankIsRefused) {
   EXPECT_NE(corrupt(b, rank1, at<uint32_t>(b, rank1) + 1).find("remap rank"), std::string::npos);
 }
 
-// A blob without a remap (remap_bits 0) must have no remap bytes and slot
-// numbers for every triangle; one that claims a remap of 0-bit entries, or
-// fewer slots than triangles, is refused.
-TEST(Corruption, MissingRemapMustBeWhole) {
+// A blob without a remap (remap_size 0) must have slot numbers for every
+// triangle and no entry width; a remap in input order (remap_bits 0) must
+// still count its used slots right.
+TEST(Corruption, MissingOrInOrderRemapMustBeWhole) {
   BuildOptions o = parse_layout("QuadTree/Float3SOA4");
   o.triangle_ids = false;
-  std::vector<uint8_t> b = build_blob(make_sphere(16, 32, 1, {0, 0, 0}), o, "s");
+  const Mesh sphere = make_sphere(16, 32, 1, {0, 0, 0});
+  std::vector<uint8_t> b = build_blob(sphere, o, "s");
   const BlobHeader& h = header_of(b.data());
-  ASSERT_EQ(h.remap_bits, 0u);
+  ASSERT_FALSE(has_remap(h));
   ASSERT_EQ(validate(b), "");
   EXPECT_NE(corrupt(b, 4 * MC_HDR_REMAP_SLOTS, h.triangle_count - 1).find("slot numbers for"), std::string::npos);
-  // Remap bytes the header claims: past the blob's end, or (the blob grown
-  // to hold them) bytes of 0-bit entries.
-  EXPECT_NE(corrupt(b, offsetof(BlobHeader, remap_size), 8).find("remap section"), std::string::npos);
-  std::vector<uint8_t> grown = b;
-  grown.resize(b.size() + 8, 0);
-  const uint32_t total = uint32_t(grown.size());
-  std::memcpy(grown.data() + offsetof(BlobHeader, total_size), &total, 4);
-  EXPECT_NE(corrupt(grown, offsetof(BlobHeader, remap_size), 8).find("0-bit entries"), std::string::npos);
+  EXPECT_NE(corrupt(b, 4 * MC_HDR_REMAP_BITS, 17).find("no remap section, yet"), std::string::npos);
+
+  std::vector<uint8_t> in_order = build_blob(sphere, parse_layout("BruteForce/Float3"), "s");
+  const BlobHeader& k = header_of(in_order.data());
+  ASSERT_TRUE(has_remap(k));
+  ASSERT_EQ(k.remap_bits, 0u) << "brute force keeps the input order";
+  ASSERT_GT(remap_words(k), 1u);
+  const size_t rank1 = k.remap_offset + 8ull * remap_words(k) + 4;
+  EXPECT_NE(corrupt(in_order, rank1, at<uint32_t>(in_order, rank1) + 1).find("remap rank"), std::string::npos);
+  EXPECT_NE(corrupt(in_order, 4 * MC_HDR_REMAP_SIZE, 8).find("too small"), std::string::npos);
 }
 
 TEST(Corruption, DepthBeyondTheLimitIsRefused) {

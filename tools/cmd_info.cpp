@@ -61,13 +61,14 @@ void add_info(CLI::App& app) {
     row("walked", s.walked());
     row("remap", s.remap);
     row("total", s.total);
-    if (layout::has_remap(h))
-      std::printf("  remap: %u entries of %u bits, %u slot numbers (%.0f%% used)\n", h.triangle_count, h.remap_bits,
+    if (!layout::has_remap(h))
+      std::printf("  remap: none (asked for): a hit names its triangle by slot number, below %u\n", h.remap_slots);
+    else if (h.remap_bits == 0)
+      std::printf("  remap: in input order, %u slot numbers (%.0f%% used): the used-slot bitmap and ranks only\n",
                   h.remap_slots, 100.0 * h.triangle_count / std::max(1u, h.remap_slots));
     else
-      std::printf("  remap: none: a hit names its triangle by slot number (below %u), the input's own number when the "
-                  "build kept the input order\n",
-                  h.remap_slots);
+      std::printf("  remap: %u entries of %u bits, %u slot numbers (%.0f%% used)\n", h.triangle_count, h.remap_bits,
+                  h.remap_slots, 100.0 * h.triangle_count / std::max(1u, h.remap_slots));
   });
 }
 

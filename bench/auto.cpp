@@ -6,15 +6,11 @@
 namespace meshcast::bench {
 
 std::vector<AutoSetting> auto_settings() {
-  std::vector<AutoSetting> out(4);
-  out[0].label = "speed first";
-  out[1].label = "speed first, 1024-ray trial";
-  out[1].limits.trial_rays = 1024;
-  out[2].label = "memory first";
-  out[2].limits.goal = AutoGoal::Memory;
-  out[3].label = "memory first, error <= 2e-6";
-  out[3].limits.goal = AutoGoal::Memory;
-  out[3].limits.max_error = 2e-6;
+  std::vector<AutoSetting> out;
+  for (const char* text : {"speed", "speed,trial=1024", "memory", "memory,error=2e-6"}) {
+    const AutoLimits l = parse_auto_setting(text);
+    out.push_back({describe(l), l});
+  }
   return out;
 }
 
@@ -53,6 +49,7 @@ AutoTable bench_auto(const Mesh& mesh, const std::string& name, size_t rays, uin
       const double v = metric(c.timing, setting.limits, rays);
       if (v < row.best_value) row.best_value = v, row.best = c.layout;
     }
+    if (row.eligible == 0) row.best_value = 0;  // nothing to compare with
     table.rows.push_back(row);
   }
   return table;

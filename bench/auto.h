@@ -25,7 +25,7 @@ struct AutoRow {
   Timing timing;          // the choice, measured like the combos rows
   double choose_ms = 0;   // auto's whole decision: statistics, builds, trial
   std::string best;       // the best combos layout meeting the limits
-  double best_value = 0;  // its ns a ray (speed) or bytes a triangle (memory)
+  double best_value = 0;  // its ns a ray (speed) or bytes a triangle (memory); 0 when none is eligible
   double value = 0;       // the choice's, in the same unit
   size_t eligible = 0;    // combos layouts meeting the limits
 };

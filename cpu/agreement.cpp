@@ -173,7 +173,8 @@ Mesh stored_mesh(const std::vector<uint8_t>& blob) {
   const layout::BlobHeader& h = layout::header_of(blob.data());
   Mesh m;
   // Without a remap, triangles are numbered by slot: holes become
-  // triangles of one point (zero area), which no ray hits.
+  // triangles of one point (zero area, vertex 0 three times), which no ray
+  // hits.
   const size_t count = layout::has_remap(h) ? h.triangle_count : h.remap_slots;
   m.vertices.resize(count * 3);
   m.triangles.assign(count, Triangle{0, 0, 0});

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 
 #include "cpu/rays.h"
 #include "cpu/trace.h"
@@ -41,9 +42,10 @@ bool readable(const AutoLimits& l, const std::string& layout) {
 // meshes small enough that testing every triangle is no worse than a walk.
 bool worth_trying(const AutoLimits& l, const MeshStats& s, const std::string& layout) {
   const BuildOptions o = parse_layout(layout);
+  if (!readable(l, layout)) return false;
   if (o.tree_format == MC_TREE_BRUTEFORCE) return !l.readers.empty() && s.triangles <= 4096;
   if (o.triangle_format == MC_TRI_FLOAT3SOA128 || o.triangle_format == MC_TRI_BITPACKSOA128) return !l.readers.empty();
-  return readable(l, layout);
+  return true;
 }
 
 // Builds `c`, fills in its exact figures and checks them against the
@@ -81,6 +83,16 @@ double time_rays(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
   return best / double(rays.size());
 }
 
+// The narrowest index the indexed encodings can use: they store each used
+// vertex once (layout/indexed.h), so the used vertices decide. Says why.
+std::string index_width(const MeshStats& s, std::vector<std::string>& reasons) {
+  const bool narrow = s.used_vertices <= 65536;
+  reasons.push_back(format(narrow ? "%.0f used vertices (<= 65,536): 16-bit indices"
+                                  : "%.0f used vertices (> 65,536): 32-bit indices",
+                           double(s.used_vertices), 0));
+  return narrow ? "16" : "32";
+}
+
 // Speed first. The order is the rule: the first candidate meeting the
 // limits is taken when there is no trial.
 std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, std::vector<std::string>& reasons) {
@@ -88,7 +100,6 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
   auto add = [&](const std::string& layout, const std::string& why) {
     if (worth_trying(l, s, layout)) out.push_back(candidate(l, layout, kLeaf, why));
   };
-  const std::string w = s.vertices <= 65536 ? "16" : "32";
   if (!l.readers.empty()) {
     reasons.push_back("CPU and GPU: only the layouts a Vulkan method reads, in the order of their CPU walkers' "
                       "speed (bench combos); the GPU's own order depends on the device (bench gpu)");
@@ -100,6 +111,7 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
       if (std::none_of(out.begin(), out.end(), [&](const AutoCandidate& c) { return c.label == r; })) add(r, "read by a Vulkan method");
     return out;
   }
+  const std::string w = index_width(s, reasons);
   // Half-float nodes are half the bytes of a float node: once the nodes of
   // a mesh of millions of triangles outgrow the caches they win (terrain_2M:
   // QuadTreeHalfFloat first in bench combos); below that, float nodes (bunny00
@@ -107,7 +119,7 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
   const bool large = s.triangles >= (1u << 20);
   const std::vector<std::string> trees =
       large ? std::vector<std::string>{"QuadTreeHalfFloat", "QuadTree"} : std::vector<std::string>{"QuadTree", "QuadTreeHalfFloat"};
-  reasons.push_back(std::string(large ? "over 2^20 triangles: half-float quad tree nodes first (their nodes stay in cache)"
+  reasons.push_back(std::string(large ? "2^20 triangles or more: half-float quad tree nodes first (their nodes stay in cache)"
                                       : "under 2^20 triangles: float quad tree nodes first, half-float next") +
                     "; leaves of " + std::to_string(kLeaf));
   std::vector<std::pair<std::string, std::string>> encodings = {
@@ -142,11 +154,9 @@ std::vector<AutoCandidate> memory_list(const MeshStats& s, const AutoLimits& l, 
     for (const std::string& r : l.readers) add(r, "read by a Vulkan method");
     return out;
   }
-  const std::string w = s.vertices <= 65536 ? "16" : "32";
-  reasons.push_back(s.vertices <= 65536 ? "at most 65,536 vertices: 16-bit indices"
-                                        : format("%.0f vertices: over 65,536, 32-bit indices", double(s.vertices), 0));
   if (s.corners_per_vertex >= 2) {
     reasons.push_back(format("%.1f corners a vertex (>= 2): indexed encodings store each vertex once", s.corners_per_vertex, 0));
+    const std::string w = index_width(s, reasons);
     add("AABBTreeCompressed/Indexed8BitPackSOA4", "12-byte nodes, 8-bit indices into a block's quantized vertices");
     add("SKDTree/Indexed8BitPackSOA4", "the smallest nodes (one plane pair)");
     add("AABBTreeCompressed/Indexed" + w + "BitPackSOA4", "quantized shared vertices, " + w + "-bit indices");
@@ -271,11 +281,45 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
   return out;
 }
 
-std::string describe(const AutoLimits& limits, const AutoChoice& choice) {
-  std::string text = std::string("auto layout: ") + goal_name(limits.goal) + " first, " +
-                     (limits.readers.empty() ? "CPU only" : "CPU and GPU");
+AutoLimits parse_auto_setting(const std::string& text) {
+  AutoLimits l;
+  size_t at = 0;
+  for (bool first = true; at <= text.size(); first = false) {
+    const size_t comma = std::min(text.find(',', at), text.size());
+    const std::string part = text.substr(at, comma - at);
+    at = comma + 1;
+    if (first) {
+      l.goal = parse_goal(part);
+      continue;
+    }
+    const size_t eq = part.find('=');
+    const std::string key = part.substr(0, eq), value = eq == std::string::npos ? "" : part.substr(eq + 1);
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !(v >= 0))
+      throw InputError("auto setting '" + text + "': '" + part + "' is not KEY=NUMBER (trial, bytes, error)");
+    if (key == "trial")
+      l.trial_rays = uint32_t(std::min(v, 1e6));
+    else if (key == "bytes")
+      l.max_bytes_per_triangle = v;
+    else if (key == "error")
+      l.max_error = v;
+    else
+      throw InputError("auto setting '" + text + "': unknown '" + key + "' (trial, bytes, error)");
+  }
+  return l;
+}
+
+std::string describe(const AutoLimits& limits) {
+  std::string text = std::string(goal_name(limits.goal)) + " first, " + (limits.readers.empty() ? "CPU only" : "CPU and GPU");
   text += limits.max_bytes_per_triangle > 0 ? format(", at most %.2f bytes a triangle", limits.max_bytes_per_triangle, 0) : "";
   text += limits.max_error > 0 ? format(", error at most %.2g of the diagonal", limits.max_error, 0) : "";
+  text += limits.trial_rays > 0 ? format(", a %.0f-ray trial", limits.trial_rays, 0) : "";
+  return text;
+}
+
+std::string describe(const AutoLimits& limits, const AutoChoice& choice) {
+  std::string text = "auto layout: " + describe(limits);
   text += "\n" + describe(choice.stats);
   for (const std::string& r : choice.reasons) text += "  rule             " + r + "\n";
   char line[512];

@@ -42,6 +42,13 @@ struct AutoLimits {
   bool triangle_ids = true;   // BuildOptions::triangle_ids of every candidate
 };
 
+// A setting as text, for benches and tests: "speed" or "memory", then any
+// of ",trial=RAYS", ",bytes=B" (bytes a triangle), ",error=E" (of the
+// diagonal). InputError naming the part it cannot read.
+AutoLimits parse_auto_setting(const std::string& text);
+// "speed first, CPU only, at most 20.00 bytes a triangle, ...".
+std::string describe(const AutoLimits& limits);
+
 struct AutoCandidate {
   std::string label;  // the layout, with the leaf size where not 8
   BuildOptions options;

@@ -47,8 +47,8 @@ struct BuildOptions {
   uint32_t hybrid_leaf = 256;
   // The remap section, which turns a hit's slot into the caller's triangle
   // number. false: left out, hits name triangles by slot number (see
-  // layout/blob.h has_remap; stored_mesh gives their corners). Left out
-  // anyway when the build kept the input order.
+  // layout/blob.h has_remap; stored_mesh gives their corners). When the
+  // build kept the input order it is only the used-slot bitmap and ranks.
   bool triangle_ids = true;
 };
 

@@ -58,8 +58,8 @@ std::string describe(const MeshStats& s) {
                 "  triangles        %zu (%zu degenerate)\n"
                 "  vertices         %zu (%zu used), %.2f corners a vertex\n"
                 "  paired           %.1f%% of triangles across a shared edge (seed 003)\n"
-                "  box              diagonal %g, centre %.3g diagonals from the origin, flatness %.3f\n"
-                "  triangle sizes   90th / 10th percentile %.2f\n",
+                "  box              diagonal %g, centre %.3g diagonals from the origin, flatness %.3f (reported)\n"
+                "  triangle sizes   90th / 10th percentile %.2f (reported)\n",
                 s.triangles, s.degenerate, s.vertices, s.used_vertices, s.corners_per_vertex, 100 * s.paired_ratio,
                 s.diagonal, s.origin_distance, s.flatness, s.size_spread);
   return text;

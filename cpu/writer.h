@@ -35,8 +35,8 @@ CodecOps codec_ops(uint32_t format);  // throws InputError for an unknown format
 inline uint32_t align(uint64_t v, uint32_t a) { return uint32_t((v + a - 1) / a * a); }
 
 // Appends the remap section (slot -> input triangle, MC_NO_HIT for an
-// unused slot) and fills the header's remap fields; none when `keep` is
-// false or the remap is the identity (the input order kept).
+// unused slot) and fills the header's remap fields: bitmap and ranks only
+// when the slots keep the input order, none when `keep` is false.
 void append_remap(std::vector<uint8_t>& bytes, layout::BlobHeader& h, const std::vector<uint32_t>& remap, bool keep);
 
 // Shared by both tree writers: the blob under construction.

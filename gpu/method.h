@@ -71,6 +71,8 @@ struct MethodLayout {
   const char* layout;
 };
 std::span<const MethodLayout> method_layouts();
+// The first method of that list that reads the blob's layout; "" for none.
+std::string method_reading(std::span<const uint8_t> blob);
 
 // AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs a
 // slot: a batch of rays goes in chunks of pairs / batches rays. make_method's

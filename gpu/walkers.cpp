@@ -3,6 +3,7 @@
 // Each is a shader and the layout it reads; the host side is the same.
 #include <algorithm>
 
+#include "cpu/encode.h"
 #include "cpu/mesh.h"
 #include "layout/blob.h"
 #include "gpu/batch.h"
@@ -72,6 +73,15 @@ std::span<const MethodLayout> method_layouts() {
                                       {"bruteforce", "BruteForce/BitPackSOA128"},
                                       {"bruteforce", "BruteForce/Float3SOA128"}};
   return kAll;
+}
+
+std::string method_reading(std::span<const uint8_t> blob) {
+  if (blob.size() < sizeof(layout::BlobHeader)) return "";
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  const std::string name = layout_name(h.tree_format, h.triangle_format);
+  for (const MethodLayout& c : method_layouts())
+    if (name == c.layout) return c.method;
+  return "";
 }
 
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,

@@ -410,8 +410,12 @@ std::string validate(std::span<const uint8_t> blob) {
   if (!has_remap(h)) {
     // Hits name slots: every slot number must stay below MC_NO_HIT.
     if (h.remap_bits != 0) return "no remap section, yet remap entries of " + num(h.remap_bits) + " bits";
-    if (h.remap_slots < h.triangle_count || h.remap_slots == MC_NO_HIT)
-      return "no remap, and " + num(h.remap_slots) + " slot numbers for " + num(h.triangle_count) + " triangles";
+    // Slot numbers come from block offsets in the tree section plus a lane:
+    // no more of them than that (stored_mesh and callers size arrays by it).
+    const uint64_t reachable = uint64_t(h.tree_size) / std::max(1u, h.slot_divisor) + 128;
+    if (h.remap_slots < h.triangle_count || h.remap_slots > reachable)
+      return "no remap, and " + num(h.remap_slots) + " slot numbers for " + num(h.triangle_count) +
+             " triangles (at most " + num(reachable) + " from the tree section)";
   } else {
     // remap_bits 0: in input order, no entries (layout/blob.h).
     if (h.remap_bits > 32 || (h.remap_bits != 0 && (uint64_t(1) << h.remap_bits) < h.triangle_count))

@@ -108,6 +108,43 @@ TEST(Host, SubmitWaitEqualsTheSynchronousCpuOnEveryGpuLayout) {
   }
 }
 
+// CasterOptions::hit_outputs reach both backends: u, v and the point as the
+// synchronous CPU walk gives them (which asks for the same), t and the
+// triangle as without them.
+TEST(Host, HitOutputsOnBothBackends) {
+  Mesh m = make_terrain(48, 32, 4);
+  NamedMesh named{"terrain_3k", std::make_shared<const Mesh>(m)};
+  const std::vector<Ray>& rays = test_rays(named, RayKind::Long, 1000);
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "terrain");
+  std::vector<Hit> plain(rays.size());
+  BlobView(blob, "terrain").trace(rays, plain);
+  for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+    if (b == Backend::Vulkan && cpu_only()) continue;
+    CasterOptions o = options(b);
+    o.hit_outputs = MC_HIT_UV | MC_HIT_POINT;
+    Caster caster(blob, "terrain", o);
+    ASSERT_TRUE(b == Backend::Cpu || caster.gpu_available()) << caster.gpu_error();
+    std::vector<Hit> hits(rays.size());
+    EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, b);
+    const std::vector<Hit> cpu = sync_cpu(caster, rays);
+    expect_same(hits, plain, host::backend_name(b));
+    size_t with_point = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      if (hits[i].triangle == MC_NO_HIT || hits[i].triangle != cpu[i].triangle) continue;
+      EXPECT_NEAR(hits[i].u, cpu[i].u, 1e-5f) << i;
+      EXPECT_NEAR(hits[i].v, cpu[i].v, 1e-5f) << i;
+      for (int a = 0; a < 3; ++a) {
+        const double p = double(rays[i].org[a]) + double(hits[i].t) * rays[i].dir[a];
+        EXPECT_NEAR(hits[i].point[a], p, 1e-4) << i;
+      }
+      with_point += hits[i].point[0] != 0 || hits[i].point[1] != 0 || hits[i].point[2] != 0;
+      EXPECT_EQ(plain[i].u, 0.0f) << "not asked for: " << i;
+    }
+    EXPECT_GT(with_point, rays.size() / 4) << host::backend_name(b);
+    EXPECT_EQ(caster.validation_messages(), 0u);
+  }
+}
+
 // Eight frames of different sizes and rays, collected in reverse order.
 TEST(Host, FramesInFlightNeverMix) {
   Mesh m = make_sphere(24, 48, 1, {0, 0, 0});

@@ -29,20 +29,13 @@ gpu::Context& context() {
   return ctx;
 }
 
-// The first method that reads the blob's layout.
-std::string method_for(const std::vector<uint8_t>& blob) {
-  const layout::BlobHeader& h = layout::header_of(blob.data());
-  const std::string name = layout_name(h.tree_format, h.triangle_format);
-  for (const gpu::MethodLayout& c : gpu::method_layouts())
-    if (name == c.layout) return c.method;
-  return "none reads " + name;
-}
 #endif
 
 class Robustness : public ::testing::TestWithParam<std::string> {
  protected:
   // "TREE/TRIANGLES", with "+pairing": seed 003's pairs as the builder's
-  // unit; with "@METHOD": traced by that GPU method instead of the CPU.
+  // unit; with "+noids": no remap (hits name slots); with "@METHOD": traced
+  // by that GPU method instead of the CPU.
   std::string layout() const { return GetParam().substr(0, GetParam().find_first_of("+@")); }
   std::string method() const {
     size_t at = GetParam().find('@');
@@ -50,15 +43,16 @@ class Robustness : public ::testing::TestWithParam<std::string> {
   }
   BuildOptions options() const {
     BuildOptions o = parse_layout(layout());
-    o.pairing = GetParam().find('+') != std::string::npos;
+    o.pairing = GetParam().find("+pairing") != std::string::npos;
+    o.triangle_ids = GetParam().find("+noids") == std::string::npos;
     return o;
   }
-  // "auto:SETTING" (testing.h auto_limits) builds the layout the automatic
+  // "auto:SETTING" (cpu/auto_layout.h parse_auto_setting) builds the layout the automatic
   // layout chooses for each probe mesh; anything else the named layout.
   bool automatic() const { return GetParam().rfind("auto:", 0) == 0; }
   std::vector<uint8_t> build(const Mesh& mesh, const char* what) const {
     if (!automatic()) return build_blob(mesh, options(), what);
-    AutoLimits limits = auto_limits(layout().substr(5));
+    AutoLimits limits = parse_auto_setting(layout().substr(5));
 #ifdef MESHCAST_TEST_GPU
     for (const gpu::MethodLayout& c : gpu::method_layouts()) limits.readers.push_back(c.layout);
 #endif
@@ -69,7 +63,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
                          uint32_t outputs = 0) {
 #ifdef MESHCAST_TEST_GPU
     std::unique_ptr<gpu::Method> m =
-        gpu::make_method(context(), automatic() ? method_for(blob) : method(), blob, GetParam(), 1, outputs);
+        gpu::make_method(context(), automatic() ? gpu::method_reading(blob) : method(), blob, GetParam(), 1, outputs);
     std::vector<Hit> hits(rays.size());
     uint64_t unwalkable = m->trace(rays, hits);
     if (skipped) *skipped = unwalkable;
@@ -335,7 +329,7 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
   std::string n = info.param;
   for (char& c : n)
-    if (c == '/' || c == '+' || c == '@' || c == ':' || c == ',' || c == '-' || c == '.') c = '_';
+    if (c == '/' || c == '+' || c == '@' || c == ':' || c == ',' || c == '-' || c == '.' || c == '=') c = '_';
   return n;
 }
 
@@ -343,7 +337,10 @@ std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
 // Every GPU method on every layout it reads.
 std::vector<std::string> gpu_cases() {
   std::vector<std::string> names;
-  for (const gpu::MethodLayout& c : gpu::method_layouts()) names.push_back(std::string(c.layout) + "@" + c.method);
+  for (const gpu::MethodLayout& c : gpu::method_layouts()) {
+    names.push_back(std::string(c.layout) + "@" + c.method);
+    names.push_back(std::string(c.layout) + "+noids@" + c.method);  // the shaders' no-remap path
+  }
   for (const std::string& setting : auto_settings()) names.push_back("auto:" + setting);
   return names;
 }

@@ -40,16 +40,16 @@ std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<R
 
 // `hits` against the double-precision oracle over the mesh `blob` stores
 // (the input mesh, or stored_mesh(blob) for the formats that move
-// vertices): same triangle, t within 1e-5 of the diagonal. A failure names
+// vertices and for blobs without a remap, whose hits name slots): same
+// triangle, t within 1e-5 of the diagonal. A failure names
 // `what` and the first problem. Returns how many rays hit.
 size_t expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
                      const std::vector<Hit>& hits, const std::string& what);
 
 // The automatic layout's settings the suites run (auto_test, the stiff
-// suite): "speed", "speed,trial" (a 256-ray trial), "memory",
-// "memory,error" (stated error at most 2e-6 of the diagonal) and
-// "speed,bytes" (at most 20 bytes a triangle: past the fast layouts).
+// suite), as parse_auto_setting reads them: speed first, with a 256-ray
+// trial, memory first, memory under a 2e-6 error bound, and speed under 20
+// bytes a triangle (past the fast layouts).
 std::vector<std::string> auto_settings();
-AutoLimits auto_limits(const std::string& setting);
 
 }  // namespace meshcast::testing

@@ -34,7 +34,11 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {
+    // --layout auto for the Vulkan backend: a layout a method reads, and that method.
+    const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
+    if (vulkan_auto) args->layout.gpu = true;
     Loaded in = load_input(args->input, args->layout);
+    if (vulkan_auto) args->method = gpu::method_reading(in.blob);
     std::vector<Ray> rays = read_rays(args->rays);
     std::vector<Hit> hits(rays.size());
     std::vector<double> pass_ms, device_ms;
@@ -100,7 +104,10 @@ void add_render(CLI::App& app) {
   cmd->add_option("--method", args->method, "GPU method for the blob's layout (see trace --help)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->callback([args] {
+    const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
+    if (vulkan_auto) args->layout.gpu = true;
     Loaded in = load_input(args->input, args->layout);
+    if (vulkan_auto) args->method = gpu::method_reading(in.blob);
     std::string device = "CPU, one thread";
     Picture p;
     if (args->backend == "vulkan") {

@@ -83,7 +83,18 @@ bool is_blob_file(const std::string& path) {
 }  // namespace
 
 Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* report) {
-  if (a.layout != "auto" || is_blob_file(path)) return load_mesh_or_blob(path, a.layout == "auto" ? BuildOptions{} : build_options(a));
+  const LayoutArgs defaults;
+  const bool automatic = a.layout == "auto";
+  // Options that would be silently dropped are refused instead.
+  if (automatic && (a.leaf != defaults.leaf || !a.splitter.empty() || !a.order.empty() || !a.grouping.empty() ||
+                    a.pairing || a.lbvh_depth != 0 || a.lbvh_left_first || a.zbt_no_shuffle || a.zbt_no_cache ||
+                    a.hybrid_leaf != defaults.hybrid_leaf))
+    throw InputError("--layout auto chooses the leaf size and builds each layout with its own options; leave out "
+                     "--leaf, --splitter, --order, --grouping, --pairing, --lbvh-*, --no-shuffle, --no-box-cache and "
+                     "--hybrid-leaf, or name a layout");
+  if (!automatic && (a.goal != defaults.goal || a.max_bytes != 0 || a.max_error != 0 || a.gpu || a.trial != 0))
+    throw InputError("--goal, --max-bytes, --max-error, --gpu and --trial are limits for --layout auto");
+  if (!automatic || is_blob_file(path)) return load_mesh_or_blob(path, automatic ? BuildOptions{} : build_options(a));
   AutoLimits limits;
   limits.goal = parse_goal(a.goal);
   limits.max_bytes_per_triangle = a.max_bytes, limits.max_error = a.max_error;

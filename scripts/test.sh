@@ -16,15 +16,16 @@ echo "== AddressSanitizer + UBSan: every CPU test suite and the fuzz corpora"
 # instrumented (their own allocations would read as leaks); they run in the
 # Release build above and the host layer under TSan below.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_SANITIZE=ON >/dev/null
-cmake --build build-asan -j"$jobs" --target layout_test oracle_test walker_test build_test robustness_test io_test \
-      pairing_test zerobyte_test limits_test blob_fuzz mesh_fuzz
+asan_suites=(walker_test robustness_test auto_test build_test layout_test oracle_test io_test pairing_test zerobyte_test
+             limits_test)
+cmake --build build-asan -j"$jobs" --target "${asan_suites[@]}" blob_fuzz mesh_fuzz
 # One process a suite, $jobs at a time (CTest's one process a test would
 # load the meshes and compute the oracle's answers again for every test),
 # with MESHCAST_TEST_QUICK: bunny00 and the generated meshes only, fewer
 # rays a set (the Release and scalar runs walk all of them). A failing suite
 # prints its log; xargs waits for the others and fails the pipeline.
 asan_env=(env MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp")
-printf '%s\n' walker_test robustness_test build_test layout_test oracle_test io_test pairing_test zerobyte_test limits_test |
+printf '%s\n' "${asan_suites[@]}" |
   "${asan_env[@]}" xargs -P"$jobs" -I{} sh -c 'build-asan/bin/{} --gtest_brief=1 > build-asan/{}.log 2>&1 && echo "  {}: passed" ||
                                               { echo "  {}: FAILED"; tail -50 build-asan/{}.log; exit 1; }'
 "${asan_env[@]}" build-asan/bin/blob_fuzz fuzz/corpus/blob

@@ -97,8 +97,8 @@ std::string index_width(const MeshStats& s, std::vector<std::string>& reasons) {
 // limits is taken when there is no trial.
 std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, std::vector<std::string>& reasons) {
   std::vector<AutoCandidate> out;
-  auto add = [&](const std::string& layout, const std::string& why) {
-    if (worth_trying(l, s, layout)) out.push_back(candidate(l, layout, kLeaf, why));
+  auto add = [&](const std::string& layout, const std::string& why, uint32_t leaf = kLeaf) {
+    if (worth_trying(l, s, layout)) out.push_back(candidate(l, layout, leaf, why));
   };
   if (!l.readers.empty()) {
     reasons.push_back("CPU and GPU: only the layouts a Vulkan method reads, in the order of their CPU walkers' "
@@ -139,7 +139,9 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
   // Under a tight byte limit: the small layouts that walk fastest.
   for (const std::string& enc : {std::string("Indexed8BitPackSOA4"), "Indexed" + w + "BitPackSOA4", std::string("CompressedStrip")})
     add("QuadTreeHalfFloat/" + enc, "small and fast: half-float nodes over a compact encoding");
+  add("QuadTreeHalfFloat/Indexed8BitPackSOA4", "small and fast; leaves of 16: fewer nodes", 16);
   add("AABBTreeCompressed/Indexed8BitPackSOA4", "the smallest tree in bench combos, when nothing faster fits");
+  add("AABBTreeCompressed/Indexed8BitPackSOA4", "the smallest tree; leaves of 16: fewer nodes", 16);
   return out;
 }
 

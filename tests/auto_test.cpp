@@ -14,16 +14,6 @@
 namespace meshcast::testing {
 namespace {
 
-Mesh soup_of(const Mesh& m) {
-  Mesh soup;
-  for (size_t t = 0; t < m.triangles.size(); ++t) {
-    const uint32_t base = uint32_t(soup.vertices.size());
-    for (int c = 0; c < 3; ++c) soup.vertices.push_back(m.corner(t, c));
-    soup.triangles.push_back({base, base + 1, base + 2});
-  }
-  return soup;
-}
-
 // Expected figures from the generators' own geometry (io/generate.h).
 TEST(MeshStats, SphereGridAndSoup) {
   const int rings = 16, segments = 32;  // segments a multiple of 4: the box touches the sphere on every axis
@@ -39,7 +29,7 @@ TEST(MeshStats, SphereGridAndSoup) {
   EXPECT_GT(s.paired_ratio, 0.9) << "a closed welded mesh pairs almost whole";
   EXPECT_EQ(s.degenerate, 0u);
 
-  const MeshStats soup = measure_mesh(soup_of(sphere));
+  const MeshStats soup = measure_mesh(unwelded(sphere));
   EXPECT_NEAR(soup.corners_per_vertex, 1.0, 1e-12);
   EXPECT_EQ(soup.paired_ratio, 0.0) << "pairing goes by shared vertex indices; a soup shares none";
 
@@ -76,7 +66,7 @@ TEST(AutoLayout, IndexWidthFollowsTheVertexCount) {
 
 // A triangle soup: no indexed or pair encodings are shortlisted.
 TEST(AutoLayout, SoupGetsNoIndexedOrPairCandidates) {
-  const Mesh soup = soup_of(make_sphere(12, 24, 1.0f, {}));
+  const Mesh soup = unwelded(make_sphere(12, 24, 1.0f, {}));
   for (AutoGoal goal : {AutoGoal::Speed, AutoGoal::Memory}) {
     AutoLimits l;
     l.goal = goal;

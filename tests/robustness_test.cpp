@@ -69,10 +69,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     if (skipped) *skipped = unwalkable;
     return hits;
 #else
-    std::vector<Hit> hits(rays.size());
-    uint64_t unwalkable = BlobView(blob, GetParam()).trace(rays, hits, outputs);
-    if (skipped) *skipped = unwalkable;
-    return hits;
+    return trace_all(blob, rays, skipped, outputs);
 #endif
   }
 #ifdef MESHCAST_TEST_GPU
@@ -93,18 +90,6 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     expect_oracle(mesh, blob, rays, trace(blob, rays), what);
   }
 };
-
-// The same surface with every triangle owning its three vertices (as STL
-// gives it): equal positions must still decode to equal bits.
-Mesh unwelded(const Mesh& m) {
-  Mesh soup;
-  for (size_t t = 0; t < m.triangles.size(); ++t) {
-    uint32_t base = uint32_t(soup.vertices.size());
-    for (int c = 0; c < 3; ++c) soup.vertices.push_back(m.corner(t, c));
-    soup.triangles.push_back({base, base + 1, base + 2});
-  }
-  return soup;
-}
 
 // Closed sphere, welded and unwelded: rays from inside must all hit; rays
 // aimed at its vertices and edge midpoints from the centre must all hit.

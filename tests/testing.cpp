@@ -65,10 +65,21 @@ const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, c
   return cache[key];
 }
 
-std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped) {
+Mesh unwelded(const Mesh& m) {
+  Mesh soup;
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    const uint32_t base = uint32_t(soup.vertices.size());
+    for (int c = 0; c < 3; ++c) soup.vertices.push_back(m.corner(t, c));
+    soup.triangles.push_back({base, base + 1, base + 2});
+  }
+  return soup;
+}
+
+std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped,
+                           uint32_t outputs) {
   BlobView view(blob, "test blob");
   std::vector<Hit> hits(rays.size());
-  uint64_t s = view.trace(rays, hits);
+  uint64_t s = view.trace(rays, hits, outputs);
   if (skipped) *skipped = s;
   return hits;
 }

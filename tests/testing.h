@@ -36,7 +36,13 @@ bool quick();
 const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays);
 const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count = 10000);
 
-std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr);
+// `outputs`: the per-hit outputs asked for (MC_HIT_*).
+std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr,
+                           uint32_t outputs = 0);
+
+// The same surface with every triangle owning its three vertices (as STL
+// gives it): a triangle soup, no vertex shared.
+Mesh unwelded(const Mesh& m);
 
 // `hits` against the double-precision oracle over the mesh `blob` stores
 // (the input mesh, or stored_mesh(blob) for the formats that move

@@ -14,7 +14,7 @@
 
 namespace meshcast::tools {
 
-Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options) {
+Loaded load_mesh_or_blob(const std::string& path, const MeshBuilder& build) {
   Loaded out;
   auto t0 = std::chrono::steady_clock::now();
   std::vector<uint8_t> head = read_file(path);
@@ -30,7 +30,7 @@ Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options) {
   out.mesh = read_mesh(path);
   out.load_ms = ms_since(t0);
   auto t1 = std::chrono::steady_clock::now();
-  out.blob = build_blob(*out.mesh, options, path, &out.report);
+  out.blob = build(*out.mesh, &out.report);
   out.build_ms = ms_since(t1);
   return out;
 }
@@ -71,17 +71,6 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
       ->check(CLI::Range(8u, uint32_t(MC_ZBT_MAX_TRIANGLES)));
 }
 
-namespace {
-bool is_blob_file(const std::string& path) {
-  uint32_t magic = 0;
-  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
-    if (std::fread(&magic, 4, 1, f) != 1) magic = 0;
-    std::fclose(f);
-  }
-  return magic == MC_BLOB_MAGIC;
-}
-}  // namespace
-
 Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* report) {
   const LayoutArgs defaults;
   const bool automatic = a.layout == "auto";
@@ -94,7 +83,10 @@ Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* repor
                      "--hybrid-leaf, or name a layout");
   if (!automatic && (a.goal != defaults.goal || a.max_bytes != 0 || a.max_error != 0 || a.gpu || a.trial != 0))
     throw InputError("--goal, --max-bytes, --max-error, --gpu and --trial are limits for --layout auto");
-  if (!automatic || is_blob_file(path)) return load_mesh_or_blob(path, automatic ? BuildOptions{} : build_options(a));
+  if (!automatic) {
+    const BuildOptions options = build_options(a);
+    return load_mesh_or_blob(path, [&](const Mesh& mesh, BuildReport* r) { return build_blob(mesh, options, path, r); });
+  }
   AutoLimits limits;
   limits.goal = parse_goal(a.goal);
   limits.max_bytes_per_triangle = a.max_bytes, limits.max_error = a.max_error;
@@ -102,17 +94,12 @@ Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* repor
     for (const gpu::MethodLayout& m : gpu::method_layouts()) limits.readers.push_back(m.layout);
   limits.trial_rays = a.trial;
   limits.triangle_ids = !a.no_triangle_ids;
-  Loaded out;
-  auto t0 = std::chrono::steady_clock::now();
-  out.mesh = read_mesh(path);
-  out.load_ms = ms_since(t0);
-  auto t1 = std::chrono::steady_clock::now();
-  AutoChoice choice = choose_layout(*out.mesh, limits, path);
-  out.build_ms = ms_since(t1);
-  out.blob = std::move(choice.blob);
-  out.report = choice.report;
-  std::fprintf(report, "%s", describe(limits, choice).c_str());
-  return out;
+  return load_mesh_or_blob(path, [&](const Mesh& mesh, BuildReport* r) {
+    AutoChoice choice = choose_layout(mesh, limits, path);
+    std::fprintf(report, "%s", describe(limits, choice).c_str());
+    *r = choice.report;
+    return std::move(choice.blob);
+  });
 }
 
 BuildOptions build_options(const LayoutArgs& a) {

@@ -2,6 +2,7 @@
 // blob, timing, and printing.
 #pragma once
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,8 +20,9 @@ struct Loaded {
 };
 
 // A path whose first bytes are the blob magic is read as a blob (and
-// validated); anything else is read as a mesh and built with `options`.
-Loaded load_mesh_or_blob(const std::string& path, const BuildOptions& options);
+// validated); anything else is read as a mesh and built by `build`.
+using MeshBuilder = std::function<std::vector<uint8_t>(const Mesh& mesh, BuildReport* report)>;
+Loaded load_mesh_or_blob(const std::string& path, const MeshBuilder& build);
 
 // Options of --layout and --leaf, with the defaults of the foundation issue.
 BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter = "");

@@ -35,7 +35,7 @@ int bin_of(float c, float lo, float extent) {
 }  // namespace
 
 uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cbox) const {
-  float best_cost = INFINITY;
+  double best_cost = INFINITY;
   int best_axis = -1, best_bin = 0;
   for (int axis = 0; axis < 3; ++axis) {
     float lo = cbox.min[axis], extent = cbox.max[axis] - lo;
@@ -48,7 +48,7 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
       ++bin_count[b];
     }
     // Sweep from the right, then evaluate each split from the left.
-    std::array<float, kBins> right_area{};
+    std::array<double, kBins> right_area{};
     std::array<uint32_t, kBins> right_count{};
     Box3 acc;
     uint32_t n = 0;
@@ -63,7 +63,7 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
       acc.grow(bin_box[b]);
       n += bin_count[b];
       if (n == 0 || right_count[b + 1] == 0) continue;
-      float cost = acc.half_area() * n + right_area[b + 1] * right_count[b + 1];
+      double cost = acc.half_area() * n + right_area[b + 1] * right_count[b + 1];
       if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = b;
     }
   }

@@ -15,7 +15,8 @@ constexpr uint32_t kSplitterDepth = 40;
 
 // SAH cost relative to the root box, unit costs for nodes and triangles.
 inline double sah_cost(const BuildTree& t) {
-  double root = std::max(1e-30, double(t.nodes[0].box.half_area())), cost = 0;
+  double root = t.nodes[0].box.half_area(), cost = 0;
+  if (!(root > 0)) root = 1;  // a flat or point-sized root: costs in absolute units
   for (const BuildNode& n : t.nodes) cost += n.box.half_area() / root * (n.leaf() ? n.count : 1.0);
   return cost;
 }

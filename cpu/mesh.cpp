@@ -21,10 +21,13 @@ Vec3 Box3::centre() const {
 
 Vec3 Box3::extent() const { return {max.x - min.x, max.y - min.y, max.z - min.z}; }
 
-float Box3::half_area() const {
-  if (empty()) return 0.0f;
-  Vec3 e = extent();
-  return e.x * e.y + e.y * e.z + e.z * e.x;
+double Box3::half_area() const {
+  // In double: float products of extents near 1e-30 underflow to 0 (every
+  // split then costs the same and the tree degenerates into a chain), and
+  // near 1e20 they overflow.
+  if (empty()) return 0.0;
+  const double x = double(max.x) - min.x, y = double(max.y) - min.y, z = double(max.z) - min.z;
+  return x * y + y * z + z * x;
 }
 
 double Box3::diagonal() const {

@@ -24,7 +24,7 @@ struct Box3 {
   bool empty() const { return min.x > max.x; }
   Vec3 centre() const;
   Vec3 extent() const;
-  float half_area() const;  // SAH cost unit: xy + yz + zx
+  double half_area() const;  // SAH cost unit: xy + yz + zx, in double (1e-30 or 1e30 wide boxes)
   double diagonal() const;
 };
 
@@ -44,8 +44,9 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Coordinates beyond this (about 1.27e30) are refused: extents, areas and
-// half-float scales computed from them must stay finite in float.
+// Coordinates beyond this (about 1.27e30) are refused, in meshes and in ray
+// origins: extents, areas and half-float scales computed from them must stay
+// finite in float, and the triangle test's double redo must stay in range.
 constexpr float kMaxCoordinate = 0x1p100f;
 
 // Checks what every layout relies on: at least one triangle, every index in

@@ -1,6 +1,7 @@
 #include "cpu/oracle.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 namespace meshcast {
@@ -24,7 +25,8 @@ double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3&
   if (det == 0) return INFINITY;
   double T = (U * az + V * bz + W * cz) * sz;
   double t = T / det;
-  if (!(t >= 0) || t > double(ray.tmax)) return INFINITY;
+  // A t past the largest float is no hit: no walker could report it.
+  if (!(t >= 0) || t > double(ray.tmax) || t > double(FLT_MAX)) return INFINITY;
   return t;
 }
 

@@ -6,15 +6,21 @@
 //    sheared so it runs along +z, edge functions are evaluated in 2D with the
 //    same operands for both triangles of a shared edge, and an edge function
 //    that rounds to exactly zero is recomputed in double, so a ray through a
-//    shared edge or vertex always hits at least one of its triangles.
-// Both are two-sided and accept t in [0, t_max].
+//    shared edge or vertex always hits at least one of its triangles. So is
+//    a lane whose determinant or T overflowed or fell below kSettleTiny
+//    (coordinates near the +-2^100 limit, tiny meshes, tiny or huge
+//    directions): float cannot settle it, double always can.
+// Both are two-sided and accept t in [0, t_max]; a hit whose t exceeds the
+// largest float is a miss (the hit record carries t as a float).
 #pragma once
 #include <algorithm>
 #include <atomic>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 
 #include "cpu/counters.h"
+#include "cpu/mesh.h"
 #include "cpu/simd.h"
 #include "layout/formats.h"
 
@@ -38,12 +44,14 @@ struct Hit {
 };
 static_assert(sizeof(Hit) == 28, "the Vulkan methods' hit record (shaders/hits.glsl) is the same 7 words");
 
-// A ray the walkers may walk: finite origin and direction, a direction that
-// is not zero (nor denormal), t_max not NaN and not negative (infinity allowed). Any other
-// ray is answered as a miss and counted.
+// A ray the walkers may walk: an origin within +-2^100 (the coordinate
+// range of meshes, kMaxCoordinate), a finite direction that is not zero
+// (nor below FLT_MIN), t_max not NaN and not negative (infinity allowed).
+// Any other ray is answered as a miss and counted. Within these ranges every
+// ray-space quantity of the triangle test fits a double (see kSettleTiny).
 inline bool ray_is_walkable(const Ray& r) {
   for (int a = 0; a < 3; ++a)
-    if (!std::isfinite(r.org[a]) || !std::isfinite(r.dir[a])) return false;
+    if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !std::isfinite(r.dir[a])) return false;
   // A direction whose largest component is below FLT_MIN counts as zero:
   // its reciprocal would overflow.
   float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
@@ -136,22 +144,43 @@ struct LaneHit {
   float t = 0, u = 0, v = 0;
 };
 
-// Double-precision redo of one lane whose edge function rounded to zero.
+// Below this a determinant or T has lost bits to underflow (products of
+// coordinates near 1e-20 and smaller): such lanes are settled in double.
+// Every ray-space value the double redo forms stays inside double's normal
+// range: sheared coordinates are floats within +-2^102, sz within 2^-128..2^126,
+// so products lie between 2^-575 and 2^433.
+constexpr float kSettleTiny = 0x1p-100f;
+
+// Double-precision redo of one lane float could not settle. Corners in ray
+// space (sheared x, y; z not yet scaled by sz): every product of two floats
+// is exact in double, so an edge function's sign is exact.
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
-                            const float cy, const float az, const float bz, const float cz, float closest,
-                            LaneHit* out);
+                            const float cy, const float az, const float bz, const float cz, const float sz,
+                            float closest, LaneHit* out);
+
+// Lanes whose float det and T can be trusted: finite (no overflow, no
+// inf - inf) and at least kSettleTiny in magnitude (no underflow). A lane
+// inside all three edges that fails this is settled in double, as are the
+// lanes with an edge function of exactly 0.
+template <class F4>
+inline auto float_settles(const F4& det, const F4& T) {
+  const F4 tiny = F4::splat(kSettleTiny), inf = F4::splat(INFINITY);
+  const F4 d = simd::abs(det), a = simd::abs(T);
+  return (d >= tiny) & (d < inf) & (a >= tiny) & (a < inf);
+}
 
 // The lanes of `redo` settled in double: corners in ray space (x, y of the
-// three corners, then their scaled z) stored, each lane redone by
+// three corners, then their unscaled z) stored, each lane redone by
 // watertight_lane_double against limit(); take(lane, hit) for each hit.
 template <class F4, class Limit, class Take>
-inline void settle_in_double(int redo, const F4 (&p)[9], Limit&& limit, Take&& take) {
+inline void settle_in_double(int redo, const F4 (&p)[9], float sz, Limit&& limit, Take&& take) {
   float l[9][F4::kLanes];
   for (int k = 0; k < 9; ++k) p[k].store(l[k]);
   for (int m = redo; m; m &= m - 1) {
     int i = __builtin_ctz(m);
     LaneHit h;
-    if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i], limit(), &h))
+    if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i], sz,
+                               limit(), &h))
       take(i, h);
   }
 }
@@ -224,12 +253,13 @@ inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float 
   M4 inside = simd::andnot(neg & pos, valid);
   M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
   F4 det = U + V + W;
-  az = sz * az, bz = sz * bz, cz = sz * cz;
-  F4 T = U * az + V * bz + W * cz;
+  F4 T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
   F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
   F4 t = Ts / dets;
-  M4 accept = inside & (det != zero) & (Ts >= zero) & (t <= F4::splat(closest));
-  accept = simd::andnot(edge_zero, accept);
+  // Lanes float cannot settle go to double below; t past the largest float
+  // is no hit (it cannot be reported).
+  M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
+  M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (t <= F4::splat(std::min(closest, FLT_MAX))));
 
   LaneHit best;
   int acc = simd::bits(accept);
@@ -245,9 +275,9 @@ inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float 
     float d = Ul[best.lane] + Vl[best.lane] + Wl[best.lane];
     best.u = Vl[best.lane] / d, best.v = Wl[best.lane] / d;
   }
-  // Rare: an edge function of 0 in float; settle those lanes in double.
-  if (int redo = simd::bits(edge_zero & valid))
-    settle_in_double(redo, {ax, ay, bx, by, cx, cy, az, bz, cz}, [&] { return best.lane >= 0 ? best.t : closest; },
+  // Rare: an edge function of 0, or det or T out of float's reach.
+  if (int lanes = simd::bits(redo))
+    settle_in_double(lanes, {ax, ay, bx, by, cx, cy, az, bz, cz}, r.sz, [&] { return best.lane >= 0 ? best.t : closest; },
                      [&](int i, const LaneHit& h) {
                        if (best.lane < 0 || h.t < best.t) best = h, best.lane = i;
                      });
@@ -274,11 +304,11 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(used))) + __builtin_popcount(unsigned(simd::bits(second)))));
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
-  F4 x[4], y[4], z[4];
+  F4 x[4], y[4], z[4], zs[4];  // z: relative to the origin; zs: scaled by sz
   for (int k = 0; k < 4; ++k) {
     z[k] = v[k][2] - oz;
     x[k] = (v[k][0] - ox) - sx * z[k], y[k] = (v[k][1] - oy) - sy * z[k];
-    z[k] = sz * z[k];
+    zs[k] = sz * z[k];
   }
   // Edge functions as triangle_test writes them: E(P, Q) = Q.x P.y - Q.y P.x.
   auto edge = [&](int p, int q) { return x[q] * y[p] - y[q] * x[p]; };
@@ -294,10 +324,11 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     M4 inside = simd::andnot(neg & pos, valid);
     M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
     F4 det = U + V + W;
-    F4 T = U * z[corner[tri][0]] + V * z[corner[tri][1]] + W * z[corner[tri][2]];
+    F4 T = U * zs[corner[tri][0]] + V * zs[corner[tri][1]] + W * zs[corner[tri][2]];
     F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
     F4 t = Ts / dets;
-    M4 accept = simd::andnot(edge_zero, inside & (det != zero) & (Ts >= zero) & (t <= F4::splat(closest)));
+    M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
+    M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (t <= F4::splat(std::min(closest, FLT_MAX))));
     float tl[kW], Ul[kW], Vl[kW], Wl[kW];
     t.store(tl), U.store(Ul), V.store(Vl), W.store(Wl);
     for (int m = simd::bits(accept); m; m &= m - 1) {
@@ -310,10 +341,10 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
         }
       }
     }
-    // Rare: an edge function of 0 in float; settle those lanes in double.
+    // Rare: an edge function of 0, or det or T out of float's reach.
     const int* k = corner[tri];
-    if (int redo = simd::bits(edge_zero & valid))
-      settle_in_double(redo, {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]], z[k[0]], z[k[1]], z[k[2]]},
+    if (int lanes = simd::bits(redo))
+      settle_in_double(lanes, {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]], z[k[0]], z[k[1]], z[k[2]]}, r.sz,
                        [&] { return best.lane >= 0 ? best.t : closest; },
                        [&](int i, const LaneHit& h) {
                          if (best.lane < 0 || h.t < best.t) best = {i, tri == 1, h.t, h.u, h.v};

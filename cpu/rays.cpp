@@ -1,5 +1,11 @@
 #include "cpu/rays.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -76,7 +82,16 @@ std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_
   return rays;
 }
 
+void require_regular_file(const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the file (" + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) throw InputError(path + ": is a directory, not a file");
+  if (!S_ISREG(st.st_mode))
+    throw InputError(path + ": not a regular file (a device, pipe or socket has no size to read up to)");
+}
+
 std::vector<uint8_t> read_file(const std::string& path) {
+  require_regular_file(path);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(path + ": cannot open the file");
   std::streamoff size = in.tellg();
@@ -87,10 +102,35 @@ std::vector<uint8_t> read_file(const std::string& path) {
   return bytes;
 }
 
-void write_file(const std::string& path, const void* data, size_t size) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(static_cast<const char*>(data), std::streamsize(size));
-  if (!out) throw InputError(path + ": cannot write the file");
+void write_file(const std::string& path, std::initializer_list<Bytes> pieces) {
+  auto failed = [&](const char* what, int err) {
+    return OutputError(path + ": cannot write the file (" + what + ": " + std::strerror(err) + ")");
+  };
+  // A device or pipe is written in place: renaming over it would replace it.
+  struct stat st;
+  const bool in_place = ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode);
+  std::string temp = path + ".partial-XXXXXX";
+  const int fd = in_place ? ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC) : ::mkstemp(temp.data());
+  if (fd < 0) throw failed("open", errno);
+  int err = 0;
+  const char* step = "write";
+  for (const Bytes& b : pieces) {
+    const char* p = static_cast<const char*>(b.data);
+    for (size_t left = b.size; left > 0 && !err;) {
+      const ssize_t n = ::write(fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) err = n < 0 ? errno : ENOSPC;
+      else p += n, left -= size_t(n);
+    }
+  }
+  if (!err && !in_place && ::fchmod(fd, 0644) != 0) err = errno, step = "chmod";
+  if (!err && !in_place && ::fsync(fd) != 0) err = errno, step = "flush";
+  if (::close(fd) != 0 && !err) err = errno, step = "close";
+  if (!err && !in_place && ::rename(temp.c_str(), path.c_str()) != 0) err = errno, step = "rename";
+  if (err) {
+    if (!in_place) ::unlink(temp.c_str());
+    throw failed(step, err);
+  }
 }
 
 namespace {
@@ -121,11 +161,12 @@ struct HitRecord {
 std::vector<Ray> read_rays(const std::string& path) { return read_records<Ray>(path, "RAYS", 28); }
 
 void write_rays(const std::string& path, const std::vector<Ray>& rays) {
-  std::vector<uint8_t> b(8 + rays.size() * 28);
-  uint32_t n = uint32_t(rays.size());
-  std::memcpy(b.data(), "RAYS", 4), std::memcpy(b.data() + 4, &n, 4);
-  for (size_t i = 0; i < rays.size(); ++i) std::memcpy(b.data() + 8 + i * 28, &rays[i], 28);
-  write_file(path, b.data(), b.size());
+  if (rays.size() > kMaxRayCount)
+    throw InputError(path + ": " + std::to_string(rays.size()) + " rays, more than a rays file may hold (" +
+                     std::to_string(kMaxRayCount) + ")");
+  const uint32_t n = uint32_t(rays.size());
+  static_assert(sizeof(Ray) == 28 && std::endian::native == std::endian::little, "a Ray is its record");
+  write_file(path, {{"RAYS", 4}, {&n, 4}, {rays.data(), rays.size() * sizeof(Ray)}});
 }
 
 std::vector<Hit> read_hits(const std::string& path) {

@@ -3,6 +3,8 @@
 //   hits: "HITS", uint32 count, per ray float32 t (inf: miss), uint32 triangle
 // All little-endian.
 #pragma once
+#include <initializer_list>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,8 +32,30 @@ void write_rays(const std::string& path, const std::vector<Ray>& rays);
 std::vector<Hit> read_hits(const std::string& path);
 void write_hits(const std::string& path, const std::vector<Hit>& hits);
 
-// Whole-file helpers for blobs.
+// Most rays a rays file may hold, and `meshcast rays --count` make: 2^27
+// (3.5 GiB of records).
+constexpr size_t kMaxRayCount = size_t(1) << 27;
+
+// Throws InputError naming the path unless it is a regular file (a
+// directory, a device such as /dev/zero or a pipe is refused before any read).
+void require_regular_file(const std::string& path);
+
+// Whole-file helpers for blobs, rays and hits: read_file reads a regular file
+// (require_regular_file). write_file writes the pieces in order to a file
+// beside `path`, checks every write, the flush and the close, then renames it
+// to `path`, so a failed write (a full disk) leaves no partial file under
+// that name; an existing path that is not a regular file (/dev/null,
+// /dev/full, a pipe) is written in place. Failures throw OutputError naming
+// the path and the reason.
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+struct Bytes {
+  const void* data;
+  size_t size;
+};
 std::vector<uint8_t> read_file(const std::string& path);
-void write_file(const std::string& path, const void* data, size_t size);
+void write_file(const std::string& path, std::initializer_list<Bytes> pieces);
+inline void write_file(const std::string& path, const void* data, size_t size) { write_file(path, {{data, size}}); }
 
 }  // namespace meshcast

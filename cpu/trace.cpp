@@ -1,5 +1,7 @@
 #include "cpu/trace.h"
 
+#include <algorithm>
+#include <cfloat>
 #include <vector>
 
 #include "cpu/mesh.h"
@@ -54,20 +56,21 @@ const std::vector<Entry> kWalkers = make_walkers();
 }  // namespace
 
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
-                            const float cy, const float az, const float bz, const float cz, float closest,
-                            LaneHit* out) {
+                            const float cy, const float az, const float bz, const float cz, const float sz,
+                            float closest, LaneHit* out) {
   double U = double(cx) * by - double(cy) * bx;
   double V = double(ax) * cy - double(ay) * cx;
   double W = double(bx) * ay - double(by) * ax;
   if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return false;
   double det = U + V + W;
   if (det == 0) return false;
-  double T = U * az + V * bz + W * cz;
+  double T = (U * az + V * bz + W * cz) * double(sz);
   if (det < 0) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0) return false;
-  float t = float(T / det);
-  if (!(t <= closest)) return false;
-  out->t = t, out->u = float(V / det), out->v = float(W / det);
+  // Compared in double: a t past the largest float is no hit.
+  const double t = T / det;
+  if (!(t <= double(std::min(closest, FLT_MAX)))) return false;
+  out->t = float(t), out->u = float(V / det), out->v = float(W / det);
   return true;
 }
 

@@ -63,7 +63,7 @@ class SkdWriter : public TreeWriter {
   void choose(BuildTree& t, uint32_t n, const Box3& region) {
     BuildNode& b = t.nodes[n];
     if (b.leaf()) return;
-    float best = INFINITY;
+    double best = INFINITY;
     Box3 best_left, best_right;
     for (int a = 0; a < 3; ++a) {
       uint32_t lo = b.left, hi = b.right;
@@ -71,7 +71,7 @@ class SkdWriter : public TreeWriter {
       Box3 l = region, r = region;
       l.max[a] = std::min(region.max[a], t.nodes[lo].box.max[a]);
       r.min[a] = std::max(region.min[a], t.nodes[hi].box.min[a]);
-      float cost = l.half_area() + r.half_area();
+      double cost = l.half_area() + r.half_area();
       if (cost < best) best = cost, axis_[n] = uint8_t(a), best_left = l, best_right = r, b.left = lo, b.right = hi;
     }
     choose(t, b.left, best_left);

@@ -1,6 +1,7 @@
 #include "gpu/vulkan.h"
 
 #include <algorithm>
+#include <charconv>
 #include <bit>
 #include <cctype>
 #include <cstdlib>
@@ -138,7 +139,10 @@ Context::Context(const DeviceChoice& choice) {
           if (props[i].deviceType == type) pick = int(i);
       if (pick < 0) pick = 0;
     } else if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
-      pick = std::stoi(wanted) < int(count) ? std::stoi(wanted) : -1;
+      // An index: any number of digits (a long one is no device, not a crash).
+      uint64_t index = 0;
+      const auto [end, ec] = std::from_chars(wanted.data(), wanted.data() + wanted.size(), index);
+      pick = ec == std::errc() && end == wanted.data() + wanted.size() && index < count ? int(index) : -1;
     } else {
       for (uint32_t i = 0; i < count && pick < 0; ++i)
         if (lower(props[i].deviceName).find(lower(wanted)) != std::string::npos) pick = int(i);
@@ -146,7 +150,9 @@ Context::Context(const DeviceChoice& choice) {
     if (pick < 0) {
       std::string list;
       for (uint32_t i = 0; i < count; ++i) list += "\n  " + std::to_string(i) + ": " + props[i].deviceName;
-      throw GpuError("Vulkan: no device matches '" + wanted + "'; devices:" + list);
+      throw GpuError("Vulkan: no device matches '" + wanted + "' (" +
+                     (choice.device.empty() ? "$MESHCAST_VK_DEVICE" : "the device asked for") + "): an index below " +
+                     std::to_string(count) + " or part of a name; devices:" + list);
     }
     physical_ = devices[size_t(pick)];
     name_ = props[size_t(pick)].deviceName;

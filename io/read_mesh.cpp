@@ -33,6 +33,8 @@
 // we never create a DefaultLogger, so it uses its NullLogger.
 #include "io/read_mesh.h"
 
+#include "cpu/rays.h"
+
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>
 
@@ -266,7 +268,7 @@ std::vector<Vec3> scan_stl_ascii(const std::string& path, std::string_view text)
 // printable ASCII, one statement a line.
 void check_ply_layout(const std::string& path, std::string_view text) {
   struct Prop { int count_size = 0, size = 0; };  // count_size > 0: a list
-  struct Element { size_t n = 0; std::vector<Prop> props; };
+  struct Element { std::string_view name; size_t n = 0; std::vector<Prop> props; std::vector<std::string_view> names; };
   std::vector<Element> elements;
   auto type_size = [](std::string_view t) {
     if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
@@ -307,7 +309,12 @@ void check_ply_layout(const std::string& path, std::string_view text) {
       // is malformed (and would overflow the record total below).
       if (t.size() != 3 || !parse_int(t[2], n) || n < 0 || uint64_t(n) > text.size())
         fail(path, ln.at() + "malformed file: bad element line");
-      elements.push_back({size_t(n), {}});
+      // Assimp reads `tristrips` but drops triangles of every strip (1 of 2;
+      // restarts at -1 lose more): refused rather than read wrong.
+      if (t[1] == "tristrips")
+        fail(path, ln.at() + "PLY element 'tristrips' (triangle strips) is not supported: write the triangles "
+                             "as a 'face' element");
+      elements.push_back({t[1], size_t(n), {}, {}});
     } else if (t[0] == "property") {
       // `property TYPE NAME` or `property list COUNT_TYPE TYPE NAME`
       bool list = t.size() == 5 && t[1] == "list";
@@ -317,11 +324,18 @@ void check_ply_layout(const std::string& path, std::string_view text) {
       if (p.size == 0 || (list && p.count_size == 0) || !integer_count)
         fail(path, ln.at() + "malformed file: bad property line");
       elements.back().props.push_back(p);
+      elements.back().names.push_back(t.back());
     } else {
       fail(path, ln.at() + "malformed file: unknown PLY header line '" + std::string(t[0].substr(0, 32)) + "'");
     }
   }
   if (end == std::string_view::npos) fail(path, "malformed file: no PLY header ending in end_header");
+  // Assimp reads a missing coordinate as 0: a vertex needs x, y and z.
+  for (const Element& e : elements)
+    if (e.name == "vertex")
+      for (std::string_view axis : {"x", "y", "z"})
+        if (std::find(e.names.begin(), e.names.end(), axis) == e.names.end())
+          fail(path, "malformed file: the PLY vertex element has no '" + std::string(axis) + "' property");
   size_t records = 0, pos = end;
   for (const Element& e : elements) records += e.n;
   if (format == "ascii") {  // one record per line
@@ -351,6 +365,24 @@ void check_ply_layout(const std::string& path, std::string_view text) {
   if (pos > text.size()) fail(path, "malformed file: truncated binary PLY");
 }
 
+// STL: Assimp reads a file as binary when its size is 84 + 50 n bytes (n the
+// facet count at byte 80), else as text when it starts with `solid`; anything
+// else gets its "Failed to determine STL storage representation". A binary
+// file cut short is the usual cause: say so, with the sizes.
+void check_stl_layout(const std::string& path, std::string_view text) {
+  uint32_t n = 0;
+  if (text.size() >= 84) std::memcpy(&n, text.data() + 80, 4);
+  if (text.size() >= 84 && text.size() == 84 + 50ull * n) return;
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  if (first != std::string_view::npos && text.substr(first, 5) == "solid") return;
+  if (text.size() < 84)
+    fail(path, "malformed file: " + std::to_string(text.size()) +
+                   " bytes, neither ASCII STL (no 'solid') nor binary STL (an 84-byte header at least)");
+  fail(path, "malformed file: binary STL truncated or padded: the header says " + std::to_string(n) +
+                 " facets (84 + 50 x " + std::to_string(n) + " = " + std::to_string(84 + 50ull * n) +
+                 " bytes) but the file has " + std::to_string(text.size()) + " bytes");
+}
+
 Polys read_assimp(const std::string& path) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, 0);  // 0: no post-processing, see top
@@ -377,9 +409,12 @@ Polys read_assimp(const std::string& path) {
   return p;
 }
 
-// Same number within a few ulps (Assimp's rounding), or both NaN.
+// Same number within a few ulps (Assimp's rounding), or both NaN, or both
+// below FLT_MIN: Assimp's fast_atoreal reads denormals inexactly (7.5e-43
+// comes out another denormal or 0), and the exact scan's value is kept.
 bool close(float a, float b) {
   if (a == b || (std::isnan(a) && std::isnan(b))) return true;
+  if (std::fabs(a) < FLT_MIN && std::fabs(b) < FLT_MIN) return true;
   return std::fabs(a - b) <= 4e-7f * std::max(std::fabs(a), std::fabs(b));
 }
 bool close(const Vec3& a, const Vec3& b) { return close(a.x, b.x) && close(a.y, b.y) && close(a.z, b.z); }
@@ -425,8 +460,7 @@ void check_polygons(const std::string& path, const Polys& p) {
 }  // namespace
 
 Mesh read_mesh(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a mesh file");
+  require_regular_file(path);  // a directory, /dev/zero or a pipe: refused before reading
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, "cannot open file (missing or unreadable)");
   std::stringstream buf;
@@ -447,6 +481,7 @@ Mesh read_mesh(const std::string& path) {
     cross_check(path, result, read_assimp(path));
   } else {
     if (ext == ".ply") check_ply_layout(path, text);
+    if (ext == ".stl") check_stl_layout(path, text);
     Polys as = read_assimp(path);
     if (ext == ".ply" && text.find("format ascii") < text.find("end_header")) {
       if (auto v = scan_ply_ascii(path, text)) take_coordinates(path, as, *v);

@@ -17,7 +17,7 @@ echo "== AddressSanitizer + UBSan: every CPU test suite and the fuzz corpora"
 # Release build above and the host layer under TSan below.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_SANITIZE=ON >/dev/null
 asan_suites=(walker_test robustness_test auto_test build_test layout_test oracle_test io_test pairing_test zerobyte_test
-             limits_test)
+             limits_test hostile_test)
 cmake --build build-asan -j"$jobs" --target "${asan_suites[@]}" blob_fuzz mesh_fuzz
 # One process a suite, $jobs at a time (CTest's one process a test would
 # load the meshes and compute the oracle's answers again for every test),

@@ -1,24 +1,32 @@
 // The watertight ray/triangle test of cpu/ray.h (Woop, Benthin, Wald 2013),
 // operation for operation: every product and difference is `precise`, so no
 // compiler fuses them into an fma and both triangles of a shared edge get
-// the same roundings; an edge function that rounds to 0 is redone in
-// double, as on the CPU. Two-sided; accepts t in [0, closest].
+// the same roundings; a lane float cannot settle (an edge function of 0, a
+// det or T that overflowed or fell below kSettleTiny) is redone in double,
+// as on the CPU. Two-sided; accepts t in [0, closest]; a t past the largest
+// float is no hit.
 #ifndef MESHCAST_WATERTIGHT_GLSL
 #define MESHCAST_WATERTIGHT_GLSL
 
+#define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/ray.h kSettleTiny
+#define kFloatMax uintBitsToFloat(0x7F7FFFFFu)
+#define kFloatInf uintBitsToFloat(0x7F800000u)
+
+// Corners in ray space: sheared x, y, and z not yet scaled by sz.
 bool watertight_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
-                       float closest, out float t, out float u, out float v) {
+                       float sz, float closest, out float t, out float u, out float v) {
   precise double U = double(cx) * double(by) - double(cy) * double(bx);
   precise double V = double(ax) * double(cy) - double(ay) * double(cx);
   precise double W = double(bx) * double(ay) - double(by) * double(ax);
   if ((U < 0.0lf || V < 0.0lf || W < 0.0lf) && (U > 0.0lf || V > 0.0lf || W > 0.0lf)) return false;
   precise double det = U + V + W;
   if (det == 0.0lf) return false;
-  precise double T = U * double(az) + V * double(bz) + W * double(cz);
+  precise double T = (U * double(az) + V * double(bz) + W * double(cz)) * double(sz);
   if (det < 0.0lf) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0.0lf) return false;
-  t = float(T / det);
-  if (!(t <= closest)) return false;
+  precise double td = T / det;
+  if (!(td <= double(min(closest, kFloatMax)))) return false;
+  t = float(td);
   u = float(V / det), v = float(W / det);
   return true;
 }
@@ -34,16 +42,17 @@ bool watertight(GpuRay r, vec3 a, vec3 b, vec3 c, float closest, out float t, ou
   precise float U = cx * by - cy * bx;
   precise float V = ax * cy - ay * cx;
   precise float W = bx * ay - by * ax;
-  az = r.sz * az, bz = r.sz * bz, cz = r.sz * cz;
-  if (U == 0.0 || V == 0.0 || W == 0.0) return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, closest, t, u, v);
+  if (U == 0.0 || V == 0.0 || W == 0.0) return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   precise float det = U + V + W;
-  if (det == 0.0) return false;
-  precise float T = U * az + V * bz + W * cz;
-  const float Ts = det < 0.0 ? -T : T, dets = abs(det);
+  precise float T = U * (r.sz * az) + V * (r.sz * bz) + W * (r.sz * cz);
+  const float dets = abs(det), Tabs = abs(T);
+  if (!(dets >= kSettleTiny && dets < kFloatInf && Tabs >= kSettleTiny && Tabs < kFloatInf))
+    return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
+  const float Ts = det < 0.0 ? -T : T;
   if (!(Ts >= 0.0)) return false;
   t = Ts / dets;
-  if (!(t <= closest)) return false;
+  if (!(t <= min(closest, kFloatMax))) return false;
   u = V / det, v = W / det;
   return true;
 }

@@ -30,6 +30,9 @@ if [[ ! -f $data/bunny00.off ]]; then
   printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n3 0 1 2\n3 1 3 2\n' >"$mesh"
 fi
 
+printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n' >"$work/tiny_square.off"
+# A binary STL of 2 facets (84 + 100 bytes), for the truncated-STL check.
+{ head -c 80 /dev/zero; printf '\x02\x00\x00\x00'; head -c 100 /dev/zero; } >"$work/tiny_bin.stl"
 check rays 0 "rays ->" -- "$meshcast" rays "$mesh" --kind long --count 500 --seed 3 --out "$work/r.rays"
 check rays-kind 105 "kind" -- "$meshcast" rays "$mesh" --kind sideways --count 5 --out "$work/x.rays"
 check build 0 "bytes/triangle" -- "$meshcast" build "$mesh" --layout quadtree/float3soa4 --leaf 4 --out "$work/m.blob"
@@ -102,6 +105,58 @@ printf '\x55' | dd of="$work/flip.blob" bs=1 seek=300 conv=notrunc status=none
 check flipped-blob 2 "flip.blob.*checksum" -- "$meshcast" info "$work/flip.blob"
 head -c 30 "$work/r.rays" >"$work/cut.rays"
 check truncated-rays 2 "cut.rays" -- "$meshcast" trace "$work/m.blob" --rays "$work/cut.rays" --out "$work/x.hits"
+
+
+# Issue 17: hostile input through the command line.
+# Every --json output parses as JSON, a path with quotes, backslashes and a
+# byte that is not UTF-8 included; NaN is null, not a bare nan.
+json_ok() {  # json_ok NAME -- command...: exit 0 and stdout one JSON object
+  local name=$1
+  shift 2
+  local out
+  if out=$("$@" 2>/dev/null) && python3 -c 'import json, sys; o = json.loads(sys.stdin.read()); assert isinstance(o, dict)' <<<"$out"; then
+    echo "ok   $name"; passes=$((passes + 1))
+  else
+    echo "FAIL $name: not one JSON object:"; echo "$out" | head -5; failures=$((failures + 1))
+  fi
+}
+odd=$work/$'we"ird\\path\xff'.off
+cp "$mesh" "$odd"
+json_ok json-info -- "$meshcast" info "$mesh" --json
+json_ok json-info-odd-path -- "$meshcast" info "$odd" --json
+json_ok json-info-blob -- "$meshcast" info "$work/m.blob" --json
+json_ok json-info-auto -- "$meshcast" info "$odd" --layout auto --json
+json_ok json-trace -- "$meshcast" trace "$odd" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/hj.hits" --json
+json_ok json-trace-vulkan -- "$meshcast" trace "$odd" --layout BruteForce/Float3SOA128 --backend vulkan --rays "$work/r.rays" --out "$work/hj2.hits" --json --repeat 1
+check json-path-kept 0 'we\\"ird\\\\path' -- "$meshcast" info "$odd" --json
+# Output lost without an error: every write is checked (exit 4, the path and
+# the reason), and a failed write leaves no file under the final name.
+check full-hits 4 "/dev/full.*No space left" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out /dev/full
+head -c $((8 + 28 * 3)) "$work/r.rays" >"$work/three.rays"
+printf '\x03\x00\x00\x00' | dd of="$work/three.rays" bs=1 seek=4 conv=notrunc status=none
+check full-hits-small 4 "/dev/full.*No space left" -- "$meshcast" trace "$work/m.blob" --rays "$work/three.rays" --out /dev/full
+check full-rays 4 "/dev/full.*No space left" -- "$meshcast" rays "$mesh" --count 3 --out /dev/full
+check full-blob 4 "/dev/full.*No space left" -- "$meshcast" build "$work/tiny_square.off" --out /dev/full
+check full-png 4 "/dev/full.*No space left" -- "$meshcast" render "$mesh" --png /dev/full --width 16 --height 16
+check missing-dir-out 4 "nodir/x.hits.*cannot write" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out "$work/nodir/x.hits"
+ls "$work" | grep -q partial && { echo "FAIL a partial file was left in $work"; failures=$((failures + 1)); }
+# Unclear failures: a message naming the input and the limit, exit 2 (input)
+# or 3 (device).
+mkdir -p "$work/adir.off"
+check dir-mesh 2 "adir.off: is a directory" -- "$meshcast" info "$work/adir.off"
+check dir-blob 2 "$work: is a directory" -- "$meshcast" info "$work"
+check dir-rays 2 "$work: is a directory" -- "$meshcast" trace "$work/m.blob" --rays "$work" --out "$work/x.hits"
+check dev-zero-mesh 2 "/dev/zero: not a regular file" -- "$meshcast" info /dev/zero
+check device-huge 3 "no device matches '99999999999'.*an index below" -- "$meshcast" trace "$work/m.blob" --backend vulkan --method quadtree --device 99999999999 --rays "$work/r.rays" --out "$work/x.hits"
+check device-huge-env 3 "no device matches '99999999999' \(\\\$MESHCAST_VK_DEVICE\)" -- env MESHCAST_VK_DEVICE=99999999999 "$meshcast" trace "$work/m.blob" --backend vulkan --method quadtree --rays "$work/r.rays" --out "$work/x.hits"
+check rays-count-huge 105 "count.*134217728" -- "$meshcast" rays "$mesh" --count 4294967295 --out "$work/x.rays"
+head -c 150 "$work/tiny_bin.stl" >"$work/cut.stl" 2>/dev/null
+check truncated-stl 2 "cut.stl: malformed file: binary STL truncated.*2 facets" -- "$meshcast" info "$work/cut.stl"
+check max-bytes-nan 2 "--max-bytes nan: a finite number" -- "$meshcast" info "$mesh" --layout auto --max-bytes nan
+check max-error-nan 2 "--max-error nan: a finite number" -- "$meshcast" info "$mesh" --layout auto --max-error nan
+check blob-leaf 2 "m.blob: is a blob.*--leaf applies only to a mesh" -- "$meshcast" info "$work/m.blob" --leaf 4
+check blob-layout 2 "m.blob: is a blob.*--layout applies only" -- "$meshcast" trace "$work/m.blob" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/x.hits"
+check blob-pairing 2 "m.blob: is a blob.*--pairing" -- "$meshcast" info "$work/m.blob" --pairing
 
 echo "$passes passed, $failures failed"
 exit $((failures > 0))

@@ -28,19 +28,27 @@ void add_info(CLI::App& app) {
     double n = h.triangle_count;
     std::string layout = layout_name(h.tree_format, h.triangle_format);
     if (args->json) {
-      std::printf("{\"input\":\"%s\",\"layout\":\"%s\",\"leaf_size\":%u,\"triangles\":%u,\"nodes\":%u,"
-                  "\"leaves\":%u,\"depth\":%u,\"sah_cost\":%.3f,\"build_ms\":%.3f,"
-                  "\"bounds_min\":[%g,%g,%g],\"bounds_max\":[%g,%g,%g],"
-                  "\"bytes\":{\"header\":%llu,\"nodes\":%llu,\"triangles\":%llu,\"vertices\":%llu,"
-                  "\"remap\":%llu,\"total\":%llu},"
-                  "\"bytes_per_triangle\":{\"header\":%.3f,\"nodes\":%.3f,\"triangles\":%.3f,\"vertices\":%.3f,"
-                  "\"walked\":%.3f,\"remap\":%.3f,\"total\":%.3f},\"remap_bits\":%u}\n",
-                  args->input.c_str(), layout.c_str(), h.leaf_size, h.triangle_count, h.node_count, h.leaf_count,
-                  h.max_depth, in.report.sah_cost, in.build_ms, h.bounds_min[0], h.bounds_min[1], h.bounds_min[2],
-                  h.bounds_max[0], h.bounds_max[1], h.bounds_max[2], (unsigned long long)s.header,
-                  (unsigned long long)s.nodes, (unsigned long long)s.triangles, (unsigned long long)s.vertices,
-                  (unsigned long long)s.remap, (unsigned long long)s.total, s.header / n, s.nodes / n,
-                  s.triangles / n, s.vertices / n, s.walked() / n, s.remap / n, s.total / n, h.remap_bits);
+      auto per_triangle = [&](uint64_t b) { return double(b) / n; };
+      print_json({{"input", args->input},
+                  {"layout", layout},
+                  {"leaf_size", h.leaf_size},
+                  {"triangles", h.triangle_count},
+                  {"nodes", h.node_count},
+                  {"leaves", h.leaf_count},
+                  {"depth", h.max_depth},
+                  {"sah_cost", in.mesh ? nlohmann::ordered_json(in.report.sah_cost) : nlohmann::ordered_json(nullptr)},  // a blob has none
+                  {"build_ms", in.build_ms},
+                  {"bounds_min", {h.bounds_min[0], h.bounds_min[1], h.bounds_min[2]}},
+                  {"bounds_max", {h.bounds_max[0], h.bounds_max[1], h.bounds_max[2]}},
+                  {"bytes",
+                   {{"header", s.header}, {"nodes", s.nodes}, {"triangles", s.triangles}, {"vertices", s.vertices},
+                    {"remap", s.remap}, {"total", s.total}}},
+                  {"bytes_per_triangle",
+                   {{"header", per_triangle(s.header)}, {"nodes", per_triangle(s.nodes)},
+                    {"triangles", per_triangle(s.triangles)}, {"vertices", per_triangle(s.vertices)},
+                    {"walked", per_triangle(s.walked())}, {"remap", per_triangle(s.remap)},
+                    {"total", per_triangle(s.total)}}},
+                  {"remap_bits", h.remap_bits}});
       return;
     }
     std::printf("%s\n  layout       %s, leaf size %u\n", args->input.c_str(), layout.c_str(), h.leaf_size);

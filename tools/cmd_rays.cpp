@@ -18,7 +18,7 @@ void add_rays(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("rays", "write a rays file for a mesh");
   cmd->add_option("input", args->input, "mesh file")->required();
   cmd->add_option("--kind", args->kind, "long, probe or radial")->check(CLI::IsMember({"long", "probe", "radial"}));
-  cmd->add_option("--count", args->count, "number of rays")->check(CLI::Range(size_t(1), size_t(0xFFFFFFFFu)));
+  cmd->add_option("--count", args->count, "number of rays, at most 2^27")->check(CLI::Range(size_t(1), kMaxRayCount));
   cmd->add_option("--seed", args->seed, "random seed");
   cmd->add_option("--out", args->out, "rays file to write")->required();
   cmd->callback([args] {

@@ -69,11 +69,9 @@ void add_trace(CLI::App& app) {
     std::string layout = layout_name(h.tree_format, h.triangle_format);
     double device_ns = rays.empty() || device_ms.empty() ? 0 : median(device_ms) * 1e6 / double(rays.size());
     if (args->json) {
-      std::printf("{\"input\":\"%s\",\"layout\":\"%s\",\"device\":\"%s\",\"load_ms\":%.3f,\"build_ms\":%.3f,"
-                  "\"rays\":%zu,\"hits\":%zu,\"invalid_rays\":%llu,\"repeat\":%u,\"ns_per_ray\":%.2f,"
-                  "\"device_ns_per_ray\":%.2f}\n",
-                  args->input.c_str(), layout.c_str(), device.c_str(), in.load_ms, in.build_ms, rays.size(), hit_count,
-                  (unsigned long long)skipped, args->repeat, ns, device_ns);
+      print_json({{"input", args->input}, {"layout", layout}, {"device", device}, {"load_ms", in.load_ms},
+                  {"build_ms", in.build_ms}, {"rays", rays.size()}, {"hits", hit_count}, {"invalid_rays", skipped},
+                  {"repeat", args->repeat}, {"ns_per_ray", ns}, {"device_ns_per_ray", device_ns}});
     } else {
       std::printf("%s: %s, load %.1f ms, build %.1f ms\n", args->input.c_str(), layout.c_str(), in.load_ms,
                   in.build_ms);

@@ -3,6 +3,8 @@
 #include "tools/commands.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "cpu/auto_layout.h"
@@ -42,7 +44,28 @@ BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std:
   return o;
 }
 
+namespace {
+
+// Every option add_layout_options adds: a blob's layout was fixed when it was
+// built, so a blob input refuses them all.
+const char* const kLayoutOptions[] = {"--layout",  "--goal",        "--max-bytes",        "--max-error",
+                                      "--gpu",     "--trial",       "--leaf",             "--splitter",
+                                      "--order",   "--lbvh-depth",  "--lbvh-left-first",  "--grouping",
+                                      "--no-triangle-ids", "--pairing", "--no-shuffle",   "--no-box-cache",
+                                      "--hybrid-leaf"};
+
+// NaN passes CLI11's NonNegativeNumber; "no limit" is 0, so NaN and
+// infinity are refused.
+void check_limit(const char* option, double value) {
+  if (!std::isfinite(value))
+    throw InputError(std::string(option) + " " + (std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf") +
+                     ": a finite number at least 0 (0: no limit)");
+}
+
+}  // namespace
+
 void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
+  a.command = cmd;
   cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh, or auto (chosen for the mesh)");
   cmd->add_option("--goal", a.goal, "auto: speed (fastest) or memory (fewest bytes)");
   cmd->add_option("--max-bytes", a.max_bytes, "auto: at most this many blob bytes a triangle (0: no limit)")
@@ -71,7 +94,8 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
       ->check(CLI::Range(8u, uint32_t(MC_ZBT_MAX_TRIANGLES)));
 }
 
-Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* report) {
+// load_input's work once the limits are checked.
+static Loaded load_as_asked(const std::string& path, const LayoutArgs& a, std::FILE* report) {
   const LayoutArgs defaults;
   const bool automatic = a.layout == "auto";
   // Options that would be silently dropped are refused instead.
@@ -102,6 +126,18 @@ Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* repor
   });
 }
 
+Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* report) {
+  check_limit("--max-bytes", a.max_bytes);
+  check_limit("--max-error", a.max_error);
+  Loaded in = load_as_asked(path, a, report);
+  if (!in.mesh && a.command)
+    for (const char* option : kLayoutOptions)
+      if (a.command->count(option) > 0)
+        throw InputError(path + ": is a blob, whose layout was fixed when it was built; " + option +
+                         " applies only to a mesh input");
+  return in;
+}
+
 BuildOptions build_options(const LayoutArgs& a) {
   BuildOptions o = layout_options(a.layout, a.leaf, a.splitter);
   if (!a.order.empty()) o.node_order = parse_node_order(a.order);
@@ -112,6 +148,10 @@ BuildOptions build_options(const LayoutArgs& a) {
   o.triangle_ids = !a.no_triangle_ids;
   o.zbt_shuffle = !a.zbt_no_shuffle, o.zbt_box_cache = !a.zbt_no_cache, o.hybrid_leaf = a.hybrid_leaf;
   return o;
+}
+
+void print_json(const nlohmann::ordered_json& object) {
+  std::printf("%s\n", object.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
 }
 
 double median(std::vector<double> v) {

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cpu/encode.h"
 #include "cpu/mesh.h"
 
@@ -41,5 +43,10 @@ struct SectionBytes {
 SectionBytes section_bytes(const std::vector<uint8_t>& blob);
 
 void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+
+// One JSON object on a line of stdout, written by nlohmann::json: strings are
+// escaped, bytes that are not UTF-8 (a path's) become U+FFFD, NaN and
+// infinities become null. Keys stay in the order given.
+void print_json(const nlohmann::ordered_json& object);
 
 }  // namespace meshcast::tools

@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "cpu/mesh.h"
+#include "cpu/rays.h"
 #include "gpu/vulkan.h"
 #include "tools/commands.h"
 
@@ -22,6 +23,9 @@ int main(int argc, char** argv) {
   } catch (const meshcast::InputError& e) {
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return 2;
+  } catch (const meshcast::OutputError& e) {  // an output file not written (a full disk, no permission)
+    std::fprintf(stderr, "meshcast: %s\n", e.what());
+    return 4;
   } catch (const meshcast::gpu::GpuError& e) {  // no Vulkan, no such device: the CPU path still works
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return 3;

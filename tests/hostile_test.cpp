@@ -1,0 +1,202 @@
+// Hostile input (issue 17): what an adversarial run found, one test per
+// defect, each on files the test makes itself. The wrong answers at large
+// coordinates are probed on every layout and every Vulkan method by the
+// stiff suite (robustness_test.cpp: ExtremeMagnitudesAndDirectionLengths,
+// LargeCoordinatesHitTheNearTriangle); the command line's side (exit codes,
+// --json, --out /dev/full, --device, --count) by cli_test.sh.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cpu/encode.h"
+#include "cpu/rays.h"
+#include "io/generate.h"
+#include "io/read_mesh.h"
+#include "layout/blob.h"
+#include "tests/testing.h"
+
+namespace fs = std::filesystem;
+
+namespace meshcast::testing {
+namespace {
+
+fs::path scratch() {
+  static fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("meshcast_hostile_test_" + std::to_string(getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::string make_file(const std::string& name, const std::string& bytes) {
+  const std::string path = (scratch() / name).string();
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+// `f` must throw E whose message holds every one of `words`.
+template <class E, class F>
+void expect_throws(F&& f, std::initializer_list<std::string> words) {
+  try {
+    f();
+    ADD_FAILURE() << "no error; expected one naming '" << *words.begin() << "'";
+  } catch (const E& e) {
+    const std::string msg = e.what();
+    for (const std::string& w : words) EXPECT_NE(msg.find(w), std::string::npos) << "'" << w << "' not in: " << msg;
+  }
+}
+
+const char* kSquare = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n";
+
+// 2. A `tristrips` element: Assimp kept 1 of the 2 triangles of a strip (1 of
+// 4 with a restart); refused, naming the file and the element.
+TEST(Hostile, PlyTriangleStripsAreRefused) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n";
+  const std::string path = make_file("strip.ply", header + kSquare + "4 0 1 3 2\n");
+  expect_throws<InputError>([&] { read_mesh(path); }, {"strip.ply", "tristrips"});
+  const std::string restart = make_file("restart.ply", header + kSquare + "7 0 1 3 -1 1 2 3\n");
+  expect_throws<InputError>([&] { read_mesh(restart); }, {"restart.ply", "tristrips"});
+}
+
+// 2. A vertex element without z was read with z = 0; refused, naming the
+// property (and x, y likewise).
+TEST(Hostile, PlyVertexWithoutACoordinateIsRefused) {
+  for (const char* missing : {"x", "y", "z"}) {
+    std::string props;
+    for (const char* axis : {"x", "y", "z"})
+      if (std::strcmp(axis, missing) != 0) props += std::string("property float ") + axis + "\n";
+    const std::string path = make_file(std::string("no_") + missing + ".ply",
+                                       "ply\nformat ascii 1.0\nelement vertex 3\n" + props +
+                                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                           "0 0\n1 0\n0 1\n3 0 1 2\n");
+    expect_throws<InputError>([&] { read_mesh(path); }, {path, std::string("no '") + missing + "' property"});
+  }
+}
+
+// 3. A denormal coordinate (7.5e-43, as a script writes a sphere of radius
+// 1e-10) was refused as "reads differently in Assimp"; the exact value is read.
+TEST(Hostile, PlyDenormalCoordinatesReadExactly) {
+  const std::string path =
+      make_file("denormal.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                "7.5e-43 0 0\n1e-10 -3e-44 0\n0 1e-10 1.4e-45\n3 0 1 2\n");
+  const Mesh m = read_mesh(path);
+  ASSERT_EQ(m.vertices.size(), 3u);
+  EXPECT_EQ(m.vertices[0].x, 7.5e-43f);
+  EXPECT_EQ(m.vertices[1].y, -3e-44f);
+  EXPECT_EQ(m.vertices[2].z, 1.4e-45f);
+  EXPECT_EQ(m.triangles.size(), 1u);
+}
+
+// 3. ZeroByteHybrid refused a 6,400-triangle sphere of radius 1e-30 as deeper
+// than 64 levels (float SAH areas underflowed to 0, so every split cost the
+// same); it builds, and answers as the oracle does, as every layout must.
+TEST(Hostile, TinySphereBuildsInEveryLayout) {
+  const Mesh s = make_sphere(41, 80, 1e-30f, {0, 0, 0});
+  ASSERT_GE(s.triangles.size(), 6400u);
+  const std::vector<Ray> rays = make_rays(s, RayKind::Long, 300, 3);
+  for (const std::string& layout : layout_names()) {
+    const std::vector<uint8_t> blob = build_blob(s, parse_layout(layout), "sphere of radius 1e-30");
+    expect_oracle(s, blob, rays, trace_all(blob, rays), layout);
+    EXPECT_LE(layout::header_of(blob.data()).max_depth, 40u) << layout;
+  }
+}
+
+// 4. Output to a full disk exited 0 with nothing written: every write is
+// checked. /dev/full is written in place (renaming over a device would
+// replace it) and fails with the path and the reason.
+TEST(Hostile, WritesToAFullDeviceFail) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
+  const std::vector<Ray> rays(3, Ray{{0, 0, 0}, {0, 0, 1}, INFINITY});
+  expect_throws<OutputError>([&] { write_rays("/dev/full", rays); }, {"/dev/full", "No space left"});
+  expect_throws<OutputError>([&] { write_hits("/dev/full", std::vector<Hit>(5)); }, {"/dev/full", "No space left"});
+  expect_throws<OutputError>([&] { write_file("/dev/full", "x", 1); }, {"/dev/full", "No space left"});
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+}
+
+// 4. A regular file is written beside its name and renamed: a write that
+// fails (here the file-size limit, as a full disk would) leaves the old file
+// whole and no partial file behind.
+TEST(Hostile, AFailedWriteLeavesNoPartialFile) {
+  const fs::path dir = scratch() / "aside";
+  fs::create_directories(dir);
+  const std::string path = (dir / "m.blob").string();
+  write_file(path, "old", 3);
+  const std::vector<uint8_t> big(1 << 16, 7);
+  struct rlimit before;
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &before), 0);
+  struct rlimit small = before;
+  small.rlim_cur = 4096;
+  auto old_handler = std::signal(SIGXFSZ, SIG_IGN);  // the write then fails with EFBIG
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  expect_throws<OutputError>([&] { write_file(path, big.data(), big.size()); }, {path, "write"});
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &before), 0);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(read_file(path), std::vector<uint8_t>({'o', 'l', 'd'}));
+  size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 1u) << "a partial file was left beside " << path;
+  write_file(path, big.data(), big.size());
+  EXPECT_EQ(read_file(path), big);
+}
+
+// 5. A directory ended in std::bad_alloc, /dev/zero was read until memory ran
+// out: both are refused before any read, naming the path.
+TEST(Hostile, DirectoriesAndDevicesAreRefusedBeforeReading) {
+  const std::string dir = scratch().string();
+  expect_throws<InputError>([&] { read_file(dir); }, {dir, "is a directory"});
+  expect_throws<InputError>([&] { read_rays(dir); }, {dir, "is a directory"});
+  expect_throws<InputError>([&] { read_mesh(dir); }, {dir, "is a directory"});
+  const std::string off_dir = (scratch() / "mesh.off").string();
+  fs::create_directories(off_dir);
+  expect_throws<InputError>([&] { read_mesh(off_dir); }, {off_dir, "is a directory"});
+  if (fs::exists("/dev/zero")) {
+    expect_throws<InputError>([&] { read_mesh("/dev/zero"); }, {"/dev/zero", "not a regular file"});
+    expect_throws<InputError>([&] { read_file("/dev/zero"); }, {"/dev/zero", "not a regular file"});
+  }
+}
+
+// 5. A truncated binary STL got Assimp's "Failed to determine STL storage
+// representation"; the message now gives the facet count and both sizes.
+TEST(Hostile, TruncatedBinaryStlSaysSo) {
+  std::string stl(80, ' ');
+  const uint32_t facets = 2;
+  stl.append(reinterpret_cast<const char*>(&facets), 4);
+  stl.append(50 + 20, '\0');  // one whole facet and part of the second
+  const std::string path = make_file("cut.stl", stl);
+  expect_throws<InputError>([&] { read_mesh(path); }, {"cut.stl", "truncated", "2 facets", "184 bytes", "154 bytes"});
+  const std::string tiny = make_file("tiny.stl", "abc");
+  expect_throws<InputError>([&] { read_mesh(tiny); }, {"tiny.stl", "3 bytes"});
+}
+
+// 5. More rays than a rays file may hold are refused before any copy.
+TEST(Hostile, RayCountLimitIsNamed) {
+  EXPECT_EQ(kMaxRayCount, size_t(1) << 27);
+  std::string rays(8, '\0');
+  std::memcpy(rays.data(), "RAYS", 4);
+  const uint32_t n = 0xFFFFFFFFu;
+  std::memcpy(rays.data() + 4, &n, 4);
+  const std::string path = make_file("huge.rays", rays);
+  expect_throws<InputError>([&] { read_rays(path); }, {"huge.rays", "4294967295 records"});
+}
+
+}  // namespace
+}  // namespace meshcast::testing
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  const int rc = RUN_ALL_TESTS();
+  std::error_code ec;
+  fs::remove_all(meshcast::testing::scratch(), ec);
+  return rc;
+}

@@ -3,13 +3,15 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "cpu/rays.h"
+
 namespace meshcast::bench {
 
 std::string plot_scatter(const std::string& png, const std::string& title, const std::string& xlabel,
                          const std::string& ylabel, const std::vector<Series>& series, bool log_y, bool log_x,
                          bool lines) {
   std::string script = png + ".gp";
-  std::ofstream gp(script);
+  OutputText gp(script);
   size_t points = 0;
   for (const Series& s : series) points += s.points.size();
   // Many labelled points (one per tree and encoding) need room.
@@ -34,7 +36,7 @@ std::string plot_scatter(const std::string& png, const std::string& title, const
       for (const Point& p : s.points) gp << p.x << " " << p.y << " \"" << p.label << "\"\n";
       gp << "e\n";
     }
-  gp.close();
+  gp.commit();
   if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) return "gnuplot not installed (apt-get install gnuplot-nox)";
   if (std::system(("gnuplot '" + script + "'").c_str()) != 0) return "gnuplot failed on " + script;
   return "";

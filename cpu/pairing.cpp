@@ -11,10 +11,11 @@ namespace meshcast {
 namespace {
 
 // The surface area of the box of the edge p-q. Computed from the edge's
-// canonical ends, so both half-edges of a twin get the same bits.
-float edge_box_area(const Vec3& p, const Vec3& q) {
-  const float ex = std::fabs(q.x - p.x), ey = std::fabs(q.y - p.y), ez = std::fabs(q.z - p.z);
-  return 2.0f * (ex * ey + ey * ez + ez * ex);
+// canonical ends, so both half-edges of a twin get the same bits; in double,
+// so edges of meshes near 1e-30 or 1e20 neither underflow to 0 nor overflow.
+double edge_box_area(const Vec3& p, const Vec3& q) {
+  const double ex = std::fabs(double(q.x) - p.x), ey = std::fabs(double(q.y) - p.y), ez = std::fabs(double(q.z) - p.z);
+  return 2.0 * (ex * ey + ey * ez + ez * ex);
 }
 
 bool share_edge_by_index(const Triangle& a, const Triangle& b) {
@@ -57,7 +58,7 @@ std::vector<HalfEdge> half_edge_table(const Mesh& mesh) {
 
 std::vector<CompressedEdge> compressed_edge_table(const Mesh& mesh) {
   const Box3 box = mesh.bounds();
-  float largest = 0;
+  double largest = 0;
   for (uint32_t t = 0; t < mesh.triangles.size(); ++t)
     for (int k = 0; k < 3; ++k) largest = std::max(largest, edge_box_area(mesh.corner(t, k), mesh.corner(t, (k + 1) % 3)));
   std::vector<CompressedEdge> table;

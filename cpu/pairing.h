@@ -23,7 +23,7 @@
 namespace meshcast {
 
 struct HalfEdge {
-  float area;               // surface area of the edge's axis-aligned box
+  double area;              // surface area of the edge's axis-aligned box (double: see edge_box_area)
   uint32_t first, second;   // vertex indices, first < second
   uint32_t triangle;
 };

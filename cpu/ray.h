@@ -26,6 +26,9 @@
 
 namespace meshcast {
 
+// The largest direction component a ray may have (ray_is_walkable).
+constexpr float kMaxDirection = 0x1p126f;
+
 struct Ray {
   float org[3];
   float dir[3];
@@ -45,13 +48,15 @@ struct Hit {
 static_assert(sizeof(Hit) == 28, "the Vulkan methods' hit record (shaders/hits.glsl) is the same 7 words");
 
 // A ray the walkers may walk: an origin within +-2^100 (the coordinate
-// range of meshes, kMaxCoordinate), a finite direction that is not zero
-// (nor below FLT_MIN), t_max not NaN and not negative (infinity allowed).
-// Any other ray is answered as a miss and counted. Within these ranges every
-// ray-space quantity of the triangle test fits a double (see kSettleTiny).
+// range of meshes, kMaxCoordinate), direction components within +-2^126
+// (so every reciprocal the tests use, 1/dir and the shear's sz, is a normal
+// float: a GPU may flush denormals to 0) and not all below FLT_MIN, t_max
+// not NaN and not negative (infinity allowed). Any other ray is answered as
+// a miss and counted. Within these ranges every ray-space quantity of the
+// triangle test fits a double (see kSettleTiny).
 inline bool ray_is_walkable(const Ray& r) {
   for (int a = 0; a < 3; ++a)
-    if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !std::isfinite(r.dir[a])) return false;
+    if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !(std::fabs(r.dir[a]) <= kMaxDirection)) return false;
   // A direction whose largest component is below FLT_MIN counts as zero:
   // its reciprocal would overflow.
   float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
@@ -147,7 +152,7 @@ struct LaneHit {
 // Below this a determinant or T has lost bits to underflow (products of
 // coordinates near 1e-20 and smaller): such lanes are settled in double.
 // Every ray-space value the double redo forms stays inside double's normal
-// range: sheared coordinates are floats within +-2^102, sz within 2^-128..2^126,
+// range: sheared coordinates are floats within +-2^102, sz within 2^-126..2^126,
 // so products lie between 2^-575 and 2^433.
 constexpr float kSettleTiny = 0x1p-100f;
 
@@ -158,15 +163,18 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
                             const float cy, const float az, const float bz, const float cz, const float sz,
                             float closest, LaneHit* out);
 
-// Lanes whose float det and T can be trusted: finite (no overflow, no
-// inf - inf) and at least kSettleTiny in magnitude (no underflow). A lane
-// inside all three edges that fails this is settled in double, as are the
-// lanes with an edge function of exactly 0.
+// Lanes whose float det and T can be trusted: T finite (no overflow, no
+// inf - inf), det below 2^126 (Vulkan bounds a float division's error only
+// for divisors up to 2^126; a GPU's reciprocal of a larger one may flush to
+// 0 and give t = 0), both at least kSettleTiny in magnitude (no underflow).
+// A lane inside all three edges that fails this is settled in double, as
+// are the lanes with an edge function of exactly 0. The shaders test the
+// same (watertight.glsl), so both sides settle the same lanes alike.
 template <class F4>
 inline auto float_settles(const F4& det, const F4& T) {
-  const F4 tiny = F4::splat(kSettleTiny), inf = F4::splat(INFINITY);
+  const F4 tiny = F4::splat(kSettleTiny), huge = F4::splat(0x1p126f), inf = F4::splat(INFINITY);
   const F4 d = simd::abs(det), a = simd::abs(T);
-  return (d >= tiny) & (d < inf) & (a >= tiny) & (a < inf);
+  return (d >= tiny) & (d < huge) & (a >= tiny) & (a < inf);
 }
 
 // The lanes of `redo` settled in double: corners in ray space (x, y of the

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <bit>
+#include <filesystem>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -102,16 +103,48 @@ std::vector<uint8_t> read_file(const std::string& path) {
   return bytes;
 }
 
+void OutputText::commit() {
+  const std::string text = str();
+  write_file(path_, text.data(), text.size());
+}
+
+namespace {
+
+// The mode a new file gets from open(..., 0666): 0666 less the umask, read
+// from /proc (umask() itself would change it for every thread a moment).
+mode_t new_file_mode() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("Umask:", 0) == 0) return mode_t(0666 & ~std::stoul(line.substr(6), nullptr, 8));
+  return 0644;
+}
+
+}  // namespace
+
 void write_file(const std::string& path, std::initializer_list<Bytes> pieces) {
   auto failed = [&](const char* what, int err) {
     return OutputError(path + ": cannot write the file (" + what + ": " + std::strerror(err) + ")");
   };
-  // A device or pipe is written in place: renaming over it would replace it.
+  // Written beside its name and renamed over it: a regular file or a new
+  // path. In place: a device or pipe (renaming would replace it), a
+  // symbolic link (renaming would replace the link, not what it names:
+  // /dev/stdout), and an existing file in a folder we may not create in.
   struct stat st;
-  const bool in_place = ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode);
-  std::string temp = path + ".partial-XXXXXX";
-  const int fd = in_place ? ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC) : ::mkstemp(temp.data());
-  if (fd < 0) throw failed("open", errno);
+  const bool exists = ::lstat(path.c_str(), &st) == 0;
+  bool in_place = exists && !S_ISREG(st.st_mode);
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  std::string temp = (folder.empty() ? std::string(".") : folder) + "/.meshcast-XXXXXX";
+  int fd = -1;
+  if (!in_place) {
+    fd = ::mkostemp(temp.data(), O_CLOEXEC);
+    if (fd < 0 && exists && (errno == EACCES || errno == EPERM || errno == EROFS)) in_place = true;
+    else if (fd < 0) throw failed("create", errno);
+  }
+  if (in_place) {
+    fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+    if (fd < 0) throw failed("open", errno);
+  }
   int err = 0;
   const char* step = "write";
   for (const Bytes& b : pieces) {
@@ -123,7 +156,9 @@ void write_file(const std::string& path, std::initializer_list<Bytes> pieces) {
       else p += n, left -= size_t(n);
     }
   }
-  if (!err && !in_place && ::fchmod(fd, 0644) != 0) err = errno, step = "chmod";
+  // A replaced file keeps its mode; a new one gets what open() would give.
+  const mode_t mode = exists ? (st.st_mode & 07777) : new_file_mode();
+  if (!err && !in_place && ::fchmod(fd, mode) != 0) err = errno, step = "chmod";
   if (!err && !in_place && ::fsync(fd) != 0) err = errno, step = "flush";
   if (::close(fd) != 0 && !err) err = errno, step = "close";
   if (!err && !in_place && ::rename(temp.c_str(), path.c_str()) != 0) err = errno, step = "rename";

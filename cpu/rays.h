@@ -4,6 +4,7 @@
 // All little-endian.
 #pragma once
 #include <initializer_list>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -55,6 +56,17 @@ struct Bytes {
   size_t size;
 };
 std::vector<uint8_t> read_file(const std::string& path);
+
+// Text output (CSV, plot scripts, profiles): built in memory, then written
+// by write_file when commit() is called, so it is checked the same way.
+class OutputText : public std::ostringstream {
+ public:
+  explicit OutputText(std::string path) : path_(std::move(path)) {}
+  void commit();
+
+ private:
+  std::string path_;
+};
 void write_file(const std::string& path, std::initializer_list<Bytes> pieces);
 inline void write_file(const std::string& path, const void* data, size_t size) { write_file(path, {{data, size}}); }
 

@@ -1,3 +1,4 @@
+#include "cpu/rays.h"
 #include "host/caster.h"
 
 #include <algorithm>
@@ -413,8 +414,9 @@ void Caster::measure_crossover() {
   note << "; measured at start-up";
   crossover_note_ = note.str();
   if (!options_.profile.empty()) {
-    std::ofstream out(options_.profile);
+    OutputText out(options_.profile);
     out << "meshcast-profile 1\n" << key << "\n" << crossover_ << "\n" << crossover_note_ << "\n";
+    out.commit();
   }
 }
 

@@ -373,8 +373,14 @@ void check_stl_layout(const std::string& path, std::string_view text) {
   uint32_t n = 0;
   if (text.size() >= 84) std::memcpy(&n, text.data() + 80, 4);
   if (text.size() >= 84 && text.size() == 84 + 50ull * n) return;
+  // Text: starts with `solid` and is text throughout (many binary writers
+  // put `solid` in their 80-byte header too, then floats follow).
   const size_t first = text.find_first_not_of(" \t\r\n");
-  if (first != std::string_view::npos && text.substr(first, 5) == "solid") return;
+  const bool ascii = std::all_of(text.begin(), text.end(), [](char c) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    return (u >= 0x20 && u < 0x7f) || u == '\t' || u == '\n' || u == '\r' || u == '\f' || u == '\v';
+  });
+  if (first != std::string_view::npos && text.substr(first, 5) == "solid" && ascii) return;
   if (text.size() < 84)
     fail(path, "malformed file: " + std::to_string(text.size()) +
                    " bytes, neither ASCII STL (no 'solid') nor binary STL (an 84-byte header at least)");

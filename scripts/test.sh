@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: the Release build, then every CPU suite and the fuzz
 # corpora under AddressSanitizer/UBSan, the host layer under ThreadSanitizer,
-# the portable scalar build (MESHCAST_SCALAR) through the same tests, and
-# last the fuzz targets under libFuzzer for a bounded time (scripts/fuzz.sh).
+# the CPU suites on the portable scalar build (MESHCAST_SCALAR), and last the
+# fuzz targets under libFuzzer for a bounded time (scripts/fuzz.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -11,23 +11,28 @@ jobs=$(nproc)
 echo "== Release (AVX2)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900
 
+# The CPU suites, run one process a suite, $jobs at a time (CTest's one
+# process a test would load the meshes and compute the oracle's answers again
+# for every test), with MESHCAST_TEST_QUICK: bunny00 and the generated meshes
+# only, fewer rays a set (the Release run walks all of them). A failing
+# suite prints its log; xargs waits for the others and fails the pipeline.
+cpu_suites=(walker_test robustness_test auto_test build_test layout_test oracle_test io_test pairing_test zerobyte_test
+            limits_test hostile_test)
+run_suites() {  # run_suites BUILD_DIR
+  printf '%s\n' "${cpu_suites[@]}" |
+    env MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp" \
+      xargs -P"$jobs" -I{} sh -c "$1"'/bin/{} --gtest_brief=1 > '"$1"'/{}.log 2>&1 && echo "  {}: passed" ||
+                                 { echo "  {}: FAILED"; tail -50 '"$1"'/{}.log; exit 1; }'
+}
+
 echo "== AddressSanitizer + UBSan: every CPU test suite and the fuzz corpora"
 # The Vulkan suites stay out of this build: lavapipe and the loader are not
 # instrumented (their own allocations would read as leaks); they run in the
 # Release build above and the host layer under TSan below.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_SANITIZE=ON >/dev/null
-asan_suites=(walker_test robustness_test auto_test build_test layout_test oracle_test io_test pairing_test zerobyte_test
-             limits_test hostile_test)
-cmake --build build-asan -j"$jobs" --target "${asan_suites[@]}" blob_fuzz mesh_fuzz
-# One process a suite, $jobs at a time (CTest's one process a test would
-# load the meshes and compute the oracle's answers again for every test),
-# with MESHCAST_TEST_QUICK: bunny00 and the generated meshes only, fewer
-# rays a set (the Release and scalar runs walk all of them). A failing suite
-# prints its log; xargs waits for the others and fails the pipeline.
-asan_env=(env MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp")
-printf '%s\n' "${asan_suites[@]}" |
-  "${asan_env[@]}" xargs -P"$jobs" -I{} sh -c 'build-asan/bin/{} --gtest_brief=1 > build-asan/{}.log 2>&1 && echo "  {}: passed" ||
-                                              { echo "  {}: FAILED"; tail -50 build-asan/{}.log; exit 1; }'
+cmake --build build-asan -j"$jobs" --target "${cpu_suites[@]}" blob_fuzz mesh_fuzz
+run_suites build-asan
+asan_env=(env MESHCAST_DATA="$PWD/data" LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp")
 "${asan_env[@]}" build-asan/bin/blob_fuzz fuzz/corpus/blob
 "${asan_env[@]}" build-asan/bin/mesh_fuzz fuzz/corpus/mesh
 
@@ -38,10 +43,12 @@ cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHCAST_TSAN=ON >/
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 
-echo "== Portable scalar path, with the box and triangle test counters compiled in"
+echo "== Portable scalar path, with the box and triangle test counters compiled in: the CPU suites"
+# The scalar build changes only cpu/simd.h's lanes: the CPU suites (quick, as
+# under ASan) cover it; the Vulkan suites read the same shaders as Release.
 cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON >/dev/null
-cmake --build build-scalar -j"$jobs"
-ctest --test-dir build-scalar --output-on-failure -j"$jobs" --timeout 900
+cmake --build build-scalar -j"$jobs" --target "${cpu_suites[@]}"
+run_suites build-scalar
 
 echo "== libFuzzer: the blob validator + walker and the mesh reader + builder"
 bash scripts/fuzz.sh

@@ -2,7 +2,8 @@
 // operation for operation: every product and difference is `precise`, so no
 // compiler fuses them into an fma and both triangles of a shared edge get
 // the same roundings; a lane float cannot settle (an edge function of 0, a
-// det or T that overflowed or fell below kSettleTiny) is redone in double,
+// det or T that overflowed or fell below kSettleTiny, a det of 2^126 or more,
+// beyond the divisors Vulkan bounds a division's error for) is redone in double,
 // as on the CPU. Two-sided; accepts t in [0, closest]; a t past the largest
 // float is no hit.
 #ifndef MESHCAST_WATERTIGHT_GLSL
@@ -11,6 +12,7 @@
 #define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/ray.h kSettleTiny
 #define kFloatMax uintBitsToFloat(0x7F7FFFFFu)
 #define kFloatInf uintBitsToFloat(0x7F800000u)
+#define kDivisorMax uintBitsToFloat(0x7E800000u)  // 2^126: Vulkan bounds a division's error up to this divisor
 
 // Corners in ray space: sheared x, y, and z not yet scaled by sz.
 bool watertight_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
@@ -47,7 +49,7 @@ bool watertight(GpuRay r, vec3 a, vec3 b, vec3 c, float closest, out float t, ou
   precise float det = U + V + W;
   precise float T = U * (r.sz * az) + V * (r.sz * bz) + W * (r.sz * cz);
   const float dets = abs(det), Tabs = abs(T);
-  if (!(dets >= kSettleTiny && dets < kFloatInf && Tabs >= kSettleTiny && Tabs < kFloatInf))
+  if (!(dets >= kSettleTiny && dets < kDivisorMax && Tabs >= kSettleTiny && Tabs < kFloatInf))
     return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
   const float Ts = det < 0.0 ? -T : T;
   if (!(Ts >= 0.0)) return false;

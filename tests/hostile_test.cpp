@@ -3,7 +3,8 @@
 // coordinates are probed on every layout and every Vulkan method by the
 // stiff suite (robustness_test.cpp: ExtremeMagnitudesAndDirectionLengths,
 // LargeCoordinatesHitTheNearTriangle); the command line's side (exit codes,
-// --json, --out /dev/full, --device, --count) by cli_test.sh.
+// --json, --out /dev/full, a write cut short, links, --device, --count,
+// NaN limits, layout options with a blob) by cli_test.sh.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -25,21 +26,6 @@ namespace fs = std::filesystem;
 
 namespace meshcast::testing {
 namespace {
-
-fs::path scratch() {
-  static fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("meshcast_hostile_test_" + std::to_string(getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-std::string make_file(const std::string& name, const std::string& bytes) {
-  const std::string path = (scratch() / name).string();
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
-}
 
 // `f` must throw E whose message holds every one of `words`.
 template <class E, class F>
@@ -128,7 +114,7 @@ TEST(Hostile, WritesToAFullDeviceFail) {
 // fails (here the file-size limit, as a full disk would) leaves the old file
 // whole and no partial file behind.
 TEST(Hostile, AFailedWriteLeavesNoPartialFile) {
-  const fs::path dir = scratch() / "aside";
+  const fs::path dir = scratch_dir() / "aside";
   fs::create_directories(dir);
   const std::string path = (dir / "m.blob").string();
   write_file(path, "old", 3);
@@ -153,11 +139,11 @@ TEST(Hostile, AFailedWriteLeavesNoPartialFile) {
 // 5. A directory ended in std::bad_alloc, /dev/zero was read until memory ran
 // out: both are refused before any read, naming the path.
 TEST(Hostile, DirectoriesAndDevicesAreRefusedBeforeReading) {
-  const std::string dir = scratch().string();
+  const std::string dir = scratch_dir().string();
   expect_throws<InputError>([&] { read_file(dir); }, {dir, "is a directory"});
   expect_throws<InputError>([&] { read_rays(dir); }, {dir, "is a directory"});
   expect_throws<InputError>([&] { read_mesh(dir); }, {dir, "is a directory"});
-  const std::string off_dir = (scratch() / "mesh.off").string();
+  const std::string off_dir = (scratch_dir() / "mesh.off").string();
   fs::create_directories(off_dir);
   expect_throws<InputError>([&] { read_mesh(off_dir); }, {off_dir, "is a directory"});
   if (fs::exists("/dev/zero")) {
@@ -179,24 +165,5 @@ TEST(Hostile, TruncatedBinaryStlSaysSo) {
   expect_throws<InputError>([&] { read_mesh(tiny); }, {"tiny.stl", "3 bytes"});
 }
 
-// 5. More rays than a rays file may hold are refused before any copy.
-TEST(Hostile, RayCountLimitIsNamed) {
-  EXPECT_EQ(kMaxRayCount, size_t(1) << 27);
-  std::string rays(8, '\0');
-  std::memcpy(rays.data(), "RAYS", 4);
-  const uint32_t n = 0xFFFFFFFFu;
-  std::memcpy(rays.data() + 4, &n, 4);
-  const std::string path = make_file("huge.rays", rays);
-  expect_throws<InputError>([&] { read_rays(path); }, {"huge.rays", "4294967295 records"});
-}
-
 }  // namespace
 }  // namespace meshcast::testing
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  const int rc = RUN_ALL_TESTS();
-  std::error_code ec;
-  fs::remove_all(meshcast::testing::scratch(), ec);
-  return rc;
-}

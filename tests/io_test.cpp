@@ -14,26 +14,13 @@
 
 #include "io/generate.h"
 #include "io/read_mesh.h"
+#include "tests/testing.h"
 
 namespace fs = std::filesystem;
 using namespace meshcast;
+using meshcast::testing::make_file;
 
 namespace {
-
-fs::path temp_dir() {
-  static fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("meshcast_io_test_" + std::to_string(getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-std::string write_file(const std::string& name, const std::string& bytes) {
-  std::string path = (temp_dir() / name).string();
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
-}
 
 // The reference polygon set: a triangle, a quad and a pentagon over 6 vertices.
 // 0.1 is not exactly representable: checks correct rounding of text formats.
@@ -79,7 +66,7 @@ void expect_error(const std::string& path, const std::string& word) {
 }  // namespace
 
 TEST(ReadMesh, OffKeepsIndexingAndFanOrder) {
-  std::string p = write_file("a.off", std::string("OFF\n# comment\n6 3 0\n") + kVertText +
+  std::string p = make_file("a.off", std::string("OFF\n# comment\n6 3 0\n") + kVertText +
                                            "3 0 1 2\n4 0 1 2 3\n5 0 1 4 5 2\n");
   expect_same(read_mesh(p), kVerts, kFanned);
 }
@@ -87,14 +74,14 @@ TEST(ReadMesh, OffKeepsIndexingAndFanOrder) {
 TEST(ReadMesh, ObjRestoresSharedVerticesAcrossGroups) {
   // Assimp splits this into several aiMeshes and unrolls the corners; the
   // reader must give back the file's 6 vertices and its face order.
-  std::string p = write_file("a.obj", std::string("# test\n") + "v 0.1 0 0\nv 1 0 0\nv 1 1 0.5\n" +
+  std::string p = make_file("a.obj", std::string("# test\n") + "v 0.1 0 0\nv 1 0 0\nv 1 1 0.5\n" +
                                            "g one\nf 1 2 3\nv 0 1 0\nv 2 0 -3\nv 2 1 0.001\nusemtl m\n" +
                                            "f 1/1 2/2 3/3 4/4\ng two\nl 1 2\nf -6//1 -5//1 5//1 6//1 3//1\n");
   expect_same(read_mesh(p), kVerts, kFanned);
 }
 
 TEST(ReadMesh, PlyAscii) {
-  std::string p = write_file("a.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n5 0 1 4 5 2\n");
+  std::string p = make_file("a.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n5 0 1 4 5 2\n");
   expect_same(read_mesh(p), kVerts, kFanned);
   // Windows line ends in the header and a UTF-8 comment are still PLY.
   std::string header = ply_header("binary_little_endian");
@@ -102,11 +89,11 @@ TEST(ReadMesh, PlyAscii) {
   for (char c : header.substr(0, header.size() - 11)) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
   crlf += "comment auteur Zo\xc3\xab\r\nend_header\n";
   std::string bin = binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}});
-  expect_same(read_mesh(write_file("crlf.ply", crlf + bin.substr(header.size()))), kVerts, kFanned);
+  expect_same(read_mesh(make_file("crlf.ply", crlf + bin.substr(header.size()))), kVerts, kFanned);
 }
 
 TEST(ReadMesh, PlyBinary) {
-  std::string p = write_file("b.ply", binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}}));
+  std::string p = make_file("b.ply", binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}}));
   expect_same(read_mesh(p), kVerts, kFanned);
 }
 
@@ -126,7 +113,7 @@ TEST(ReadMesh, StlAsciiAndBinary) {
   }
   a += "endsolid one\n";
   const std::vector<Triangle> tris = {{0, 1, 2}, {3, 4, 5}};
-  expect_same(read_mesh(write_file("a.stl", a)), kVerts, tris);
+  expect_same(read_mesh(make_file("a.stl", a)), kVerts, tris);
 
   std::string b(80, '\0');
   uint32_t n = 2;
@@ -137,66 +124,66 @@ TEST(ReadMesh, StlAsciiAndBinary) {
     for (int k = 0; k < 3; ++k) b.append(reinterpret_cast<const char*>(&kVerts[f * 3 + k]), 12);
     b.append(2, '\0');
   }
-  expect_same(read_mesh(write_file("b.stl", b)), kVerts, tris);
+  expect_same(read_mesh(make_file("b.stl", b)), kVerts, tris);
 }
 
 TEST(ReadMeshErrors, MissingUnknownMalformed) {
-  expect_error((temp_dir() / "no_such_file.off").string(), "cannot open");
-  expect_error(write_file("mesh.xyz", "1 2 3\n"), "unknown format");
-  expect_error(write_file("garbage.off", "hello world\n"), "malformed");
-  expect_error(write_file("garbage_index.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 x 2\n"), "malformed");
-  expect_error(write_file("truncated.off", std::string("OFF\n6 2 0\n") + kVertText + "3 0 1 2\n"), "ends after");
-  expect_error(write_file("garbage.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n"), "malformed");
+  expect_error((meshcast::testing::scratch_dir() / "no_such_file.off").string(), "cannot open");
+  expect_error(make_file("mesh.xyz", "1 2 3\n"), "unknown format");
+  expect_error(make_file("garbage.off", "hello world\n"), "malformed");
+  expect_error(make_file("garbage_index.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 x 2\n"), "malformed");
+  expect_error(make_file("truncated.off", std::string("OFF\n6 2 0\n") + kVertText + "3 0 1 2\n"), "ends after");
+  expect_error(make_file("garbage.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n"), "malformed");
   // Assimp hangs on a PLY header without end_header and reads past the end of
   // truncated PLY files; the reader checks the layout first.
-  expect_error(write_file("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), "end_header");
-  expect_error(write_file("short.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n"), "truncated");
+  expect_error(make_file("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), "end_header");
+  expect_error(make_file("short.ply", ply_header("ascii") + kVertText + "3 0 1 2\n4 0 1 2 3\n"), "truncated");
   std::string bin = binary_ply({{0, 1, 2}, {0, 1, 2, 3}, {0, 1, 4, 5, 2}});
-  expect_error(write_file("short_bin.ply", bin.substr(0, bin.size() - 6)), "truncated");
+  expect_error(make_file("short_bin.ply", bin.substr(0, bin.size() - 6)), "truncated");
   // A header line that is no PLY keyword made Assimp read past its buffers
   // (found by fuzz/mesh_fuzz).
-  expect_error(write_file("bad_keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\npropertLL float x\nend_header\n"),
+  expect_error(make_file("bad_keyword.ply", "ply\nformat ascii 1.0\nelement vertex 3\npropertLL float x\nend_header\n"),
                "unknown PLY header line");
-  expect_error(write_file("short_property.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty\nend_header\n"),
+  expect_error(make_file("short_property.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty\nend_header\n"),
                "bad property line");
-  expect_error(write_file("hash.ply", "ply\nformat ascii 1.0\nelement vertex 3\n#propertLL float x\nend_header\n"),
+  expect_error(make_file("hash.ply", "ply\nformat ascii 1.0\nelement vertex 3\n#propertLL float x\nend_header\n"),
                "'#' in a PLY header line");
-  expect_error(write_file("huge_element.ply", "ply\nformat binary_little_endian 1.0\nelement foo 4000000000\nend_header\n"),
+  expect_error(make_file("huge_element.ply", "ply\nformat binary_little_endian 1.0\nelement foo 4000000000\nend_header\n"),
                "bad element line");
-  expect_error(write_file("float_count.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list float int v\nend_header\n"),
+  expect_error(make_file("float_count.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty list float int v\nend_header\n"),
                "bad property line");
-  expect_error(write_file("header_byte.ply", "ply\nformat ascii 1.0\nelement vertex 3\x8a\nend_header\n"),
+  expect_error(make_file("header_byte.ply", "ply\nformat ascii 1.0\nelement vertex 3\x8a\nend_header\n"),
                "printable ASCII");
-  expect_error(write_file("garbage.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"), "malformed");
-  expect_error(write_file("big_face.off", std::string("OFF\n6 1 0\n") + kVertText + "10 0 1 2 3 4 5 0 1 2 3\n"),
+  expect_error(make_file("garbage.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"), "malformed");
+  expect_error(make_file("big_face.off", std::string("OFF\n6 1 0\n") + kVertText + "10 0 1 2 3 4 5 0 1 2 3\n"),
                "corners");
 }
 
 TEST(ReadMeshErrors, NonFiniteCoordinates) {
-  expect_error(write_file("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"), "NaN");
-  expect_error(write_file("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n"), "infinite");
-  expect_error(write_file("nan.ply", ply_header("ascii") + "0 0 0\n1 0 0\n1 1 nan\n0 1 0\n2 0 0\n2 1 0\n" +
+  expect_error(make_file("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"), "NaN");
+  expect_error(make_file("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1e39 0\nf 1 2 3\n"), "infinite");
+  expect_error(make_file("nan.ply", ply_header("ascii") + "0 0 0\n1 0 0\n1 1 nan\n0 1 0\n2 0 0\n2 1 0\n" +
                                          "3 0 1 2\n3 0 2 3\n3 1 4 5\n"),
                "NaN");
 }
 
 TEST(ReadMeshErrors, OutOfRangeIndices) {
   // Assimp clamps this one to vertex 5 without a word.
-  expect_error(write_file("oor.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 1 6\n"), "out of range");
-  expect_error(write_file("neg.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 -1 2\n"), "out of range");
-  expect_error(write_file("oor.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "out of range");
-  expect_error(write_file("oor.ply", ply_header("ascii") + kVertText + "3 0 1 2\n3 0 1 7\n3 0 1 2\n"),
+  expect_error(make_file("oor.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 1 6\n"), "out of range");
+  expect_error(make_file("neg.off", std::string("OFF\n6 1 0\n") + kVertText + "3 0 -1 2\n"), "out of range");
+  expect_error(make_file("oor.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "out of range");
+  expect_error(make_file("oor.ply", ply_header("ascii") + kVertText + "3 0 1 2\n3 0 1 7\n3 0 1 2\n"),
                "out of range");
-  expect_error(write_file("oor_bin.ply", binary_ply({{0, 1, 2}, {0, 1, 6}, {0, 1, 2}})), "out of range");
-  expect_error(write_file("neg_bin.ply", binary_ply({{0, 1, 2}, {0, -1, 2}, {0, 1, 2}})), "out of range");
+  expect_error(make_file("oor_bin.ply", binary_ply({{0, 1, 2}, {0, 1, 6}, {0, 1, 2}})), "out of range");
+  expect_error(make_file("neg_bin.ply", binary_ply({{0, 1, 2}, {0, -1, 2}, {0, 1, 2}})), "out of range");
 }
 
 TEST(ReadMeshErrors, EmptyAndPointsOrLinesOnly) {
-  expect_error(write_file("empty.off", std::string("OFF\n6 0 0\n") + kVertText), "no faces");
-  expect_error(write_file("empty.obj", std::string("v 0 0 0\nv 1 0 0\n")), "no faces");
-  expect_error(write_file("pl.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\np 1\n"), "lines");
-  expect_error(write_file("pl.off", std::string("OFF\n6 2 0\n") + kVertText + "2 0 1\n1 2\n"), "lines");
-  expect_error(write_file("blank.stl", "solid x\nendsolid x\n"), "empty");
+  expect_error(make_file("empty.off", std::string("OFF\n6 0 0\n") + kVertText), "no faces");
+  expect_error(make_file("empty.obj", std::string("v 0 0 0\nv 1 0 0\n")), "no faces");
+  expect_error(make_file("pl.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\np 1\n"), "lines");
+  expect_error(make_file("pl.off", std::string("OFF\n6 2 0\n") + kVertText + "2 0 1\n1 2\n"), "lines");
+  expect_error(make_file("blank.stl", "solid x\nendsolid x\n"), "empty");
 }
 
 // --- the CGAL meshes against an independent, naive OFF parse ---------------

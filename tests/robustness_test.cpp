@@ -225,13 +225,15 @@ TEST_P(Robustness, FarTinyAndHugeMeshes) {
 }
 
 // Issue 17: coordinates from 1e-30 to 1e30 (the +-2^100 limit) and direction
-// lengths scaled by 2^-130 .. 2^100. The float test overflows (det, T) or
-// underflows there; those lanes are settled in double, and a t past the
-// largest float is a miss on both sides. Every ray gets the oracle's answer.
+// lengths scaled by 2^-130 .. 2^100 (those with a component beyond 2^126 or
+// all below FLT_MIN are counted misses, as the oracle has them). The float
+// test overflows (det, T) or underflows there, and at 1e19 det passes 2^126;
+// those lanes are settled in double, and a t past the largest float is a
+// miss on both sides. Every ray gets the oracle's answer.
 TEST_P(Robustness, ExtremeMagnitudesAndDirectionLengths) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (double radius : {1e-30, 1e-20, 1e-13, 1e13, 1e20, 1e30}) {
+  for (double radius : {1e-30, 1e-20, 1e-13, 1e13, 1e19, 1e20, 1e30}) {
     const Mesh s = make_sphere(8, 16, float(radius), {0, 0, 0});
     std::vector<Ray> base;  // origins within 1.2 radii (inside the coordinate limit), aimed into the sphere's box
     for (int i = 0; i < 120; ++i) {
@@ -248,42 +250,49 @@ TEST_P(Robustness, ExtremeMagnitudesAndDirectionLengths) {
       for (Ray r : base) {
         for (float& d : r.dir) d = float(d * f);
         const float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
-        if (m >= 0x1p-120f && m <= 0x1p120f) rays.push_back(r);
+        if (m >= 0x1p-120f && m <= kMaxDirection) rays.push_back(r);
       }
     ASSERT_GT(rays.size(), 300u);
     expect_answers(s, rays, ("sphere of radius " + std::to_string(radius)).c_str());
   }
 }
 
-// The adversarial run's case (issue 17): two layers 1e13 wide at z = -1e13
-// and z = 0 (a triangle of each was the report's mesh; grids of them here, so
-// every layout's overhead fits auto's byte limit). From z = 1e13 straight
-// down, the ray must hit the upper layer at t = 1e13: float's T overflowed,
-// giving t = inf and the first triangle tested, and with t_max 3e13 a miss.
+// The adversarial run's case (issue 17): two triangles with corners (0,0),
+// (1e13,0), (0,1e13) at z = -1e13 and at z = 0. From (1e12, 1e12, 1e13)
+// straight down the ray must hit the upper one (triangle 1) at t = 1e13;
+// float's T overflowed, giving t = inf and triangle 0, and with t_max 3e13
+// a miss. Two grids far off to the side give every layout some bulk (auto's
+// byte limit counts a blob's fixed overhead per triangle).
 TEST_P(Robustness, LargeCoordinatesHitTheNearTriangle) {
   const float e = 1e13f;
   Mesh m;
+  m.vertices = {{0, 0, -e}, {e, 0, -e}, {0, e, -e}, {0, 0, 0}, {e, 0, 0}, {0, e, 0}};
+  m.triangles = {{0, 1, 2}, {3, 4, 5}};
   for (float z : {-e, 0.0f}) {
     const Mesh g = make_grid_plane(6, 6);
     const uint32_t base = uint32_t(m.vertices.size());
-    for (Vec3 v : g.vertices) m.vertices.push_back({v.x * (e / 6), v.y * (e / 6), z});
+    for (Vec3 v : g.vertices) m.vertices.push_back({3 * e + v.x * (e / 6), v.y * (e / 6), z});
     for (Triangle t : g.triangles) m.triangles.push_back({base + t[0], base + t[1], base + t[2]});
   }
   std::vector<Ray> rays;
   for (float tmax : {INFINITY, 3e13f})
-    for (float len : {1.0f, 1e-20f, 1e20f}) rays.push_back({{1.1e12f, 1.3e12f, e}, {0, 0, -len}, tmax});
-  const std::vector<uint8_t> blob = build(m, "two layers at 1e13");
+    for (float len : {1.0f, 1e-20f, 1e20f}) rays.push_back({{1e12f, 1e12f, e}, {0, 0, -len}, tmax});
+  const std::vector<uint8_t> blob = build(m, "two triangles at 1e13");
   const std::vector<Hit> hits = trace(blob, rays);
+  const bool ids = layout::has_remap(layout::header_of(blob.data()));
   for (size_t i = 0; i < rays.size(); ++i) {
     const float expected = e / -rays[i].dir[2];
     if (expected > rays[i].tmax) {
       EXPECT_EQ(hits[i].triangle, MC_NO_HIT) << "ray " << i;
       continue;
     }
+    if (ids) {
+      EXPECT_EQ(hits[i].triangle, 1u) << "ray " << i;
+    }
     EXPECT_NE(hits[i].triangle, MC_NO_HIT) << "ray " << i;
     EXPECT_NEAR(hits[i].t, expected, 1e-6 * expected) << "ray " << i;
   }
-  expect_answers(m, rays, "two layers at 1e13");
+  expect_answers(m, rays, "two triangles at 1e13");
 }
 
 TEST_P(Robustness, SliversAndDegenerateTriangles) {
@@ -346,6 +355,9 @@ TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
       {{nan, 1, 1}, {0, 0, -1}, inf}, {{1, 1, 1}, {0, nan, -1}, inf}, {{inf, 1, 1}, {0, 0, -1}, inf},
       {{1, 1, 1}, {0, 0, -inf}, inf}, {{1, 1, 1}, {0, 0, 0}, inf},    {{1, 1, 1}, {-0.0f, 0.0f, -0.0f}, inf},
       {{1, 1, 1}, {0, 0, -1}, nan},   {{1, 1, 1}, {0, 0, -1}, -1.0f},
+      {{0x1p101f, 1, 1}, {-1, 0, -1}, inf},  // origin beyond +-2^100
+      {{1, 1, 1}, {0, 0, -0x1p127f}, inf},   // a component beyond 2^126
+      {{1, 1, 1}, {0x1p-127f, 0, 0}, inf},   // every component below FLT_MIN
   };
   uint64_t skipped = 0;
   std::vector<Hit> hits = trace(blob, rays, &skipped);

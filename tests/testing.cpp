@@ -1,7 +1,10 @@
 #include "tests/testing.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -21,6 +24,32 @@ std::optional<Mesh> data_mesh(const std::string& name) {
 }
 
 bool quick() { return std::getenv("MESHCAST_TEST_QUICK") != nullptr; }
+
+namespace {
+
+// Made on first use, removed with everything in it when the process exits.
+struct Scratch {
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("meshcast_test_" + std::to_string(::getpid()));
+  Scratch() { std::filesystem::create_directories(dir); }
+  ~Scratch() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+};
+
+}  // namespace
+
+std::filesystem::path scratch_dir() {
+  static Scratch scratch;
+  return scratch.dir;
+}
+
+std::string make_file(const std::string& name, const std::string& bytes) {
+  const std::string path = (scratch_dir() / name).string();
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
 
 std::vector<NamedMesh> test_meshes(bool large) {
   static std::map<std::string, std::shared_ptr<const Mesh>> cache;

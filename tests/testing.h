@@ -1,6 +1,7 @@
 // Shared test helpers: the test meshes, oracle answers computed once per
 // mesh and ray set, and the agreement rules of the foundation issue.
 #pragma once
+#include <filesystem>
 #include <map>
 #include <tuple>
 #include <memory>
@@ -25,6 +26,11 @@ struct NamedMesh {
   std::string name;
   std::shared_ptr<const Mesh> mesh;
 };
+// Files a test makes: a folder of this process's own under the system's
+// temp folder (removed when the process exits), and a file of `bytes` in it.
+std::filesystem::path scratch_dir();
+std::string make_file(const std::string& name, const std::string& bytes);
+
 // Generated meshes plus the four public ones when present. `large` adds the
 // 1M+ triangle terrain. Under sanitizers (MESHCAST_TEST_QUICK set, see
 // scripts/test.sh) the three larger public meshes are left out.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <algorithm>
 
+#include "cpu/rays.h"
 #include "cpu/counters.h"
 #include "bench/encodings.h"
 #include "bench/error.h"
@@ -59,7 +60,7 @@ void add_bench(CLI::App& app) {
     std::printf("| encoding | brute force ms (min) | median | bytes/tri | seed ms | seed bytes/tri | QuadTree ms (min) "
                 "| median | bytes/tri in QuadTree | disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     std::string csv_path = args->out_dir + "/encodings.csv";
-    std::ofstream csv(csv_path);
+    OutputText csv(csv_path);
     csv << "encoding,brute_min_ms_1024,brute_median_ms_1024,brute_bytes_per_tri,seed_ms_1024,seed_bytes_per_tri,"
            "quadtree_min_ms_1024,quadtree_median_ms_1024,quadtree_bytes_per_tri,disagreements\n";
     bench::Series brute{"BruteForce", {}}, tree{"QuadTree, leaf 8", {}};
@@ -79,6 +80,7 @@ void add_bench(CLI::App& app) {
     std::string why = bench::plot_scatter(png, "Triangle encodings on " + args->input + " (minimum of passes)",
                                           "bytes per triangle (blocks + shared vertices)", "microseconds per ray",
                                           {brute, tree}, true);
+    csv.commit();
     std::printf("\ncsv: %s\nplot: %s\n", csv_path.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
 
@@ -120,7 +122,7 @@ void add_bench(CLI::App& app) {
                   "walked B/tri (seed) | holes B/tri | disagreements |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
                   label);
       std::string stem = targs->out_dir + "/" + kind + (targs->input == "terrain_2M" ? "_terrain_2M" : "");
-      std::ofstream csv(stem + ".csv");
+      OutputText csv(stem + ".csv");
       csv << "label,layout,min_us_per_ray,median_us_per_ray,seed_us_per_ray,build_ms,sah_cost,tree_bytes_per_tri,"
              "walked_bytes_per_tri,seed_bytes_per_tri,hole_bytes_per_tri,disagreements\n";
       // One series (colour) per tree format, each point labelled.
@@ -152,6 +154,7 @@ void add_bench(CLI::App& app) {
       std::string why = bench::plot_scatter(png, std::string(kind) + " on " + targs->input + " (minimum of passes)",
                                             "bytes per triangle walked (nodes, blocks, vertices)", "microseconds per ray",
                                             series, kind == "combos", kind == "combos" || kind == "trees");
+      csv.commit();
       std::printf("\ncsv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
     });
   }
@@ -199,7 +202,7 @@ void add_bench(CLI::App& app) {
                 res.gpu_error.empty() ? "" : (" (" + res.gpu_error + ")").c_str(), res.threads, lopts->second);
     std::filesystem::create_directories(largs->out_dir);
     std::string stem = largs->out_dir + "/latency" + (largs->input == "terrain_2M" ? "_terrain_2M" : "");
-    std::ofstream csv(stem + ".csv");
+    OutputText csv(stem + ".csv");
     csv << "backend,batch,batches,p50_ms,p99_ms,rays_per_second,device_ms,frame_ahead_ready,frame_ahead_rays_per_second\n";
     std::vector<bench::Series> series;
     double lo = 1e30, hi = 0;
@@ -224,6 +227,7 @@ void add_bench(CLI::App& app) {
                               (res.crossover == ~0u ? " (no crossover: the CPU first at every size)" : "");
     std::string why = bench::plot_scatter(png, title,
                                           "rays in the batch", "milliseconds, submit to ready", series, true, true, true);
+    csv.commit();
     std::printf("csv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
 
@@ -244,7 +248,7 @@ void add_bench(CLI::App& app) {
     for (const std::string& n : names) inputs.push_back({n, bench_mesh(n)});
     std::vector<bench::ErrorRow> rows = bench::bench_error(inputs, eargs->rays, eargs->repeat, *edevice);
     std::filesystem::create_directories(eargs->out_dir);
-    std::ofstream csv(eargs->out_dir + "/error.csv");
+    OutputText csv(eargs->out_dir + "/error.csv");
     csv << "mesh,backend,layout,us_per_ray,bytes_per_tri,max_dt,mean_dt,max_surface,bound,rays,false_misses,false_hits,"
            "wrong_triangles\n";
     std::printf("\n%zu long rays a mesh, one thread (GPU: device time); errors relative to the mesh diagonal against the "
@@ -298,6 +302,7 @@ void add_bench(CLI::App& app) {
         ++above;
       }
     std::printf("\n%zu of %zu rows within their format's stated bound\n", rows.size() - above, rows.size());
+    csv.commit();
     std::printf("\ncsv: %s/error.csv\nplots: %s, %s\n", eargs->out_dir.c_str(), why1.empty() ? png1.c_str() : why1.c_str(),
                 why2.empty() ? png2.c_str() : why2.c_str());
   });
@@ -341,7 +346,7 @@ void add_bench(CLI::App& app) {
                 "|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
                 pargs->rays, pargs->repeat);
     std::filesystem::create_directories(pargs->out_dir);
-    std::ofstream csv(pargs->out_dir + "/pairing.csv");
+    OutputText csv(pargs->out_dir + "/pairing.csv");
     csv << "mesh,triangles,pairing_ms,paired_before,paired_after,decision,layout,us_per_ray,us_per_ray_paired,"
            "walked_bytes,walked_bytes_paired,box_tests,box_tests_paired,triangle_tests,triangle_tests_paired,disagreements\n";
     // Test counts exist in a counting build alone (MESHCAST_COUNT_TESTS).
@@ -367,6 +372,7 @@ void add_bench(CLI::App& app) {
     }
     std::printf("\ndecisions:\n");
     for (size_t i = 0; i < rows.size(); i += 2) std::printf("  %s: %s\n", rows[i].mesh.c_str(), rows[i].decision.c_str());
+    csv.commit();
     std::printf("csv: %s/pairing.csv\n%s\n", pargs->out_dir.c_str(),
                 kCountTests ? "test counts: one more pass with the counters (this build counts; its times are not for comparison)"
                             : "test counts: '-' (build with -DMESHCAST_COUNT_TESTS=ON to count them)");

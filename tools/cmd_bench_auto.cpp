@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "cpu/rays.h"
 #include "bench/auto.h"
 #include "tools/commands.h"
 
@@ -33,7 +34,7 @@ void add_bench_auto(CLI::App* bench) {
                "terrain_2M", "terrain_66k"};
     std::filesystem::create_directories(args->out_dir);
     const std::string csv_path = args->out_dir + "/auto.csv";
-    std::ofstream csv(csv_path);
+    OutputText csv(csv_path);
     csv << "mesh,setting,choice,ns_per_ray,bytes_per_tri,error_bound,disagreements,choose_ms,best,best_value,value,"
            "ratio,eligible\n";
     std::printf("%zu long rays (seed 1), one thread, minimum of %u passes; bytes: the whole blob a triangle; "
@@ -63,6 +64,7 @@ void add_bench_auto(CLI::App* bench) {
       }
       std::fflush(stdout);
     }
+    csv.commit();
     std::printf("\n%zu of %zu choices more than 10%% from the best meeting their limits (%zu with no combos layout "
                 "meeting them)\ncsv: %s\n",
                 outside, names.size() * bench::auto_settings().size(), unmatched, csv_path.c_str());

@@ -1,5 +1,7 @@
 // meshcast: build blobs, cast rays, inspect layouts, run the main job.
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 
 #include "cpu/mesh.h"
 #include "cpu/rays.h"
@@ -19,7 +21,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every refused option or value is the input's fault: 2.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const meshcast::InputError& e) {
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return 2;
@@ -32,6 +35,11 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return 1;
+  }
+  // What was printed must have reached stdout (`info --json >/dev/full`).
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr, "meshcast: standard output: cannot write (%s)\n", std::strerror(errno));
+    return 4;
   }
   return 0;
 }

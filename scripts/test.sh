@@ -10,20 +10,31 @@ jobs=$(nproc)
 
 # The CPU suites (CTest label `cpu`), run one process a suite, $jobs at a
 # time: CTest's one process a test would load the meshes and compute the
-# oracle's answers again for each of its 2,000-odd tests (5 of Release's 9
-# minutes). `run_suites DIR quick` sets MESHCAST_TEST_QUICK: bunny00 and the
-# generated meshes only, fewer rays a set (the sanitizer and scalar builds;
-# Release walks everything). A failing suite prints its log; xargs waits for
-# the others and fails the pipeline.
-cpu_suites=(walker_test robustness_test auto_test build_test layout_test oracle_test io_test pairing_test zerobyte_test
-            limits_test hostile_test)
-run_suites() {  # run_suites BUILD_DIR [quick]
-  local quick=()
-  [[ ${2:-} == quick ]] && quick=(MESHCAST_TEST_QUICK=1)
-  printf '%s\n' "${cpu_suites[@]}" |
+# oracle's answers again for each of its 2,000-odd tests. `quick` sets
+# MESHCAST_TEST_QUICK: bunny00, the sphere and the grid only, fewer rays a
+# set (the sanitizer and scalar builds; Release walks everything). A failing
+# suite prints its log; xargs waits for the others and fails the pipeline.
+# The longest first; walker_test (every layout) in two shards, so the two
+# cores finish together.
+cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test
+            hostile_test oracle_test io_test)
+# What the scalar build changes (cpu/simd.h's lanes): the suites that walk.
+walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test)
+run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
+  local dir=$1 quick=()
+  [[ $2 == quick ]] && quick=(MESHCAST_TEST_QUICK=1)
+  shift 2
+  local items=() s
+  for s in "$@"; do
+    if [[ $s == walker_test ]]; then items+=(walker_test#0 walker_test#1); else items+=("$s"); fi
+  done
+  printf '%s\n' "${items[@]}" |
     env MESHCAST_DATA="$PWD/data" "${quick[@]}" LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp" \
-      xargs -P"$jobs" -I{} sh -c "$1"'/bin/{} --gtest_brief=1 > '"$1"'/{}.log 2>&1 && echo "  {}: passed" ||
-                                 { echo "  {}: FAILED"; tail -50 '"$1"'/{}.log; exit 1; }'
+      xargs -P"$jobs" -I{} sh -c '
+        dir=$0 item=$1 suite=${1%#*}
+        if [ "$suite" != "$item" ]; then export GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=${item#*#}; fi
+        "$dir/bin/$suite" --gtest_brief=1 > "$dir/$item.log" 2>&1 && echo "  $item: passed" ||
+          { echo "  $item: FAILED"; tail -50 "$dir/$item.log"; exit 1; }' "$dir" {}
 }
 stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
 # The sanitizer builds: -O2 with line tables only (-g1): reports keep their
@@ -32,7 +43,7 @@ stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
 sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG")
 
 stage "Release (AVX2): the CPU suites"
-run_suites build
+run_suites build full "${cpu_suites[@]}"
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
@@ -44,7 +55,7 @@ stage "AddressSanitizer + UBSan: every CPU test suite"
 # libFuzzer stage (and without sanitizers in Release's CTest).
 cmake -S . -B build-asan "${sanitizer_flags[@]}" -DMESHCAST_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$jobs" --target "${cpu_suites[@]}"
-run_suites build-asan quick
+run_suites build-asan quick "${cpu_suites[@]}"
 
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan)"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
@@ -53,12 +64,12 @@ cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 
-stage "Portable scalar path, with the box and triangle test counters compiled in: the CPU suites"
-# The scalar build changes only cpu/simd.h's lanes: the CPU suites (quick, as
-# under ASan) cover it; the Vulkan suites read the same shaders as Release.
+stage "Portable scalar path, with the box and triangle test counters compiled in: the suites that walk"
+# The scalar build changes only cpu/simd.h's lanes: the suites that walk
+# (quick, as under ASan) cover it; the Vulkan suites read the same shaders.
 cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON >/dev/null
-cmake --build build-scalar -j"$jobs" --target "${cpu_suites[@]}"
-run_suites build-scalar quick
+cmake --build build-scalar -j"$jobs" --target "${walk_suites[@]}"
+run_suites build-scalar quick "${walk_suites[@]}"
 
 stage "libFuzzer: the blob validator + walker and the mesh reader + builder"
 bash scripts/fuzz.sh

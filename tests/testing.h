@@ -33,7 +33,8 @@ std::string make_file(const std::string& name, const std::string& bytes);
 
 // Generated meshes plus the four public ones when present. `large` adds the
 // 1M+ triangle terrain. Under sanitizers (MESHCAST_TEST_QUICK set, see
-// scripts/test.sh) the three larger public meshes are left out.
+// scripts/test.sh) the three larger public meshes and the 64k terrain are
+// left out.
 std::vector<NamedMesh> test_meshes(bool large);
 // True when MESHCAST_TEST_QUICK is set: the suites walk fewer rays a set.
 bool quick();

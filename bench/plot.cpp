@@ -1,7 +1,6 @@
 #include "bench/plot.h"
 
 #include <cstdlib>
-#include <fstream>
 
 #include "cpu/rays.h"
 

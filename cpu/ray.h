@@ -155,6 +155,9 @@ struct LaneHit {
 // range: sheared coordinates are floats within +-2^102, sz within 2^-126..2^126,
 // so products lie between 2^-575 and 2^433.
 constexpr float kSettleTiny = 0x1p-100f;
+// A determinant from this up is settled in double too: Vulkan bounds a float
+// division's error only for divisors below 2^126 (see float_settles).
+constexpr float kSettleHuge = 0x1p126f;
 
 // Double-precision redo of one lane float could not settle. Corners in ray
 // space (sheared x, y; z not yet scaled by sz): every product of two floats
@@ -172,7 +175,7 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
 // same (watertight.glsl), so both sides settle the same lanes alike.
 template <class F4>
 inline auto float_settles(const F4& det, const F4& T) {
-  const F4 tiny = F4::splat(kSettleTiny), huge = F4::splat(0x1p126f), inf = F4::splat(INFINITY);
+  const F4 tiny = F4::splat(kSettleTiny), huge = F4::splat(kSettleHuge), inf = F4::splat(INFINITY);
   const F4 d = simd::abs(det), a = simd::abs(T);
   return (d >= tiny) & (d < huge) & (a >= tiny) & (a < inf);
 }

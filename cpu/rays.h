@@ -37,12 +37,10 @@ void write_hits(const std::string& path, const std::vector<Hit>& hits);
 // (3.5 GiB of records).
 constexpr size_t kMaxRayCount = size_t(1) << 27;
 
-// Throws InputError naming the path unless it is a regular file (a
-// directory, a device such as /dev/zero or a pipe is refused before any read).
-void require_regular_file(const std::string& path);
-
-// Whole-file helpers for blobs, rays and hits: read_file reads a regular file
-// (require_regular_file). write_file writes the pieces in order to a file
+// Whole-file helpers for meshes, blobs, rays and hits: read_file reads a
+// regular file and throws InputError naming the path for anything else (a
+// directory, a device such as /dev/zero or a pipe is refused before any
+// read: it has no size to read up to). write_file writes the pieces in order to a file
 // beside `path`, checks every write, the flush and the close, then renames it
 // to `path`, so a failed write (a full disk) leaves no partial file under
 // that name; an existing path that is not a regular file (/dev/null,

@@ -1,4 +1,3 @@
-#include "cpu/rays.h"
 #include "host/caster.h"
 
 #include <algorithm>
@@ -10,6 +9,7 @@
 #include <stdexcept>
 
 #include "cpu/mesh.h"
+#include "cpu/rays.h"
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
 #include "layout/blob.h"

@@ -46,9 +46,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <string_view>
 
 namespace meshcast {
@@ -267,8 +265,8 @@ std::vector<Vec3> scan_stl_ascii(const std::string& path, std::string_view text)
 // sees the file and lets through only a header of the PLY grammar in
 // printable ASCII, one statement a line.
 void check_ply_layout(const std::string& path, std::string_view text) {
-  struct Prop { int count_size = 0, size = 0; };  // count_size > 0: a list
-  struct Element { std::string_view name; size_t n = 0; std::vector<Prop> props; std::vector<std::string_view> names; };
+  struct Prop { int count_size = 0, size = 0; std::string_view name; };  // count_size > 0: a list
+  struct Element { std::string_view name; size_t n = 0; std::vector<Prop> props; };
   std::vector<Element> elements;
   auto type_size = [](std::string_view t) {
     if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
@@ -314,17 +312,16 @@ void check_ply_layout(const std::string& path, std::string_view text) {
       if (t[1] == "tristrips")
         fail(path, ln.at() + "PLY element 'tristrips' (triangle strips) is not supported: write the triangles "
                              "as a 'face' element");
-      elements.push_back({t[1], size_t(n), {}, {}});
+      elements.push_back({t[1], size_t(n), {}});
     } else if (t[0] == "property") {
       // `property TYPE NAME` or `property list COUNT_TYPE TYPE NAME`
       bool list = t.size() == 5 && t[1] == "list";
       if (elements.empty() || t.size() != (list ? 5u : 3u)) fail(path, ln.at() + "malformed file: bad property line");
-      Prop p{list ? type_size(t[2]) : 0, type_size(t[list ? 3 : 1])};
+      Prop p{list ? type_size(t[2]) : 0, type_size(t[list ? 3 : 1]), t.back()};
       const bool integer_count = !list || (t[2] != "float" && t[2] != "float32" && t[2] != "double" && t[2] != "float64");
       if (p.size == 0 || (list && p.count_size == 0) || !integer_count)
         fail(path, ln.at() + "malformed file: bad property line");
       elements.back().props.push_back(p);
-      elements.back().names.push_back(t.back());
     } else {
       fail(path, ln.at() + "malformed file: unknown PLY header line '" + std::string(t[0].substr(0, 32)) + "'");
     }
@@ -334,7 +331,7 @@ void check_ply_layout(const std::string& path, std::string_view text) {
   for (const Element& e : elements)
     if (e.name == "vertex")
       for (std::string_view axis : {"x", "y", "z"})
-        if (std::find(e.names.begin(), e.names.end(), axis) == e.names.end())
+        if (std::none_of(e.props.begin(), e.props.end(), [&](const Prop& p) { return p.name == axis; }))
           fail(path, "malformed file: the PLY vertex element has no '" + std::string(axis) + "' property");
   size_t records = 0, pos = end;
   for (const Element& e : elements) records += e.n;
@@ -368,11 +365,12 @@ void check_ply_layout(const std::string& path, std::string_view text) {
 // STL: Assimp reads a file as binary when its size is 84 + 50 n bytes (n the
 // facet count at byte 80), else as text when it starts with `solid`; anything
 // else gets its "Failed to determine STL storage representation". A binary
-// file cut short is the usual cause: say so, with the sizes.
-void check_stl_layout(const std::string& path, std::string_view text) {
+// file cut short is the usual cause: say so, with the sizes. Returns whether
+// the file is binary (Assimp's rule), else it is text.
+bool check_stl_layout(const std::string& path, std::string_view text) {
   uint32_t n = 0;
   if (text.size() >= 84) std::memcpy(&n, text.data() + 80, 4);
-  if (text.size() >= 84 && text.size() == 84 + 50ull * n) return;
+  if (text.size() >= 84 && text.size() == 84 + 50ull * n) return true;
   // Text: starts with `solid` and is text throughout (many binary writers
   // put `solid` in their 80-byte header too, then floats follow).
   const size_t first = text.find_first_not_of(" \t\r\n");
@@ -380,7 +378,7 @@ void check_stl_layout(const std::string& path, std::string_view text) {
     const unsigned char u = static_cast<unsigned char>(c);
     return (u >= 0x20 && u < 0x7f) || u == '\t' || u == '\n' || u == '\r' || u == '\f' || u == '\v';
   });
-  if (first != std::string_view::npos && text.substr(first, 5) == "solid" && ascii) return;
+  if (first != std::string_view::npos && text.substr(first, 5) == "solid" && ascii) return false;
   if (text.size() < 84)
     fail(path, "malformed file: " + std::to_string(text.size()) +
                    " bytes, neither ASCII STL (no 'solid') nor binary STL (an 84-byte header at least)");
@@ -466,18 +464,13 @@ void check_polygons(const std::string& path, const Polys& p) {
 }  // namespace
 
 Mesh read_mesh(const std::string& path) {
-  require_regular_file(path);  // a directory, /dev/zero or a pipe: refused before reading
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, "cannot open file (missing or unreadable)");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) fail(path, "cannot read file");
-  const std::string text = buf.str();
-
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower((unsigned char)c));
   if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl")
     fail(path, "unknown format '" + ext + "' (expected .off, .obj, .ply or .stl)");
+  // read_file refuses a directory, /dev/zero or a pipe before reading.
+  const std::vector<uint8_t> bytes = read_file(path);
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 
   Polys result;
   if (ext == ".off" || ext == ".obj") {
@@ -487,16 +480,12 @@ Mesh read_mesh(const std::string& path) {
     cross_check(path, result, read_assimp(path));
   } else {
     if (ext == ".ply") check_ply_layout(path, text);
-    if (ext == ".stl") check_stl_layout(path, text);
+    const bool binary_stl = ext == ".stl" && check_stl_layout(path, text);
     Polys as = read_assimp(path);
     if (ext == ".ply" && text.find("format ascii") < text.find("end_header")) {
       if (auto v = scan_ply_ascii(path, text)) take_coordinates(path, as, *v);
-    } else if (ext == ".stl") {
-      // Assimp's rule: binary when the size matches the facet count in the header.
-      uint32_t n = 0;
-      if (text.size() >= 84) std::memcpy(&n, text.data() + 80, 4);
-      bool binary = text.size() >= 84 && text.size() == 84 + 50ull * n;
-      if (!binary) take_coordinates(path, as, scan_stl_ascii(path, text));
+    } else if (ext == ".stl" && !binary_stl) {
+      take_coordinates(path, as, scan_stl_ascii(path, text));
     }
     result = std::move(as);
   }

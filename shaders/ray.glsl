@@ -8,6 +8,8 @@
 #define MESHCAST_RAY_GLSL
 
 #define MC_GPU_RAY_WORDS 16u
+#define kInfinity uintBitsToFloat(0x7F800000u)
+#define kFloatMax uintBitsToFloat(0x7F7FFFFFu)
 
 struct GpuRay {
   vec3 org, dir, inv;

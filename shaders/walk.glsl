@@ -12,7 +12,6 @@ float max_keep(float a, float b) { return a > b ? a : b; }
 float min_keep(float a, float b) { return a < b ? a : b; }
 
 // 1 + 2 gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (cpu/ray.h).
-#define kInfinity uintBitsToFloat(0x7F800000u)
 const float kFarScale = 1.0 + 2.0 * (3.0 * 5.9604644775390625e-8) / (1.0 - 3.0 * 5.9604644775390625e-8);
 
 struct Closest {

@@ -10,9 +10,7 @@
 #define MESHCAST_WATERTIGHT_GLSL
 
 #define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/ray.h kSettleTiny
-#define kFloatMax uintBitsToFloat(0x7F7FFFFFu)
-#define kFloatInf uintBitsToFloat(0x7F800000u)
-#define kDivisorMax uintBitsToFloat(0x7E800000u)  // 2^126: Vulkan bounds a division's error up to this divisor
+#define kSettleHuge uintBitsToFloat(0x7E800000u)  // 2^126, cpu/ray.h kSettleHuge
 
 // Corners in ray space: sheared x, y, and z not yet scaled by sz.
 bool watertight_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
@@ -49,7 +47,7 @@ bool watertight(GpuRay r, vec3 a, vec3 b, vec3 c, float closest, out float t, ou
   precise float det = U + V + W;
   precise float T = U * (r.sz * az) + V * (r.sz * bz) + W * (r.sz * cz);
   const float dets = abs(det), Tabs = abs(T);
-  if (!(dets >= kSettleTiny && dets < kDivisorMax && Tabs >= kSettleTiny && Tabs < kFloatInf))
+  if (!(dets >= kSettleTiny && dets < kSettleHuge && Tabs >= kSettleTiny && Tabs < kInfinity))
     return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
   const float Ts = det < 0.0 ? -T : T;
   if (!(Ts >= 0.0)) return false;

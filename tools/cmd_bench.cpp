@@ -1,13 +1,12 @@
 // meshcast bench encodings [MESH]: seed 000 §3.11 on this machine.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <cmath>
 #include <algorithm>
 
-#include "cpu/rays.h"
 #include "cpu/counters.h"
+#include "cpu/rays.h"
 #include "bench/encodings.h"
 #include "bench/error.h"
 #include "bench/gpu.h"

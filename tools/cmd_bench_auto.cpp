@@ -3,10 +3,9 @@
 // meeting the same limits, measured in one run.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
-#include "cpu/rays.h"
 #include "bench/auto.h"
+#include "cpu/rays.h"
 #include "tools/commands.h"
 
 namespace meshcast::tools {

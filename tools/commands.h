@@ -38,9 +38,8 @@ struct LayoutArgs {
   double max_bytes = 0, max_error = 0;
   bool gpu = false;
   uint32_t trial = 0;
-  // The subcommand these were parsed for: which options the user gave (a
-  // blob input refuses every one of them).
-  const CLI::App* command = nullptr;
+  // The options add_layout_options added: a blob input refuses any the user gave.
+  std::vector<const CLI::Option*> options;
 };
 void add_layout_options(CLI::App* cmd, LayoutArgs& args);
 BuildOptions build_options(const LayoutArgs& args);  // throws InputError for bad names

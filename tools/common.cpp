@@ -46,14 +46,6 @@ BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std:
 
 namespace {
 
-// Every option add_layout_options adds: a blob's layout was fixed when it was
-// built, so a blob input refuses them all.
-const char* const kLayoutOptions[] = {"--layout",  "--goal",        "--max-bytes",        "--max-error",
-                                      "--gpu",     "--trial",       "--leaf",             "--splitter",
-                                      "--order",   "--lbvh-depth",  "--lbvh-left-first",  "--grouping",
-                                      "--no-triangle-ids", "--pairing", "--no-shuffle",   "--no-box-cache",
-                                      "--hybrid-leaf"};
-
 // NaN passes CLI11's NonNegativeNumber; "no limit" is 0, so NaN and
 // infinity are refused.
 void check_limit(const char* option, double value) {
@@ -65,7 +57,7 @@ void check_limit(const char* option, double value) {
 }  // namespace
 
 void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
-  a.command = cmd;
+  const size_t before = cmd->get_options().size();
   cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh, or auto (chosen for the mesh)");
   cmd->add_option("--goal", a.goal, "auto: speed (fastest) or memory (fewest bytes)");
   cmd->add_option("--max-bytes", a.max_bytes, "auto: at most this many blob bytes a triangle (0: no limit)")
@@ -92,6 +84,8 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
   cmd->add_option("--hybrid-leaf", a.hybrid_leaf, "ZeroByteHybrid: largest leaf, each one zero-byte tree")
       ->check(CLI::Range(8u, uint32_t(MC_ZBT_MAX_TRIANGLES)));
+  const std::vector<CLI::Option*> all = cmd->get_options();
+  a.options.assign(all.begin() + std::ptrdiff_t(before), all.end());
 }
 
 // load_input's work once the limits are checked.
@@ -130,10 +124,11 @@ Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* repor
   check_limit("--max-bytes", a.max_bytes);
   check_limit("--max-error", a.max_error);
   Loaded in = load_as_asked(path, a, report);
-  if (!in.mesh && a.command)
-    for (const char* option : kLayoutOptions)
-      if (a.command->count(option) > 0)
-        throw InputError(path + ": is a blob, whose layout was fixed when it was built; " + option +
+  // A blob's layout was fixed when it was built.
+  if (!in.mesh)
+    for (const CLI::Option* option : a.options)
+      if (option->count() > 0)
+        throw InputError(path + ": is a blob, whose layout was fixed when it was built; " + option->get_name() +
                          " applies only to a mesh input");
   return in;
 }

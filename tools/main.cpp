@@ -18,23 +18,25 @@ int main(int argc, char** argv) {
   meshcast::tools::add_demo(app);
   meshcast::tools::add_bench(app);
   meshcast::tools::add_render(app);
+  // Exit codes (README): 2 the input, 3 no Vulkan or no such device, 4 an
+  // output not written, 1 anything else.
+  auto report = [](const std::exception& e, int code) {
+    std::fprintf(stderr, "meshcast: %s\n", e.what());
+    return code;
+  };
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; every refused option or value is the input's fault: 2.
     return app.exit(e) == 0 ? 0 : 2;
   } catch (const meshcast::InputError& e) {
-    std::fprintf(stderr, "meshcast: %s\n", e.what());
-    return 2;
-  } catch (const meshcast::OutputError& e) {  // an output file not written (a full disk, no permission)
-    std::fprintf(stderr, "meshcast: %s\n", e.what());
-    return 4;
-  } catch (const meshcast::gpu::GpuError& e) {  // no Vulkan, no such device: the CPU path still works
-    std::fprintf(stderr, "meshcast: %s\n", e.what());
-    return 3;
+    return report(e, 2);
+  } catch (const meshcast::OutputError& e) {
+    return report(e, 4);
+  } catch (const meshcast::gpu::GpuError& e) {  // the CPU path still works
+    return report(e, 3);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "meshcast: %s\n", e.what());
-    return 1;
+    return report(e, 1);
   }
   // What was printed must have reached stdout (`info --json >/dev/full`).
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {

@@ -83,8 +83,6 @@ std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_
   return rays;
 }
 
-namespace {
-
 void require_regular_file(const std::string& path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the file (" + std::strerror(errno) + ")");
@@ -92,8 +90,6 @@ void require_regular_file(const std::string& path) {
   if (!S_ISREG(st.st_mode))
     throw InputError(path + ": not a regular file (a device, pipe or socket has no size to read up to)");
 }
-
-}  // namespace
 
 std::vector<uint8_t> read_file(const std::string& path) {
   require_regular_file(path);

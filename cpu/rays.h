@@ -53,6 +53,9 @@ struct Bytes {
   const void* data;
   size_t size;
 };
+// The check read_file makes first, for a reader that must judge the path
+// before it reads (read_mesh: kind of file, then extension, then bytes).
+void require_regular_file(const std::string& path);
 std::vector<uint8_t> read_file(const std::string& path);
 
 // Text output (CSV, plot scripts, profiles): built in memory, then written

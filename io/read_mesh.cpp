@@ -464,11 +464,12 @@ void check_polygons(const std::string& path, const Polys& p) {
 }  // namespace
 
 Mesh read_mesh(const std::string& path) {
+  // A directory or /dev/zero is named as such whatever its name ends in.
+  require_regular_file(path);
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower((unsigned char)c));
   if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl")
     fail(path, "unknown format '" + ext + "' (expected .off, .obj, .ply or .stl)");
-  // read_file refuses a directory, /dev/zero or a pipe before reading.
   const std::vector<uint8_t> bytes = read_file(path);
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 

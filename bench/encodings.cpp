@@ -11,7 +11,7 @@
 #include "cpu/encode.h"
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "layout/blob.h"
 
 namespace meshcast::bench {

@@ -10,8 +10,9 @@
 #include "cpu/encode.h"
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 #include "layout/blob.h"
 
 namespace meshcast::bench {
@@ -79,7 +80,7 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
     };
     for (const std::string& layout : layout_names()) {
       BuildOptions o = parse_layout(layout);
-      if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST) continue;  // the GPU's
+      if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST) continue;  // the GPU's
       std::fprintf(stderr, "  %s %s\n", in.name.c_str(), layout.c_str());
       std::vector<uint8_t> blob;
       try {

@@ -8,8 +8,9 @@
 #include "cpu/encode.h"
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 #include "layout/blob.h"
 
 namespace meshcast::bench {

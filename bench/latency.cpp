@@ -6,7 +6,7 @@
 
 #include "cpu/encode.h"
 #include "cpu/rays.h"
-#include "host/caster.h"
+#include "meshcast/caster.h"
 
 namespace meshcast::bench {
 

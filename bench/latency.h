@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast::bench {
 

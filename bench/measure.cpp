@@ -6,7 +6,7 @@
 #include "cpu/agreement.h"
 #include "cpu/counters.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "layout/blob.h"
 #include "layout/lbvh.h"
 

@@ -6,7 +6,7 @@
 
 #include "cpu/encode.h"
 #include "cpu/oracle.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 
 namespace meshcast::bench {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "bench/measure.h"
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast::bench {
 

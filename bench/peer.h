@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "cpu/ray.h"
 
 namespace meshcast::bench {

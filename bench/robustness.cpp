@@ -5,7 +5,7 @@
 
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "io/generate.h"
 
 namespace meshcast::bench {

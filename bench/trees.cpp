@@ -126,8 +126,8 @@ std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, siz
   Setup s = setup(mesh, rays);
   std::vector<TreeRow> rows;
   for (const auto& [layout, o] : cases) {
-    if (o.tree_format == MC_TREE_BRUTEFORCE || o.triangle_format == MC_TRI_FLOAT3SOA128 ||
-        o.triangle_format == MC_TRI_BITPACKSOA128 || !kept(layout))
+    if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.triangles) == MC_TRI_FLOAT3SOA128 ||
+        uint32_t(o.layout.triangles) == MC_TRI_BITPACKSOA128 || !kept(layout))
       continue;
     std::fprintf(stderr, "  %s\n", layout.c_str());
     auto it = seed.find(layout);

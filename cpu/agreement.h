@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "cpu/oracle.h"
 #include "cpu/ray.h"
 

@@ -6,7 +6,7 @@
 #include <cstdlib>
 
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 
 namespace meshcast {
 
@@ -43,8 +43,8 @@ bool readable(const AutoLimits& l, const std::string& layout) {
 bool worth_trying(const AutoLimits& l, const MeshStats& s, const std::string& layout) {
   const BuildOptions o = parse_layout(layout);
   if (!readable(l, layout)) return false;
-  if (o.tree_format == MC_TREE_BRUTEFORCE) return !l.readers.empty() && s.triangles <= 4096;
-  if (o.triangle_format == MC_TRI_FLOAT3SOA128 || o.triangle_format == MC_TRI_BITPACKSOA128) return !l.readers.empty();
+  if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE) return !l.readers.empty() && s.triangles <= 4096;
+  if (uint32_t(o.layout.triangles) == MC_TRI_FLOAT3SOA128 || uint32_t(o.layout.triangles) == MC_TRI_BITPACKSOA128) return !l.readers.empty();
   return true;
 }
 
@@ -231,7 +231,7 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
     std::vector<size_t> again;
     for (size_t i = 0; i < out.candidates.size(); ++i) {
       const AutoCandidate& c = out.candidates[i];
-      const uint32_t tree = c.options.tree_format;  // the formats whose leaves are not the builder's
+      const uint32_t tree = uint32_t(c.options.layout.tree);  // the formats whose leaves are not the builder's
       if (c.built && c.refused.empty() && tree != MC_TREE_ZEROBYTE && tree != MC_TREE_ZEROBYTEHYBRID &&
           tree != MC_TREE_AABBLIST && tree != MC_TREE_BRUTEFORCE)
         again.push_back(i);
@@ -243,7 +243,7 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
     const size_t from = out.candidates.size();
     for (size_t a : again) {
       const AutoCandidate& small = out.candidates[a];
-      out.candidates.push_back(candidate(limits, layout_name(small.options.tree_format, small.options.triangle_format), 16,
+      out.candidates.push_back(candidate(limits, layout_name(uint32_t(small.options.layout.tree), uint32_t(small.options.layout.triangles)), 16,
                                          small.why + "; leaves of 16: fewer nodes, fuller blocks"));
     }
     if (!again.empty()) out.reasons.push_back("memory first: the smallest tree layouts once more with leaves of 16");

@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "cpu/mesh.h"
+#include "meshcast/build.h"
+#include "meshcast/mesh.h"
 #include "layout/formats.h"
 
 namespace meshcast {
@@ -27,10 +28,10 @@ struct BuildTree {
   uint32_t leaf_count() const;
 };
 
-// The splitters of seed 000 §4.1. Every one builds top down (build_topdown.h):
-// a node with at most `leaf_size` triangles becomes a leaf; a larger one is
-// always split, so no leaf exceeds leaf_size.
-enum class Splitter { Binning, LongestAxis, Mean, Morton, FixedLeafSize };
+// The splitters of seed 000 §4.1 (meshcast/build.h's Splitter). Every one
+// builds top down (build_topdown.h): a node with at most `leaf_size`
+// triangles becomes a leaf; a larger one is always split, so no leaf
+// exceeds leaf_size.
 
 // SAH over 32 binned centres per axis (Günther et al. 2007).
 // `depth_limit`: nodes at that depth become leaves whatever their count
@@ -74,13 +75,7 @@ std::vector<Splitter> all_splitters();
 // axes: the order the Morton splitter cuts.
 std::vector<uint32_t> morton_sorted(const std::vector<Vec3>& centres);
 
-// AABBList batches (seed 000 §7): how triangles are grouped into batches of
-// MC_LIST_BATCH, each batch later one box.
-//   ClosestCentroid  the seed's greedy: the unused triangle with the lowest
-//                    centre x and the batch - 1 unused triangles whose
-//                    centres lie nearest to its centre
-//   Morton           consecutive runs of the Morton order
-enum class Grouping { ClosestCentroid, Morton };
+// AABBList batches (meshcast/build.h's Grouping).
 // The triangle order, batch after batch (every batch full but the last).
 std::vector<uint32_t> group_batches(const std::vector<Box3>& boxes, uint32_t batch, Grouping grouping);
 Grouping parse_grouping(const std::string& name);

@@ -60,6 +60,38 @@ CodecOps codec_ops(uint32_t format) {
   throw InputError("unknown triangle format " + std::to_string(format));
 }
 
+// The public names (meshcast/build.h) are the ids a blob stores.
+static_assert(uint32_t(TreeFormat::AABBTree) == MC_TREE_AABBTREE &&
+              uint32_t(TreeFormat::QuadTree) == MC_TREE_QUADTREE &&
+              uint32_t(TreeFormat::QuadTreeHalfFloat) == MC_TREE_QUADTREEHALFFLOAT &&
+              uint32_t(TreeFormat::BruteForce) == MC_TREE_BRUTEFORCE &&
+              uint32_t(TreeFormat::AABBTreeSplitAxis) == MC_TREE_AABBTREESPLITAXIS &&
+              uint32_t(TreeFormat::AABBTreePNS) == MC_TREE_AABBTREEPNS &&
+              uint32_t(TreeFormat::AABBTreeCompressed) == MC_TREE_AABBTREECOMPRESSED &&
+              uint32_t(TreeFormat::SKDTree) == MC_TREE_SKDTREE &&
+              uint32_t(TreeFormat::StacklessLBVH) == MC_TREE_STACKLESSLBVH &&
+              uint32_t(TreeFormat::AABBList) == MC_TREE_AABBLIST &&
+              uint32_t(TreeFormat::ZeroByteTree) == MC_TREE_ZEROBYTE &&
+              uint32_t(TreeFormat::ZeroByteHybrid) == MC_TREE_ZEROBYTEHYBRID);
+static_assert(uint32_t(TriangleFormat::Float3) == MC_TRI_FLOAT3 &&
+              uint32_t(TriangleFormat::Float3SOA4) == MC_TRI_FLOAT3SOA4 &&
+              uint32_t(TriangleFormat::Indexed8BitPackSOA4) == MC_TRI_INDEXED8BITPACKSOA4 &&
+              uint32_t(TriangleFormat::Indexed16) == MC_TRI_INDEXED16 &&
+              uint32_t(TriangleFormat::Indexed32) == MC_TRI_INDEXED32 &&
+              uint32_t(TriangleFormat::Indexed16SOA4) == MC_TRI_INDEXED16SOA4 &&
+              uint32_t(TriangleFormat::Indexed32SOA4) == MC_TRI_INDEXED32SOA4 &&
+              uint32_t(TriangleFormat::Indexed16BitPackSOA4) == MC_TRI_INDEXED16BITPACKSOA4 &&
+              uint32_t(TriangleFormat::Indexed32BitPackSOA4) == MC_TRI_INDEXED32BITPACKSOA4 &&
+              uint32_t(TriangleFormat::Float3SOA8) == MC_TRI_FLOAT3SOA8 &&
+              uint32_t(TriangleFormat::Float3SOA128) == MC_TRI_FLOAT3SOA128 &&
+              uint32_t(TriangleFormat::BitPackSOA4) == MC_TRI_BITPACKSOA4 &&
+              uint32_t(TriangleFormat::BitPackSOA128) == MC_TRI_BITPACKSOA128 &&
+              uint32_t(TriangleFormat::BitPack) == MC_TRI_BITPACK &&
+              uint32_t(TriangleFormat::UncompressedStrip) == MC_TRI_UNCOMPRESSEDSTRIP &&
+              uint32_t(TriangleFormat::CompressedStrip) == MC_TRI_COMPRESSEDSTRIP &&
+              uint32_t(TriangleFormat::Indexed24) == MC_TRI_INDEXED24 &&
+              uint32_t(TriangleFormat::Float3PairSOA4) == MC_TRI_FLOAT3PAIRSOA4);
+
 namespace {
 
 // Every tree format id, in the order of cpu/pairs.h.
@@ -175,16 +207,16 @@ BuildTree build_paired(const Mesh& mesh, const BuildOptions& o, const std::vecto
 BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec,
                     uint32_t depth_limit, BuildReport* report) {
   const uint32_t chunk = layout::brute_chunk(codec.lanes);
-  if (o.pairing && (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST))
-    throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(o.tree_format)) +
+  if (o.pairing && (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST))
+    throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) +
                      " keeps its own triangle order");
   if (o.pairing) return build_paired(mesh, o, boxes, depth_limit, report);
-  if (o.tree_format == MC_TREE_BRUTEFORCE) {
+  if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE) {
     std::vector<uint32_t> input(boxes.size());
     std::iota(input.begin(), input.end(), 0u);
     return chunk_tree(boxes, std::move(input), chunk);
   }
-  if (o.tree_format == MC_TREE_AABBLIST) {
+  if (uint32_t(o.layout.tree) == MC_TREE_AABBLIST) {
     static_assert(MC_LIST_BATCH % MC_BRUTE_CHUNK == 0 && MC_LIST_BATCH % 128 == 0, "records must tile a batch");
     return chunk_tree(boxes, group_batches(boxes, MC_LIST_BATCH, o.grouping), chunk);
   }
@@ -194,7 +226,7 @@ BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<B
 }  // namespace
 
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
-  switch (o.tree_format) {
+  switch (uint32_t(o.layout.tree)) {
     case MC_TREE_AABBTREE: return make_aabb_writer(false);
     case MC_TREE_AABBTREESPLITAXIS: return make_aabb_writer(true);
     case MC_TREE_AABBTREEPNS: return make_pns_writer();
@@ -272,23 +304,28 @@ void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector
   }
 }
 
+std::vector<uint8_t> build_blob(const MeshView& mesh, const BuildOptions& options, const std::string& name,
+                                BuildReport* report) {
+  return build_blob(copy_mesh(mesh, name), options, name, report);
+}
+
 std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
                                 BuildReport* report) {
   auto start = std::chrono::steady_clock::now();
   check_mesh(mesh, name);
-  if (o.tree_format == MC_TREE_ZEROBYTE || o.tree_format == MC_TREE_ZEROBYTEHYBRID)
+  if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
     return build_zerobyte_blob(mesh, o, name, report);
   if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
     throw InputError(name + ": leaf size " + std::to_string(o.leaf_size) + " is outside 1.." +
                      std::to_string(MC_QUAD_MAX_COUNT) + " (5-bit triangle counts, seed 000 5.6)");
-  if (layout::tree_format_name(o.tree_format).empty()) throw InputError(name + ": unknown tree format");
-  CodecOps codec = codec_ops(o.triangle_format);
-  if (std::string why = node_order_refusal(o.tree_format, o.node_order); !why.empty())
+  if (layout::tree_format_name(uint32_t(o.layout.tree)).empty()) throw InputError(name + ": unknown tree format");
+  CodecOps codec = codec_ops(uint32_t(o.layout.triangles));
+  if (std::string why = node_order_refusal(uint32_t(o.layout.tree), o.node_order); !why.empty())
     throw InputError(name + ": " + why);
 
   BlobHeader h{};
   h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
-  h.tree_format = o.tree_format, h.triangle_format = o.triangle_format;
+  h.tree_format = uint32_t(o.layout.tree), h.triangle_format = uint32_t(o.layout.triangles);
   h.triangle_count = uint32_t(mesh.triangles.size());
   h.leaf_size = o.leaf_size;
   h.slot_divisor = codec.slot_divisor;
@@ -336,7 +373,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   }
 
   uint32_t depth_limit = ~0u;
-  if (o.tree_format == MC_TREE_STACKLESSLBVH) {
+  if (uint32_t(o.layout.tree) == MC_TREE_STACKLESSLBVH) {
     // The seed's choice, within the heap's reach (the capacity check then
     // says when a mesh is too large for it).
     uint32_t d = o.lbvh_depth ? o.lbvh_depth
@@ -350,7 +387,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   try {
     tree = build_for(mesh, o, boxes, codec, depth_limit, report);
   } catch (const InputError& e) {
-    throw InputError(name + ": " + std::string(layout::tree_format_name(o.tree_format)) + ": " + e.what());
+    throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());
   }
   uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
   Writer writer{corners, tree, codec, h, {}, {}, {}, {}, {}, {}};
@@ -375,7 +412,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   try {
     tree_writer->fill(writer);
   } catch (const std::length_error& e) {  // a codec's own limit (index width)
-    throw InputError(name + ": " + layout_name(o.tree_format, o.triangle_format) + ": " + e.what());
+    throw InputError(name + ": " + layout_name(uint32_t(o.layout.tree), uint32_t(o.layout.triangles)) + ": " + e.what());
   }
   // Vertices and remap at most 8 + 12 bytes a triangle on top of this.
   if (uint64_t(hd.vertex_offset) + writer.pool.size() + 12ull * mesh.triangles.size() + 4096 > 0xF0000000ull)
@@ -432,14 +469,19 @@ bool moves_vertices(uint32_t triangle_format) {
   return c.grid != layout::kGridNone || c.moves_floats;
 }
 
+std::vector<Layout> all_layouts() {
+  std::vector<Layout> all;
+  for (uint32_t t : tree_formats())
+    for (uint32_t c : triangle_formats()) all.push_back({TreeFormat(t), TriangleFormat(c)});
+  // Seed 004's trees live in the mesh's own indices: one triangle format.
+  all.push_back({TreeFormat::ZeroByteTree, TriangleFormat::Indexed24});
+  all.push_back({TreeFormat::ZeroByteHybrid, TriangleFormat::Indexed24});
+  return all;
+}
+
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
-  for (uint32_t t : tree_formats())
-    for (uint32_t c : triangle_formats())
-      names.push_back(layout_name(t, c));
-  // Seed 004's trees live in the mesh's own indices: one triangle format.
-  names.push_back(layout_name(MC_TREE_ZEROBYTE, MC_TRI_INDEXED24));
-  names.push_back(layout_name(MC_TREE_ZEROBYTEHYBRID, MC_TRI_INDEXED24));
+  for (Layout l : all_layouts()) names.push_back(layout_name(l));
   return names;
 }
 
@@ -447,24 +489,23 @@ std::string layout_name(uint32_t tree, uint32_t triangles) {
   return std::string(layout::tree_format_name(tree)) + "/" + std::string(layout::triangle_format_name(triangles));
 }
 
+std::string layout_name(Layout l) { return layout_name(uint32_t(l.tree), uint32_t(l.triangles)); }
+
+Layout parse_layout_name(const std::string& name) { return parse_layout(name).layout; }
+
 BuildOptions parse_layout(const std::string& text) {
   auto lower = [](std::string s) {
     for (char& ch : s) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     return s;
   };
-  std::vector<std::pair<uint32_t, uint32_t>> pairs;
-  for (uint32_t t : tree_formats())
-    for (uint32_t c : triangle_formats()) pairs.push_back({t, c});
-  pairs.push_back({MC_TREE_ZEROBYTE, MC_TRI_INDEXED24});
-  pairs.push_back({MC_TREE_ZEROBYTEHYBRID, MC_TRI_INDEXED24});
-  for (auto [t, c] : pairs)
-      if (lower(layout_name(t, c)) == lower(text)) {
-        BuildOptions o;
-        o.tree_format = t, o.triangle_format = c;
-        // The seed 001 heap is built by Morton-code middle split.
-        if (t == MC_TREE_STACKLESSLBVH) o.splitter = Splitter::Morton;
-        return o;
-      }
+  for (Layout l : all_layouts())
+    if (lower(layout_name(l)) == lower(text)) {
+      BuildOptions o;
+      o.layout = l;
+      // The seed 001 heap is built by Morton-code middle split.
+      if (l.tree == TreeFormat::StacklessLBVH) o.splitter = Splitter::Morton;
+      return o;
+    }
   std::string valid;
   for (const std::string& n : layout_names()) valid += "\n  " + n;
   throw InputError("unknown layout '" + text + "'; valid layouts (TREE/TRIANGLES):" + valid);

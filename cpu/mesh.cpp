@@ -1,7 +1,8 @@
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace meshcast {
 
@@ -59,6 +60,40 @@ void check_mesh(const Mesh& mesh, const std::string& name) {
                          " but the mesh has only " + std::to_string(mesh.vertices.size()) + " vertices");
   if (mesh.triangles.size() > 0xFFFFFFFEu)
     throw InputError(name + ": more than 2^32-2 triangles");
+}
+
+Mesh copy_mesh(const MeshView& view, const std::string& name) {
+  const size_t index_bytes = view.index_type == IndexType::Uint16 ? 2 : 4;
+  const size_t triangle_stride = view.triangle_stride ? view.triangle_stride : 3 * index_bytes;
+  if ((view.vertex_count && !view.positions) || (view.triangle_count && !view.indices))
+    throw InputError(name + ": a null position or index array with a nonzero count");
+  if (view.vertex_stride < 3 * sizeof(float))
+    throw InputError(name + ": vertex stride " + std::to_string(view.vertex_stride) +
+                     " is shorter than a position (12 bytes: three floats)");
+  if (triangle_stride < 3 * index_bytes)
+    throw InputError(name + ": triangle stride " + std::to_string(triangle_stride) + " is shorter than three " +
+                     std::to_string(8 * index_bytes) + "-bit indices");
+  if (view.vertex_count > 0xFFFFFFFFu)
+    throw InputError(name + ": " + std::to_string(view.vertex_count) + " vertices; 32-bit indices reach 2^32");
+  Mesh mesh;
+  mesh.vertices.resize(view.vertex_count);
+  const auto* positions = static_cast<const unsigned char*>(view.positions);
+  for (size_t i = 0; i < view.vertex_count; ++i) std::memcpy(&mesh.vertices[i], positions + i * view.vertex_stride, 12);
+  mesh.triangles.resize(view.triangle_count);
+  const auto* indices = static_cast<const unsigned char*>(view.indices);
+  for (size_t t = 0; t < view.triangle_count; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const unsigned char* at = indices + t * triangle_stride + size_t(k) * index_bytes;
+      if (index_bytes == 2) {
+        uint16_t v;
+        std::memcpy(&v, at, 2);
+        mesh.triangles[t][size_t(k)] = v;
+      } else {
+        std::memcpy(&mesh.triangles[t][size_t(k)], at, 4);
+      }
+    }
+  check_mesh(mesh, name);
+  return mesh;
 }
 
 }  // namespace meshcast

@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <string>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast {
 

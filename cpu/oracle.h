@@ -6,7 +6,7 @@
 #pragma once
 #include <vector>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "cpu/ray.h"
 
 namespace meshcast {

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast {
 

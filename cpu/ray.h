@@ -20,49 +20,15 @@
 #include <cstdint>
 
 #include "cpu/counters.h"
-#include "cpu/mesh.h"
 #include "cpu/simd.h"
 #include "layout/formats.h"
+#include "meshcast/ray.h"
 
 namespace meshcast {
 
-// The largest direction component a ray may have (ray_is_walkable).
-constexpr float kMaxDirection = 0x1p126f;
-
-struct Ray {
-  float org[3];
-  float dir[3];
-  float tmax;
-};
-
-static_assert(sizeof(Ray) == 28, "Ray is the 7 floats of a rays-file record");
-
-struct Hit {
-  float t = INFINITY;
-  uint32_t triangle = MC_NO_HIT;  // index in the caller's mesh
-  // Only when asked for (MC_HIT_UV): barycentrics of corners 1 and 2
-  // (strips: of a rotation of the triangle's corners, the winding kept).
-  float u = 0, v = 0;
-  float point[3] = {0, 0, 0};     // only when asked for (MC_HIT_POINT): org + t * dir
-};
-static_assert(sizeof(Hit) == 28, "the Vulkan methods' hit record (shaders/hits.glsl) is the same 7 words");
-
-// A ray the walkers may walk: an origin within +-2^100 (the coordinate
-// range of meshes, kMaxCoordinate), direction components within +-2^126
-// (so every reciprocal the tests use, 1/dir and the shear's sz, is a normal
-// float: a GPU may flush denormals to 0) and not all below FLT_MIN, t_max
-// not NaN and not negative (infinity allowed). Any other ray is answered as
-// a miss and counted. Within these ranges every ray-space quantity of the
-// triangle test fits a double (see kSettleTiny).
-inline bool ray_is_walkable(const Ray& r) {
-  for (int a = 0; a < 3; ++a)
-    if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !(std::fabs(r.dir[a]) <= kMaxDirection)) return false;
-  // A direction whose largest component is below FLT_MIN counts as zero:
-  // its reciprocal would overflow.
-  float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
-  if (!(m >= 0x1p-126f)) return false;
-  return !std::isnan(r.tmax) && r.tmax >= 0;
-}
+static_assert(kNoHit == MC_NO_HIT && uint32_t(HitOutputs::Uv) == MC_HIT_UV &&
+                  uint32_t(HitOutputs::Point) == MC_HIT_POINT,
+              "the public names are layout/formats.h's values, which the shaders read");
 
 // 1 + 2 * gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (Ize 2013).
 constexpr float kFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);

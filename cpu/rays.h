@@ -3,14 +3,12 @@
 //   hits: "HITS", uint32 count, per ray float32 t (inf: miss), uint32 triangle
 // All little-endian.
 #pragma once
-#include <initializer_list>
-#include <sstream>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "cpu/mesh.h"
 #include "cpu/ray.h"
+#include "layout/files.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast {
 
@@ -36,39 +34,5 @@ void write_hits(const std::string& path, const std::vector<Hit>& hits);
 // Most rays a rays file may hold, and `meshcast rays --count` make: 2^27
 // (3.5 GiB of records).
 constexpr size_t kMaxRayCount = size_t(1) << 27;
-
-// Whole-file helpers for meshes, blobs, rays and hits: read_file reads a
-// regular file and throws InputError naming the path for anything else (a
-// directory, a device such as /dev/zero or a pipe is refused before any
-// read: it has no size to read up to). write_file writes the pieces in order to a file
-// beside `path`, checks every write, the flush and the close, then renames it
-// to `path`, so a failed write (a full disk) leaves no partial file under
-// that name; an existing path that is not a regular file (/dev/null,
-// /dev/full, a pipe) is written in place. Failures throw OutputError naming
-// the path and the reason.
-struct OutputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-struct Bytes {
-  const void* data;
-  size_t size;
-};
-// The check read_file makes first, for a reader that must judge the path
-// before it reads (read_mesh: kind of file, then extension, then bytes).
-void require_regular_file(const std::string& path);
-std::vector<uint8_t> read_file(const std::string& path);
-
-// Text output (CSV, plot scripts, profiles): built in memory, then written
-// by write_file when commit() is called, so it is checked the same way.
-class OutputText : public std::ostringstream {
- public:
-  explicit OutputText(std::string path) : path_(std::move(path)) {}
-  void commit();
-
- private:
-  std::string path_;
-};
-void write_file(const std::string& path, std::initializer_list<Bytes> pieces);
-inline void write_file(const std::string& path, const void* data, size_t size) { write_file(path, {{data, size}}); }
 
 }  // namespace meshcast

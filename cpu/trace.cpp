@@ -1,12 +1,12 @@
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 
 #include <algorithm>
 #include <cfloat>
 #include <vector>
 
-#include "cpu/mesh.h"
 #include "cpu/pairs.h"
 #include "cpu/walk.h"
+#include "layout/blob.h"
 #include "layout/quadtree.h"
 
 namespace meshcast {
@@ -51,7 +51,12 @@ std::vector<Entry> make_walkers() {
   return entries;
 }
 
-const std::vector<Entry> kWalkers = make_walkers();
+// Made on first use, not at static initialisation: a BlobView made by
+// another translation unit's static initialiser finds it ready.
+const std::vector<Entry>& walkers() {
+  static const std::vector<Entry> table = make_walkers();
+  return table;
+}
 
 }  // namespace
 
@@ -78,15 +83,25 @@ BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : by
   std::string why = layout::validate(bytes);
   if (!why.empty()) throw InputError(name + ": " + why);
   const layout::BlobHeader& h = layout::header_of(bytes.data());
-  for (const Entry& e : kWalkers)
+  for (const Entry& e : walkers())
     if (e.tree == h.tree_format && e.triangles == h.triangle_format) walk_ = e.walk;
   if (!walk_) throw InputError(name + ": no walker for this layout");
 }
 
-uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, uint32_t outputs) const {
+uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs) const {
+  if (hits.size() < rays.size())
+    throw UsageError("BlobView::trace: " + std::to_string(rays.size()) + " rays but room for " +
+                     std::to_string(hits.size()) + " hits; the hits span must hold one hit a ray");
   uint64_t skipped = 0;
-  walk_(bytes_.data(), rays.data(), hits.data(), std::min(rays.size(), hits.size()), &skipped, outputs);
+  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, uint32_t(outputs));
   return skipped;
 }
+
+Layout BlobView::layout() const {
+  const layout::BlobHeader& h = layout::header_of(bytes_.data());
+  return {TreeFormat(h.tree_format), TriangleFormat(h.triangle_format)};
+}
+
+uint32_t BlobView::triangle_count() const { return layout::header_of(bytes_.data()).triangle_count; }
 
 }  // namespace meshcast

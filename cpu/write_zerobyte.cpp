@@ -252,9 +252,9 @@ std::string ZeroByteStats::describe() const {
 std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
                                          BuildReport* report) {
   auto start = std::chrono::steady_clock::now();
-  const bool hybrid = o.tree_format == MC_TREE_ZEROBYTEHYBRID;
+  const bool hybrid = uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID;
   const std::string what = name + ": " + (hybrid ? "ZeroByteHybrid" : "ZeroByteTree");
-  if (o.triangle_format != MC_TRI_INDEXED24) throw InputError(what + " stores the mesh's own indices: Indexed24 only");
+  if (uint32_t(o.layout.triangles) != MC_TRI_INDEXED24) throw InputError(what + " stores the mesh's own indices: Indexed24 only");
   if (o.pairing) throw InputError(what + ": pairing builds the other trees; a zero-byte tree picks its own order");
   if (!hybrid && mesh.triangles.size() > MC_ZBT_MAX_TRIANGLES)
     throw InputError(what + " holds at most " + std::to_string(MC_ZBT_MAX_TRIANGLES) +
@@ -319,7 +319,7 @@ std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o
 
   BlobHeader h{};
   h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
-  h.tree_format = o.tree_format, h.triangle_format = MC_TRI_INDEXED24;
+  h.tree_format = uint32_t(o.layout.tree), h.triangle_format = MC_TRI_INDEXED24;
   h.triangle_count = uint32_t(mesh.triangles.size());
   h.node_count = stats.nodes + top_nodes;
   h.leaf_count = stats.leaves;

@@ -155,7 +155,7 @@ std::unique_ptr<TreeWriter> make_pns_writer();                  // AABBTreePNS (
 std::unique_ptr<TreeWriter> make_quad_writer(bool half, NodeOrder order);  // §5.6-5.7 in a §4.3 order
 std::unique_ptr<TreeWriter> make_bruteforce_writer();           // §3.11
 std::unique_ptr<TreeWriter> make_aabblist_writer();             // §7, method 2
-std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);  // the one for options.tree_format
+std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);  // the one for options.layout.tree
 
 std::unique_ptr<TreeWriter> make_compressed_writer();  // AABBTreeCompressed (§5.4)
 std::unique_ptr<TreeWriter> make_skd_writer();         // SKDTree (§5.5)

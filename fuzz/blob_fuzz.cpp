@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "cpu/agreement.h"
-#include "cpu/mesh.h"
-#include "cpu/trace.h"
+#include "meshcast/mesh.h"
+#include "meshcast/blob.h"
 #include "fuzz/rays.h"
 #include "layout/blob.h"
 

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "cpu/encode.h"
-#include "cpu/mesh.h"
-#include "cpu/trace.h"
+#include "meshcast/mesh.h"
+#include "meshcast/blob.h"
 #include "fuzz/rays.h"
 #include "io/read_mesh.h"
 #include "layout/blob.h"

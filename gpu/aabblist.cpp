@@ -60,11 +60,11 @@ class AABBListMethod : public BatchMethod {
       const uint32_t end = std::min(n, base + chunk_);
       const Push boxes{base, end, records_}, args{0, 0, limits.maxComputeWorkGroupCount[0]}, test{0, n, records_};
       boxes_.dispatch(cb, slot, &boxes, box_groups, end - base, 1);
-      compute_barrier(cb);
+      ctx_.compute_barrier(cb);
       args_.dispatch(cb, slot, &args, 1, 1, 1);
-      indirect_barrier(cb);
+      ctx_.indirect_barrier(cb);
       test_.dispatch_indirect(cb, slot, &test, *control_[slot], 4);
-      compute_barrier(cb);
+      ctx_.compute_barrier(cb);
     }
     const Push resolve{0, n, records_};
     resolve_.dispatch(cb, slot, &resolve, (n + 63) / 64, 1, 1);

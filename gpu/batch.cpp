@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cstring>
 
-#include "cpu/mesh.h"
-#include "cpu/trace.h"
+#include "meshcast/mesh.h"
+#include "meshcast/blob.h"
 #include "gpu/rays.h"
 #include "layout/blob.h"
 
@@ -30,22 +30,22 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
   blob_->upload(blob);
   for (Slot& s : slots_) {
     VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(vkCreateFence(ctx.device(), &fci, nullptr, &s.fence), "vkCreateFence");
+    check(ctx_.vk().CreateFence(ctx.device(), &fci, nullptr, &s.fence), "vkCreateFence");
     s.cb = ctx.allocate_command_buffer();
     if (ctx.has_timestamps()) {
       VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
       q.queryType = VK_QUERY_TYPE_TIMESTAMP, q.queryCount = 2;
-      check(vkCreateQueryPool(ctx.device(), &q, nullptr, &s.queries), "vkCreateQueryPool");
+      check(ctx_.vk().CreateQueryPool(ctx.device(), &q, nullptr, &s.queries), "vkCreateQueryPool");
     }
   }
 }
 
 BatchMethod::~BatchMethod() {
   for (Slot& s : slots_) {
-    if (s.in_flight) vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000);
-    if (s.queries) vkDestroyQueryPool(ctx_.device(), s.queries, nullptr);
+    if (s.in_flight) ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000);
+    if (s.queries) ctx_.vk().DestroyQueryPool(ctx_.device(), s.queries, nullptr);
     if (s.cb) ctx_.free_command_buffer(s.cb);
-    if (s.fence) vkDestroyFence(ctx_.device(), s.fence, nullptr);
+    if (s.fence) ctx_.vk().DestroyFence(ctx_.device(), s.fence, nullptr);
   }
 }
 
@@ -84,21 +84,21 @@ uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
   std::memset(s.keys->data(), 0xFF, uint64_t(s.n) * 8);
   prepare(slot, s.n);
   if (s.recorded != s.n) {  // recorded once a batch size, resubmitted after
-    check(vkResetCommandBuffer(s.cb, 0), "vkResetCommandBuffer");
+    check(ctx_.vk().ResetCommandBuffer(s.cb, 0), "vkResetCommandBuffer");
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    check(vkBeginCommandBuffer(s.cb, &bi), "vkBeginCommandBuffer");
+    check(ctx_.vk().BeginCommandBuffer(s.cb, &bi), "vkBeginCommandBuffer");
     if (s.queries) {
-      vkCmdResetQueryPool(s.cb, s.queries, 0, 2);
-      vkCmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
+      ctx_.vk().CmdResetQueryPool(s.cb, s.queries, 0, 2);
+      ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
     }
     record(s.cb, slot, s.n);
     // The hits (mapped memory) made visible to the host that reads them after the fence.
     VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(s.cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr,
+    ctx_.vk().CmdPipelineBarrier(s.cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr,
                          0, nullptr);
-    if (s.queries) vkCmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
-    check(vkEndCommandBuffer(s.cb), "vkEndCommandBuffer");
+    if (s.queries) ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
+    check(ctx_.vk().EndCommandBuffer(s.cb), "vkEndCommandBuffer");
     s.recorded = s.n;
   }
   ctx_.submit_async(s.cb, s.fence);
@@ -109,7 +109,7 @@ uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
 bool BatchMethod::ready(uint32_t slot) {
   Slot& s = slots_.at(slot);
   if (!s.in_flight) return true;
-  VkResult r = vkGetFenceStatus(ctx_.device(), s.fence);
+  VkResult r = ctx_.vk().GetFenceStatus(ctx_.device(), s.fence);
   if (r == VK_NOT_READY) return false;
   check(r, "waiting for the GPU");
   return true;
@@ -118,13 +118,13 @@ bool BatchMethod::ready(uint32_t slot) {
 void BatchMethod::wait(uint32_t slot) {
   Slot& s = slots_.at(slot);
   if (s.in_flight)
-    check(vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
+    check(ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
 }
 
 void BatchMethod::finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) {
   Slot& s = slots_.at(slot);
   if (s.in_flight) {
-    check(vkWaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
+    check(ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
     s.in_flight = false;  // only once done: a failed wait leaves the destructor to wait again
   }
   if (s.n) std::memcpy(hits.data(), s.hits->data(), uint64_t(std::min<size_t>(s.n, hits.size())) * sizeof(Hit));
@@ -133,7 +133,7 @@ void BatchMethod::finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) 
     timing->device_ms = 0;
     uint64_t stamps[2];
     if (s.n && s.queries &&
-        vkGetQueryPoolResults(ctx_.device(), s.queries, 0, 2, sizeof stamps, stamps, 8,
+        ctx_.vk().GetQueryPoolResults(ctx_.device(), s.queries, 0, 2, sizeof stamps, stamps, 8,
                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) == VK_SUCCESS)
       timing->device_ms = double(stamps[1] - stamps[0]) * ctx_.timestamp_period_ns() * 1e-6;
   }

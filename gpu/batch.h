@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 
 namespace meshcast::gpu {
 

@@ -7,7 +7,7 @@
 #include <algorithm>
 
 #include "gpu/batch.h"
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "layout/blob.h"
 #include "shaders/bruteforce_bitpack.h"
 #include "shaders/bruteforce_float3.h"
@@ -40,7 +40,7 @@ class BruteForceMethod : public BatchMethod {
       Push push{base, n, records_};
       test_.dispatch(cb, slot, &push, records_, std::min(max_y, n - base), 1);
     }
-    compute_barrier(cb);
+    ctx_.compute_barrier(cb);
     Push push{0, n, records_};
     resolve_.dispatch(cb, slot, &push, (n + 63) / 64, 1, 1);
   }

@@ -9,10 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "cpu/ray.h"
-#include "gpu/vulkan.h"
+#include "meshcast/errors.h"
+#include "meshcast/ray.h"
 
 namespace meshcast::gpu {
+
+// The Vulkan context (gpu/vulkan.h): a Method's user needs no Vulkan header,
+// so the host layer builds the same with the Vulkan backend off.
+class Context;
 
 struct GpuTiming {
   double device_ms = 0;  // between the batch's first and last GPU timestamps (0 without timestamps)

@@ -12,30 +12,6 @@ namespace meshcast::gpu {
 
 namespace {
 
-// volk keeps one global table of function pointers. A context may not load
-// its own instance or device into it: a second context would overwrite the
-// first's pointers (and an instance without VK_EXT_debug_utils would leave
-// the messenger functions null for every other context: a crash at exit on
-// NVIDIA's driver, found on an H100). So the table is filled once, through
-// vkGetInstanceProcAddr of the first instance: for core functions the
-// loader returns its trampolines, which dispatch on the handle passed, so
-// they serve every instance and device of the process. Extension functions
-// each context fetches for itself.
-std::mutex volk_mutex;
-bool volk_loaded = false;
-
-VkResult volk_initialize_once() {
-  std::lock_guard lock(volk_mutex);
-  static VkResult result = volkInitialize();
-  return result;
-}
-
-void volk_load_once(VkInstance instance) {
-  std::lock_guard lock(volk_mutex);
-  if (!volk_loaded) volkLoadInstance(instance);
-  volk_loaded = true;
-}
-
 const char* result_name(VkResult r) {
   switch (r) {
     case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
@@ -56,11 +32,11 @@ std::string lower(std::string s) {
   return s;
 }
 
-bool has_layer(const char* name) {
+bool has_layer(const VulkanFunctions& vk, const char* name) {
   uint32_t n = 0;
-  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  vk.EnumerateInstanceLayerProperties(&n, nullptr);
   std::vector<VkLayerProperties> layers(n);
-  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  vk.EnumerateInstanceLayerProperties(&n, layers.data());
   for (const VkLayerProperties& l : layers)
     if (std::strcmp(l.layerName, name) == 0) return true;
   return false;
@@ -83,14 +59,17 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::on_message(VkDebugUtilsMessageSeverityFl
 }
 
 Context::Context(const DeviceChoice& choice) {
-  if (volk_initialize_once() != VK_SUCCESS)
-    throw GpuError("Vulkan: no Vulkan loader found (install libvulkan1 and a driver, e.g. mesa-vulkan-drivers)");
-  if (volkGetInstanceVersion() < VK_API_VERSION_1_2)
-    throw GpuError("Vulkan: the loader offers Vulkan " + std::to_string(VK_API_VERSION_MINOR(volkGetInstanceVersion())) +
-                   ".x; meshcast needs 1.2");
+  const PFN_vkGetInstanceProcAddr loader = loader_get_instance_proc_addr();
+  if (!loader) throw GpuError("Vulkan: no Vulkan loader found (install libvulkan1 and a driver, e.g. mesa-vulkan-drivers)");
+  load_global_functions(vk_, loader);
+  uint32_t version = VK_API_VERSION_1_0;
+  if (vk_.EnumerateInstanceVersion) vk_.EnumerateInstanceVersion(&version);
+  if (version < VK_API_VERSION_1_2)
+    throw GpuError("Vulkan: the loader offers Vulkan 1." + std::to_string(VK_API_VERSION_MINOR(version)) +
+                   "; meshcast needs 1.2");
   const char* env_validation = std::getenv("MESHCAST_VK_VALIDATION");
   bool validation = choice.validation || (env_validation && std::string(env_validation) == "1");
-  if (validation && !has_layer("VK_LAYER_KHRONOS_validation"))
+  if (validation && !has_layer(vk_, "VK_LAYER_KHRONOS_validation"))
     throw GpuError("Vulkan: validation asked for, but VK_LAYER_KHRONOS_validation is not installed (vulkan-validationlayers)");
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
@@ -102,33 +81,30 @@ Context::Context(const DeviceChoice& choice) {
   ici.pApplicationInfo = &app;
   if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 1,
                   ici.ppEnabledExtensionNames = &ext;
-  check(vkCreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
+  check(vk_.CreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
   // A throw below (no such device, a missing feature) would skip the
   // destructor: release what exists so far, then let it go on.
   try {
-    volk_load_once(instance_);
+    load_instance_functions(vk_, instance_);
     if (validation) {
-      auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-          vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-      destroy_messenger_ = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-          vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-      if (!create || !destroy_messenger_) throw GpuError("Vulkan: validation asked for, but VK_EXT_debug_utils is missing");
+      if (!vk_.CreateDebugUtilsMessengerEXT || !vk_.DestroyDebugUtilsMessengerEXT)
+        throw GpuError("Vulkan: validation asked for, but VK_EXT_debug_utils is missing");
       VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
       mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
       mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                         VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
       mci.pfnUserCallback = &Context::on_message;
       mci.pUserData = this;
-      check(create(instance_, &mci, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+      check(vk_.CreateDebugUtilsMessengerEXT(instance_, &mci, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
     }
 
     uint32_t count = 0;
-    vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+    vk_.EnumeratePhysicalDevices(instance_, &count, nullptr);
     std::vector<VkPhysicalDevice> devices(count);
-    vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+    vk_.EnumeratePhysicalDevices(instance_, &count, devices.data());
     if (devices.empty()) throw GpuError("Vulkan: no device found (install mesa-vulkan-drivers for lavapipe)");
     std::vector<VkPhysicalDeviceProperties> props(count);
-    for (uint32_t i = 0; i < count; ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
+    for (uint32_t i = 0; i < count; ++i) vk_.GetPhysicalDeviceProperties(devices[i], &props[i]);
     std::string wanted = choice.device;
     if (wanted.empty())
       if (const char* env = std::getenv("MESHCAST_VK_DEVICE")) wanted = env;
@@ -156,9 +132,7 @@ Context::Context(const DeviceChoice& choice) {
     }
     physical_ = devices[size_t(pick)];
     name_ = props[size_t(pick)].deviceName;
-    limits_ = props[size_t(pick)].limits;
     if (props[size_t(pick)].apiVersion < VK_API_VERSION_1_2) throw GpuError("Vulkan: " + name_ + " does not offer Vulkan 1.2");
-    vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
 
     // What every method needs: 64-bit integers (remap words, keys) and
     // doubles (the watertight test's rare redo, the exact BitPack decode).
@@ -167,10 +141,9 @@ Context::Context(const DeviceChoice& choice) {
     // two refuse a device without them (require_int64_atomics).
     VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
-    vkGetPhysicalDeviceFeatures2(physical_, &f2);
+    vk_.GetPhysicalDeviceFeatures2(physical_, &f2);
     if (!f2.features.shaderInt64 || !f2.features.shaderFloat64)
       throw GpuError("Vulkan: " + name_ + " lacks shaderInt64 or shaderFloat64, which every GPU method uses");
-    int64_atomics_ = f12.shaderBufferInt64Atomics == VK_TRUE;
     VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     e12.shaderBufferInt64Atomics = f12.shaderBufferInt64Atomics;
     VkPhysicalDeviceFeatures2 e2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &e12};
@@ -178,81 +151,135 @@ Context::Context(const DeviceChoice& choice) {
     e2.features.shaderFloat64 = VK_TRUE;
 
     uint32_t families = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+    vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
     std::vector<VkQueueFamilyProperties> qf(families);
-    vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
-    uint32_t family = families;
-    for (uint32_t i = 0; i < families && family == families; ++i)
-      if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) family = i;
-    if (family == families) throw GpuError("Vulkan: " + name_ + " has no compute queue");
-    timestamps_ = qf[family].timestampValidBits > 0 && limits_.timestampPeriod > 0;
-    timestamp_ns_ = limits_.timestampPeriod;
+    vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
+    family_ = families;
+    for (uint32_t i = 0; i < families && family_ == families; ++i)
+      if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT) family_ = i;
+    if (family_ == families) throw GpuError("Vulkan: " + name_ + " has no compute queue");
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-    qci.queueFamilyIndex = family, qci.queueCount = 1, qci.pQueuePriorities = &priority;
+    qci.queueFamilyIndex = family_, qci.queueCount = 1, qci.pQueuePriorities = &priority;
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &e2};
     dci.queueCreateInfoCount = 1, dci.pQueueCreateInfos = &qci;
-    check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
-    vkGetDeviceQueue(device_, family, 0, &queue_);
-    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, pci.queueFamilyIndex = family;
-    check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
-    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
-
+    check(vk_.CreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
+    load_device_functions(vk_, device_);
+    vk_.GetDeviceQueue(device_, family_, 0, &queue_);
+    set_up_device(f12.shaderBufferInt64Atomics == VK_TRUE);
   } catch (...) {
     release();
     throw;
   }
 }
 
+Context::Context(const ExternalDevice& external) : owns_device_(false) {
+  if (!external.instance || !external.physical_device || !external.device || !external.queue)
+    throw GpuError("Vulkan: an engine's device needs its instance, physical device, device and queue (one was null)");
+  const PFN_vkGetInstanceProcAddr get =
+      external.get_instance_proc_addr ? external.get_instance_proc_addr : loader_get_instance_proc_addr();
+  if (!get) throw GpuError("Vulkan: no vkGetInstanceProcAddr given and no Vulkan loader found");
+  load_global_functions(vk_, get);
+  instance_ = external.instance;
+  physical_ = external.physical_device;
+  device_ = external.device;
+  queue_ = external.queue;
+  family_ = external.queue_family;
+  try {
+    load_instance_functions(vk_, instance_);
+    load_device_functions(vk_, device_);
+    VkPhysicalDeviceProperties props;
+    vk_.GetPhysicalDeviceProperties(physical_, &props);
+    name_ = props.deviceName;
+    uint32_t families = 0;
+    vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> qf(families);
+    vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
+    if (family_ >= families || !(qf[family_].queueFlags & VK_QUEUE_COMPUTE_BIT))
+      throw GpuError("Vulkan: queue family " + std::to_string(family_) + " of " + name_ + " (of " +
+                     std::to_string(families) + ") offers no compute");
+    // Which features the engine enabled Vulkan cannot say; what the device
+    // offers bounds it (the device must have enabled them: ExternalDevice).
+    VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+    vk_.GetPhysicalDeviceFeatures2(physical_, &f2);
+    if (!f2.features.shaderInt64 || !f2.features.shaderFloat64)
+      throw GpuError("Vulkan: " + name_ + " lacks shaderInt64 or shaderFloat64, which every GPU method uses");
+    set_up_device(f12.shaderBufferInt64Atomics == VK_TRUE);
+  } catch (...) {
+    release();
+    throw;
+  }
+}
+
+void Context::set_up_device(bool int64_atomics) {
+  VkPhysicalDeviceProperties props;
+  vk_.GetPhysicalDeviceProperties(physical_, &props);
+  limits_ = props.limits;
+  vk_.GetPhysicalDeviceMemoryProperties(physical_, &memory_);
+  int64_atomics_ = int64_atomics;
+  uint32_t families = 0;
+  vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> qf(families);
+  vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
+  timestamps_ = qf[family_].timestampValidBits > 0 && limits_.timestampPeriod > 0;
+  timestamp_ns_ = limits_.timestampPeriod;
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, pci.queueFamilyIndex = family_;
+  check(vk_.CreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  check(vk_.CreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
+}
+
 Context::~Context() { release(); }
 
 void Context::release() {
+  // Only what this context made: an engine's device and instance stay.
   if (device_) {
-    vkDeviceWaitIdle(device_);
-    vkDestroyFence(device_, fence_, nullptr);
-    vkDestroyCommandPool(device_, pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    if (owns_device_ && vk_.DeviceWaitIdle) vk_.DeviceWaitIdle(device_);
+    if (fence_) vk_.DestroyFence(device_, fence_, nullptr);
+    if (pool_) vk_.DestroyCommandPool(device_, pool_, nullptr);
+    if (owns_device_ && vk_.DestroyDevice) vk_.DestroyDevice(device_, nullptr);
   }
-  if (messenger_) destroy_messenger_(instance_, messenger_, nullptr);
-  if (instance_) vkDestroyInstance(instance_, nullptr);
+  if (!owns_device_) return;
+  if (messenger_) vk_.DestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
+  if (instance_ && vk_.DestroyInstance) vk_.DestroyInstance(instance_, nullptr);
 }
 
 VkCommandBuffer Context::allocate_command_buffer() {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = pool_, ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, ai.commandBufferCount = 1;
   VkCommandBuffer cb;
-  check(vkAllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
+  check(vk_.AllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
   return cb;
 }
 
-void Context::free_command_buffer(VkCommandBuffer cb) { vkFreeCommandBuffers(device_, pool_, 1, &cb); }
+void Context::free_command_buffer(VkCommandBuffer cb) { vk_.FreeCommandBuffers(device_, pool_, 1, &cb); }
 
 void Context::submit_async(VkCommandBuffer cb, VkFence fence) {
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1, si.pCommandBuffers = &cb;
-  check(vkResetFences(device_, 1, &fence), "vkResetFences");
-  check(vkQueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
+  check(vk_.ResetFences(device_, 1, &fence), "vkResetFences");
+  check(vk_.QueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
 }
 
 VkCommandBuffer Context::begin() {
   VkCommandBuffer cb = allocate_command_buffer();
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
+  check(vk_.BeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
   return cb;
 }
 
 void Context::end_and_wait(VkCommandBuffer cb) {
-  check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+  check(vk_.EndCommandBuffer(cb), "vkEndCommandBuffer");
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1, si.pCommandBuffers = &cb;
-  check(vkResetFences(device_, 1, &fence_), "vkResetFences");
-  check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
-  VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, 600ull * 1000 * 1000 * 1000);
-  vkFreeCommandBuffers(device_, pool_, 1, &cb);
+  check(vk_.ResetFences(device_, 1, &fence_), "vkResetFences");
+  check(vk_.QueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
+  VkResult r = vk_.WaitForFences(device_, 1, &fence_, VK_TRUE, 600ull * 1000 * 1000 * 1000);
+  vk_.FreeCommandBuffers(device_, pool_, 1, &cb);
   check(r, "waiting for the GPU");
 }
 
@@ -284,9 +311,9 @@ Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUs
                    "'s maxStorageBufferRange (" + std::to_string(ctx.limits().maxStorageBufferRange) + " bytes)");
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = size_, bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | usage, bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  check(vkCreateBuffer(ctx.device(), &bci, nullptr, &buffer_), "vkCreateBuffer");
+  check(ctx_.vk().CreateBuffer(ctx.device(), &bci, nullptr, &buffer_), "vkCreateBuffer");
   VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
+  ctx_.vk().GetBufferMemoryRequirements(ctx.device(), buffer_, &req);
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
   // Mapped memory is read back by the host every batch (hits, keys): cached
@@ -297,13 +324,13 @@ Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUs
                         : ctx.has_memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
                             ? ctx.memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
                             : ctx.memory_type(req.memoryTypeBits, host);
-  VkResult r = vkAllocateMemory(ctx.device(), &mai, nullptr, &memory_);
+  VkResult r = ctx_.vk().AllocateMemory(ctx.device(), &mai, nullptr, &memory_);
   if (r != VK_SUCCESS) {
-    vkDestroyBuffer(ctx.device(), buffer_, nullptr);
+    ctx_.vk().DestroyBuffer(ctx.device(), buffer_, nullptr);
     check(r, ("allocating the " + what).c_str());
   }
-  check(vkBindBufferMemory(ctx.device(), buffer_, memory_, 0), "vkBindBufferMemory");
-  if (mapped) check(vkMapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+  check(ctx_.vk().BindBufferMemory(ctx.device(), buffer_, memory_, 0), "vkBindBufferMemory");
+  if (mapped) check(ctx_.vk().MapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
 }
 
 void Buffer::upload(std::span<const uint8_t> bytes) {
@@ -312,18 +339,18 @@ void Buffer::upload(std::span<const uint8_t> bytes) {
   std::memcpy(staging.data(), bytes.data(), bytes.size());
   ctx_.submit([&](VkCommandBuffer cb) {
     VkBufferCopy region{0, 0, bytes.size()};
-    vkCmdCopyBuffer(cb, staging.handle(), buffer_, 1, &region);
+    ctx_.vk().CmdCopyBuffer(cb, staging.handle(), buffer_, 1, &region);
     // The copy is done before any later submission's shaders read it.
     VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr,
+    ctx_.vk().CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr,
                          0, nullptr);
   });
 }
 
 Buffer::~Buffer() {
-  vkDestroyBuffer(ctx_.device(), buffer_, nullptr);
-  vkFreeMemory(ctx_.device(), memory_, nullptr);
+  ctx_.vk().DestroyBuffer(ctx_.device(), buffer_, nullptr);
+  ctx_.vk().FreeMemory(ctx_.device(), memory_, nullptr);
 }
 
 Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
@@ -335,16 +362,16 @@ Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint
     b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
   VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   dl.bindingCount = bindings, dl.pBindings = b.data();
-  check(vkCreateDescriptorSetLayout(d, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  check(ctx_.vk().CreateDescriptorSetLayout(d, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
   VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   pl.setLayoutCount = 1, pl.pSetLayouts = &set_layout_;
   if (push_bytes) pl.pushConstantRangeCount = 1, pl.pPushConstantRanges = &range;
-  check(vkCreatePipelineLayout(d, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+  check(ctx_.vk().CreatePipelineLayout(d, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
   VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   sm.codeSize = spirv_bytes, sm.pCode = spirv;
   VkShaderModule module;
-  check(vkCreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
+  check(ctx_.vk().CreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
   VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   // A shader that does not declare constant 0 ignores it (Vulkan spec,
   // VkSpecializationMapEntry).
@@ -352,26 +379,26 @@ Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint
   const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &hit_outputs};
   cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", &spec};
   cp.layout = layout_;
-  VkResult r = vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
-  vkDestroyShaderModule(d, module, nullptr);
+  VkResult r = ctx_.vk().CreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
+  ctx_.vk().DestroyShaderModule(d, module, nullptr);
   check(r, "vkCreateComputePipelines");
   VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings * sets};
   VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dp.maxSets = sets, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
-  check(vkCreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
+  check(ctx_.vk().CreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
   std::vector<VkDescriptorSetLayout> layouts(sets, set_layout_);
   sets_handles_.resize(sets);
   VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   da.descriptorPool = pool_, da.descriptorSetCount = sets, da.pSetLayouts = layouts.data();
-  check(vkAllocateDescriptorSets(d, &da, sets_handles_.data()), "vkAllocateDescriptorSets");
+  check(ctx_.vk().AllocateDescriptorSets(d, &da, sets_handles_.data()), "vkAllocateDescriptorSets");
 }
 
 Pipeline::~Pipeline() {
   VkDevice d = ctx_.device();
-  vkDestroyDescriptorPool(d, pool_, nullptr);
-  vkDestroyPipeline(d, pipeline_, nullptr);
-  vkDestroyPipelineLayout(d, layout_, nullptr);
-  vkDestroyDescriptorSetLayout(d, set_layout_, nullptr);
+  ctx_.vk().DestroyDescriptorPool(d, pool_, nullptr);
+  ctx_.vk().DestroyPipeline(d, pipeline_, nullptr);
+  ctx_.vk().DestroyPipelineLayout(d, layout_, nullptr);
+  ctx_.vk().DestroyDescriptorSetLayout(d, set_layout_, nullptr);
 }
 
 void Pipeline::bind(const std::vector<const Buffer*>& buffers, uint32_t set) {
@@ -382,38 +409,38 @@ void Pipeline::bind(const std::vector<const Buffer*>& buffers, uint32_t set) {
     writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_handles_[set], i, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                  nullptr, &info[i], nullptr};
   }
-  vkUpdateDescriptorSets(ctx_.device(), bindings_, writes.data(), 0, nullptr);
+  ctx_.vk().UpdateDescriptorSets(ctx_.device(), bindings_, writes.data(), 0, nullptr);
 }
 
 void Pipeline::bind_for(VkCommandBuffer cb, uint32_t set, const void* push) const {
-  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_handles_[set], 0, nullptr);
-  if (push_bytes_) vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
+  ctx_.vk().CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  ctx_.vk().CmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_handles_[set], 0, nullptr);
+  if (push_bytes_) ctx_.vk().CmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
 }
 
 void Pipeline::dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
   bind_for(cb, set, push);
-  vkCmdDispatch(cb, x, y, z);
+  ctx_.vk().CmdDispatch(cb, x, y, z);
 }
 
 void Pipeline::dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* push, const Buffer& args,
                                  uint64_t offset) const {
   bind_for(cb, set, push);
-  vkCmdDispatchIndirect(cb, args.handle(), offset);
+  ctx_.vk().CmdDispatchIndirect(cb, args.handle(), offset);
 }
 
-static void barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access) {
+void Context::barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access) const {
   VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT;
   mb.dstAccessMask = dst_access;
-  vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dst_stages, 0, 1, &mb, 0, nullptr, 0, nullptr);
+  vk_.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dst_stages, 0, 1, &mb, 0, nullptr, 0, nullptr);
 }
 
-void compute_barrier(VkCommandBuffer cb) {
+void Context::compute_barrier(VkCommandBuffer cb) const {
   barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
-void indirect_barrier(VkCommandBuffer cb) {
+void Context::indirect_barrier(VkCommandBuffer cb) const {
   barrier(cb, VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }

@@ -1,6 +1,6 @@
-// The Vulkan context every GPU method shares (Vulkan 1.2 through volk):
-// instance, one device chosen deterministically, its compute queue, and
-// small owners for buffers and compute pipelines. Nothing here knows a blob
+// The Vulkan context every GPU method shares (Vulkan 1.2, its functions in
+// a table of its own: gpu/vk_functions.h): an instance and one device chosen
+// deterministically with its compute queue, or an engine's own, and small owners for buffers and compute pipelines. Nothing here knows a blob
 // layout; the methods (gpu/bruteforce.cpp, ...) do.
 #pragma once
 #include <cstdint>
@@ -10,18 +10,13 @@
 #include <string>
 #include <vector>
 
-#include <volk.h>
+#include "gpu/vk_functions.h"
+#include "meshcast/errors.h"
 
 namespace meshcast::gpu {
 
-// No Vulkan, no device, or a Vulkan call that failed: the message says which
-// and why. The CPU path never needs the GPU.
-// lost: the device is gone (VK_ERROR_DEVICE_LOST); other errors (a
-// buffer beyond a limit, memory) concern one request and leave it usable.
-struct GpuError : std::runtime_error {
-  explicit GpuError(const std::string& what, bool lost = false) : std::runtime_error(what), lost(lost) {}
-  bool lost;
-};
+// GpuError (meshcast/errors.h): the CPU path never needs the GPU.
+using meshcast::GpuError;
 
 struct DeviceChoice {
   // "" : $MESHCAST_VK_DEVICE, else the first discrete GPU, else the first
@@ -33,15 +28,34 @@ struct DeviceChoice {
   bool validation = false;
 };
 
+// An engine's own Vulkan objects, for a context that makes none of its own
+// (it still makes a command pool, fences and its buffers on that device).
+// The device must have been created with shaderInt64 and shaderFloat64
+// enabled (and shaderBufferInt64Atomics for the bruteforce and aabblist
+// methods); the queue belongs to `queue_family`, which must offer compute,
+// and Vulkan's rule holds that no two threads submit to one queue at once:
+// give meshcast a queue the engine does not submit to from another thread.
+// The engine's objects must outlive the context, which never destroys them.
+struct ExternalDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  uint32_t queue_family = 0;
+  PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;  // null: the loader's
+};
+
 class Context {
  public:
   explicit Context(const DeviceChoice& choice = {});
+  explicit Context(const ExternalDevice& external);
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   const std::string& device_name() const { return name_; }
   VkDevice device() const { return device_; }
+  const VulkanFunctions& vk() const { return vk_; }
   const VkPhysicalDeviceLimits& limits() const { return limits_; }
   uint32_t validation_messages() const { return messages_; }
   const std::string& last_validation_message() const { return last_message_; }
@@ -67,19 +81,30 @@ class Context {
   // A memory type among `bits` with all of `wanted`; with `required` false
   // any of `bits` when none has them, else GpuError.
   uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required = true) const;
+
+  // A barrier that makes compute-shader writes visible to the next dispatch.
+  void compute_barrier(VkCommandBuffer cb) const;
+  // The same, and visible as the arguments of the next indirect dispatch.
+  void indirect_barrier(VkCommandBuffer cb) const;
   bool has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const;
 
  private:
   VkCommandBuffer begin();
   void end_and_wait(VkCommandBuffer cb);
   void release();
+  // What both constructors do once the device is known: its properties,
+  // features, queue family, command pool and fence.
+  void set_up_device(bool int64_atomics);
+  void barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access) const;
   static VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT,
                                                    VkDebugUtilsMessageTypeFlagsEXT,
                                                    const VkDebugUtilsMessengerCallbackDataEXT*, void*);
 
+  VulkanFunctions vk_;
+  bool owns_device_ = true;  // false: the engine's instance and device
+  uint32_t family_ = 0;
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger_ = nullptr;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
@@ -153,11 +178,6 @@ class Pipeline {
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorSet> sets_handles_;
 };
-
-// A barrier that makes compute-shader writes visible to the next dispatch.
-void compute_barrier(VkCommandBuffer cb);
-// The same, and visible as the arguments of the next indirect dispatch.
-void indirect_barrier(VkCommandBuffer cb);
 
 // Throws GpuError naming `what` when r is not VK_SUCCESS.
 void check(VkResult r, const char* what);

@@ -4,7 +4,7 @@
 #include <algorithm>
 
 #include "cpu/encode.h"
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "layout/blob.h"
 #include "gpu/batch.h"
 #include "shaders/aabbtree_float3.h"

@@ -1,4 +1,4 @@
-#include "host/caster.h"
+#include "meshcast/caster.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,10 +8,13 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "cpu/mesh.h"
-#include "cpu/rays.h"
+#include "meshcast/mesh.h"
+#include "layout/files.h"
 #include "gpu/method.h"
+#if MESHCAST_VULKAN
 #include "gpu/vulkan.h"
+#endif
+#include "host/jobs.h"
 #include "layout/blob.h"
 
 namespace meshcast::host {
@@ -79,20 +82,35 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
   records_.reserve(kRecords);
 
   if (options_.backend != Backend::Cpu) {
+#if !MESHCAST_VULKAN
+    gpu_error_ = "meshcast was built without its Vulkan backend (MESHCAST_VULKAN=OFF): the CPU answers";
+#else
     try {
-      gpu_ = std::make_unique<gpu::Context>(gpu::DeviceChoice{options_.device, options_.validation});
+      const VulkanObjects& engine = options_.engine_vulkan;
+      if (engine.device) {
+        gpu::ExternalDevice external;
+        external.instance = static_cast<VkInstance>(engine.instance);
+        external.physical_device = static_cast<VkPhysicalDevice>(engine.physical_device);
+        external.device = static_cast<VkDevice>(engine.device);
+        external.queue = static_cast<VkQueue>(engine.queue);
+        external.queue_family = engine.queue_family;
+        external.get_instance_proc_addr = reinterpret_cast<PFN_vkGetInstanceProcAddr>(engine.get_instance_proc_addr);
+        gpu_ = std::make_shared<gpu::Context>(external);
+      } else {
+        gpu_ = std::make_shared<gpu::Context>(gpu::DeviceChoice{options_.device, options_.validation});
+      }
       std::vector<std::string> names = options_.gpu_method.empty() ? gpu::method_names()
                                                                      : std::vector<std::string>{options_.gpu_method};
       for (const std::string& m : names) {
         try {
-          method_ = gpu::make_method(*gpu_, m, blob, name, options_.frames, options_.hit_outputs);
+          method_ = gpu::make_method(*gpu_, m, blob, name, options_.frames, uint32_t(options_.hit_outputs));
           break;
         } catch (const InputError&) {
           if (!options_.gpu_method.empty()) throw;
         }
       }
       if (!method_)
-        throw gpu::GpuError("no GPU method reads " + std::string(layout::tree_format_name(layout::header_of(blob.data()).tree_format)) +
+        throw GpuError("no GPU method reads " + std::string(layout::tree_format_name(layout::header_of(blob.data()).tree_format)) +
                             "/" + std::string(layout::triangle_format_name(layout::header_of(blob.data()).triangle_format)));
       completion_ = std::thread([this] { gpu_completions(); });
     } catch (const std::exception& e) {  // GpuError, or InputError for a method that does not read the layout
@@ -100,6 +118,7 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
       gpu_.reset();
       gpu_error_ = e.what();
     }
+#endif
   }
   if (options_.backend == Backend::Automatic && gpu_available()) {
     try {
@@ -129,9 +148,13 @@ Caster::~Caster() {
   gpu_.reset();
 }
 
+#if MESHCAST_VULKAN
 std::string Caster::device_name() const { return gpu_ ? gpu_->device_name() : "none"; }
-
 uint32_t Caster::validation_messages() const { return gpu_ ? gpu_->validation_messages() : 0; }
+#else
+std::string Caster::device_name() const { return "none"; }
+uint32_t Caster::validation_messages() const { return 0; }
+#endif
 
 Backend Caster::choose(uint32_t rays) const {
   if (!gpu_available() || options_.backend == Backend::Cpu) return Backend::Cpu;
@@ -159,7 +182,7 @@ Ticket Caster::submit(std::span<const Ray> rays) {
         break;
       }
     if (!s)
-      throw std::runtime_error("all " + std::to_string(slots_.size()) +
+      throw UsageError("all " + std::to_string(slots_.size()) +
                                " frames hold batches not yet collected; wait() for one before submitting more");
     s->state = Slot::Running;
     s->id = next_id_++;
@@ -174,7 +197,7 @@ Ticket Caster::submit(std::span<const Ray> rays) {
       try {
         start_gpu(*s);
         return t;
-      } catch (const gpu::GpuError& e) {
+      } catch (const GpuError& e) {
         // A lost device is given up; any other refusal (a batch beyond a
         // buffer limit, memory) sends just this batch to the CPU.
         if (e.lost) gpu_failed(e.what());
@@ -233,10 +256,10 @@ void Caster::gpu_completions() {
       pending_.pop_front();
     }
     try {
-      if (gpu_failed_) throw gpu::GpuError(gpu_error());
+      if (gpu_failed_) throw GpuError(gpu_error());
       method_->wait(s->index);
       complete(*s, Backend::Vulkan);
-    } catch (const gpu::GpuError& e) {  // waiting failed: the device is lost
+    } catch (const GpuError& e) {  // waiting failed: the device is lost
       gpu_failed(e.what());
       start_cpu(*s);
     }
@@ -259,26 +282,33 @@ void Caster::complete(Slot& s, Backend ran_on) {
   }
 }
 
+Caster::Slot& Caster::slot_of(const Ticket& t) const {
+  if (t.slot >= slots_.size())
+    throw UsageError("ticket " + std::to_string(t.id) + " names frame slot " + std::to_string(t.slot) + " of " +
+                     std::to_string(slots_.size()) + ": not a ticket of this caster");
+  return *slots_[t.slot];
+}
+
 bool Caster::poll(const Ticket& t) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Slot& s = *slots_.at(t.slot);
+  const Slot& s = slot_of(t);
   if (s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting)
-    throw std::invalid_argument("ticket " + std::to_string(t.id) + " is unknown or already collected");
+    throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
   return s.state == Slot::Ready;
 }
 
 BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
-  Slot& s = *slots_.at(t.slot);
+  Slot& s = slot_of(t);
   BatchRecord r;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
-    if (gone()) throw std::invalid_argument("ticket " + std::to_string(t.id) + " is unknown or already collected");
+    if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
     if (hits.size() < s.n)
-      throw std::invalid_argument("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
+      throw UsageError("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
     // Another thread may collect the same ticket first: then this one throws.
     changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
-    if (gone()) throw std::invalid_argument("ticket " + std::to_string(t.id) + " was collected by another thread");
+    if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " was collected by another thread");
     s.state = Slot::Collecting;
     r = {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
   }
@@ -290,7 +320,7 @@ BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
       method_->finish(s.index, hits.first(s.n), &timing);  // straight from the mapped buffer
       r.device_ms = timing.device_ms;
       copied = true;
-    } catch (const gpu::GpuError& e) {  // the device went while reading back: the CPU answers
+    } catch (const GpuError& e) {  // the device went while reading back: the CPU answers
       gpu_failed(e.what());
       view_.trace(s.rays, hits.first(s.n), options_.hit_outputs);
       r.ran_on = Backend::Cpu;

@@ -1,6 +1,5 @@
-// Where the CPU backend's work runs. An engine with its own job system
-// implements JobSystem; without one, the caster makes a WorkerPool over the
-// machine's cores.
+// The caster's own workers, when the engine gives it no job system
+// (meshcast/jobs.h): a pool over the machine's cores.
 #pragma once
 #include <condition_variable>
 #include <cstdint>
@@ -9,17 +8,9 @@
 #include <thread>
 #include <vector>
 
-namespace meshcast::host {
+#include "meshcast/jobs.h"
 
-// run(count, work) arranges for work(i) to be called once for every i in
-// [0, count), on any threads, and may return before they run. `work` stays
-// alive until every call has returned (the caster keeps it per frame slot).
-class JobSystem {
- public:
-  virtual ~JobSystem() = default;
-  virtual void run(uint32_t count, const std::function<void(uint32_t)>& work) = 0;
-  virtual uint32_t threads() const = 0;  // how many run at once (for sizing the jobs)
-};
+namespace meshcast::host {
 
 // Worker threads taking job indices from a queue of posted runs. The queue
 // keeps its capacity, so after warm-up posting allocates nothing.

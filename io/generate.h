@@ -2,7 +2,7 @@
 #pragma once
 #include <cstdint>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast {
 

@@ -33,7 +33,7 @@
 // we never create a DefaultLogger, so it uses its NullLogger.
 #include "io/read_mesh.h"
 
-#include "cpu/rays.h"
+#include "layout/files.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>

@@ -5,7 +5,7 @@
 #pragma once
 #include <string>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast {
 

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgtest-dev dpkg-dev nlohmann-json3-dev
-          libvulkan-dev libvulkan-volk-dev glslang-tools  # the Vulkan backend: headers, loader, volk, glslang
+          libvulkan-dev glslang-tools  # the Vulkan backend: headers, loader, glslang
           mesa-vulkan-drivers vulkan-validationlayers      # lavapipe (a Vulkan device on the CPU), the layers the tests run
           libembree-dev gnuplot-nox  # Embree: a peer measured beside meshcast; gnuplot: bench plots
           python3)                   # the CLI test parses every --json output with Python's json module

@@ -64,12 +64,18 @@ cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 
-stage "Portable scalar path, with the box and triangle test counters compiled in: the suites that walk"
+stage "Portable scalar path without the Vulkan backend, the test counters compiled in: the suites that walk, the host layer"
 # The scalar build changes only cpu/simd.h's lanes: the suites that walk
 # (quick, as under ASan) cover it; the Vulkan suites read the same shaders.
-cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON >/dev/null
-cmake --build build-scalar -j"$jobs" --target "${walk_suites[@]}"
-run_suites build-scalar quick "${walk_suites[@]}"
+# Built with MESHCAST_VULKAN=OFF, it also builds and tests the CPU-only host
+# layer (host_test: a caster asked for Vulkan answers on the CPU).
+cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON \
+      -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
+cmake --build build-scalar -j"$jobs" --target "${walk_suites[@]}" host_test
+run_suites build-scalar quick "${walk_suites[@]}" host_test
+
+stage "The package: installed and used by the examples (CMake and pkg-config), and as a subproject"
+bash scripts/package_test.sh
 
 stage "libFuzzer: the blob validator + walker and the mesh reader + builder"
 bash scripts/fuzz.sh

@@ -143,7 +143,7 @@ TEST(NoRemap, EveryLayoutAnswersBySlot) {
     // Kept input order (brute force, but for the pair encoding, which puts
     // each pair side by side): the remap is the used-slot bitmap and ranks
     // alone, and the hits still name the input's triangles.
-    if (with.tree_format == MC_TREE_BRUTEFORCE && with.triangle_format != MC_TRI_FLOAT3PAIRSOA4) {
+    if (uint32_t(with.layout.tree) == MC_TREE_BRUTEFORCE && uint32_t(with.layout.triangles) != MC_TRI_FLOAT3PAIRSOA4) {
       EXPECT_EQ(ha.remap_bits, 0u) << layout;
       EXPECT_LT(double(ha.remap_size) / double(mesh.triangles.size()), 0.25) << layout << ": 12 bytes a 64 slots";
       expect_oracle(mesh, a, rays, ha_hits, layout + " (input order kept)");

@@ -291,7 +291,7 @@ TEST(Build, NodeOrdersAFormatCannotHoldAreRefusedWithTheReason) {
 }
 
 TEST(Build, LayoutNamesAreCaseInsensitiveAndUnknownOnesListTheValid) {
-  EXPECT_EQ(parse_layout("quadtreehalffloat/indexed8bitpacksoa4").tree_format, MC_TREE_QUADTREEHALFFLOAT);
+  EXPECT_EQ(uint32_t(parse_layout("quadtreehalffloat/indexed8bitpacksoa4").layout.tree), MC_TREE_QUADTREEHALFFLOAT);
   try {
     parse_layout("OctTree/Float3");
     FAIL();

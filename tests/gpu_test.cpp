@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 #include "io/generate.h"
 #include "tests/testing.h"
 
@@ -53,7 +54,7 @@ TEST(Gpu, ValidationLayersReportAnInvalidCall) {
   info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   info.size = 0, info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   VkBuffer buffer = VK_NULL_HANDLE;
-  if (vkCreateBuffer(ctx.device(), &info, nullptr, &buffer) == VK_SUCCESS && buffer) vkDestroyBuffer(ctx.device(), buffer, nullptr);
+  if (ctx.vk().CreateBuffer(ctx.device(), &info, nullptr, &buffer) == VK_SUCCESS && buffer) ctx.vk().DestroyBuffer(ctx.device(), buffer, nullptr);
   EXPECT_GT(ctx.validation_messages(), 0u);
 }
 
@@ -69,8 +70,8 @@ TEST(Gpu, UnknownDeviceIsRefusedWithTheList) {
 // Contexts come and go beside one another: one without validation (so
 // without the debug-utils extension) made and dropped, one refused, then
 // the first context still traces and is destroyed cleanly at exit. On an
-// H100 the shared volk table once held the dropped context's pointers and
-// the process crashed at exit.
+// H100 a shared function table (volk's) once held the dropped context's
+// pointers and the process crashed at exit; now each context has its own.
 TEST(Gpu, ContextsSideBySideKeepTheirOwnFunctions) {
   Mesh m = make_sphere(6, 12, 1, {0, 0, 0});
   std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
@@ -110,7 +111,7 @@ TEST_P(GpuMethods, MatchTheCpuAndTheOracle) {
     // A quantized layout is judged on the mesh it stores, as on the CPU (kept
     // alive across the kinds: the oracle cache refers to it by name).
     NamedMesh reference = m;
-    if (moves_vertices(parse_layout(mc.layout).triangle_format))
+    if (moves_vertices(uint32_t(parse_layout(mc.layout).layout.triangles)))
       reference = {m.name + "#" + mc.layout, std::make_shared<const Mesh>(stored_mesh(blob))};
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
       const size_t count = std::string_view(mc.method) == "bruteforce" ? 2000 : 10000;

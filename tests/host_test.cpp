@@ -13,8 +13,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "gpu/vulkan.h"
-#include "host/caster.h"
+#include "meshcast/caster.h"
 #include "io/generate.h"
 #include "tests/testing.h"
 
@@ -39,14 +38,33 @@ using host::Caster;
 using host::CasterOptions;
 
 // $MESHCAST_HOST_CPU_ONLY=1 keeps Vulkan out (for a ThreadSanitizer run
-// on a driver whose own threads make it report what it cannot see).
-bool cpu_only() { return std::getenv("MESHCAST_HOST_CPU_ONLY") != nullptr; }
+// on a driver whose own threads make it report what it cannot see), as does
+// a build without the Vulkan backend (MESHCAST_VULKAN=OFF).
+bool cpu_only() { return !MESHCAST_VULKAN || std::getenv("MESHCAST_HOST_CPU_ONLY") != nullptr; }
 
 CasterOptions options(Backend b, uint32_t frames = 4) {
   CasterOptions o;
   o.backend = b, o.frames = frames, o.validation = true;
   return o;
 }
+
+#if !MESHCAST_VULKAN
+// Built without Vulkan: a caster asked for it says so and the CPU answers.
+TEST(Host, WithoutTheVulkanBackendTheCpuAnswers) {
+  const Mesh m = make_terrain(32, 32, 1);
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "terrain");
+  for (Backend b : {Backend::Vulkan, Backend::Automatic}) {
+    Caster caster(blob, "terrain", options(b));
+    EXPECT_FALSE(caster.gpu_available());
+    EXPECT_NE(caster.gpu_error().find("MESHCAST_VULKAN=OFF"), std::string::npos) << caster.gpu_error();
+    const std::vector<Ray> rays = make_rays(m, RayKind::Long, 500, 1);
+    std::vector<Hit> now(rays.size()), later(rays.size());
+    caster.trace_now(rays, now);
+    EXPECT_EQ(caster.wait(caster.submit(rays), later).ran_on, Backend::Cpu);
+    for (size_t i = 0; i < rays.size(); ++i) EXPECT_EQ(later[i].triangle, now[i].triangle) << i;
+  }
+}
+#endif
 
 // Same triangle as the synchronous CPU walk, t within 1e-6 relative; a
 // different triangle only at exactly the same t.
@@ -121,7 +139,7 @@ TEST(Host, HitOutputsOnBothBackends) {
   for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
     if (b == Backend::Vulkan && cpu_only()) continue;
     CasterOptions o = options(b);
-    o.hit_outputs = MC_HIT_UV | MC_HIT_POINT;
+    o.hit_outputs = HitOutputs::Uv | HitOutputs::Point;
     Caster caster(blob, "terrain", o);
     ASSERT_TRUE(b == Backend::Cpu || caster.gpu_available()) << caster.gpu_error();
     std::vector<Hit> hits(rays.size());
@@ -158,15 +176,42 @@ TEST(Host, FramesInFlightNeverMix) {
       frames.push_back(make_rays(m, f % 2 ? RayKind::Radial : RayKind::Long, 100 + 300 * f, 40 + f));
       tickets.push_back(caster.submit(frames.back()));
     }
-    EXPECT_THROW(caster.submit(frames[0]), std::runtime_error);  // all eight frames are taken
+    EXPECT_THROW(caster.submit(frames[0]), UsageError);  // all eight frames are taken
     for (uint32_t f = 8; f-- > 0;) {
       std::vector<Hit> hits(frames[f].size());
       caster.wait(tickets[f], hits);
       expect_same(hits, sync_cpu(caster, frames[f]), "frame " + std::to_string(f));
-      EXPECT_THROW(caster.wait(tickets[f], hits), std::invalid_argument);  // collected once
+      EXPECT_THROW(caster.wait(tickets[f], hits), UsageError);  // collected once
     }
     EXPECT_EQ(caster.validation_messages(), 0u);
   }
+}
+
+// A caller's mistakes get a UsageError naming what was wrong: a ticket of
+// another caster or a made-up one, a hits span too short for the batch, on
+// the caster and on a BlobView.
+TEST(Host, MisuseIsAUsageError) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  Caster caster(blob, "sphere", options(Backend::Cpu, 2));
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 50, 3);
+  std::vector<Hit> hits(rays.size()), short_hits(rays.size() - 1);
+  auto expect_usage = [](auto&& call, const std::string& words) {
+    try {
+      call();
+      ADD_FAILURE() << "no error; expected one saying '" << words << "'";
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  expect_usage([&] { caster.poll(host::Ticket{12345, 7}); }, "not a ticket of this caster");
+  expect_usage([&] { caster.wait(host::Ticket{12345, 7}, hits); }, "not a ticket of this caster");
+  expect_usage([&] { caster.wait(host::Ticket{12345, 0}, hits); }, "unknown or already collected");
+  const host::Ticket t = caster.submit(rays);
+  expect_usage([&] { caster.wait(t, short_hits); }, "needs room for 50 hits");
+  caster.wait(t, hits);
+  expect_usage([&] { caster.trace_now(rays, short_hits); }, "room for 49 hits");
+  expect_usage([&] { BlobView(blob, "sphere").trace(rays, short_hits); }, "50 rays but room for 49 hits");
 }
 
 TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
@@ -176,7 +221,9 @@ TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
   o.device = "no such device";
   Caster caster(blob, "sphere", o);
   EXPECT_FALSE(caster.gpu_available());
-  EXPECT_NE(caster.gpu_error().find("no such device"), std::string::npos) << caster.gpu_error();
+  // Without the Vulkan backend the error says that instead.
+  EXPECT_NE(caster.gpu_error().find(MESHCAST_VULKAN ? "no such device" : "MESHCAST_VULKAN=OFF"), std::string::npos)
+      << caster.gpu_error();
   EXPECT_NE(caster.why(100).find("unavailable"), std::string::npos) << caster.why(100);
   std::vector<Ray> rays = make_rays(m, RayKind::Long, 500, 3);
   std::vector<Hit> hits(rays.size());
@@ -204,7 +251,7 @@ struct FaultySphere {
 TEST(Host, ARefusedBatchGoesToTheCpuAndTheGpuStays) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
   FaultySphere f([](int submission) {
-    if (submission == 2) throw gpu::GpuError("Vulkan: the ray buffer exceeds a limit (injected by the test)");
+    if (submission == 2) throw GpuError("Vulkan: the ray buffer exceeds a limit (injected by the test)");
   });
   Caster& caster = *f.caster;
   const std::vector<Ray>& rays = f.rays;
@@ -219,7 +266,7 @@ TEST(Host, ARefusedBatchGoesToTheCpuAndTheGpuStays) {
 TEST(Host, ALostDeviceMovesTheBatchesToTheCpu) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
   FaultySphere f([](int submission) {
-    if (submission > 1) throw gpu::GpuError("Vulkan: device lost (injected by the test)", true);
+    if (submission > 1) throw GpuError("Vulkan: device lost (injected by the test)", true);
   });
   Caster& caster = *f.caster;
   const std::vector<Ray>& rays = f.rays;

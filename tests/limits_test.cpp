@@ -132,8 +132,8 @@ TEST(Limits, TheDeepestTreesTheBuilderMakesWalkRight) {
     const uint32_t depth = layout::header_of(blob.data()).max_depth;
     // The quad trees pull grandchildren up into 4-wide nodes and the
     // SKDTree places its own planes: shallower, still deep.
-    const bool binary = o.tree_format != MC_TREE_QUADTREE && o.tree_format != MC_TREE_QUADTREEHALFFLOAT &&
-                        o.tree_format != MC_TREE_SKDTREE;
+    const bool binary = uint32_t(o.layout.tree) != MC_TREE_QUADTREE && uint32_t(o.layout.tree) != MC_TREE_QUADTREEHALFFLOAT &&
+                        uint32_t(o.layout.tree) != MC_TREE_SKDTREE;
     if (binary)
       EXPECT_EQ(depth, 48u) << layout;
     else

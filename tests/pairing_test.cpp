@@ -122,11 +122,11 @@ TEST(PairedTrees, LeavesHoldWholePairsAndWalkersAgreeWithTheOracle) {
     const Pairing pairs = pair_triangles(*m.mesh);
     for (const std::string& name : layout_names()) {
       BuildOptions o = parse_layout(name);
-      if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST) continue;
-      if (o.triangle_format != MC_TRI_FLOAT3 && o.triangle_format != MC_TRI_FLOAT3SOA4 &&
-          o.triangle_format != MC_TRI_INDEXED8BITPACKSOA4 && o.triangle_format != MC_TRI_FLOAT3PAIRSOA4)
+      if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST) continue;
+      if (uint32_t(o.layout.triangles) != MC_TRI_FLOAT3 && uint32_t(o.layout.triangles) != MC_TRI_FLOAT3SOA4 &&
+          uint32_t(o.layout.triangles) != MC_TRI_INDEXED8BITPACKSOA4 && uint32_t(o.layout.triangles) != MC_TRI_FLOAT3PAIRSOA4)
         continue;
-      if (o.tree_format == MC_TREE_ZEROBYTE || o.tree_format == MC_TREE_ZEROBYTEHYBRID) continue;
+      if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID) continue;
       o.pairing = true;
       BuildReport report;
       std::vector<uint8_t> blob = build_blob(*m.mesh, o, m.name, &report);
@@ -135,7 +135,7 @@ TEST(PairedTrees, LeavesHoldWholePairsAndWalkersAgreeWithTheOracle) {
       std::vector<uint32_t> leaf_of(m.mesh->triangles.size(), ~0u);
       uint32_t leaf = 0, split = 0;
       layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t count) {
-        EXPECT_LE(count, o.tree_format == MC_TREE_STACKLESSLBVH ? MC_QUAD_MAX_COUNT - 1 : o.leaf_size) << name;
+        EXPECT_LE(count, uint32_t(o.layout.tree) == MC_TREE_STACKLESSLBVH ? MC_QUAD_MAX_COUNT - 1 : o.leaf_size) << name;
         for (uint32_t i = 0; i < count; ++i) leaf_of[layout::remap_entry(blob.data(), h, layout::slot_of(h, block, i))] = leaf;
         ++leaf;
       });
@@ -143,7 +143,7 @@ TEST(PairedTrees, LeavesHoldWholePairsAndWalkersAgreeWithTheOracle) {
         split += pairs.partner[t] != MC_NO_HIT && leaf_of[t] != leaf_of[pairs.partner[t]];
       EXPECT_EQ(split, 0u) << name << " on " << m.name << ": pairs split across leaves";
       NamedMesh reference = m;
-      if (moves_vertices(o.triangle_format))
+      if (moves_vertices(uint32_t(o.layout.triangles)))
         reference = {m.name + "#paired#" + name, std::make_shared<const Mesh>(stored_mesh(blob))};
       for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
         const std::vector<Ray>& rays = test_rays(m, kind, 2000);

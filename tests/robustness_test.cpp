@@ -20,6 +20,7 @@
 #include "tests/testing.h"
 #ifdef MESHCAST_TEST_GPU
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 #endif
 
 namespace meshcast::testing {
@@ -423,10 +424,10 @@ std::vector<std::string> paired_layouts() {
   std::vector<std::string> names;
   for (const std::string& n : layout_names()) {
     BuildOptions o = parse_layout(n);
-    if (o.tree_format == MC_TREE_BRUTEFORCE || o.tree_format == MC_TREE_AABBLIST || o.tree_format == MC_TREE_ZEROBYTE ||
-        o.tree_format == MC_TREE_ZEROBYTEHYBRID)
+    if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE ||
+        uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
       continue;
-    if (o.triangle_format == MC_TRI_FLOAT3SOA4 || o.triangle_format == MC_TRI_INDEXED8BITPACKSOA4) names.push_back(n + "+pairing");
+    if (uint32_t(o.layout.triangles) == MC_TRI_FLOAT3SOA4 || uint32_t(o.layout.triangles) == MC_TRI_INDEXED8BITPACKSOA4) names.push_back(n + "+pairing");
   }
   return names;
 }

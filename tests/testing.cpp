@@ -110,7 +110,7 @@ std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<R
                            uint32_t outputs) {
   BlobView view(blob, "test blob");
   std::vector<Hit> hits(rays.size());
-  uint64_t s = view.trace(rays, hits, outputs);
+  uint64_t s = view.trace(rays, hits, HitOutputs(outputs));
   if (skipped) *skipped = s;
   return hits;
 }

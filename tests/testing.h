@@ -12,10 +12,10 @@
 #include "cpu/agreement.h"
 #include "cpu/auto_layout.h"
 #include "cpu/encode.h"
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 
 namespace meshcast::testing {
 

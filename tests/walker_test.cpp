@@ -29,10 +29,10 @@ void check_layout(const std::string& layout_name_, bool large) {
     // gives the exact answers; the distance to the input mesh is checked
     // against the stated bound separately (QuantizedVerticesWithinBound).
     NamedMesh reference = m;
-    if (moves_vertices(options.triangle_format))
+    if (moves_vertices(uint32_t(options.layout.triangles)))
       reference = {m.name + "#" + layout_name_, std::make_shared<const Mesh>(stored_mesh(blob))};
     // BruteForce tests every triangle for every ray: fewer rays keep it quick.
-    size_t count = options.tree_format == MC_TREE_BRUTEFORCE ? 400 : quick() ? 2000 : 10000;
+    size_t count = uint32_t(options.layout.tree) == MC_TREE_BRUTEFORCE ? 400 : quick() ? 2000 : 10000;
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
       const std::vector<Ray>& rays = test_rays(m, kind, count);
       const std::vector<OracleHit>& oracle = oracle_answers(reference, kind, rays);
@@ -58,7 +58,7 @@ TEST_P(WalkerVsOracle, AllMeshesAllRayKinds) { check_layout(GetParam(), false); 
 uint64_t oracle_mistakes(const std::vector<uint8_t>& blob, const NamedMesh& m, const BuildOptions& o,
                          const std::string& variant, RayKind kind, size_t count, std::string* problem) {
   NamedMesh reference = m;
-  if (moves_vertices(o.triangle_format))
+  if (moves_vertices(uint32_t(o.layout.triangles)))
     reference = {m.name + "#" + variant, std::make_shared<const Mesh>(stored_mesh(blob))};
   const std::vector<Ray>& rays = test_rays(m, kind, count);
   Agreement a = compare(*reference.mesh, rays, trace_all(blob, rays), oracle_answers(reference, kind, rays),

@@ -91,7 +91,7 @@ TEST(ZeroByte, TheSeedsLimitsAreRefusedWithTheNumbers) {
   }
   // Other triangle formats do not pair with the zero-byte trees.
   BuildOptions o = parse_layout("ZeroByteTree/Indexed24");
-  o.triangle_format = MC_TRI_FLOAT3;
+  o.layout.triangles = TriangleFormat::Float3;
   EXPECT_THROW(build_blob(make_sphere(6, 12, 1, {0, 0, 0}), o, "sphere"), InputError);
 }
 

@@ -8,8 +8,9 @@
 #include "cpu/agreement.h"
 #include "cpu/oracle.h"
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 #include "io/read_mesh.h"
 #include "layout/blob.h"
 #include "tools/commands.h"
@@ -83,7 +84,7 @@ void add_demo(CLI::App& app) {
       BlobView view(blob, name);
       // The bit-packed layout is judged on the mesh it stores (its vertices
       // moved by at most the quantization bound), the others on the input.
-      bool quantized = moves_vertices(o.triangle_format);
+      bool quantized = moves_vertices(uint32_t(o.layout.triangles));
       Mesh stored = quantized ? stored_mesh(blob) : Mesh{};
       std::unique_ptr<OracleTree> stored_tree = quantized ? std::make_unique<OracleTree>(stored) : nullptr;
       SectionBytes s = section_bytes(blob);

@@ -3,8 +3,9 @@
 #include <cstdio>
 
 #include "cpu/rays.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "gpu/method.h"
+#include "gpu/vulkan.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 #include "tools/render.h"

@@ -10,7 +10,7 @@
 #include "cpu/auto_layout.h"
 #include "cpu/rays.h"
 #include "gpu/method.h"
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "io/read_mesh.h"
 #include "layout/blob.h"
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cpu/encode.h"
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 
 namespace meshcast::tools {
 

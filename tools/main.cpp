@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "cpu/mesh.h"
+#include "meshcast/mesh.h"
 #include "cpu/rays.h"
 #include "gpu/vulkan.h"
 #include "tools/commands.h"

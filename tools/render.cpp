@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "cpu/trace.h"
+#include "meshcast/blob.h"
 #include "layout/blob.h"
 #include "tools/common.h"
 

@@ -27,9 +27,9 @@
 #include <thread>
 #include <vector>
 
-#include "cpu/ray.h"
-#include "cpu/trace.h"
-#include "host/jobs.h"
+#include "meshcast/blob.h"
+#include "meshcast/jobs.h"
+#include "meshcast/ray.h"
 
 namespace meshcast::gpu {
 class Context;
@@ -37,6 +37,8 @@ class Method;
 }
 
 namespace meshcast::host {
+
+class WorkerPool;
 
 enum class Backend { Cpu, Vulkan, Automatic };
 const char* backend_name(Backend b);
@@ -62,15 +64,34 @@ struct Percentiles {
   double p50_ms = 0, p99_ms = 0, rays_per_second = 0;
 };
 
+// An engine's own Vulkan objects, for a Vulkan backend that makes no instance
+// or device of its own: the handles as the engine holds them (VkInstance,
+// VkPhysicalDevice, VkDevice, VkQueue, PFN_vkGetInstanceProcAddr), cast to
+// void* so this header needs no Vulkan. The device must have shaderInt64 and
+// shaderFloat64 enabled (and shaderBufferInt64Atomics for the bruteforce and
+// aabblist methods), `queue` must be of `queue_family`, which offers compute,
+// and must not be submitted to by the engine from another thread while the
+// caster lives; everything must outlive the caster, which destroys none of it.
+// get_instance_proc_addr: null for the loader's.
+struct VulkanObjects {
+  void* instance = nullptr;
+  void* physical_device = nullptr;
+  void* device = nullptr;
+  void* queue = nullptr;
+  uint32_t queue_family = 0;
+  void* get_instance_proc_addr = nullptr;
+};
+
 struct CasterOptions {
   Backend backend = Backend::Automatic;
   uint32_t frames = 4;          // batches in flight at most
   uint32_t threads = 0;         // CPU workers (0: every core), unless `jobs` is given
   JobSystem* jobs = nullptr;    // an engine's job system (not owned) instead of meshcast's pool
   std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
+  VulkanObjects engine_vulkan;  // the engine's device instead (its `device` set): `device` unused
   std::string gpu_method;       // "" : the one that reads the blob's layout
   bool validation = false;      // Vulkan validation layers
-  uint32_t hit_outputs = 0;     // per-hit outputs (MC_HIT_UV, MC_HIT_POINT) on either backend
+  HitOutputs hit_outputs = HitOutputs::None;  // what each hit carries besides t and the triangle, either backend
   std::string profile;          // file with a saved crossover; measured and written when absent
   // Test hook: called before every GPU submission; throwing GpuError there
   // acts as a lost device.
@@ -89,11 +110,13 @@ class Caster {
   Caster& operator=(const Caster&) = delete;
 
   // Copies the rays and starts the batch; returns at once. Throws
-  // std::runtime_error when all `frames` slots hold uncollected batches.
+  // UsageError when all `frames` slots hold uncollected batches.
   Ticket submit(std::span<const Ray> rays);
+  // Whether the batch is ready. UsageError for a ticket this caster did not
+  // issue or that was already collected.
   bool poll(const Ticket& t);
   // Blocks until ready, copies the hits into `hits` (at least the batch's
-  // size) and frees the slot; returns that batch's record.
+  // size, else UsageError) and frees the slot; returns that batch's record.
   BatchRecord wait(const Ticket& t, std::span<Hit> hits);
   // The calling thread walks the rays now (the CPU walker, no pool).
   void trace_now(std::span<const Ray> rays, std::span<Hit> hits) const;
@@ -117,6 +140,7 @@ class Caster {
 
  private:
   struct Slot;
+  Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
   void start_cpu(Slot& s);
   void start_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
@@ -128,7 +152,7 @@ class Caster {
   CasterOptions options_;
   std::unique_ptr<WorkerPool> pool_;
   JobSystem* jobs_ = nullptr;
-  std::unique_ptr<gpu::Context> gpu_;
+  std::shared_ptr<gpu::Context> gpu_;  // shared_ptr: deleted where Vulkan is known (none without it)
   std::unique_ptr<gpu::Method> method_;
   std::string gpu_error_;
   std::atomic<bool> gpu_failed_{false};

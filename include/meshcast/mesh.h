@@ -3,10 +3,12 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "meshcast/errors.h"
 
 namespace meshcast {
 
@@ -39,15 +41,33 @@ struct Mesh {
   Box3 bounds() const;
 };
 
-// Thrown for bad input; the message names the input and the problem.
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 // Coordinates beyond this (about 1.27e30) are refused, in meshes and in ray
 // origins: extents, areas and half-float scales computed from them must stay
 // finite in float, and the triangle test's double redo must stay in range.
 constexpr float kMaxCoordinate = 0x1p100f;
+
+// A mesh in the caller's own memory, read where it lies: `vertex_count`
+// positions of three floats (x, y, z) every `vertex_stride` bytes, and
+// `triangle_count` triangles of three 16- or 32-bit vertex indices every
+// `triangle_stride` bytes (0: the three indices packed, 6 or 12 bytes). An
+// engine's interleaved vertex buffer and its index buffer serve as they are;
+// build_blob reads them once and keeps nothing.
+enum class IndexType : uint8_t { Uint16, Uint32 };
+struct MeshView {
+  const void* positions = nullptr;
+  size_t vertex_count = 0;
+  size_t vertex_stride = 3 * sizeof(float);
+  const void* indices = nullptr;
+  size_t triangle_count = 0;
+  IndexType index_type = IndexType::Uint32;
+  size_t triangle_stride = 0;
+};
+
+// The view's mesh, copied into a Mesh and checked (check_mesh), named
+// `name` in messages; InputError also for a null array with a count, a
+// stride shorter than its element, or sizes beyond 2^32 vertices.
+Mesh copy_mesh(const MeshView& view, const std::string& name);
 
 // Checks what every layout relies on: at least one triangle, every index in
 // range, every coordinate finite and within kMaxCoordinate. `name` is used in the message (a file path or

@@ -1,0 +1,40 @@
+# `cmake --install`: the public headers, the libraries, the meshcast program
+# (when built), a CMake package (find_package(meshcast CONFIG)) with its
+# version file, and pkg-config files (meshcast, meshcast-host).
+include(CMakePackageConfigHelpers)
+
+set(MESHCAST_INSTALLED meshcast_core meshcast_host)
+if(MESHCAST_VULKAN)
+  list(APPEND MESHCAST_INSTALLED meshcast_gpu)  # the host layer's static part, linked through meshcast::host
+endif()
+if(MESHCAST_READER)
+  list(APPEND MESHCAST_INSTALLED meshcast_io)
+endif()
+install(TARGETS ${MESHCAST_INSTALLED} EXPORT meshcastTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/meshcast DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+if(MESHCAST_TOOLS)
+  install(TARGETS meshcast RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
+
+set(MESHCAST_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/meshcast)
+install(EXPORT meshcastTargets NAMESPACE meshcast:: DESTINATION ${MESHCAST_CMAKE_DIR})
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/meshcastConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/meshcastConfig.cmake INSTALL_DESTINATION ${MESHCAST_CMAKE_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/meshcastConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/meshcastConfig.cmake ${PROJECT_BINARY_DIR}/meshcastConfigVersion.cmake
+        DESTINATION ${MESHCAST_CMAKE_DIR})
+
+# pkg-config: the libraries in link order, with what they need of the system.
+set(MESHCAST_HOST_LIBS "-lmeshcast_host")
+if(MESHCAST_VULKAN)
+  string(APPEND MESHCAST_HOST_LIBS " -lmeshcast_vulkan -ldl")
+endif()
+# The prefix found from the .pc file's own folder, so the package may be
+# installed anywhere (cmake --install --prefix) and still point at itself.
+file(RELATIVE_PATH MESHCAST_PC_TO_PREFIX /${CMAKE_INSTALL_LIBDIR}/pkgconfig /)
+string(REGEX REPLACE "/$" "" MESHCAST_PC_TO_PREFIX "${MESHCAST_PC_TO_PREFIX}")
+foreach(pc meshcast meshcast-host)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/${pc}.pc.in ${PROJECT_BINARY_DIR}/${pc}.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endforeach()

@@ -1,0 +1,71 @@
+// A built blob, validated once and then walked on the calling thread; and a
+// blob's file: loaded whole, memory-mapped, or saved.
+//
+//   meshcast::MappedBlob file("level.mcb");                 // or load_blob(...)
+//   meshcast::BlobView view(file.bytes(), "level.mcb");     // validates
+//   view.trace(rays, hits);                                 // this thread
+//
+// A BlobView does not copy the bytes: they must outlive it and stay
+// unchanged. It is only ever read, so any number of threads may trace
+// through one view at once.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "meshcast/build.h"
+#include "meshcast/ray.h"
+
+namespace meshcast {
+
+class BlobView {
+ public:
+  // Proves every offset and index of the blob in range (the header, its
+  // checksum, every section) before any walk; InputError naming `name` and
+  // what is wrong.
+  BlobView(std::span<const uint8_t> bytes, const std::string& name);
+
+  // The closest hit of each ray, written to hits[i]; returns how many rays
+  // were not walkable (ray_is_walkable: answered as misses). `outputs`: what
+  // else each hit carries. UsageError when hits is shorter than rays.
+  uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs = HitOutputs::None) const;
+
+  std::span<const uint8_t> bytes() const { return bytes_; }
+  Layout layout() const;
+  uint32_t triangle_count() const;  // of the input mesh
+
+ private:
+  std::span<const uint8_t> bytes_;
+  void (*walk_)(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t) = nullptr;
+};
+
+// A blob file read whole into memory (not validated: give it to a BlobView
+// or a Caster). InputError naming the path for a missing, unreadable or
+// non-regular file.
+std::vector<uint8_t> load_blob(const std::string& path);
+
+// Writes the blob beside `path`, then renames it over `path`, so a failed
+// write (a full disk) leaves no partial file under that name. OutputError
+// naming the path and the reason.
+void save_blob(const std::string& path, std::span<const uint8_t> blob);
+
+// A blob file mapped read-only into memory: no copy, the pages shared with
+// every process that maps it. InputError naming the path when it cannot be
+// opened or mapped. The bytes live as long as the MappedBlob.
+class MappedBlob {
+ public:
+  explicit MappedBlob(const std::string& path);
+  ~MappedBlob();
+  MappedBlob(MappedBlob&& other) noexcept;
+  MappedBlob& operator=(MappedBlob&& other) noexcept;
+  MappedBlob(const MappedBlob&) = delete;
+  MappedBlob& operator=(const MappedBlob&) = delete;
+  std::span<const uint8_t> bytes() const { return {static_cast<const uint8_t*>(data_), size_}; }
+
+ private:
+  void* data_ = nullptr;
+  size_t size_ = 0;
+};
+
+}  // namespace meshcast

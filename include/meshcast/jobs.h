@@ -1,0 +1,20 @@
+// Where the CPU backend's work runs. An engine with its own job system
+// implements JobSystem and hands it to the Caster (CasterOptions::jobs);
+// without one, the caster makes a pool of workers over the machine's cores.
+#pragma once
+#include <cstdint>
+#include <functional>
+
+namespace meshcast::host {
+
+// run(count, work) arranges for work(i) to be called once for every i in
+// [0, count), on any threads, and may return before they run. `work` stays
+// alive until every call has returned (the caster keeps it per frame slot).
+class JobSystem {
+ public:
+  virtual ~JobSystem() = default;
+  virtual void run(uint32_t count, const std::function<void(uint32_t)>& work) = 0;
+  virtual uint32_t threads() const = 0;  // how many run at once (for sizing the jobs)
+};
+
+}  // namespace meshcast::host

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "bench/trees.h"
-#include "cpu/auto_layout.h"
+#include "builder/auto_layout.h"
 
 namespace meshcast::bench {
 

@@ -7,12 +7,13 @@
 #include <cstdio>
 #include <map>
 
-#include "cpu/agreement.h"
-#include "cpu/encode.h"
-#include "cpu/oracle.h"
-#include "cpu/rays.h"
+#include "check/agreement.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
+#include "check/oracle.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::bench {
 

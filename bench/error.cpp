@@ -6,14 +6,15 @@
 #include <cmath>
 #include <cstdio>
 
-#include "cpu/agreement.h"
-#include "cpu/encode.h"
-#include "cpu/oracle.h"
-#include "cpu/rays.h"
+#include "check/agreement.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
+#include "check/oracle.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::bench {
 

@@ -4,8 +4,9 @@
 #include <chrono>
 #include <memory>
 
-#include "cpu/encode.h"
-#include "cpu/rays.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
+#include "check/ray_files.h"
 #include "meshcast/caster.h"
 
 namespace meshcast::bench {
@@ -90,6 +91,7 @@ LatencyResult bench_latency(const Mesh& mesh, const std::string& name, double fr
   host::CasterOptions automatic = all;
   automatic.backend = host::Backend::Automatic, automatic.device = device;
   host::Caster caster(blob, name, automatic);
+  caster.wait_for_crossover();
   result.crossover = caster.crossover();
   result.why_small = caster.why(16);
   result.why_large = caster.why(65536);

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <chrono>
 
-#include "cpu/agreement.h"
+#include "check/agreement.h"
 #include "cpu/counters.h"
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "layout/lbvh.h"
 
 namespace meshcast::bench {

@@ -4,8 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "cpu/encode.h"
-#include "cpu/oracle.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
+#include "check/oracle.h"
 #include "meshcast/blob.h"
 
 namespace meshcast::bench {

@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <random>
 
-#include "cpu/pairing.h"
-#include "cpu/rays.h"
-#include "io/generate.h"
+#include "builder/pairing.h"
+#include "check/ray_files.h"
+#include "check/generate.h"
 #include "io/read_mesh.h"
 
 namespace meshcast::bench {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "meshcast/mesh.h"
-#include "cpu/ray.h"
+#include "cpu/intersect.h"
 
 namespace meshcast::bench {
 

@@ -2,7 +2,7 @@
 
 #include <cstdlib>
 
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 
 namespace meshcast::bench {
 

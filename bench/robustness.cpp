@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "cpu/oracle.h"
-#include "cpu/rays.h"
+#include "check/oracle.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
-#include "io/generate.h"
+#include "check/generate.h"
 
 namespace meshcast::bench {
 

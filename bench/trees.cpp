@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <map>
 
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 
 namespace meshcast::bench {
 

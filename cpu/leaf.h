@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <bit>
 
-#include "cpu/ray.h"
+#include "cpu/intersect.h"
 #include "layout/codecs.h"
 #include "layout/zerobyte.h"
 

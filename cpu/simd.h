@@ -4,7 +4,7 @@
 //
 // min/max keep the *second* operand when either is NaN (the SSE rule), and the
 // scalar path copies that rule: the box test relies on it to drop the NaN of
-// 0 * inf from a slab the ray lies in (see cpu/ray.h).
+// 0 * inf from a slab the ray lies in (see cpu/intersect.h).
 #pragma once
 #include <bit>
 #include <cstdint>

@@ -6,7 +6,7 @@
 
 #include "cpu/pairs.h"
 #include "cpu/walk.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "layout/quadtree.h"
 
 namespace meshcast {

@@ -1,5 +1,5 @@
 // Walkers: one per tree family, instantiated per triangle codec. trace()
-// (cpu/trace.h) picks the instantiation from the blob header once per batch.
+// (include/meshcast/blob.h) picks the instantiation from the blob header once per batch.
 #pragma once
 #include <cstddef>
 #include <cstdint>

@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "cpu/agreement.h"
+#include "check/agreement.h"
 #include "meshcast/mesh.h"
 #include "meshcast/blob.h"
 #include "fuzz/rays.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 using namespace meshcast;
 

@@ -11,12 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "cpu/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "meshcast/mesh.h"
 #include "meshcast/blob.h"
 #include "fuzz/rays.h"
 #include "io/read_mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 using namespace meshcast;
 

@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "gpu/batch.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "shaders/aabblist_args.h"
 #include "shaders/aabblist_bitpack.h"
 #include "shaders/aabblist_boxes.h"

@@ -7,7 +7,7 @@
 #include "meshcast/mesh.h"
 #include "meshcast/blob.h"
 #include "gpu/rays.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::gpu {
 

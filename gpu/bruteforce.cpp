@@ -8,7 +8,7 @@
 
 #include "gpu/batch.h"
 #include "meshcast/mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "shaders/bruteforce_bitpack.h"
 #include "shaders/bruteforce_float3.h"
 #include "shaders/resolve_bitpack.h"

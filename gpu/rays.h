@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "cpu/ray.h"
+#include "cpu/intersect.h"
 
 namespace meshcast::gpu {
 

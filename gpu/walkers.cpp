@@ -3,9 +3,10 @@
 // Each is a shader and the layout it reads; the host side is the same.
 #include <algorithm>
 
-#include "cpu/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "meshcast/mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "gpu/batch.h"
 #include "shaders/aabbtree_float3.h"
 #include "shaders/aabbtree_strip.h"

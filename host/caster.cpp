@@ -15,7 +15,7 @@
 #include "gpu/vulkan.h"
 #endif
 #include "host/jobs.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::host {
 
@@ -65,7 +65,10 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
     pool_ = std::make_unique<WorkerPool>(options_.threads);
     jobs_ = pool_.get();
   }
-  for (uint32_t i = 0; i < options_.frames; ++i) {
+  // One slot more than the game's frames: the Automatic backend's
+  // measurement runs on it beside the game's batches.
+  game_slots_ = options_.frames;
+  for (uint32_t i = 0; i < game_slots_ + 1; ++i) {
     auto s = std::make_unique<Slot>();
     s->index = i;
     Slot* sp = s.get();
@@ -103,7 +106,7 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
                                                                      : std::vector<std::string>{options_.gpu_method};
       for (const std::string& m : names) {
         try {
-          method_ = gpu::make_method(*gpu_, m, blob, name, options_.frames, uint32_t(options_.hit_outputs));
+          method_ = gpu::make_method(*gpu_, m, blob, name, uint32_t(slots_.size()), uint32_t(options_.hit_outputs));
           break;
         } catch (const InputError&) {
           if (!options_.gpu_method.empty()) throw;
@@ -120,17 +123,34 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
     }
 #endif
   }
-  if (options_.backend == Backend::Automatic && gpu_available()) {
+  if (options_.backend != Backend::Automatic || !gpu_available() || load_crossover()) {
+    crossover_known_ = true;
+    return;
+  }
+  crossover_note_ = "being measured in the background; the CPU answers meanwhile";
+  measuring_ = std::thread([this] {
     try {
       measure_crossover();
     } catch (const std::exception& e) {  // the GPU failed while measured: the CPU it is
-      options_.backend = Backend::Automatic;
       gpu_failed(std::string("measuring the crossover: ") + e.what());
     }
-  }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      crossover_known_ = true;
+    }
+    changed_.notify_all();
+  });
+}
+
+void Caster::wait_for_crossover() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return crossover_known_.load(); });
 }
 
 Caster::~Caster() {
+  // The measurement stops after its current batch.
+  stop_measuring_ = true;
+  if (measuring_.joinable()) measuring_.join();
   // Collect what is still running, so no job or fence outlives the caster.
   {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -159,7 +179,7 @@ uint32_t Caster::validation_messages() const { return 0; }
 Backend Caster::choose(uint32_t rays) const {
   if (!gpu_available() || options_.backend == Backend::Cpu) return Backend::Cpu;
   if (options_.backend == Backend::Vulkan) return Backend::Vulkan;
-  return rays >= crossover_ ? Backend::Vulkan : Backend::Cpu;
+  return rays >= crossover_.load() ? Backend::Vulkan : Backend::Cpu;
 }
 
 std::string Caster::why(uint32_t rays) const {
@@ -167,50 +187,57 @@ std::string Caster::why(uint32_t rays) const {
   if (options_.backend == Backend::Cpu) return n + "CPU, as the caster was made";
   if (!gpu_available()) return n + "CPU, the GPU is unavailable (" + gpu_error() + ")";
   if (options_.backend == Backend::Vulkan) return n + "Vulkan on " + device_name() + ", as the caster was made";
-  if (crossover_ == ~0u) return n + "CPU, the GPU finished no batch size first (" + crossover_note_ + ")";
-  return n + (rays >= crossover_ ? "Vulkan on " + device_name() + ", at or above" : "CPU, below") +
-         " the crossover of " + std::to_string(crossover_) + " rays (" + crossover_note_ + ")";
+  std::string note;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    note = crossover_note_;
+  }
+  const uint32_t crossover = crossover_.load();
+  if (!crossover_known_) return n + "CPU, while the crossover is " + note;
+  if (crossover == ~0u) return n + "CPU, the GPU finished no batch size first (" + note + ")";
+  return n + (rays >= crossover ? "Vulkan on " + device_name() + ", at or above" : "CPU, below") +
+         " the crossover of " + std::to_string(crossover) + " rays (" + note + ")";
 }
 
 Ticket Caster::submit(std::span<const Ray> rays) {
   Slot* s = nullptr;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (auto& slot : slots_)
-      if (slot->state == Slot::Free) {
-        s = slot.get();
-        break;
-      }
+    for (uint32_t i = 0; i < game_slots_ && !s; ++i)
+      if (slots_[i]->state == Slot::Free) s = slots_[i].get();
     if (!s)
-      throw UsageError("all " + std::to_string(slots_.size()) +
-                               " frames hold batches not yet collected; wait() for one before submitting more");
+      throw UsageError("all " + std::to_string(game_slots_) +
+                       " frames hold batches not yet collected; wait() for one before submitting more");
     s->state = Slot::Running;
     s->id = next_id_++;
   }
-  const Ticket t{s->id, s->index};
+  start(*s, rays, choose(uint32_t(rays.size())));
+  return {s->id, s->index};
+}
+
+void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   try {
-    s->submit_ms = now_ms();
-    s->n = uint32_t(rays.size());
-    s->rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-    s->hits.resize(s->n);
-    if (choose(s->n) == Backend::Vulkan && s->n > 0) {
+    s.submit_ms = now_ms();
+    s.n = uint32_t(rays.size());
+    s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+    s.hits.resize(s.n);
+    if (backend == Backend::Vulkan && gpu_available() && s.n > 0) {
       try {
-        start_gpu(*s);
-        return t;
+        start_gpu(s);
+        return;
       } catch (const GpuError& e) {
         // A lost device is given up; any other refusal (a batch beyond a
         // buffer limit, memory) sends just this batch to the CPU.
         if (e.lost) gpu_failed(e.what());
       }
     }
-    start_cpu(*s);
+    start_cpu(s);
   } catch (...) {  // nothing started: the slot is free again
     std::lock_guard<std::mutex> lock(mutex_);
-    s->state = Slot::Free;
+    s.state = Slot::Free;
     changed_.notify_all();
     throw;
   }
-  return t;
 }
 
 void Caster::start_cpu(Slot& s) {
@@ -283,9 +310,9 @@ void Caster::complete(Slot& s, Backend ran_on) {
 }
 
 Caster::Slot& Caster::slot_of(const Ticket& t) const {
-  if (t.slot >= slots_.size())
+  if (t.slot >= game_slots_)
     throw UsageError("ticket " + std::to_string(t.id) + " names frame slot " + std::to_string(t.slot) + " of " +
-                     std::to_string(slots_.size()) + ": not a ticket of this caster");
+                     std::to_string(game_slots_) + ": not a ticket of this caster");
   return *slots_[t.slot];
 }
 
@@ -297,8 +324,9 @@ bool Caster::poll(const Ticket& t) {
   return s.state == Slot::Ready;
 }
 
-BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
-  Slot& s = slot_of(t);
+BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return collect(slot_of(t), t, hits, true); }
+
+BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, bool record) {
   BatchRecord r;
   {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -332,9 +360,11 @@ BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) {
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (records_.size() < kRecords) records_.push_back(r);
-    else records_[recorded_ % kRecords] = r;
-    ++recorded_;
+    if (record) {
+      if (records_.size() < kRecords) records_.push_back(r);
+      else records_[recorded_ % kRecords] = r;
+      ++recorded_;
+    }
     s.state = Slot::Free;
     changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
   }
@@ -377,26 +407,38 @@ Percentiles Caster::percentiles(Backend b, uint32_t rays) const {
   return p;
 }
 
+namespace {
+
+// What a saved profile is known by: the device, the layout, the mesh.
+std::string profile_key(const std::string& device, const BlobView& view) {
+  const layout::BlobHeader& h = layout::header_of(view.bytes().data());
+  return device + " | " + std::string(layout::tree_format_name(h.tree_format)) + "/" +
+         std::string(layout::triangle_format_name(h.triangle_format)) + " | " + std::to_string(h.triangle_count) +
+         " triangles | " + std::to_string(h.checksum);
+}
+
+}  // namespace
+
+bool Caster::load_crossover() {
+  if (options_.profile.empty()) return false;
+  std::ifstream in(options_.profile);
+  std::string magic, saved_key, note;
+  uint32_t crossover = 0;
+  if (!(std::getline(in, magic) && magic == "meshcast-profile 1" && std::getline(in, saved_key) &&
+        saved_key == profile_key(device_name(), view_) && in >> crossover && std::getline(in >> std::ws, note)))
+    return false;
+  crossover_ = crossover;
+  crossover_note_ = note + ", loaded from " + options_.profile;
+  return true;
+}
+
 // The crossover: the smallest measured batch size from which on the GPU
 // returned every size first (median of 3 batches a size and backend),
-// measured on rays aimed at the blob's box from around it; or read from
-// options.profile when that file names this device and blob.
+// measured on rays aimed at the blob's box from around it, on the slot
+// after the game's (its batches are not the game's records), then saved to
+// options.profile when one is named.
 void Caster::measure_crossover() {
   const layout::BlobHeader& h = layout::header_of(view_.bytes().data());
-  const std::string key = device_name() + " | " + std::string(layout::tree_format_name(h.tree_format)) + "/" +
-                          std::string(layout::triangle_format_name(h.triangle_format)) + " | " +
-                          std::to_string(h.triangle_count) + " triangles | " + std::to_string(h.checksum);
-  if (!options_.profile.empty()) {
-    std::ifstream in(options_.profile);
-    std::string magic, saved_key, note;
-    uint32_t crossover = 0;
-    if (std::getline(in, magic) && magic == "meshcast-profile 1" && std::getline(in, saved_key) && saved_key == key &&
-        in >> crossover && std::getline(in >> std::ws, note)) {
-      crossover_ = crossover;
-      crossover_note_ = note + ", loaded from " + options_.profile;
-      return;
-    }
-  }
   std::vector<Ray> rays(16384);
   uint64_t state = 0x9E3779B97F4A7C15ull;
   auto uniform = [&] {
@@ -414,39 +456,50 @@ void Caster::measure_crossover() {
     r.tmax = INFINITY;
   }
   std::vector<Hit> hits(rays.size());
-  const Backend chosen = options_.backend;
+  Slot& slot = *slots_[game_slots_];
   std::vector<uint32_t> sizes;
   std::vector<double> cpu, gpu;
   for (uint32_t n = 1; n <= rays.size(); n *= 4) {
     sizes.push_back(n);
     for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
-      options_.backend = b;
       std::vector<double> ms;
-      for (int k = 0; k < 3; ++k) ms.push_back(wait(submit(std::span<const Ray>(rays).first(n)), hits).latency_ms);
+      for (int k = 0; k < 3; ++k) {
+        if (stop_measuring_) return;
+        Ticket t;
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          slot.state = Slot::Running;
+          slot.id = next_id_++;
+          t = {slot.id, slot.index};
+        }
+        start(slot, std::span<const Ray>(rays).first(n), b);
+        ms.push_back(collect(slot, t, hits, false).latency_ms);
+      }
       std::sort(ms.begin(), ms.end());
       (b == Backend::Cpu ? cpu : gpu).push_back(ms[1]);
     }
   }
-  options_.backend = chosen;
-  clear_records();
   if (!gpu_available()) return;
   size_t first = sizes.size();
   while (first > 0 && gpu[first - 1] < cpu[first - 1]) --first;
+  const size_t at = first < sizes.size() ? first : sizes.size() - 1;
   std::ostringstream note;
-  if (first < sizes.size()) {
-    crossover_ = sizes[first];
-    note << "at " << sizes[first] << " rays " << device_name() << " took " << gpu[first] << " ms, " << cpu_threads()
-         << " CPU threads " << cpu[first] << " ms";
-  } else {
-    note << "at " << sizes.back() << " rays " << device_name() << " took " << gpu.back() << " ms, " << cpu_threads()
-         << " CPU threads " << cpu.back() << " ms";
+  note << "at " << sizes[at] << " rays " << device_name() << " took " << gpu[at] << " ms, " << cpu_threads()
+       << " CPU threads " << cpu[at] << " ms; measured at start-up";
+  const uint32_t crossover = first < sizes.size() ? sizes[first] : ~0u;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    crossover_note_ = note.str();
+    crossover_ = crossover;
   }
-  note << "; measured at start-up";
-  crossover_note_ = note.str();
-  if (!options_.profile.empty()) {
+  if (options_.profile.empty()) return;
+  try {
     OutputText out(options_.profile);
-    out << "meshcast-profile 1\n" << key << "\n" << crossover_ << "\n" << crossover_note_ << "\n";
+    out << "meshcast-profile 1\n" << profile_key(device_name(), view_) << "\n" << crossover << "\n" << note.str() << "\n";
     out.commit();
+  } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
+    std::lock_guard<std::mutex> lock(mutex_);
+    crossover_note_ += std::string("; not saved: ") + e.what();
   }
 }
 

@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::layout {
 

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::layout {
 

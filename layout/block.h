@@ -9,7 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::layout {
 

@@ -7,7 +7,7 @@
 #pragma once
 #include <cstdint>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::layout {
 

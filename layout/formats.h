@@ -17,7 +17,7 @@
 #define MC_HIT_POINT 2u  // the hit point: org + t * dir, in float
 
 // Header fields as 32-bit word indices, for readers that see the blob as a
-// uint array (the shaders); layout/blob.h checks them against BlobHeader.
+// uint array (the shaders); layout/blob_format.h checks them against BlobHeader.
 #define MC_HDR_TREE_FORMAT 2u
 #define MC_HDR_TRIANGLE_FORMAT 3u
 #define MC_HDR_TRIANGLE_COUNT 4u

@@ -9,7 +9,7 @@
 #include <bit>
 #include <cstdint>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::layout {
 

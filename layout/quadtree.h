@@ -15,7 +15,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "layout/half.h"
 
 namespace meshcast::layout {

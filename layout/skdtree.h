@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::layout {
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "layout/leaves.h"
 
 namespace meshcast::layout {

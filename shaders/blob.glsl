@@ -1,6 +1,6 @@
 // The blob as the CPU wrote it, bound as one read-only uint array, and the
 // readers every method shares: header fields, and the remap from a triangle
-// slot to the caller's triangle index (layout/blob.h describes the section).
+// slot to the caller's triangle index (layout/blob_format.h describes the section).
 #ifndef MESHCAST_BLOB_GLSL
 #define MESHCAST_BLOB_GLSL
 
@@ -12,7 +12,7 @@ uint blob_u32(uint byte_offset) { return blob_words[byte_offset >> 2]; }
 float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_words[byte_offset >> 2]); }
 uint header(uint word) { return blob_words[word]; }
 
-// remap_entry of layout/blob.h: the used-slot bitmap (64-bit words), the
+// remap_entry of layout/blob_format.h: the used-slot bitmap (64-bit words), the
 // rank of each word, then the bit-packed entries; or in input order (no
 // entries), or no remap at all.
 uint remap_entry(uint slot) {

@@ -1,4 +1,4 @@
-// Hits as the CPU's Hit (cpu/ray.h): t, triangle (MC_NO_HIT for a miss), u,
+// Hits as the CPU's Hit (cpu/intersect.h): t, triangle (MC_NO_HIT for a miss), u,
 // v, the hit point; 7 words. u, v and the point are written only when the
 // pipeline was made for them (specialization constant 0, MC_HIT_*), else 0,
 // so a method asked for neither leaves their arithmetic to dead-code

@@ -1,5 +1,5 @@
 // Rays as the host prepares them (gpu/rays.cpp): the ray and the per-ray
-// constants of the CPU's RayPre (cpu/ray.h), computed once on the host in
+// constants of the CPU's RayPre (cpu/intersect.h), computed once on the host in
 // correctly rounded arithmetic, so the shear the GPU applies is the CPU's
 // bit for bit, and the box test's reciprocals likewise. 16 words a ray:
 //   org xyz, dir xyz, tmax, sx, sy, sz, axes (kx | ky << 2 | kz << 4),

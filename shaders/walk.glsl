@@ -1,5 +1,5 @@
 // What the one-ray-a-thread tree walkers share: the closest hit so far, the
-// conservative box test of cpu/ray.h (Ize 2013) and the Float3 leaf test.
+// conservative box test of cpu/intersect.h (Ize 2013) and the Float3 leaf test.
 #ifndef MESHCAST_WALK_GLSL
 #define MESHCAST_WALK_GLSL
 
@@ -11,7 +11,7 @@ bool sign_bit(float x) { return (floatBitsToUint(x) >> 31) != 0u; }
 float max_keep(float a, float b) { return a > b ? a : b; }
 float min_keep(float a, float b) { return a < b ? a : b; }
 
-// 1 + 2 gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (cpu/ray.h).
+// 1 + 2 gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (cpu/intersect.h).
 const float kFarScale = 1.0 + 2.0 * (3.0 * 5.9604644775390625e-8) / (1.0 - 3.0 * 5.9604644775390625e-8);
 
 struct Closest {
@@ -21,7 +21,7 @@ struct Closest {
 };
 
 // The ray's interval [tn, tf] inside the box, each end one rounding of
-// (plane - origin) * 1/d (the slabs of box_interval in cpu/ray.h).
+// (plane - origin) * 1/d (the slabs of box_interval in cpu/intersect.h).
 void box_interval(GpuRay r, vec3 mn, vec3 mx, out float tn, out float tf) {
   tn = 0.0, tf = kInfinity;
   for (int a = 0; a < 3; ++a) {
@@ -39,7 +39,7 @@ bool interval_open(float lo, float hi, float closest) {
   return lo <= limit;
 }
 
-// Entry distance of the box, or +inf for a miss (box_test of cpu/ray.h).
+// Entry distance of the box, or +inf for a miss (box_test of cpu/intersect.h).
 float box_test(GpuRay r, vec3 mn, vec3 mx, float closest) {
   float tn, tf;
   box_interval(r, mn, mx, tn, tf);

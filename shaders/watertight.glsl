@@ -1,4 +1,4 @@
-// The watertight ray/triangle test of cpu/ray.h (Woop, Benthin, Wald 2013),
+// The watertight ray/triangle test of cpu/intersect.h (Woop, Benthin, Wald 2013),
 // operation for operation: every product and difference is `precise`, so no
 // compiler fuses them into an fma and both triangles of a shared edge get
 // the same roundings; a lane float cannot settle (an edge function of 0, a
@@ -9,8 +9,8 @@
 #ifndef MESHCAST_WATERTIGHT_GLSL
 #define MESHCAST_WATERTIGHT_GLSL
 
-#define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/ray.h kSettleTiny
-#define kSettleHuge uintBitsToFloat(0x7E800000u)  // 2^126, cpu/ray.h kSettleHuge
+#define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/intersect.h kSettleTiny
+#define kSettleHuge uintBitsToFloat(0x7E800000u)  // 2^126, cpu/intersect.h kSettleHuge
 
 // Corners in ray space: sheared x, y, and z not yet scaled by sz.
 bool watertight_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,

@@ -7,14 +7,14 @@
 
 #include <cmath>
 
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
 namespace {
 
-// Expected figures from the generators' own geometry (io/generate.h).
+// Expected figures from the generators' own geometry (check/generate.h).
 TEST(MeshStats, SphereGridAndSoup) {
   const int rings = 16, segments = 32;  // segments a multiple of 4: the box touches the sphere on every axis
   const Mesh sphere = make_sphere(rings, segments, 2.0f, {3.0f, 4.0f, 0.0f});

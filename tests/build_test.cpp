@@ -6,9 +6,9 @@
 #include <functional>
 #include <set>
 
-#include "cpu/build.h"
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "builder/binary_tree.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "layout/leaves.h"
 #include "tests/testing.h"
 

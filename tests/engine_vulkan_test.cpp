@@ -10,9 +10,10 @@
 #include <cmath>
 #include <vector>
 
-#include "cpu/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "meshcast/caster.h"
-#include "io/generate.h"
+#include "check/generate.h"
 
 namespace meshcast::testing {
 namespace {

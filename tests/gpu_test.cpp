@@ -8,7 +8,7 @@
 
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
-#include "io/generate.h"
+#include "check/generate.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {

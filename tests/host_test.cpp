@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "meshcast/caster.h"
-#include "io/generate.h"
+#include "check/generate.h"
 #include "tests/testing.h"
 
 // Every allocation of this program counted, to show that a warm caster
@@ -380,6 +380,18 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
   {
     Caster caster(blob, "sphere", o);
     ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    // Construction did not wait for the measurement: until it is known,
+    // every batch goes to the CPU and why() says so.
+    const std::vector<Ray> rays = make_rays(m, RayKind::Long, 3000, 5);
+    std::vector<Hit> hits(rays.size());
+    for (int k = 0; k < 3 && !caster.crossover_known(); ++k) {
+      const std::string why = caster.why(1u << 20);
+      const host::BatchRecord r = caster.wait(caster.submit(rays), hits);
+      if (why.find("measured in the background") != std::string::npos) EXPECT_EQ(r.ran_on, Backend::Cpu) << why;
+    }
+    caster.clear_records();
+    caster.wait_for_crossover();
+    EXPECT_TRUE(caster.crossover_known());
     crossover = caster.crossover();
     EXPECT_NE(caster.why(1).find("measured at start-up"), std::string::npos) << caster.why(1);
     for (uint32_t n : {1u, 64u, 4096u, 1u << 20})
@@ -388,6 +400,7 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
   }
   ASSERT_TRUE(std::filesystem::exists(profile));
   Caster again(blob, "sphere", o);
+  EXPECT_TRUE(again.crossover_known());  // loaded in the constructor
   EXPECT_EQ(again.crossover(), crossover);
   EXPECT_NE(again.why(1).find("loaded from"), std::string::npos) << again.why(1);
   std::filesystem::remove(profile);

@@ -15,11 +15,12 @@
 #include <fstream>
 #include <string>
 
-#include "cpu/encode.h"
-#include "cpu/rays.h"
-#include "io/generate.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
+#include "check/ray_files.h"
+#include "check/generate.h"
 #include "io/read_mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "tests/testing.h"
 
 namespace fs = std::filesystem;

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "io/generate.h"
+#include "check/generate.h"
 #include "io/read_mesh.h"
 #include "tests/testing.h"
 

@@ -6,8 +6,8 @@
 #include <random>
 #include <set>
 
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "layout/block.h"
 #include "layout/half.h"
 #include "tests/testing.h"

@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {

@@ -2,8 +2,8 @@
 // force.
 #include <gtest/gtest.h>
 
-#include "cpu/oracle.h"
-#include "io/generate.h"
+#include "check/oracle.h"
+#include "check/generate.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -65,7 +65,7 @@ TEST(Oracle, DegenerateTrianglesAreNeverHit) {
   EXPECT_EQ(oracle_brute_force(m, r).triangle, MC_NO_HIT);
 }
 
-// The judge (cpu/agreement.h): a walker's miss where the oracle hits is
+// The judge (check/agreement.h): a walker's miss where the oracle hits is
 // wrong in the middle of a triangle, a tie only within float rounding of
 // its edge (a grazed silhouette, decided by rounding either way).
 TEST(Agreement, AMissIsWrongUnlessWithinRoundingOfAnEdge) {

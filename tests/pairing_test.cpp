@@ -8,9 +8,9 @@
 #include <random>
 #include <set>
 
-#include "cpu/pairing.h"
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "builder/pairing.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "layout/leaves.h"
 #include "layout/pairsoa.h"
 #include "tests/testing.h"

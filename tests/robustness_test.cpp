@@ -15,8 +15,8 @@
 #include <random>
 #include <string>
 
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "tests/testing.h"
 #ifdef MESHCAST_TEST_GPU
 #include "gpu/method.h"
@@ -50,7 +50,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     o.triangle_ids = GetParam().find("+noids") == std::string::npos;
     return o;
   }
-  // "auto:SETTING" (cpu/auto_layout.h parse_auto_setting) builds the layout the automatic
+  // "auto:SETTING" (builder/auto_layout.h parse_auto_setting) builds the layout the automatic
   // layout chooses for each probe mesh; anything else the named layout.
   bool automatic() const { return GetParam().rfind("auto:", 0) == 0; }
   std::vector<uint8_t> build(const Mesh& mesh, const char* what) const {

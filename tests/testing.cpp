@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 #include <filesystem>
 
-#include "io/generate.h"
+#include "check/generate.h"
 #include "io/read_mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::testing {
 

@@ -9,12 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "cpu/agreement.h"
-#include "cpu/auto_layout.h"
-#include "cpu/encode.h"
+#include "check/agreement.h"
+#include "builder/auto_layout.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "meshcast/mesh.h"
-#include "cpu/oracle.h"
-#include "cpu/rays.h"
+#include "check/oracle.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
 
 namespace meshcast::testing {

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "io/generate.h"
-#include "layout/blob.h"
+#include "check/generate.h"
+#include "layout/blob_format.h"
 #include "layout/leaves.h"
 #include "tests/testing.h"
 

@@ -7,8 +7,8 @@
 #include <cstring>
 
 #include "cpu/box_cache.h"
-#include "cpu/zerobyte.h"
-#include "io/generate.h"
+#include "builder/write_zerobyte.h"
+#include "check/generate.h"
 #include "layout/zerobyte.h"
 #include "tests/testing.h"
 

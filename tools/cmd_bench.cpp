@@ -1,4 +1,6 @@
-// meshcast bench encodings [MESH]: seed 000 §3.11 on this machine.
+// meshcast bench TABLE: the source documents' tables and the issues'
+// measurements on this machine, one function a table (bench auto has its own
+// file).
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -6,7 +8,7 @@
 #include <algorithm>
 
 #include "cpu/counters.h"
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "bench/encodings.h"
 #include "bench/error.h"
 #include "bench/gpu.h"
@@ -15,7 +17,7 @@
 #include "bench/plot.h"
 #include "bench/robustness.h"
 #include "bench/trees.h"
-#include "io/generate.h"
+#include "check/generate.h"
 #include "io/read_mesh.h"
 #include "tools/commands.h"
 #include "tools/common.h"
@@ -28,18 +30,19 @@ Mesh bench_mesh(const std::string& input) {
   return read_mesh(input);
 }
 
-void add_bench(CLI::App& app) {
-  CLI::App* bench = app.add_subcommand("bench", "reproduce the source documents' tables");
-  bench->require_subcommand(1);
-  add_bench_auto(bench);
-  struct Args {
-    std::string input = "data/bunny00.off", out_dir = "out";
-    size_t rays = 1024;
-    uint32_t repeat = 7;
-    std::string only;  // combos: the layouts naming one of these (comma separated)
-  };
-  auto args = std::make_shared<Args>();
-  using ArgsT = Args;
+namespace {
+
+// Options every table takes.
+struct BenchArgs {
+  std::string input = "data/bunny00.off", out_dir = "out";
+  size_t rays = 1024;
+  uint32_t repeat = 7;
+  std::string only;  // combos: the layouts naming one of these (comma separated)
+};
+
+// Seed 000 §3.11: every triangle encoding, brute force and in a QuadTree.
+void add_bench_encodings(CLI::App* bench) {
+  auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = bench->add_subcommand("encodings", "seed 000 3.11: every triangle encoding, brute force and in a QuadTree");
   cmd->add_option("mesh", args->input, "mesh file (default data/bunny00.off)");
   cmd->add_option("--rays", args->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
@@ -82,7 +85,10 @@ void add_bench(CLI::App& app) {
     csv.commit();
     std::printf("\ncsv: %s\nplot: %s\n", csv_path.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
+}
 
+// Seed 000 §4.1, §4.2, §4.3 and §6: one subcommand a table.
+void add_bench_tables(CLI::App* bench) {
   // §4.1, §4.2, §4.3 and §6: the same columns, one table each, a CSV and a
   // plot of time per ray against walked bytes per triangle.
   struct Table { const char* name; const char* what; };
@@ -93,7 +99,7 @@ void add_bench(CLI::App& app) {
       {"trees", "seed 000 6: every tree format with Float3, Binning, leaf 8"},
       {"combos", "seed 000 6: every tree with every CPU triangle encoding"}};
   for (const Table& table : tables) {
-    auto targs = std::make_shared<ArgsT>();
+    auto targs = std::make_shared<BenchArgs>();
     CLI::App* sub = bench->add_subcommand(table.name, table.what);
     sub->add_option("mesh", targs->input, "mesh file, or terrain_2M for the generated 2M-triangle terrain (default data/bunny00.off)");
     sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
@@ -157,9 +163,11 @@ void add_bench(CLI::App& app) {
       std::printf("\ncsv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
     });
   }
+}
 
-  // Seed 000 §7 on this machine's Vulkan device.
-  auto gargs = std::make_shared<ArgsT>();
+// Seed 000 §7 on this machine's Vulkan device.
+void add_bench_gpu(CLI::App* bench) {
+  auto gargs = std::make_shared<BenchArgs>();
   auto gdevice = std::make_shared<std::string>();
   CLI::App* gsub = bench->add_subcommand("gpu", "seed 000 7: the GPU methods on the Vulkan device, the CPU's best beside them");
   gsub->add_option("mesh", gargs->input, "mesh file (default data/bunny00.off)");
@@ -180,9 +188,11 @@ void add_bench(CLI::App& app) {
                   r.device_us > 0 ? std::to_string(r.device_us).substr(0, std::to_string(r.device_us).find('.') + 4).c_str() : "-",
                   r.wall_us, r.bytes, r.seed.empty() ? "-" : r.seed.c_str(), (unsigned long long)r.disagreements);
   });
+}
 
-  // Issue 6: the host layer's latency against batch size, CPU and Vulkan.
-  auto largs = std::make_shared<ArgsT>();
+// Issue 6: the host layer's latency against batch size.
+void add_bench_latency(CLI::App* bench) {
+  auto largs = std::make_shared<BenchArgs>();
   auto lopts = std::make_shared<std::pair<std::string, double>>("", 16.7);  // device, frame ms
   CLI::App* lat = bench->add_subcommand("latency", "the host layer: batch latency from 1 to 65,536 rays, CPU and Vulkan");
   lat->add_option("mesh", largs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
@@ -229,9 +239,11 @@ void add_bench(CLI::App& app) {
     csv.commit();
     std::printf("csv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
   });
+}
 
-  // Issue 7: seed 003's results table.
-  auto eargs = std::make_shared<ArgsT>();
+// Issue 8: error against run time and bytes.
+void add_bench_error(CLI::App* bench) {
+  auto eargs = std::make_shared<BenchArgs>();
   auto emeshes = std::make_shared<std::vector<std::string>>();
   auto edevice = std::make_shared<std::string>();
   CLI::App* err = bench->add_subcommand("error", "issue 8: error against run time and bytes, every tree x encoding (and GPU method)");
@@ -305,8 +317,11 @@ void add_bench(CLI::App& app) {
     std::printf("\ncsv: %s/error.csv\nplots: %s, %s\n", eargs->out_dir.c_str(), why1.empty() ? png1.c_str() : why1.c_str(),
                 why2.empty() ? png2.c_str() : why2.c_str());
   });
+}
 
-  auto rargs = std::make_shared<ArgsT>();
+// Issue 8: the watertight test against Moller-Trumbore.
+void add_bench_robustness(CLI::App* bench) {
+  auto rargs = std::make_shared<BenchArgs>();
   CLI::App* rob = bench->add_subcommand("robustness", "issue 8: the watertight test against plain Moller-Trumbore, time and leaks");
   rob->add_option("mesh", rargs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
   rob->add_option("--rays", rargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
@@ -327,8 +342,11 @@ void add_bench(CLI::App& app) {
                   (unsigned long long)r.leaks_watertight, (unsigned long long)r.probes,
                   (unsigned long long)r.leaks_plain, (unsigned long long)r.probes);
   });
+}
 
-  auto pargs = std::make_shared<ArgsT>();
+// Seed 003: triangle pairing.
+void add_bench_pairing(CLI::App* bench) {
+  auto pargs = std::make_shared<BenchArgs>();
   auto pdata = std::make_shared<std::string>("data");
   CLI::App* pair = bench->add_subcommand("pairing", "seed 003: triangle pairing, before and after, as the builder's unit");
   pair->add_option("--data", *pdata, "folder of the public meshes (bunny00, armadillo, refined_elephant, ChineseDragon-10kv)");
@@ -376,9 +394,11 @@ void add_bench(CLI::App& app) {
                 kCountTests ? "test counts: one more pass with the counters (this build counts; its times are not for comparison)"
                             : "test counts: '-' (build with -DMESHCAST_COUNT_TESTS=ON to count them)");
   });
+}
 
-  // Issue 4's offset test for the half-float tree.
-  auto oargs = std::make_shared<ArgsT>();
+// Issue 4: the half-float tree far from the origin.
+void add_bench_offset(CLI::App* bench) {
+  auto oargs = std::make_shared<BenchArgs>();
   CLI::App* off = bench->add_subcommand("offset", "QuadTreeHalfFloat far from the origin: 0.15 units at 1000, 150 at 30000");
   off->add_option("mesh", oargs->input, "mesh file (default data/bunny00.off), scaled to each case's size");
   off->add_option("--rays", oargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
@@ -396,6 +416,22 @@ void add_bench(CLI::App& app) {
                   r.offset.min_ms * scale, r.offset.min_ms / r.origin.min_ms,
                   (unsigned long long)(r.origin.disagreements + r.offset.disagreements));
   });
+}
+
+}  // namespace
+
+void add_bench(CLI::App& app) {
+  CLI::App* bench = app.add_subcommand("bench", "reproduce the source documents' tables");
+  bench->require_subcommand(1);
+  add_bench_auto(bench);
+  add_bench_encodings(bench);
+  add_bench_tables(bench);
+  add_bench_gpu(bench);
+  add_bench_latency(bench);
+  add_bench_error(bench);
+  add_bench_robustness(bench);
+  add_bench_pairing(bench);
+  add_bench_offset(bench);
 }
 
 }  // namespace meshcast::tools

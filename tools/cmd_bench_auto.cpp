@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "bench/auto.h"
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "tools/commands.h"
 
 namespace meshcast::tools {

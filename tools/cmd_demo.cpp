@@ -5,14 +5,14 @@
 #include <cstdio>
 
 #include "bench/peer.h"
-#include "cpu/agreement.h"
-#include "cpu/oracle.h"
-#include "cpu/rays.h"
+#include "check/agreement.h"
+#include "check/oracle.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
 #include "io/read_mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 #include "tools/render.h"

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 

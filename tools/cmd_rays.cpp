@@ -1,7 +1,7 @@
 // meshcast rays MESH --kind long|probe|radial --count N --seed S --out R.rays
 #include <cstdio>
 
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "io/read_mesh.h"
 #include "tools/commands.h"
 #include "tools/common.h"

@@ -2,7 +2,7 @@
 // batch cast --repeat times, the median pass reported per ray.
 #include <cstdio>
 
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "gpu/method.h"
 #include "gpu/vulkan.h"

@@ -3,7 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "cpu/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "tools/common.h"
 
 namespace meshcast::tools {
@@ -33,7 +34,7 @@ struct LayoutArgs {
   bool no_triangle_ids = false;  // BuildOptions::triangle_ids
   bool zbt_no_shuffle = false, zbt_no_cache = false;  // zero-byte trees (seed 004)
   uint32_t hybrid_leaf = 256;
-  // --layout auto (cpu/auto_layout.h): the limits it chooses under.
+  // --layout auto (builder/auto_layout.h): the limits it chooses under.
   std::string goal = "speed";
   double max_bytes = 0, max_error = 0;
   bool gpu = false;

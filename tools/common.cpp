@@ -7,12 +7,12 @@
 #include <cstdio>
 #include <cstring>
 
-#include "cpu/auto_layout.h"
-#include "cpu/rays.h"
+#include "builder/auto_layout.h"
+#include "check/ray_files.h"
 #include "gpu/method.h"
 #include "meshcast/blob.h"
 #include "io/read_mesh.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 
 namespace meshcast::tools {
 

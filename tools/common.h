@@ -9,7 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cpu/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "meshcast/mesh.h"
 
 namespace meshcast::tools {

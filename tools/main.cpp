@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "meshcast/mesh.h"
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "gpu/vulkan.h"
 #include "tools/commands.h"
 

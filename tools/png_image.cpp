@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-#include "cpu/rays.h"
+#include "check/ray_files.h"
 #include "tools/common.h"
 
 namespace meshcast::tools {

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "meshcast/blob.h"
-#include "layout/blob.h"
+#include "layout/blob_format.h"
 #include "tools/common.h"
 
 namespace meshcast::tools {

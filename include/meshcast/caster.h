@@ -124,7 +124,15 @@ class Caster {
   // Where a batch of `rays` would go now, and why in a sentence.
   Backend choose(uint32_t rays) const;
   std::string why(uint32_t rays) const;
-  uint32_t crossover() const { return crossover_; }  // GPU from this batch size on (~0u: never)
+  // The Automatic backend: GPU from this batch size on (~0u: never, or not
+  // known yet). Construction never waits for it: read from
+  // CasterOptions::profile when that names this device and blob, else
+  // measured in the background on a frame slot of its own, every batch
+  // going to the CPU meanwhile. wait_for_crossover() blocks until it is
+  // known (at once for the other backends).
+  uint32_t crossover() const { return crossover_.load(); }
+  bool crossover_known() const { return crossover_known_.load(); }
+  void wait_for_crossover();
   bool gpu_available() const { return method_ != nullptr && !gpu_failed_.load(); }
   std::string gpu_error() const;
   std::string device_name() const;
@@ -141,12 +149,18 @@ class Caster {
  private:
   struct Slot;
   Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
+  // Fills the slot with the rays and starts the batch on `backend` (the
+  // CPU too when the GPU refuses it); collect() waits for it, copies its
+  // hits and frees the slot, keeping its record if `record`.
+  void start(Slot& s, std::span<const Ray> rays, Backend backend);
+  BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, bool record);
   void start_cpu(Slot& s);
   void start_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
   void gpu_completions();
   void gpu_failed(const std::string& why);
-  void measure_crossover();
+  bool load_crossover();     // from options.profile; false when it holds none for this device and blob
+  void measure_crossover();  // on the measurement's slot; the background thread's work
 
   BlobView view_;  // the caller's blob, which must outlive the caster
   CasterOptions options_;
@@ -156,13 +170,17 @@ class Caster {
   std::unique_ptr<gpu::Method> method_;
   std::string gpu_error_;
   std::atomic<bool> gpu_failed_{false};
-  uint32_t crossover_ = ~0u;
-  std::string crossover_note_;
+  std::atomic<uint32_t> crossover_{~0u};
+  std::atomic<bool> crossover_known_{false};
+  std::string crossover_note_;          // under mutex_ once the measurement has started
+  std::thread measuring_;               // the background measurement
+  std::atomic<bool> stop_measuring_{false};
 
   mutable std::mutex mutex_;            // slots and records
   std::mutex gpu_mutex_;                // the GPU method's begin and finish
   std::condition_variable changed_;     // a slot became ready
-  std::vector<std::unique_ptr<Slot>> slots_;
+  std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
+  uint32_t game_slots_ = 0;
   uint64_t next_id_ = 1;
   std::vector<BatchRecord> records_;
   uint64_t recorded_ = 0;

@@ -1,0 +1,106 @@
+// The top-down recursion every splitter of seed 000 §4.1 shares: a node
+// with at most leaf_size triangles is a leaf, a larger one is split by the
+// splitter (or at the median of the longest centre axis when the splitter
+// cannot separate them, and always below kSplitterDepth so the depth stays
+// within the walkers' stacks). Splitters see only triangle boxes and centres.
+#pragma once
+#include <algorithm>
+
+#include "builder/binary_tree.h"
+#include "layout/formats.h"
+
+namespace meshcast {
+
+constexpr uint32_t kSplitterDepth = 40;
+
+// SAH cost relative to the root box, unit costs for nodes and triangles.
+inline double sah_cost(const BuildTree& t) {
+  double root = t.nodes[0].box.half_area(), cost = 0;
+  if (!(root > 0)) root = 1;  // a flat or point-sized root: costs in absolute units
+  for (const BuildNode& n : t.nodes) cost += n.box.half_area() / root * (n.leaf() ? n.count : 1.0);
+  return cost;
+}
+
+// Split(begin, end, centre box) reorders [begin, end) and returns the count
+// of the left part; 0 or the whole count means "cannot split".
+template <class Split>
+struct TopDown {
+  const std::vector<Box3>& boxes;
+  const std::vector<Vec3>& centres;
+  uint32_t leaf_size;
+  Split& split;
+  BuildTree tree;
+  uint32_t depth_limit = ~0u;
+  uint32_t leaf_capacity = MC_QUAD_MAX_COUNT;  // most primitives a leaf at the depth limit may take
+  const char* primitives = "triangles";
+
+  uint32_t build(uint32_t first, uint32_t count, uint32_t depth) {
+    uint32_t index = uint32_t(tree.nodes.size());
+    tree.nodes.emplace_back();
+    tree.depth = std::max(tree.depth, depth);
+    Box3 box, cbox;
+    for (uint32_t i = first; i < first + count; ++i) box.grow(boxes[tree.order[i]]), cbox.grow(centres[tree.order[i]]);
+    tree.nodes[index].box = box;
+    if (count > capacity(depth))
+      throw InputError("depth limit " + std::to_string(depth_limit + 1) + " holds at most " +
+                       std::to_string(capacity(depth)) + " " + primitives + " (" + std::to_string(leaf_capacity) +
+                       " a leaf), not " + std::to_string(count) + "; raise the depth limit");
+    if (count <= leaf_size || depth >= depth_limit) {
+      tree.nodes[index].first = first, tree.nodes[index].count = count;
+      return index;
+    }
+    uint32_t* begin = tree.order.data() + first;
+    uint32_t left = depth < kSplitterDepth ? split(begin, begin + count, cbox) : 0;
+    // Under a depth limit a side must still fit the levels left below it
+    // (halving each level, leaf_capacity a leaf); a split that would
+    // overfill one is evened out, which always fits: a splitter whose range
+    // stays sorted (Morton) moves its cut within that order, the others
+    // split at the median.
+    const uint64_t fits = capacity(depth + 1);
+    if (left == 0 || left >= count) {
+      left = median(begin, count, cbox);  // (Morton: all codes equal, any order stays sorted)
+    } else if (std::max(left, count - left) > fits) {
+      if constexpr (requires { Split::kSorted; })
+        left = uint32_t(std::clamp<uint64_t>(left, count > fits ? count - fits : 1, std::min<uint64_t>(fits, count - 1)));
+      else
+        left = median(begin, count, cbox);
+    }
+    uint32_t l = build(first, left, depth + 1);
+    uint32_t r = build(first + left, count - left, depth + 1);
+    tree.nodes[index].left = l, tree.nodes[index].right = r;
+    return index;
+  }
+
+  // Most triangles a subtree rooted at `depth` can hold under depth_limit.
+  uint64_t capacity(uint32_t depth) const {
+    if (depth_limit >= 40) return ~0ull;
+    return uint64_t(leaf_capacity) << (depth_limit - std::min(depth, depth_limit));
+  }
+
+  uint32_t median(uint32_t* begin, uint32_t count, const Box3& cbox) {
+    Vec3 e = cbox.extent();
+    int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    std::nth_element(begin, begin + count / 2, begin + count,
+                     [&](uint32_t a, uint32_t b) { return centres[a][axis] < centres[b][axis]; });
+    return count / 2;
+  }
+
+  // `order`: the starting order (identity when empty), kept by splitters
+  // that cut ranges of a presorted sequence (Morton).
+  BuildTree run(std::vector<uint32_t> order = {}) {
+    if (order.empty()) {
+      order.resize(boxes.size());
+      for (uint32_t i = 0; i < boxes.size(); ++i) order[i] = i;
+    }
+    tree.order = std::move(order);
+    tree.nodes.reserve(2 * boxes.size() / std::max(1u, leaf_size) + 1);
+    build(0, uint32_t(boxes.size()), 0);
+    tree.sah_cost = sah_cost(tree);
+    return std::move(tree);
+  }
+};
+
+std::vector<Vec3> box_centres(const std::vector<Box3>& boxes);
+
+
+}  // namespace meshcast

@@ -1,0 +1,336 @@
+// Writes a mesh into a blob (meshcast/build.h's build_blob): quantize (if the
+// triangle format does), build the binary tree from the stored triangles,
+// lay it out in the tree format, encode each leaf with the triangle format,
+// then the remap and the header.
+#include "meshcast/build.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <numeric>
+#include <unordered_map>
+
+#include "builder/binary_tree.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
+#include "builder/pairing.h"
+#include "cpu/pairs.h"
+#include "layout/aabbtree.h"
+#include "layout/codecs.h"
+#include "layout/quadtree.h"
+#include "builder/writer.h"
+#include "builder/write_zerobyte.h"
+
+namespace meshcast {
+
+using layout::BlobHeader;
+using layout::TriCorners;
+
+namespace {
+
+// kGridPowerOfTwo formats (BitPackSOA, layout/soa.h): blocks of `lanes`
+// consecutive triangles of each leaf; every position goes to the coarsest
+// block lattice among the blocks that use it, repeated until no block needs
+// a coarser step, so all blocks decode a shared position to the same bits.
+// Positions are keyed by their mesh-grid word (so unwelded copies of a
+// vertex move together) and rounded once, from the grid position, to their
+// final lattice. Returns the largest shift.
+uint32_t snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& corners, uint32_t lanes,
+                                const float grid[3]) {
+  const std::vector<TriCorners> original = corners;
+  uint32_t largest = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::unordered_map<uint64_t, uint32_t> shift;  // grid word -> lattice shift
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const BuildNode& leaf : t.nodes) {
+        if (!leaf.leaf()) continue;
+        for (uint32_t b = 0; b < leaf.count; b += lanes) {
+          float lo = INFINITY, hi = -INFINITY;
+          uint32_t end = std::min(leaf.count, b + lanes);
+          for (uint32_t i = b; i < end; ++i)
+            for (int c = 0; c < 3; ++c) {
+              float v = corners[t.order[leaf.first + i]].v[c][axis];
+              lo = std::min(lo, v), hi = std::max(hi, v);
+            }
+          float step, offset;
+          uint32_t m;
+          layout::block_step(lo, hi, grid[axis], &step, &offset, &m);
+          for (uint32_t i = b; i < end; ++i)
+            for (int c = 0; c < 3; ++c) {
+              uint32_t& s = shift[original[t.order[leaf.first + i]].packed[c]];
+              if (m > s) s = m, changed = true;
+            }
+        }
+      }
+      for (size_t k = 0; k < corners.size(); ++k)
+        for (int c = 0; c < 3; ++c) {
+          auto it = shift.find(original[k].packed[c]);
+          uint32_t m = it == shift.end() ? 0 : it->second;
+          double step = double(grid[axis]) * std::ldexp(1.0, int(m));
+          float v = original[k].v[c][axis];
+          corners[k].v[c][axis] = step > 0 ? float(std::round(double(v) / step) * step) : v;
+        }
+    }
+    for (const auto& [word, m] : shift) largest = std::max(largest, m);
+  }
+  return largest;
+}
+
+// BruteForce and AABBList: no tree. The "tree" is node 0 (the whole mesh)
+// followed by one leaf a chunk of `chunk` triangles of `order` (BruteForce:
+// input order; AABBList: batch after batch, and `chunk` divides the batch);
+// each becomes a record [count][block].
+BuildTree chunk_tree(const std::vector<Box3>& boxes, std::vector<uint32_t> order, uint32_t chunk) {
+  BuildTree t;
+  t.order = std::move(order);
+  t.nodes.emplace_back();
+  for (uint32_t i : t.order) t.nodes[0].box.grow(boxes[i]);
+  for (uint32_t first = 0; first < t.order.size(); first += chunk) {
+    BuildNode leaf;
+    leaf.first = first;
+    leaf.count = std::min<uint32_t>(chunk, uint32_t(t.order.size()) - first);
+    for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(boxes[t.order[i]]);
+    t.nodes.push_back(leaf);
+  }
+  return t;
+}
+
+// Seed 003: the tree over pairs (and the triangles left single), each
+// expanded back to its triangles side by side.
+BuildTree build_paired(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, uint32_t depth_limit,
+                       BuildReport* report) {
+  if (o.leaf_size < 2) throw InputError("pairing needs leaves of at least 2 triangles (leaf size " + std::to_string(o.leaf_size) + ")");
+  Pairing p = pair_triangles(mesh);
+  std::vector<uint32_t> members, start{0};
+  std::vector<Box3> unit_boxes;
+  for (uint32_t t = 0; t < p.partner.size(); ++t) {
+    const uint32_t q = p.partner[t];
+    if (q != MC_NO_HIT && q < t) continue;  // already in its partner's unit
+    Box3 box = boxes[t];
+    members.push_back(t);
+    if (q != MC_NO_HIT) members.push_back(q), box.grow(boxes[q]);
+    start.push_back(uint32_t(members.size()));
+    unit_boxes.push_back(box);
+  }
+  if (report) report->pairing = p.decision, report->paired_ratio = p.paired_ratio;
+  // A leaf of leaf_size / 2 units holds at most leaf_size triangles; at the
+  // depth limit half the 5-bit count's 31.
+  BuildTree units = build_tree(unit_boxes, o.splitter, o.leaf_size / 2, depth_limit, MC_QUAD_MAX_COUNT / 2);
+  return expand_groups(units, members, start);
+}
+
+BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec,
+                    uint32_t depth_limit, BuildReport* report) {
+  const uint32_t chunk = layout::brute_chunk(codec.lanes);
+  if (o.pairing && (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST))
+    throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) +
+                     " keeps its own triangle order");
+  if (o.pairing) return build_paired(mesh, o, boxes, depth_limit, report);
+  if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE) {
+    std::vector<uint32_t> input(boxes.size());
+    std::iota(input.begin(), input.end(), 0u);
+    return chunk_tree(boxes, std::move(input), chunk);
+  }
+  if (uint32_t(o.layout.tree) == MC_TREE_AABBLIST) {
+    static_assert(MC_LIST_BATCH % MC_BRUTE_CHUNK == 0 && MC_LIST_BATCH % 128 == 0, "records must tile a batch");
+    return chunk_tree(boxes, group_batches(boxes, MC_LIST_BATCH, o.grouping), chunk);
+  }
+  return build_tree(boxes, o.splitter, o.leaf_size, depth_limit);
+}
+
+}  // namespace
+
+std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
+  switch (uint32_t(o.layout.tree)) {
+    case MC_TREE_AABBTREE: return make_aabb_writer(false);
+    case MC_TREE_AABBTREESPLITAXIS: return make_aabb_writer(true);
+    case MC_TREE_AABBTREEPNS: return make_pns_writer();
+    case MC_TREE_AABBTREECOMPRESSED: return make_compressed_writer();
+    case MC_TREE_SKDTREE: return make_skd_writer();
+    case MC_TREE_STACKLESSLBVH: return make_lbvh_writer(o.lbvh_near_first);
+    case MC_TREE_QUADTREE: return make_quad_writer(false, o.node_order);
+    case MC_TREE_QUADTREEHALFFLOAT: return make_quad_writer(true, o.node_order);
+    case MC_TREE_AABBLIST: return make_aabblist_writer();
+  }
+  return make_bruteforce_writer();
+}
+
+// The remap section after the blob's bytes so far: slot -> input triangle
+// (MC_NO_HIT: no triangle), as few bits as the triangle count needs; only
+// the used slots and their ranks when the slots keep the input order; none
+// when the caller asked for none (layout/blob_format.h).
+void append_remap(std::vector<uint8_t>& bytes, BlobHeader& hd, const std::vector<uint32_t>& remap, bool keep) {
+  hd.remap_slots = uint32_t(remap.size());
+  hd.remap_offset = align(bytes.size(), 8);
+  if (!keep) {
+    hd.remap_bits = hd.remap_size = 0;
+    hd.remap_offset = align(bytes.size(), 4);
+    bytes.resize(hd.remap_offset, 0);
+    return;
+  }
+  uint32_t next = 0;  // in order: the used slots name triangles 0, 1, 2, ...
+  for (uint32_t s = 0; s < hd.remap_slots && next != MC_NO_HIT; ++s)
+    if (remap[s] != MC_NO_HIT) next = remap[s] == next ? next + 1 : MC_NO_HIT;
+  const bool in_order = next == hd.triangle_count;
+  hd.remap_bits = in_order ? 0 : std::max(1u, uint32_t(std::bit_width(hd.triangle_count - 1u)));
+  const uint32_t words = layout::remap_words(hd);
+  const uint64_t entry_bytes = in_order ? 0 : (uint64_t(hd.triangle_count) * hd.remap_bits + 7) / 8 + 8;
+  hd.remap_size = align(12ull * words + entry_bytes, 8);
+  bytes.resize(uint64_t(hd.remap_offset) + hd.remap_size, 0);
+  uint8_t* used = bytes.data() + hd.remap_offset;
+  uint8_t* rank = used + 8ull * words;
+  uint8_t* entries = rank + 4ull * words;
+  uint32_t index = 0;
+  for (uint32_t s = 0; s < hd.remap_slots; ++s) {
+    if (s % 64 == 0) std::memcpy(rank + 4ull * (s / 64), &index, 4);
+    if (remap[s] == MC_NO_HIT) continue;
+    used[s / 8] |= uint8_t(1u << (s % 8));
+    if (in_order) {
+      ++index;
+      continue;
+    }
+    uint64_t bit = uint64_t(index++) * hd.remap_bits;
+    uint64_t word;
+    std::memcpy(&word, entries + (bit >> 3), 8);
+    word |= uint64_t(remap[s]) << (bit & 7);
+    std::memcpy(entries + (bit >> 3), &word, 8);
+  }
+}
+
+std::vector<uint8_t> build_blob(const MeshView& mesh, const BuildOptions& options, const std::string& name,
+                                BuildReport* report) {
+  return build_blob(copy_mesh(mesh, name), options, name, report);
+}
+
+std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
+                                BuildReport* report) {
+  auto start = std::chrono::steady_clock::now();
+  check_mesh(mesh, name);
+  if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
+    return build_zerobyte_blob(mesh, o, name, report);
+  if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
+    throw InputError(name + ": leaf size " + std::to_string(o.leaf_size) + " is outside 1.." +
+                     std::to_string(MC_QUAD_MAX_COUNT) + " (5-bit triangle counts, seed 000 5.6)");
+  if (layout::tree_format_name(uint32_t(o.layout.tree)).empty()) throw InputError(name + ": unknown tree format");
+  CodecOps codec = codec_ops(uint32_t(o.layout.triangles));
+  if (std::string why = node_order_refusal(uint32_t(o.layout.tree), o.node_order); !why.empty())
+    throw InputError(name + ": " + why);
+
+  BlobHeader h{};
+  h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
+  h.tree_format = uint32_t(o.layout.tree), h.triangle_format = uint32_t(o.layout.triangles);
+  h.triangle_count = uint32_t(mesh.triangles.size());
+  h.leaf_size = o.leaf_size;
+  h.slot_divisor = codec.slot_divisor;
+
+  // Stored triangle corners: bit-packed formats quantize against the mesh box.
+  Box3 mesh_box = mesh.bounds();
+  const bool grid = codec.grid != layout::kGridNone;
+  for (int a = 0; a < 3; ++a) {
+    double lo = mesh_box.min[a], extent = double(mesh_box.max[a]) - lo;
+    if (codec.grid == layout::kGridMeshBox) {
+      h.quant_offset[a] = float(lo), h.quant_scale[a] = float(extent / MC_BITPACK_MAX);
+    } else if (codec.grid == layout::kGridPowerOfTwo) {
+      // The smallest power of two that spans the extent in 2^21 - 2 steps,
+      // and the grid point at or below the minimum.
+      // A flat axis keeps its one coordinate (step 0).
+      double codes = std::ldexp(1.0, int(codec.grid_bits)) - 2;
+      double step = extent > 0 ? std::ldexp(1.0, std::ilogb(extent / codes) + 1) : 0.0;
+      h.quant_scale[a] = float(step), h.quant_offset[a] = step > 0 ? float(std::floor(lo / step) * step) : float(lo);
+    } else {
+      h.quant_offset[a] = 0, h.quant_scale[a] = 0;
+    }
+  }
+  std::vector<uint64_t> packed(grid ? mesh.vertices.size() : 0);
+  for (size_t v = 0; v < packed.size(); ++v) {
+    float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
+    packed[v] = layout::bitpack_encode(p, h.quant_offset, h.quant_scale);
+  }
+  std::vector<TriCorners> corners(mesh.triangles.size());
+  std::vector<Box3> boxes(mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (int c = 0; c < 3; ++c) {
+      uint32_t v = mesh.triangles[t][c];
+      if (grid) {
+        corners[t].vertex[c] = v;
+        corners[t].packed[c] = packed[v];
+        layout::bitpack_decode(packed[v], h.quant_offset, h.quant_scale, corners[t].v[c]);
+      } else {
+        corners[t].packed[c] = 0;
+        corners[t].vertex[c] = v;
+        corners[t].v[c][0] = mesh.vertices[v].x, corners[t].v[c][1] = mesh.vertices[v].y;
+        corners[t].v[c][2] = mesh.vertices[v].z;
+      }
+      boxes[t].grow(Vec3{corners[t].v[c][0], corners[t].v[c][1], corners[t].v[c][2]});
+    }
+  }
+
+  uint32_t depth_limit = ~0u;
+  if (uint32_t(o.layout.tree) == MC_TREE_STACKLESSLBVH) {
+    // The seed's choice, within the heap's reach (the capacity check then
+    // says when a mesh is too large for it).
+    uint32_t d = o.lbvh_depth ? o.lbvh_depth
+                              : std::min(uint32_t(std::bit_width(mesh.triangles.size())) + 1, MC_LBVH_MAX_DEPTH + 1);
+    if (d > MC_LBVH_MAX_DEPTH + 1)
+      throw InputError(name + ": StacklessLBVH depth limit " + std::to_string(d) + " exceeds " +
+                       std::to_string(MC_LBVH_MAX_DEPTH + 1) + " (2^26 node slots)");
+    depth_limit = d - 1;
+  }
+  BuildTree tree;
+  try {
+    tree = build_for(mesh, o, boxes, codec, depth_limit, report);
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());
+  }
+  uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
+  Writer writer{corners, tree, codec, h, {}, {}, {}, {}, {}, {}};
+  BlobHeader& hd = writer.h;
+  writer.measure_leaves();
+
+  std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
+  try {
+    tree_writer->plan(writer);
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + e.what());
+  }
+  uint32_t depth = tree_writer->depth(tree);
+  if (depth > MC_MAX_DEPTH)
+    throw InputError(name + ": the tree is " + std::to_string(depth) + " levels deep, beyond the walkers' limit of " +
+                     std::to_string(MC_MAX_DEPTH));
+  hd.max_depth = depth;
+  hd.leaf_count = tree.leaf_count();  // BruteForce: the records
+  hd.tree_offset = align(MC_BLOB_HEADER_BYTES, 64);  // 64-byte nodes start on a cache line
+  hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
+  writer.bytes.assign(hd.vertex_offset, 0);
+  try {
+    tree_writer->fill(writer);
+  } catch (const std::length_error& e) {  // a codec's own limit (index width)
+    throw InputError(name + ": " + layout_name(uint32_t(o.layout.tree), uint32_t(o.layout.triangles)) + ": " + e.what());
+  }
+  // Vertices and remap at most 8 + 12 bytes a triangle on top of this.
+  if (uint64_t(hd.vertex_offset) + writer.pool.size() + 12ull * mesh.triangles.size() + 4096 > 0xF0000000ull)
+    throw InputError(name + ": the blob would exceed the 4 GiB its 32-bit offsets reach");
+
+  hd.vertex_size = uint32_t(writer.pool.size());
+  hd.max_block_shift = std::max(writer.max_block_shift, lattice_shift);
+  writer.bytes.resize(hd.vertex_offset + hd.vertex_size);
+  if (hd.vertex_size) std::memcpy(writer.bytes.data() + hd.vertex_offset, writer.pool.data(), hd.vertex_size);
+
+  append_remap(writer.bytes, hd, writer.remap, o.triangle_ids);
+  hd.total_size = uint32_t(writer.bytes.size());
+  std::memcpy(writer.bytes.data(), &hd, sizeof hd);
+  layout::seal(writer.bytes);
+
+  if (report) {
+    report->sah_cost = tree.sah_cost;
+    report->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+  return std::move(writer.bytes);
+}
+
+}  // namespace meshcast

@@ -1,0 +1,78 @@
+#include "builder/ray_sets.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshcast {
+
+namespace {
+
+// SplitMix64: small, fast, and the same sequence on every platform (the
+// standard distributions are not), so ray files are reproducible.
+struct Rng {
+  uint64_t s;
+  uint64_t next() {
+    uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return double(next() >> 11) * 0x1p-53; }  // [0, 1)
+  Vec3 unit() {  // uniform on the sphere
+    double z = 2 * uniform() - 1, phi = 2 * M_PI * uniform(), r = std::sqrt(std::max(0.0, 1 - z * z));
+    return {float(r * std::cos(phi)), float(r * std::sin(phi)), float(z)};
+  }
+};
+
+Vec3 lerp_box(const Box3& b, Rng& rng) {
+  return {float(b.min.x + rng.uniform() * (double(b.max.x) - b.min.x)),
+          float(b.min.y + rng.uniform() * (double(b.max.y) - b.min.y)),
+          float(b.min.z + rng.uniform() * (double(b.max.z) - b.min.z))};
+}
+
+}  // namespace
+
+RayKind parse_ray_kind(const std::string& name) {
+  if (name == "long") return RayKind::Long;
+  if (name == "probe") return RayKind::Probe;
+  if (name == "radial") return RayKind::Radial;
+  throw InputError("unknown ray kind '" + name + "'; valid kinds: long, probe, radial");
+}
+
+std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed) {
+  Rng rng{seed * 0x2545F4914F6CDD1Dull + uint64_t(kind)};
+  Box3 box = mesh.bounds();
+  Vec3 c = box.centre();
+  double diag = box.diagonal();
+  std::vector<Ray> rays(count);
+  for (Ray& r : rays) {
+    Vec3 o, d;
+    float tmax = INFINITY;
+    if (kind == RayKind::Long) {
+      Vec3 u = rng.unit();
+      o = {float(c.x + diag * u.x), float(c.y + diag * u.y), float(c.z + diag * u.z)};
+      Vec3 p = lerp_box(box, rng);
+      d = {p.x - o.x, p.y - o.y, p.z - o.z};
+    } else if (kind == RayKind::Radial) {
+      o = c;
+      d = rng.unit();
+    } else {
+      size_t t = size_t(rng.uniform() * mesh.triangles.size());
+      double a = rng.uniform(), b = rng.uniform();
+      if (a + b > 1) a = 1 - a, b = 1 - b;
+      Vec3 p0 = mesh.corner(t, 0), p1 = mesh.corner(t, 1), p2 = mesh.corner(t, 2);
+      double e1[3], e2[3], n[3];
+      for (int k = 0; k < 3; ++k) e1[k] = double(p1[k]) - p0[k], e2[k] = double(p2[k]) - p0[k];
+      n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+      double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      double side = rng.uniform() < 0.5 ? -1 : 1, off = 1e-4 * diag * side / (len > 0 ? len : 1);
+      for (int k = 0; k < 3; ++k) o[k] = float(p0[k] + a * e1[k] + b * e2[k] + (len > 0 ? n[k] * off : 0));
+      d = rng.unit();
+      tmax = float(0.05 * diag);
+    }
+    r = {{o.x, o.y, o.z}, {d.x, d.y, d.z}, tmax};
+  }
+  return rays;
+}
+
+}  // namespace meshcast

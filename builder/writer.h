@@ -1,0 +1,166 @@
+// The blob under construction, shared by every tree writer (cpu/write_*.cpp
+// and encode.cpp): the triangle codec as runtime values, the leaves' blocks,
+// the vertex pool, the remap, and the refit that makes every node bound what
+// the codec decodes.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "builder/binary_tree.h"
+#include "builder/encode.h"
+#include "layout/block.h"
+#include "layout/blob_format.h"
+
+namespace meshcast {
+
+// The parts of a triangle codec the writer needs, as a runtime value.
+struct CodecOps {
+  uint32_t format, slot_divisor;
+  layout::GridKind grid;
+  uint32_t grid_bits;  // codes a component of the mesh grid (21; CompressedStrip 20)
+  bool nested;         // blocks on nested lattices of the grid (BitPackSOA)
+  bool moves_floats;   // stores floats it has changed (UncompressedStrip)
+  uint32_t lanes;
+  uint32_t (*measure)(layout::TriCorners*, uint32_t);  // bytes of a leaf's block
+  void (*encode)(layout::TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
+};
+
+CodecOps codec_ops(uint32_t format);  // throws InputError for an unknown format
+
+inline uint32_t align(uint64_t v, uint32_t a) { return uint32_t((v + a - 1) / a * a); }
+
+// Appends the remap section (slot -> input triangle, MC_NO_HIT for an
+// unused slot) and fills the header's remap fields: bitmap and ranks only
+// when the slots keep the input order, none when `keep` is false.
+void append_remap(std::vector<uint8_t>& bytes, layout::BlobHeader& h, const std::vector<uint32_t>& remap, bool keep);
+
+// Shared by both tree writers: the blob under construction.
+struct Writer {
+  const std::vector<layout::TriCorners>& corners;
+  BuildTree& tree;  // leaf boxes are refitted to what the codec stores
+  CodecOps codec;
+  layout::BlobHeader h{};
+  std::vector<uint8_t> bytes;
+  std::vector<uint8_t> pool;
+  std::unordered_map<uint64_t, uint32_t> last_index;
+  std::vector<uint32_t> remap;
+  uint32_t max_block_shift = 0;
+  std::vector<uint32_t> leaf_bytes;  // per node: its block's bytes (leaves)
+
+  std::vector<layout::TriCorners> leaf_triangles(uint32_t n) const {
+    const BuildNode& leaf = tree.nodes[n];
+    std::vector<layout::TriCorners> tris(leaf.count);
+    for (uint32_t i = 0; i < leaf.count; ++i) {
+      tris[i] = corners[tree.order[leaf.first + i]];
+      tris[i].input = tree.order[leaf.first + i];
+    }
+    return tris;
+  }
+  void measure_leaves() {
+    leaf_bytes.assign(tree.nodes.size(), 0);
+    for (uint32_t n = 0; n < tree.nodes.size(); ++n)
+      if (tree.nodes[n].leaf()) {
+        std::vector<layout::TriCorners> tris = leaf_triangles(n);
+        leaf_bytes[n] = codec.measure(tris.data(), tree.nodes[n].count);
+      }
+  }
+
+  // Encodes leaf node n's triangles at tree-section offset `at`. The codec
+  // hands back the triangles as stored (its order, its decoded corners): the
+  // remap follows that order and the leaf's box is refitted to those corners,
+  // so node bounds always contain what the walker will decode.
+  void write_leaf(uint32_t n, uint32_t at) {
+    BuildNode& leaf = tree.nodes[n];
+    std::vector<layout::TriCorners> tris = leaf_triangles(n);
+    layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index, h.quant_scale, &max_block_shift, &h};
+    codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
+    uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
+    if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
+    leaf.box = Box3{};
+    for (uint32_t i = 0; i < leaf.count; ++i) {
+      remap[slot0 + i] = tris[i].input;
+      for (int c = 0; c < 3; ++c) leaf.box.grow(Vec3{tris[i].v[c][0], tris[i].v[c][1], tris[i].v[c][2]});
+    }
+  }
+
+  // A BruteForce record [count][block] for leaf n at tree-section offset
+  // `at` (BruteForce, AABBList); returns the offset after it.
+  uint32_t record_bytes(uint32_t n) const { return MC_BRUTE_RECORD_BYTES + leaf_bytes[n]; }
+  uint32_t write_record(uint32_t n, uint32_t at) {
+    std::memcpy(bytes.data() + h.tree_offset + at, &tree.nodes[n].count, 4);
+    write_leaf(n, at + MC_BRUTE_RECORD_BYTES);
+    return at + record_bytes(n);
+  }
+
+  // Interior boxes from the refitted leaves (children follow their parent
+  // in the builder's node order), then the header's frame from the root.
+  void refit() {
+    for (size_t n = tree.nodes.size(); n-- > 0;) {
+      BuildNode& b = tree.nodes[n];
+      if (b.leaf() || b.left == 0) continue;
+      b.box = tree.nodes[b.left].box;
+      b.box.grow(tree.nodes[b.right].box);
+    }
+    frame(tree.nodes[0].box);
+  }
+
+  // Header bounds, and the frame of half-float bounds: relative to the root
+  // centre, scaled by a power of two that puts the root's half extent near
+  // 2^14, far from both the half range limit (65504) and the subnormals.
+  void frame(const Box3& root) {
+    float half_extent = 0;
+    for (int a = 0; a < 3; ++a) {
+      h.bounds_min[a] = root.min[a], h.bounds_max[a] = root.max[a];
+      h.node_origin[a] = root.centre()[a];
+      half_extent = std::max({half_extent, std::fabs(root.max[a] - h.node_origin[a]),
+                              std::fabs(h.node_origin[a] - root.min[a])});
+    }
+    h.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
+  }
+};
+
+
+// The 8 bits of seed 002: for the octant with sign bits (x, y, z), bit
+// z | y << 1 | x << 2 is set when the second child's centre lies nearer
+// along that octant's diagonal.
+inline uint32_t pns_code(const Box3& first, const Box3& second) {
+  Vec3 a = first.centre(), b = second.centre();
+  uint32_t code = 0;
+  for (uint32_t octant = 0; octant < 8; ++octant) {
+    float dx = octant & 4 ? -1.0f : 1.0f, dy = octant & 2 ? -1.0f : 1.0f, dz = octant & 1 ? -1.0f : 1.0f;
+    double d = double(a.x - b.x) * dx + double(a.y - b.y) * dy + double(a.z - b.z) * dz;
+    if (d > 0) code |= 1u << octant;
+  }
+  return code;
+}
+
+// The tree writers of cpu/write_*.cpp: plan(w) sizes the tree section (header
+// fields tree_size, node_bytes, node_count, triangle_base, root) before the
+// buffer exists; fill(w) encodes the leaves, refits and writes the nodes.
+struct TreeWriter {
+  virtual ~TreeWriter() = default;
+  virtual void plan(Writer& w) = 0;
+  virtual void fill(Writer& w) = 0;
+  // Deepest node a walker's stack must hold (the quad trees' is their own).
+  virtual uint32_t depth(const BuildTree& t) const { return t.depth; }
+};
+
+std::unique_ptr<TreeWriter> make_aabb_writer(bool split_axis);  // AABBTree (§5.1), AABBTreeSplitAxis (§5.2)
+std::unique_ptr<TreeWriter> make_pns_writer();                  // AABBTreePNS (§5.3, seed 002)
+std::unique_ptr<TreeWriter> make_quad_writer(bool half, NodeOrder order);  // §5.6-5.7 in a §4.3 order
+std::unique_ptr<TreeWriter> make_bruteforce_writer();           // §3.11
+std::unique_ptr<TreeWriter> make_aabblist_writer();             // §7, method 2
+std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);  // the one for options.layout.tree
+
+std::unique_ptr<TreeWriter> make_compressed_writer();  // AABBTreeCompressed (§5.4)
+std::unique_ptr<TreeWriter> make_skd_writer();         // SKDTree (§5.5)
+// StacklessLBVH (seed 001); near_first: the 8 sorting bits of seed 002 in
+// each interior node, else zeros (left child first, as the seed walks).
+std::unique_ptr<TreeWriter> make_lbvh_writer(bool near_first);
+
+}  // namespace meshcast

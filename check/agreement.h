@@ -1,0 +1,46 @@
+// How a walker's answers are judged against the oracle: used by the tests
+// and by the main job's disagreement column.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "meshcast/mesh.h"
+#include "check/oracle.h"
+#include "cpu/intersect.h"
+
+namespace meshcast {
+
+struct Agreement {
+  size_t rays = 0, ties = 0, wrong = 0, t_errors = 0;
+  double max_t_error = 0;
+  std::string first_problem;
+};
+
+// Distances in double: to the triangle abc, and to its nearest edge.
+double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
+double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
+
+// The foundation rules: the walker returns the oracle's hit/miss and
+// triangle, with t within `tolerance`, a distance along the ray (1e-5 of the
+// diagonal), plus 4 float ulps of t for origins very far away. Where only
+// rounding decides, a difference is counted as a tie instead:
+//  - another triangle at the same t that touches the oracle's hit point
+//    (a shared edge or vertex, coincident triangles);
+//  - a walker hit against an oracle miss at the ends of the segment (origin
+//    on the surface, surface at t_max), on the hit triangle's edge, or for a
+//    ray lying in the triangle's plane;
+//  - a walker miss against an oracle hit at the ends of the segment, or
+//    within a few float ulps of the hit triangle's edge (a grazed silhouette).
+// A walker miss in the middle of a triangle is always wrong; leaks through
+// shared edges are checked by the closed-mesh tests. max_t_error is a
+// distance.
+Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                  const std::vector<OracleHit>& oracle, double tolerance);
+
+// The triangles as the blob stores them, decoded by its triangle format and
+// put back in input order: a triangle soup, three vertices a triangle. The
+// exact reference for formats that move vertices. A blob without a remap
+// numbers its triangles by slot (layout/blob_format.h has_remap), and so does this.
+Mesh stored_mesh(const std::vector<uint8_t>& blob);
+
+}  // namespace meshcast

@@ -1,0 +1,45 @@
+// The double-precision oracle every layout is checked against: the closest
+// hit over the unmodified input mesh, two-sided, t in [0, t_max], no epsilon
+// that drops small or thin triangles, ties broken by the lowest triangle
+// index. The triangle test is the watertight one (Woop et al. 2013) carried
+// out entirely in double, so shared edges and vertices never leak.
+#pragma once
+#include <vector>
+
+#include "meshcast/mesh.h"
+#include "cpu/intersect.h"
+
+namespace meshcast {
+
+struct OracleHit {
+  double t = INFINITY;
+  uint32_t triangle = MC_NO_HIT;
+};
+
+// Hit distance of one triangle, or +inf when the ray misses it.
+double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c);
+
+// Every triangle, in input order.
+OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray);
+
+// A simple median-split tree with double-precision boxes over the same
+// triangles, for meshes too large to brute-force; it visits every box the
+// ray touches within the best t so far (inclusive), so it finds the same
+// answer, ties included.
+class OracleTree {
+ public:
+  explicit OracleTree(const Mesh& mesh);
+  OracleHit closest(const Ray& ray) const;
+
+ private:
+  struct Node {
+    double min[3], max[3];
+    uint32_t first, count, right;  // count > 0: leaf; else left child = this + 1
+  };
+  const Mesh& mesh_;
+  std::vector<Node> nodes_;
+  std::vector<uint32_t> order_;
+  uint32_t build(uint32_t first, uint32_t count);
+};
+
+}  // namespace meshcast

@@ -1,0 +1,60 @@
+#include "check/ray_files.h"
+
+#include <cstring>
+
+namespace meshcast {
+
+namespace {
+
+template <class Record>
+std::vector<Record> read_records(const std::string& path, const char magic[4], size_t record_bytes) {
+  std::vector<uint8_t> b = read_file(path);
+  if (b.size() < 8 || std::memcmp(b.data(), magic, 4) != 0)
+    throw InputError(path + ": not a " + std::string(magic, 4) + " file (bad magic or shorter than 8 bytes)");
+  uint32_t n;
+  std::memcpy(&n, b.data() + 4, 4);
+  if (b.size() != 8 + uint64_t(n) * record_bytes)
+    throw InputError(path + ": header says " + std::to_string(n) + " records (" +
+                     std::to_string(8 + uint64_t(n) * record_bytes) + " bytes) but the file has " +
+                     std::to_string(b.size()) + " bytes");
+  std::vector<Record> out(n);
+  for (uint32_t i = 0; i < n; ++i) std::memcpy(&out[i], b.data() + 8 + size_t(i) * record_bytes, record_bytes);
+  return out;
+}
+
+struct HitRecord {
+  float t;
+  uint32_t triangle;
+};
+
+}  // namespace
+
+std::vector<Ray> read_rays(const std::string& path) { return read_records<Ray>(path, "RAYS", 28); }
+
+void write_rays(const std::string& path, const std::vector<Ray>& rays) {
+  if (rays.size() > kMaxRayCount)
+    throw InputError(path + ": " + std::to_string(rays.size()) + " rays, more than a rays file may hold (" +
+                     std::to_string(kMaxRayCount) + ")");
+  const uint32_t n = uint32_t(rays.size());
+  static_assert(sizeof(Ray) == 28 && std::endian::native == std::endian::little, "a Ray is its record");
+  write_file(path, {{"RAYS", 4}, {&n, 4}, {rays.data(), rays.size() * sizeof(Ray)}});
+}
+
+std::vector<Hit> read_hits(const std::string& path) {
+  std::vector<Hit> hits;
+  for (const HitRecord& r : read_records<HitRecord>(path, "HITS", 8)) hits.push_back({r.t, r.triangle});
+  return hits;
+}
+
+void write_hits(const std::string& path, const std::vector<Hit>& hits) {
+  std::vector<uint8_t> b(8 + hits.size() * 8);
+  uint32_t n = uint32_t(hits.size());
+  std::memcpy(b.data(), "HITS", 4), std::memcpy(b.data() + 4, &n, 4);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    HitRecord r{hits[i].t, hits[i].triangle};
+    std::memcpy(b.data() + 8 + i * 8, &r, 8);
+  }
+  write_file(path, b.data(), b.size());
+}
+
+}  // namespace meshcast

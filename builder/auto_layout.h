@@ -19,7 +19,8 @@
 #include <string>
 #include <vector>
 
-#include "builder/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "builder/mesh_stats.h"
 
 namespace meshcast {

@@ -18,7 +18,6 @@
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "builder/pairing.h"
-#include "cpu/pairs.h"
 #include "layout/aabbtree.h"
 #include "layout/codecs.h"
 #include "layout/quadtree.h"
@@ -146,18 +145,10 @@ BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<B
 }  // namespace
 
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
-  switch (uint32_t(o.layout.tree)) {
-    case MC_TREE_AABBTREE: return make_aabb_writer(false);
-    case MC_TREE_AABBTREESPLITAXIS: return make_aabb_writer(true);
-    case MC_TREE_AABBTREEPNS: return make_pns_writer();
-    case MC_TREE_AABBTREECOMPRESSED: return make_compressed_writer();
-    case MC_TREE_SKDTREE: return make_skd_writer();
-    case MC_TREE_STACKLESSLBVH: return make_lbvh_writer(o.lbvh_near_first);
-    case MC_TREE_QUADTREE: return make_quad_writer(false, o.node_order);
-    case MC_TREE_QUADTREEHALFFLOAT: return make_quad_writer(true, o.node_order);
-    case MC_TREE_AABBLIST: return make_aabblist_writer();
-  }
-  return make_bruteforce_writer();
+  return layout::with_tree_format(uint32_t(o.layout.tree), std::unique_ptr<TreeWriter>(), [&](auto tag) {
+    if constexpr (decltype(tag)::kTriangles == layout::TreeTriangles::AllCodecs) return make_writer(tag, o);
+    else return std::unique_ptr<TreeWriter>();
+  });
 }
 
 // The remap section after the blob's bytes so far: slot -> input triangle

@@ -11,6 +11,8 @@
 
 namespace meshcast {
 
+using layout::BlobHeader;
+
 void quantization_bound(const float offset[3], const float scale[3], float bound[3]) {
   for (int a = 0; a < 3; ++a) {
     float top = std::fabs(offset[a]) + float(MC_BITPACK_MAX) * scale[a];

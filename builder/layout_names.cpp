@@ -4,73 +4,33 @@
 
 #include <cctype>
 
-#include "cpu/pairs.h"
 #include "layout/blob_format.h"
+#include "layout/catalog.h"
 #include "layout/codecs.h"
+#include "layout/zerobyte.h"
 
 namespace meshcast {
 
-// The public names (meshcast/build.h) are the ids a blob stores.
-static_assert(uint32_t(TreeFormat::AABBTree) == MC_TREE_AABBTREE &&
-              uint32_t(TreeFormat::QuadTree) == MC_TREE_QUADTREE &&
-              uint32_t(TreeFormat::QuadTreeHalfFloat) == MC_TREE_QUADTREEHALFFLOAT &&
-              uint32_t(TreeFormat::BruteForce) == MC_TREE_BRUTEFORCE &&
-              uint32_t(TreeFormat::AABBTreeSplitAxis) == MC_TREE_AABBTREESPLITAXIS &&
-              uint32_t(TreeFormat::AABBTreePNS) == MC_TREE_AABBTREEPNS &&
-              uint32_t(TreeFormat::AABBTreeCompressed) == MC_TREE_AABBTREECOMPRESSED &&
-              uint32_t(TreeFormat::SKDTree) == MC_TREE_SKDTREE &&
-              uint32_t(TreeFormat::StacklessLBVH) == MC_TREE_STACKLESSLBVH &&
-              uint32_t(TreeFormat::AABBList) == MC_TREE_AABBLIST &&
-              uint32_t(TreeFormat::ZeroByteTree) == MC_TREE_ZEROBYTE &&
-              uint32_t(TreeFormat::ZeroByteHybrid) == MC_TREE_ZEROBYTEHYBRID);
-static_assert(uint32_t(TriangleFormat::Float3) == MC_TRI_FLOAT3 &&
-              uint32_t(TriangleFormat::Float3SOA4) == MC_TRI_FLOAT3SOA4 &&
-              uint32_t(TriangleFormat::Indexed8BitPackSOA4) == MC_TRI_INDEXED8BITPACKSOA4 &&
-              uint32_t(TriangleFormat::Indexed16) == MC_TRI_INDEXED16 &&
-              uint32_t(TriangleFormat::Indexed32) == MC_TRI_INDEXED32 &&
-              uint32_t(TriangleFormat::Indexed16SOA4) == MC_TRI_INDEXED16SOA4 &&
-              uint32_t(TriangleFormat::Indexed32SOA4) == MC_TRI_INDEXED32SOA4 &&
-              uint32_t(TriangleFormat::Indexed16BitPackSOA4) == MC_TRI_INDEXED16BITPACKSOA4 &&
-              uint32_t(TriangleFormat::Indexed32BitPackSOA4) == MC_TRI_INDEXED32BITPACKSOA4 &&
-              uint32_t(TriangleFormat::Float3SOA8) == MC_TRI_FLOAT3SOA8 &&
-              uint32_t(TriangleFormat::Float3SOA128) == MC_TRI_FLOAT3SOA128 &&
-              uint32_t(TriangleFormat::BitPackSOA4) == MC_TRI_BITPACKSOA4 &&
-              uint32_t(TriangleFormat::BitPackSOA128) == MC_TRI_BITPACKSOA128 &&
-              uint32_t(TriangleFormat::BitPack) == MC_TRI_BITPACK &&
-              uint32_t(TriangleFormat::UncompressedStrip) == MC_TRI_UNCOMPRESSEDSTRIP &&
-              uint32_t(TriangleFormat::CompressedStrip) == MC_TRI_COMPRESSEDSTRIP &&
-              uint32_t(TriangleFormat::Indexed24) == MC_TRI_INDEXED24 &&
-              uint32_t(TriangleFormat::Float3PairSOA4) == MC_TRI_FLOAT3PAIRSOA4);
+// The public names (meshcast/build.h) are the ids a blob stores (the tree
+// formats' are checked in layout/catalog.h).
+#define MC_PUBLIC_ID(Codec, name) static_assert(uint32_t(TriangleFormat::Codec) == layout::Codec::kFormat);
+MC_FOR_EACH_TRIANGLE_CODEC(MC_PUBLIC_ID)
+#undef MC_PUBLIC_ID
+static_assert(uint32_t(TriangleFormat::Indexed24) == layout::Indexed24::kFormat);
 
-namespace {
-
-// Every tree format id, in the order of cpu/pairs.h.
-std::vector<uint32_t> tree_formats() {
-  std::vector<uint32_t> ids;
-#define MC_ID(Tree, id) ids.push_back(id);
-  MC_FOR_EACH_TREE(MC_ID)
-#undef MC_ID
-  return ids;
-}
-
-// Every triangle format id, in the order of the list.
-std::vector<uint32_t> triangle_formats() {
-  std::vector<uint32_t> ids;
-#define MC_ID(Codec, name) ids.push_back(layout::Codec::kFormat);
-  MC_FOR_EACH_TRIANGLE_CODEC(MC_ID)
-#undef MC_ID
-  return ids;
-}
-
-}  // namespace
-
+// The catalog's trees in its order, each with the triangle formats it takes.
 std::vector<Layout> all_layouts() {
   std::vector<Layout> all;
-  for (uint32_t t : tree_formats())
-    for (uint32_t c : triangle_formats()) all.push_back({TreeFormat(t), TriangleFormat(c)});
-  // Seed 004's trees live in the mesh's own indices: one triangle format.
-  all.push_back({TreeFormat::ZeroByteTree, TriangleFormat::Indexed24});
-  all.push_back({TreeFormat::ZeroByteHybrid, TriangleFormat::Indexed24});
+#define MC_TREE_LAYOUTS(Name, ...)                                                                  \
+  if constexpr (layout::tree::Name::kTriangles == layout::TreeTriangles::AllCodecs) {                \
+    for (uint32_t c : {MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ID)}) all.push_back({TreeFormat::Name, TriangleFormat(c)}); \
+  } else {                                                                                            \
+    all.push_back({TreeFormat::Name, TriangleFormat::Indexed24});                                     \
+  }
+#define MC_CODEC_ID(Codec, name) layout::Codec::kFormat,
+  MC_FOR_EACH_TREE_FORMAT(MC_TREE_LAYOUTS)
+#undef MC_CODEC_ID
+#undef MC_TREE_LAYOUTS
   return all;
 }
 
@@ -107,16 +67,23 @@ BuildOptions parse_layout(const std::string& text) {
 }
 
 std::string node_order_refusal(uint32_t tree, NodeOrder order) {
-  if (order == NodeOrder::Default || tree == MC_TREE_QUADTREE || tree == MC_TREE_QUADTREEHALFFLOAT) return "";
+  const layout::TreeFormatInfo info = layout::tree_format_info(tree);
+  if (order == NodeOrder::Default || info.order == layout::TreeOrder::AnyOrder) return "";
   // What each other format's bits fix (seed 000 5.1-5.5, seed 001).
   NodeOrder fixed = NodeOrder::DepthFirst;
   const char* why = "its first child and its leaves' blocks sit right behind their node";
-  if (tree == MC_TREE_AABBTREEPNS) fixed = NodeOrder::DepthFirstTrianglesLast, why = "it addresses nodes by depth-first index";
-  if (tree == MC_TREE_STACKLESSLBVH) fixed = NodeOrder::BreadthFirstTrianglesLast, why = "its nodes are a heap";
-  if (tree == MC_TREE_BRUTEFORCE) return "BruteForce has no tree, so no node order";
-  if (tree == MC_TREE_AABBLIST) return "AABBList is a list of batches, so no node order";
+  switch (info.order) {
+    case layout::TreeOrder::NoTree:
+      return std::string(info.name) + (info.id == MC_TREE_AABBLIST ? " is a list of batches" : " has no tree") +
+             ", so no node order";
+    case layout::TreeOrder::DepthFirstIndex:
+      fixed = NodeOrder::DepthFirstTrianglesLast, why = "it addresses nodes by depth-first index";
+      break;
+    case layout::TreeOrder::Heap: fixed = NodeOrder::BreadthFirstTrianglesLast, why = "its nodes are a heap"; break;
+    default: break;
+  }
   if (order == fixed) return "";
-  return std::string(layout::tree_format_name(tree)) + " is always " + node_order_name(fixed) + ": " + why +
+  return std::string(info.name) + " is always " + node_order_name(fixed) + ": " + why +
          " (seed 000 4.3 orders apply where a format allows them)";
 }
 

@@ -61,6 +61,6 @@ class ListWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_aabblist_writer() { return std::make_unique<ListWriter>(); }
+std::unique_ptr<TreeWriter> make_writer(layout::tree::AABBList, const BuildOptions&) { return std::make_unique<ListWriter>(); }
 
 }  // namespace meshcast

@@ -137,7 +137,10 @@ class PnsWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_aabb_writer(bool split_axis) { return std::make_unique<AabbWriter>(split_axis); }
-std::unique_ptr<TreeWriter> make_pns_writer() { return std::make_unique<PnsWriter>(); }
+std::unique_ptr<TreeWriter> make_writer(layout::tree::AABBTree, const BuildOptions&) { return std::make_unique<AabbWriter>(false); }
+std::unique_ptr<TreeWriter> make_writer(layout::tree::AABBTreeSplitAxis, const BuildOptions&) {
+  return std::make_unique<AabbWriter>(true);
+}
+std::unique_ptr<TreeWriter> make_writer(layout::tree::AABBTreePNS, const BuildOptions&) { return std::make_unique<PnsWriter>(); }
 
 }  // namespace meshcast

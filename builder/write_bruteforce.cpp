@@ -35,6 +35,6 @@ class BruteWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_bruteforce_writer() { return std::make_unique<BruteWriter>(); }
+std::unique_ptr<TreeWriter> make_writer(layout::tree::BruteForce, const BuildOptions&) { return std::make_unique<BruteWriter>(); }
 
 }  // namespace meshcast

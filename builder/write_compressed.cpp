@@ -82,6 +82,8 @@ class CompressedWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_compressed_writer() { return std::make_unique<CompressedWriter>(); }
+std::unique_ptr<TreeWriter> make_writer(layout::tree::AABBTreeCompressed, const BuildOptions&) {
+  return std::make_unique<CompressedWriter>();
+}
 
 }  // namespace meshcast

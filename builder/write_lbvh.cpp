@@ -72,6 +72,10 @@ class LbvhWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_lbvh_writer(bool near_first) { return std::make_unique<LbvhWriter>(near_first); }
+// near_first: the 8 sorting bits of seed 002 in each interior node, else
+// zeros (left child first, as the seed walks).
+std::unique_ptr<TreeWriter> make_writer(layout::tree::StacklessLBVH, const BuildOptions& o) {
+  return std::make_unique<LbvhWriter>(o.lbvh_near_first);
+}
 
 }  // namespace meshcast

@@ -155,9 +155,12 @@ class QuadWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_quad_writer(bool half, NodeOrder order) {
-  if (half) return std::make_unique<QuadWriter<layout::QuadBoundsHalf>>(order);
-  return std::make_unique<QuadWriter<layout::QuadBoundsFloat>>(order);
+std::unique_ptr<TreeWriter> make_writer(layout::tree::QuadTree, const BuildOptions& o) {
+  return std::make_unique<QuadWriter<layout::QuadBoundsFloat>>(o.node_order);
+}
+
+std::unique_ptr<TreeWriter> make_writer(layout::tree::QuadTreeHalfFloat, const BuildOptions& o) {
+  return std::make_unique<QuadWriter<layout::QuadBoundsHalf>>(o.node_order);
 }
 
 }  // namespace meshcast

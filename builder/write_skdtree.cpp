@@ -81,6 +81,6 @@ class SkdWriter : public TreeWriter {
 
 }  // namespace
 
-std::unique_ptr<TreeWriter> make_skd_writer() { return std::make_unique<SkdWriter>(); }
+std::unique_ptr<TreeWriter> make_writer(layout::tree::SKDTree, const BuildOptions&) { return std::make_unique<SkdWriter>(); }
 
 }  // namespace meshcast

@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "builder/encode.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 
 namespace meshcast {
 

@@ -12,9 +12,11 @@
 #include <vector>
 
 #include "builder/binary_tree.h"
-#include "builder/encode.h"
-#include "layout/block.h"
+#include "builder/error_bounds.h"
+#include "builder/layout_names.h"
 #include "layout/blob_format.h"
+#include "layout/block.h"
+#include "layout/catalog.h"
 
 namespace meshcast {
 
@@ -150,17 +152,19 @@ struct TreeWriter {
   virtual uint32_t depth(const BuildTree& t) const { return t.depth; }
 };
 
-std::unique_ptr<TreeWriter> make_aabb_writer(bool split_axis);  // AABBTree (§5.1), AABBTreeSplitAxis (§5.2)
-std::unique_ptr<TreeWriter> make_pns_writer();                  // AABBTreePNS (§5.3, seed 002)
-std::unique_ptr<TreeWriter> make_quad_writer(bool half, NodeOrder order);  // §5.6-5.7 in a §4.3 order
-std::unique_ptr<TreeWriter> make_bruteforce_writer();           // §3.11
-std::unique_ptr<TreeWriter> make_aabblist_writer();             // §7, method 2
-std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);  // the one for options.layout.tree
+// Each tree format's writer (a make_writer overload on its catalog tag, in
+// its family's write_*.cpp); the zero-byte trees are not written from the
+// binary tree (builder/write_zerobyte.h).
+#define MC_WRITER_AllCodecs(Name) \
+  std::unique_ptr<TreeWriter> make_writer(layout::tree::Name, const BuildOptions& options);
+#define MC_WRITER_Indexed24(Name)
+#define MC_DECLARE_WRITER(Name, id, node_bytes, triangles, ...) MC_WRITER_##triangles(Name)
+MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WRITER)
+#undef MC_DECLARE_WRITER
+#undef MC_WRITER_Indexed24
+#undef MC_WRITER_AllCodecs
 
-std::unique_ptr<TreeWriter> make_compressed_writer();  // AABBTreeCompressed (§5.4)
-std::unique_ptr<TreeWriter> make_skd_writer();         // SKDTree (§5.5)
-// StacklessLBVH (seed 001); near_first: the 8 sorting bits of seed 002 in
-// each interior node, else zeros (left child first, as the seed walks).
-std::unique_ptr<TreeWriter> make_lbvh_writer(bool near_first);
+// The writer for options.layout.tree (null for the zero-byte trees).
+std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);
 
 }  // namespace meshcast

@@ -1,5 +1,6 @@
 #include "check/ray_files.h"
 
+#include <bit>
 #include <cstring>
 
 namespace meshcast {

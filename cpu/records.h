@@ -2,7 +2,7 @@
 // tested in order through the leaf test every tree uses: the whole of a
 // BruteForce walk, and one batch of an AABBList walk.
 #pragma once
-#include "cpu/pairs.h"
+#include "layout/codecs.h"
 #include "cpu/walk.h"
 
 namespace meshcast {

@@ -4,10 +4,10 @@
 #include <cfloat>
 #include <vector>
 
-#include "cpu/pairs.h"
 #include "cpu/walk.h"
 #include "layout/blob_format.h"
-#include "layout/quadtree.h"
+#include "layout/codecs.h"
+#include "layout/zerobyte.h"
 
 namespace meshcast {
 
@@ -18,36 +18,28 @@ struct Entry {
   WalkFn walk;
 };
 
-template <class Codec>
-constexpr WalkFn walker_for(uint32_t tree) {
-  switch (tree) {
-    case MC_TREE_AABBTREE: return &walk_aabbtree<Codec>;
-    case MC_TREE_QUADTREE: return &walk_quadtree<layout::QuadBoundsFloat, Codec>;
-    case MC_TREE_QUADTREEHALFFLOAT: return &walk_quadtree<layout::QuadBoundsHalf, Codec>;
-    case MC_TREE_BRUTEFORCE: return &walk_bruteforce<Codec>;
-    case MC_TREE_AABBTREESPLITAXIS: return &walk_aabbtree_splitaxis<Codec>;
-    case MC_TREE_AABBTREEPNS: return &walk_aabbtree_pns<Codec>;
-    case MC_TREE_AABBTREECOMPRESSED: return &walk_aabbtree_compressed<Codec>;
-    case MC_TREE_SKDTREE: return &walk_skdtree<Codec>;
-    case MC_TREE_STACKLESSLBVH: return &walk_lbvh<Codec>;
-    case MC_TREE_AABBLIST: return &walk_aabblist<Codec>;
-  }
-  return nullptr;
+template <class Tree, class Codec>
+void walk_as(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  walk<Codec>(Tree{}, blob, rays, hits, n, skipped, outputs);
 }
 
-// Every (tree, triangle format) pair of the two lists.
+// Every (tree, triangle format) pair the catalog allows: every codec under
+// the trees that take them all, Indexed24 under the zero-byte trees.
 std::vector<Entry> make_walkers() {
   std::vector<Entry> entries;
-#define MC_TREE_ENTRY(Tree, tree_id) trees.push_back(tree_id);
-#define MC_CODEC_ENTRIES(Codec, name) \
-  for (uint32_t t : trees) entries.push_back({t, layout::Codec::kFormat, walker_for<layout::Codec>(t)});
-  std::vector<uint32_t> trees;
-  MC_FOR_EACH_TREE(MC_TREE_ENTRY)
-  MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRIES)
-#undef MC_TREE_ENTRY
-#undef MC_CODEC_ENTRIES
-  entries.push_back({MC_TREE_ZEROBYTE, MC_TRI_INDEXED24, &walk_zerobyte});
-  entries.push_back({MC_TREE_ZEROBYTEHYBRID, MC_TRI_INDEXED24, &walk_zerobyte});
+  auto add = [&](auto tree) {
+    using Tree = decltype(tree);
+    if constexpr (Tree::kTriangles == layout::TreeTriangles::AllCodecs) {
+#define MC_CODEC_ENTRY(Codec, name) entries.push_back({Tree::kId, layout::Codec::kFormat, &walk_as<Tree, layout::Codec>});
+      MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRY)
+#undef MC_CODEC_ENTRY
+    } else {
+      entries.push_back({Tree::kId, layout::Indexed24::kFormat, &walk_as<Tree, layout::Indexed24>});
+    }
+  };
+#define MC_TREE_ENTRIES(Name, ...) add(layout::tree::Name{});
+  MC_FOR_EACH_TREE_FORMAT(MC_TREE_ENTRIES)
+#undef MC_TREE_ENTRIES
   return entries;
 }
 

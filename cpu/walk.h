@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "cpu/leaf.h"
+#include "layout/catalog.h"
 
 namespace meshcast {
 
@@ -13,36 +14,15 @@ namespace meshcast {
 // asked for.
 using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
 
-template <class Codec>
-void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Bounds, class Codec>
-void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-template <class Codec>
-void walk_bruteforce(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
-
-// Both zero-byte formats (Indexed24 triangles), with or without the box
-// cache as the blob's header asks.
-void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
+// One walker a tree format, chosen by the catalog's tag (layout/catalog.h):
+// each family's walk_*.cpp defines its formats' overloads and instantiates
+// them for every triangle codec (the zero-byte trees: Indexed24 alone).
+#define MC_DECLARE_WALK(Name, ...)                                                                          \
+  template <class Codec>                                                                                     \
+  void walk(layout::tree::Name, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, \
+            uint32_t outputs);
+MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WALK)
+#undef MC_DECLARE_WALK
 
 // Turns the closest slot into the caller's hit, with the outputs asked for.
 inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Closest& c, const RayPre& r) {

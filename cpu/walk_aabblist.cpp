@@ -8,7 +8,7 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBList, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
@@ -21,7 +21,7 @@ void walk_aabblist(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_aabblist<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::AABBList, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

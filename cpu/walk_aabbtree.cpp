@@ -2,14 +2,14 @@
 // nearer, push the farther with its entry distance, and drop a popped node
 // that can no longer beat the closest hit.
 #include "cpu/aabb_walk.h"
-#include "cpu/pairs.h"
+#include "layout/codecs.h"
 #include "cpu/walk.h"
 #include "layout/aabbtree.h"
 
 namespace meshcast {
 
 template <class Codec>
-void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
@@ -25,7 +25,7 @@ void walk_aabbtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 // side of the split axis (the first child is the lower one) and pushes the
 // other.
 template <class Codec>
-void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
@@ -54,7 +54,7 @@ void walk_aabbtree_splitaxis(const uint8_t* blob, const Ray* rays, Hit* hits, si
 // AABBTreePNS walker (seed 000 §5.3, seed 002): as AABBTreeSplitAxis, but
 // the near child is one AND away: bit octant(dir) of the node's 8 bits.
 template <class Codec>
-void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
@@ -82,9 +82,9 @@ void walk_aabbtree_pns(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n
 }
 
 #define MC_INSTANTIATE(Codec, name)                                                                 \
-  template void walk_aabbtree_pns<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
-  template void walk_aabbtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
-  template void walk_aabbtree_splitaxis<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::AABBTreePNS, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
+  template void walk<layout::Codec>(layout::tree::AABBTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
+  template void walk<layout::Codec>(layout::tree::AABBTreeSplitAxis, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -1,14 +1,14 @@
 // AABBTreeCompressed walker (seed 000 §5.4): as the AABBTree walker, but a
 // node's child boxes are decoded from its own decoded box, so each stack
 // entry carries the box, the child's offset and its triangle count.
-#include "cpu/pairs.h"
+#include "layout/codecs.h"
 #include "cpu/walk.h"
 #include "layout/compressed.h"
 
 namespace meshcast {
 
 template <class Codec>
-void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   const layout::CompressedBox root = layout::compressed_root_box(tree);
@@ -51,7 +51,7 @@ void walk_aabbtree_compressed(const uint8_t* blob, const Ray* rays, Hit* hits, s
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_aabbtree_compressed<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::AABBTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -9,7 +9,7 @@
 // Nodes whose bits are all 0 walk exactly as the seed.
 #include <bit>
 
-#include "cpu/pairs.h"
+#include "layout/codecs.h"
 #include "cpu/walk.h"
 #include "layout/aabbtree.h"
 #include "layout/lbvh.h"
@@ -17,7 +17,7 @@
 namespace meshcast {
 
 template <class Codec>
-void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
@@ -44,7 +44,7 @@ void walk_lbvh(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_lbvh<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::StacklessLBVH, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -3,7 +3,7 @@
 // nearest is walked next, and popped entries skipped once the closest hit is
 // nearer than their entry distance. The two formats differ only in how a
 // node's bounds are loaded (Bounds::load below).
-#include "cpu/pairs.h"
+#include "layout/codecs.h"
 #include "cpu/walk.h"
 #include "layout/quadtree.h"
 
@@ -92,11 +92,19 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   });
 }
 
-#define MC_INSTANTIATE(Codec, name)                                                                            \
-  template void walk_quadtree<layout::QuadBoundsFloat, layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, \
-                                                                      uint64_t*, uint32_t);                     \
-  template void walk_quadtree<layout::QuadBoundsHalf, layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t,  \
-                                                                     uint64_t*, uint32_t);
+template <class Codec>
+void walk(layout::tree::QuadTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  walk_quadtree<layout::QuadBoundsFloat, Codec>(blob, rays, hits, n, skipped, outputs);
+}
+
+template <class Codec>
+void walk(layout::tree::QuadTreeHalfFloat, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  walk_quadtree<layout::QuadBoundsHalf, Codec>(blob, rays, hits, n, skipped, outputs);
+}
+
+#define MC_INSTANTIATE(Codec, name)                                                                              \
+  template void walk<layout::Codec>(layout::tree::QuadTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);                                                 \
+  template void walk<layout::Codec>(layout::tree::QuadTreeHalfFloat, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

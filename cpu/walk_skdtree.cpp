@@ -6,14 +6,14 @@
 // conservative box test (Ize 2013), so no region the ray touches is culled;
 // a direction component of 0 gives an infinite distance (or NaN on the
 // plane), which max_keep/min_keep ignore, as box_test does.
-#include "cpu/pairs.h"
+#include "layout/codecs.h"
 #include "cpu/walk.h"
 #include "layout/skdtree.h"
 
 namespace meshcast {
 
 template <class Codec>
-void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
@@ -57,7 +57,7 @@ void walk_skdtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uin
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk_skdtree<layout::Codec>(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::SKDTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 }  // namespace meshcast

@@ -12,6 +12,8 @@
 #include "layout/aabbtree.h"
 #include "layout/zerobyte.h"
 
+#include <type_traits>
+
 namespace meshcast {
 
 namespace {
@@ -74,14 +76,23 @@ void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_
 
 }  // namespace
 
-void walk_zerobyte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  const layout::BlobHeader& h = layout::header_of(blob);
-  bool cache = h.root & MC_ZBT_FLAG_BOX_CACHE;
-  if (h.tree_format == MC_TREE_ZEROBYTEHYBRID)
-    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, outputs)
-                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, outputs);
+template <class Codec>
+void walk(layout::tree::ZeroByteTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  static_assert(std::is_same_v<Codec, layout::Indexed24>, "the zero-byte trees hold the mesh's own indices");
+  const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
   return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, outputs)
                : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, outputs);
 }
+
+template <class Codec>
+void walk(layout::tree::ZeroByteHybrid, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  static_assert(std::is_same_v<Codec, layout::Indexed24>, "the zero-byte trees hold the mesh's own indices");
+  const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
+  return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, outputs)
+               : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, outputs);
+}
+
+template void walk<layout::Indexed24>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+template void walk<layout::Indexed24>(layout::tree::ZeroByteHybrid, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 
 }  // namespace meshcast

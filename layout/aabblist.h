@@ -15,7 +15,8 @@ struct ListEntry {
   uint32_t count;    // triangles in the batch
   uint32_t records;  // tree-section offset of its first record
 };
-static_assert(sizeof(ListEntry) == MC_LIST_ENTRY_BYTES && offsetof(ListEntry, count) == MC_LIST_COUNT_AT &&
+static_assert(sizeof(ListEntry) == MC_LIST_ENTRY_BYTES && offsetof(ListEntry, min) == MC_LIST_MIN_AT &&
+              offsetof(ListEntry, max) == MC_LIST_MAX_AT && offsetof(ListEntry, count) == MC_LIST_COUNT_AT &&
               offsetof(ListEntry, records) == MC_LIST_RECORDS_AT);
 
 inline ListEntry load_list_entry(const uint8_t* tree, uint32_t batch) {

@@ -6,6 +6,7 @@
 // AABBTreeSplitAxis (§5.2) uses the same node, see aabb_second_child.
 #pragma once
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "layout/blob_format.h"
@@ -20,7 +21,8 @@ struct AABBNode {
   bool is_leaf() const { return (properties & MC_AABB_LEAF_BIT) != 0; }
   uint32_t value() const { return properties & MC_AABB_VALUE_MASK; }
 };
-static_assert(sizeof(AABBNode) == MC_AABB_NODE_BYTES);
+static_assert(sizeof(AABBNode) == MC_AABB_NODE_BYTES && offsetof(AABBNode, min) == MC_AABB_MIN_AT &&
+              offsetof(AABBNode, max) == MC_AABB_MAX_AT && offsetof(AABBNode, properties) == MC_AABB_PROPERTIES_AT);
 
 inline AABBNode load_aabb_node(const uint8_t* p) { return load<AABBNode>(p); }
 

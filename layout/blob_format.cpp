@@ -2,11 +2,14 @@
 #include "layout/zerobyte.h"
 
 #include <algorithm>
+#include <concepts>
+#include <type_traits>
 #include <cmath>
 #include <vector>
 
 #include "layout/aabblist.h"
 #include "layout/aabbtree.h"
+#include "layout/catalog.h"
 #include "layout/codecs.h"
 #include "layout/compressed.h"
 #include "layout/lbvh.h"
@@ -39,23 +42,7 @@ void seal(std::span<uint8_t> blob) {
   std::memcpy(blob.data(), &h, sizeof h);
 }
 
-std::string_view tree_format_name(uint32_t f) {
-  switch (f) {
-    case MC_TREE_AABBTREE: return "AABBTree";
-    case MC_TREE_QUADTREE: return "QuadTree";
-    case MC_TREE_QUADTREEHALFFLOAT: return "QuadTreeHalfFloat";
-    case MC_TREE_BRUTEFORCE: return "BruteForce";
-    case MC_TREE_AABBTREESPLITAXIS: return "AABBTreeSplitAxis";
-    case MC_TREE_AABBTREEPNS: return "AABBTreePNS";
-    case MC_TREE_AABBTREECOMPRESSED: return "AABBTreeCompressed";
-    case MC_TREE_SKDTREE: return "SKDTree";
-    case MC_TREE_STACKLESSLBVH: return "StacklessLBVH";
-    case MC_TREE_AABBLIST: return "AABBList";
-    case MC_TREE_ZEROBYTE: return "ZeroByteTree";
-    case MC_TREE_ZEROBYTEHYBRID: return "ZeroByteHybrid";
-  }
-  return "";
-}
+std::string_view tree_format_name(uint32_t f) { return tree_format_info(f).name; }
 
 std::string_view triangle_format_name(uint32_t f) {
 #define MC_NAME(Codec, text) \
@@ -125,9 +112,10 @@ std::string walk_nodes(const BlobHeader& h, uint32_t root, const char* noun, Vis
   return "";
 }
 
-template <class Codec>
-std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  const bool split_axis = h.tree_format == MC_TREE_AABBTREESPLITAXIS;
+template <class Codec, class Tag>
+  requires std::same_as<Tag, tree::AABBTree> || std::same_as<Tag, tree::AABBTreeSplitAxis>
+std::string validate_tree(Tag, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  constexpr bool split_axis = std::same_as<Tag, tree::AABBTreeSplitAxis>;
   return walk_nodes(h, 0, "node at tree offset ", [&](uint32_t at, auto push) -> std::string {
     if (at % 4 != 0 || uint64_t(at) + MC_AABB_NODE_BYTES > h.tree_size)
       return "node at tree offset " + num(at) + " is misaligned or past the tree section";
@@ -147,8 +135,14 @@ std::string walk_aabbtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
   });
 }
 
-template <class Bounds, class Codec>
-std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+// QuadTree and QuadTreeHalfFloat: the same walk over their own child bounds.
+template <class Tag>
+using QuadBoundsOf = std::conditional_t<std::same_as<Tag, tree::QuadTree>, QuadBoundsFloat, QuadBoundsHalf>;
+
+template <class Codec, class Tag>
+  requires std::same_as<Tag, tree::QuadTree> || std::same_as<Tag, tree::QuadTreeHalfFloat>
+std::string validate_tree(Tag, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  using Bounds = QuadBoundsOf<Tag>;
   struct Item { uint32_t properties, parent, depth; };
   std::vector<Item> stack{{h.root, 0, 0}};
   uint64_t visited = 0;
@@ -185,7 +179,7 @@ std::string walk_quadtree(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
 
 // AABBTreePNS: nodes by index, each child after its parent.
 template <class Codec>
-std::string walk_pns(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::AABBTreePNS, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   if (h.node_count == 0 || uint64_t(h.node_count) * MC_AABB_NODE_BYTES != h.triangle_base)
     return "AABBTreePNS: the triangle base must follow the " + num(h.node_count) + " nodes";
   return walk_nodes(h, 0, "node ", [&](uint32_t index, auto push) -> std::string {
@@ -207,7 +201,7 @@ std::string walk_pns(const uint8_t* blob, const BlobHeader& h, uint64_t* triangl
 // AABBTreeCompressed: the section header, then nodes and blocks, each
 // right child after its node, each left child right behind it.
 template <class Codec>
-std::string walk_compressed(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::AABBTreeCompressed, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   if (h.tree_size < MC_COMPRESSED_HEADER_BYTES) return "AABBTreeCompressed: the tree section is shorter than its header";
   const uint8_t* tree = blob + h.tree_offset;
   CompressedBox root = compressed_root_box(tree);
@@ -242,7 +236,7 @@ std::string walk_compressed(const uint8_t* blob, const BlobHeader& h, uint64_t* 
 // SKDTree: interior nodes and leaves of two sizes, each right child after
 // its node.
 template <class Codec>
-std::string walk_skd(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::SKDTree, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   const uint8_t* tree = blob + h.tree_offset;
   for (int a = 0; a < 3; ++a)
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
@@ -268,7 +262,7 @@ std::string walk_skd(const uint8_t* blob, const BlobHeader& h, uint64_t* triangl
 // StacklessLBVH: every node a walk reaches is a leaf or has both children
 // inside the array; holes are never reached.
 template <class Codec>
-std::string walk_lbvh(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::StacklessLBVH, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   const uint8_t* tree = blob + h.tree_offset;
   if (h.node_count == 0 || h.node_count > (1u << (MC_LBVH_MAX_DEPTH + 1)) - 1 ||
       uint64_t(h.node_count) * MC_LBVH_NODE_BYTES != h.triangle_base)
@@ -307,7 +301,7 @@ std::string check_records(const uint8_t* blob, const BlobHeader& h, uint64_t* at
 
 // BruteForce: the records must tile the tree section exactly.
 template <class Codec>
-std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::BruteForce, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   uint64_t at = 0, records = 0;
   if (std::string e = check_records<Codec>(blob, h, &at, h.tree_size, triangles, &records); !e.empty()) return e;
   if (records != h.node_count) return "BruteForce holds " + num(records) + " records, the header says " + num(h.node_count);
@@ -318,7 +312,7 @@ std::string walk_bruteforce(const uint8_t* blob, const BlobHeader& h, uint64_t* 
 // section in batch order, each batch's records holding its count, and every
 // batch but the last full (the shaders find records by arithmetic).
 template <class Codec>
-std::string walk_aabblist(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::AABBList, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   const uint8_t* tree = blob + h.tree_offset;
   if (h.node_count == 0 || h.triangle_base != uint64_t(h.node_count) * MC_LIST_ENTRY_BYTES)
     return "AABBList of " + num(h.node_count) + " batches does not start its records at tree offset " +
@@ -341,21 +335,16 @@ std::string walk_aabblist(const uint8_t* blob, const BlobHeader& h, uint64_t* tr
   return "";
 }
 
+// The tree format's validator (the catalog's switch); the zero-byte trees
+// have their own (validate_zerobyte).
 template <class Codec>
 std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  switch (h.tree_format) {
-    case MC_TREE_BRUTEFORCE: return walk_bruteforce<Codec>(blob, h, triangles);
-    case MC_TREE_AABBLIST: return walk_aabblist<Codec>(blob, h, triangles);
-    case MC_TREE_AABBTREEPNS: return walk_pns<Codec>(blob, h, triangles);
-    case MC_TREE_AABBTREECOMPRESSED: return walk_compressed<Codec>(blob, h, triangles);
-    case MC_TREE_SKDTREE: return walk_skd<Codec>(blob, h, triangles);
-    case MC_TREE_STACKLESSLBVH: return walk_lbvh<Codec>(blob, h, triangles);
-    case MC_TREE_AABBTREE:
-    case MC_TREE_AABBTREESPLITAXIS: return walk_aabbtree<Codec>(blob, h, triangles);
-    case MC_TREE_QUADTREE: return walk_quadtree<QuadBoundsFloat, Codec>(blob, h, triangles);
-    case MC_TREE_QUADTREEHALFFLOAT: return walk_quadtree<QuadBoundsHalf, Codec>(blob, h, triangles);
-  }
-  return "unknown tree format " + num(h.tree_format);
+  return with_tree_format(h.tree_format, "unknown tree format " + num(h.tree_format), [&](auto tag) -> std::string {
+    if constexpr (decltype(tag)::kTriangles == TreeTriangles::AllCodecs)
+      return validate_tree<Codec>(tag, blob, h, triangles);
+    else
+      return "the zero-byte trees hold Indexed24 triangles alone";
+  });
 }
 
 struct Section { const char* name; uint32_t offset, size; };
@@ -390,19 +379,7 @@ std::string validate(std::span<const uint8_t> blob) {
              ") overlaps another, is misaligned, or runs past the blob (" + num(blob.size()) + " bytes)";
     end = uint64_t(s.offset) + s.size;
   }
-  uint32_t node_size = 0;  // the smallest node of the format
-  switch (h.tree_format) {
-    case MC_TREE_AABBTREE:
-    case MC_TREE_AABBTREESPLITAXIS:
-    case MC_TREE_AABBTREEPNS: node_size = MC_AABB_NODE_BYTES; break;
-    case MC_TREE_AABBTREECOMPRESSED: node_size = MC_COMPRESSED_NODE_BYTES; break;
-    case MC_TREE_SKDTREE: node_size = MC_SKD_LEAF_BYTES; break;
-    case MC_TREE_STACKLESSLBVH: node_size = MC_LBVH_NODE_BYTES; break;
-    case MC_TREE_QUADTREE: node_size = MC_QUAD_NODE_BYTES; break;
-    case MC_TREE_QUADTREEHALFFLOAT: node_size = MC_QUADHALF_NODE_BYTES; break;
-    case MC_TREE_AABBLIST: node_size = MC_LIST_ENTRY_BYTES; break;
-    default: node_size = MC_BRUTE_RECORD_BYTES;
-  }
+  const uint32_t node_size = tree_format_info(h.tree_format).smallest_node;
   if (uint64_t(h.node_count) * node_size > h.tree_size)
     return "node count " + num(h.node_count) + " does not fit the tree section";
   if (h.node_bytes > h.tree_size || h.triangle_base > h.tree_size)
@@ -442,7 +419,7 @@ std::string validate(std::span<const uint8_t> blob) {
         std::isfinite(h.node_origin[1]) && std::isfinite(h.node_origin[2])))
     return "half-float node origin or scale is not finite";
 
-  if (h.tree_format == MC_TREE_ZEROBYTE || h.tree_format == MC_TREE_ZEROBYTEHYBRID) return validate_zerobyte(blob, h);
+  if (tree_format_info(h.tree_format).triangles == TreeTriangles::Indexed24) return validate_zerobyte(blob, h);
   if (h.triangle_format == MC_TRI_INDEXED24) return "Indexed24 triangles belong to the zero-byte trees alone";
 
   uint64_t triangles = 0;

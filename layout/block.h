@@ -1,8 +1,10 @@
 // What a triangle codec is given to encode one leaf's block, and what it
 // decodes one triangle back to. Each codec lives in its own header
-// (float3.h, soa.h, indexed.h, indexed8bitpacksoa4.h) with the same static members:
-//   kFormat, kSlotDivisor, kLanes, block_bytes(count), encode(...), decode(...)
+// (float3.h, soa.h, indexed.h, ...) as a struct of static members whose
+// contract is the TriangleCodec concept below; the optional traits are
+// defaulted here, once.
 #pragma once
+#include <concepts>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -45,6 +47,54 @@ struct BlockContext {
   uint32_t* max_block_shift = nullptr;  // largest m of a BitPackSOA block (soa.h)
   const BlobHeader* header = nullptr;   // the blob's header as far as it is known (grids)
 };
+
+// The contract every triangle codec meets (checked for each in codecs.h):
+//   kFormat        its MC_TRI_* id        kLanes   triangles a test takes
+//   kSlotDivisor   block bytes a slot     kGrid    where its vertices lie
+//   block_bytes(count)            bytes of a block of `count` (the most, for
+//                                 formats whose blocks vary)
+//   encode(tris, count, ctx, out) writes one leaf's block
+//   decode(blob, block, i, out)   the corners of triangle i of a block
+//   check(blob, block, count, why) what validation must prove of a block
+// Optional: kNestedBlocks, kGridBits, kMovesFloats, measure(), stored_bytes().
+template <class C>
+concept TriangleCodec = requires(TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out,
+                                 const uint8_t* blob, uint32_t block, float (&corners)[3][3], std::string* why) {
+  { C::kFormat } -> std::convertible_to<uint32_t>;
+  { C::kSlotDivisor } -> std::convertible_to<uint32_t>;
+  { C::kLanes } -> std::convertible_to<uint32_t>;
+  { C::kGrid } -> std::convertible_to<GridKind>;
+  { C::block_bytes(count) } -> std::convertible_to<uint64_t>;
+  C::encode(tris, count, ctx, out);
+  C::decode(blob, block, count, corners);
+  { C::check(blob, block, count, why) } -> std::convertible_to<bool>;
+};
+
+// The optional traits' defaults:
+//   nested_blocks  blocks on nested lattices of the mesh grid (BitPackSOA)
+//   grid_bits      bits a grid coordinate takes (the BitPack 21 otherwise)
+//   moves_floats   a float format that still moves vertices (cleared bits)
+//   measure        bytes a leaf's block will take (block_bytes otherwise)
+template <class C>
+constexpr bool nested_blocks() {
+  if constexpr (requires { C::kNestedBlocks; }) return C::kNestedBlocks;
+  else return false;
+}
+template <class C>
+constexpr uint32_t grid_bits() {
+  if constexpr (requires { C::kGridBits; }) return C::kGridBits;
+  else return MC_BITPACK_BITS;
+}
+template <class C>
+constexpr bool moves_floats() {
+  if constexpr (requires { C::kMovesFloats; }) return C::kMovesFloats;
+  else return false;
+}
+template <class C>
+uint32_t measure(TriCorners* tris, uint32_t count) {
+  if constexpr (requires { C::measure(tris, count); }) return C::measure(tris, count);
+  else return C::block_bytes(count);
+}
 
 // Bytes a block of `count` triangles takes in a blob: block_bytes(count) for
 // fixed-size formats; formats whose blocks vary (strips) read their own,

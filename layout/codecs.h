@@ -28,3 +28,9 @@
   X(UncompressedStrip, "UncompressedStrip")            \
   X(CompressedStrip, "CompressedStrip")                \
   X(Float3PairSOA4, "Float3PairSOA4")
+
+namespace meshcast::layout {
+#define MC_CHECK_CODEC(Codec, name) static_assert(TriangleCodec<Codec>, name " meets the codec contract");
+MC_FOR_EACH_TRIANGLE_CODEC(MC_CHECK_CODEC)
+#undef MC_CHECK_CODEC
+}  // namespace meshcast::layout

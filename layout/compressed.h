@@ -44,7 +44,7 @@ struct CompressedNode {
 static_assert(sizeof(CompressedNode) == MC_COMPRESSED_NODE_BYTES);
 
 inline CompressedBox compressed_root_box(const uint8_t* tree) { return load<CompressedBox>(tree); }
-inline uint32_t compressed_root_count(const uint8_t* tree) { return load<uint32_t>(tree + 24); }
+inline uint32_t compressed_root_count(const uint8_t* tree) { return load<uint32_t>(tree + MC_COMPRESSED_ROOT_COUNT_AT); }
 
 // The code of one changed value v inside [lo, hi] decoded: the largest q
 // decoding to at most v (a minimum), or the smallest decoding to at least v

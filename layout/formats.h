@@ -70,6 +70,8 @@
 // section lies at triangle_base + k * (4 + block bytes).
 #define MC_LIST_BATCH 256u
 #define MC_LIST_ENTRY_BYTES 32u
+#define MC_LIST_MIN_AT 0u              // BoundingBoxMin's byte in the entry
+#define MC_LIST_MAX_AT 12u             // BoundingBoxMax's
 #define MC_LIST_COUNT_AT 24u           // TriangleCount's byte in the entry
 #define MC_LIST_RECORDS_AT 28u         // RecordOffset's
 
@@ -121,6 +123,9 @@
 // count, its block right behind the node. Clear: the first child is right
 // behind the node and the low bits are the second child's offset.
 #define MC_AABB_NODE_BYTES 28u
+#define MC_AABB_MIN_AT 0u              // BoundingBoxMin's byte in the node
+#define MC_AABB_MAX_AT 12u             // BoundingBoxMax's
+#define MC_AABB_PROPERTIES_AT 24u      // Properties'
 #define MC_AABB_LEAF_BIT 0x80000000u
 #define MC_AABB_VALUE_MASK 0x7FFFFFFFu
 // AABBTreeSplitAxis (§5.2): an interior node's properties keep 2 bits of
@@ -155,6 +160,7 @@
 // bound = parent.min + q * (parent.max - parent.min) / 127, with side bit 0
 // when it is the left child's. q = 127 decodes to parent.max exactly.
 #define MC_COMPRESSED_HEADER_BYTES 28u
+#define MC_COMPRESSED_ROOT_COUNT_AT 24u  // RootTriangleCount's byte in the header
 #define MC_COMPRESSED_NODE_BYTES 12u
 #define MC_COMPRESSED_STEPS 127u
 #define MC_COMPRESSED_SIDE_SHIFT 21u
@@ -170,6 +176,9 @@
 #define MC_SKD_AXIS_SHIFT 30u
 #define MC_SKD_VALUE_MASK 0x3FFFFFFFu
 #define MC_SKD_INTERIOR_BYTES 12u
+#define MC_SKD_PROPERTIES_AT 0u        // Properties' byte in the node
+#define MC_SKD_LEFT_PLANE_AT 4u        // LeftPlane's (interior nodes)
+#define MC_SKD_RIGHT_PLANE_AT 8u       // RightPlane's
 #define MC_SKD_LEAF_BYTES 4u
 
 // StacklessLBVH (seed 001): nodes in heap order, node n (root 1, children
@@ -180,6 +189,10 @@
 // interior node the 8 precomputed-node-sorting bits of seed 002 (which child
 // a ray of each octant visits first; all 0 walks left first as the seed).
 #define MC_LBVH_NODE_BYTES 32u
+#define MC_LBVH_MIN_AT 0u              // BoundingBoxMin's byte in the node
+#define MC_LBVH_MAX_AT 12u             // BoundingBoxMax's
+#define MC_LBVH_COUNT_AT 24u           // Count's
+#define MC_LBVH_POSITION_AT 28u        // Position's
 #define MC_LBVH_MAX_DEPTH 25u          // 2^26 - 1 slots: 2 GiB of nodes
 
 // QuadTree / QuadTreeHalfFloat child properties (§5.6): 5 bits of triangle
@@ -189,6 +202,10 @@
 #define MC_QUAD_MAX_COUNT 31u
 #define MC_QUAD_NODE_BYTES 112u        // 24 floats + 4 uint32
 #define MC_QUADHALF_NODE_BYTES 64u     // 24 half floats + 4 uint32: a cache line
+// A quad node's bounds, SOA: min x of the 4 children, min y, min z, then the
+// maxima; the 4 child properties follow them.
+#define MC_QUAD_PROPERTIES_AT 96u      // the 4 properties' byte in a QuadTree node
+#define MC_QUADHALF_PROPERTIES_AT 48u  // in a QuadTreeHalfFloat node
 // Offsets are relative to the start of the tree section.
 
 // Triangle blocks.

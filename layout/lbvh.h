@@ -7,6 +7,7 @@
 // the walk ends when next() returns the root.
 #pragma once
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 
 #include "layout/blob_format.h"
@@ -18,7 +19,9 @@ struct LBVHNode {
   int32_t count;
   uint32_t position;
 };
-static_assert(sizeof(LBVHNode) == MC_LBVH_NODE_BYTES);
+static_assert(sizeof(LBVHNode) == MC_LBVH_NODE_BYTES && offsetof(LBVHNode, min) == MC_LBVH_MIN_AT &&
+              offsetof(LBVHNode, max) == MC_LBVH_MAX_AT && offsetof(LBVHNode, count) == MC_LBVH_COUNT_AT &&
+              offsetof(LBVHNode, position) == MC_LBVH_POSITION_AT);
 
 inline uint64_t lbvh_node_offset(uint32_t n) { return uint64_t(n - 1) * MC_LBVH_NODE_BYTES; }
 inline LBVHNode load_lbvh_node(const uint8_t* tree, uint32_t n) { return load<LBVHNode>(tree + lbvh_node_offset(n)); }

@@ -1,9 +1,11 @@
 #include "layout/leaves.h"
 
+
 #include <cmath>
 
 #include "layout/aabblist.h"
 #include "layout/aabbtree.h"
+#include "layout/catalog.h"
 #include "layout/codecs.h"
 #include "layout/compressed.h"
 #include "layout/lbvh.h"
@@ -152,6 +154,32 @@ struct Descent {
       path.pop_back();
     }
   }
+
+  // Where each tree format's descent starts (the catalog's switch calls these).
+  void from_root(tree::BruteForce) { records(0, h.tree_size); }
+  void from_root(tree::AABBList) { aabblist(); }
+  void from_root(tree::AABBTree) { aabbtree(0); }
+  void from_root(tree::AABBTreeSplitAxis) { aabbtree(0); }
+  void from_root(tree::AABBTreePNS) { pns(0); }
+  void from_root(tree::ZeroByteTree) { zerobyte(h.triangle_base); }
+  void from_root(tree::ZeroByteHybrid) { hybrid(0); }
+  void from_root(tree::AABBTreeCompressed) {
+    const CompressedBox root = compressed_root_box(tree);
+    if (uint32_t count = compressed_root_count(tree)) {
+      PathBox b = box_of(root.min, root.max);
+      return leaf(MC_COMPRESSED_HEADER_BYTES, count, &b);
+    }
+    compressed(MC_COMPRESSED_HEADER_BYTES, root);
+  }
+  void from_root(tree::SKDTree) { skd(0, box_of(h.bounds_min, h.bounds_max)); }
+  void from_root(tree::StacklessLBVH) { lbvh(1); }
+  void from_root(tree::QuadTree) { quad_root<QuadBoundsFloat>(); }
+  void from_root(tree::QuadTreeHalfFloat) { quad_root<QuadBoundsHalf>(); }
+  template <class Bounds>
+  void quad_root() {
+    if (quad_count(h.root)) return leaf(quad_offset(h.root), quad_count(h.root), nullptr);
+    quadtree<Bounds>(h.root);
+  }
 };
 
 }  // namespace
@@ -159,30 +187,10 @@ struct Descent {
 void for_each_leaf_path(const uint8_t* blob, const LeafPathVisitor& visit) {
   const BlobHeader& h = header_of(blob);
   Descent d{blob, h, blob + h.tree_offset, visit, {}};
-  switch (h.tree_format) {
-    case MC_TREE_BRUTEFORCE: return d.records(0, h.tree_size);
-    case MC_TREE_AABBLIST: return d.aabblist();
-    case MC_TREE_AABBTREE:
-    case MC_TREE_AABBTREESPLITAXIS: return d.aabbtree(0);
-    case MC_TREE_AABBTREEPNS: return d.pns(0);
-    case MC_TREE_ZEROBYTE: return d.zerobyte(h.triangle_base);
-    case MC_TREE_ZEROBYTEHYBRID: return d.hybrid(0);
-    case MC_TREE_AABBTREECOMPRESSED: {
-      CompressedBox root = compressed_root_box(d.tree);
-      if (uint32_t count = compressed_root_count(d.tree)) {
-        PathBox b = box_of(root.min, root.max);
-        return d.leaf(MC_COMPRESSED_HEADER_BYTES, count, &b);
-      }
-      return d.compressed(MC_COMPRESSED_HEADER_BYTES, root);
-    }
-    case MC_TREE_SKDTREE: return d.skd(0, box_of(h.bounds_min, h.bounds_max));
-    case MC_TREE_STACKLESSLBVH: return d.lbvh(1);
-    case MC_TREE_QUADTREE:
-    case MC_TREE_QUADTREEHALFFLOAT:
-      if (quad_count(h.root)) return d.leaf(quad_offset(h.root), quad_count(h.root), nullptr);
-      if (h.tree_format == MC_TREE_QUADTREE) return d.quadtree<QuadBoundsFloat>(h.root);
-      return d.quadtree<QuadBoundsHalf>(h.root);
-  }
+  with_tree_format(h.tree_format, 0, [&](auto tag) {
+    d.from_root(tag);
+    return 0;
+  });
 }
 
 void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t, uint32_t)>& visit) {

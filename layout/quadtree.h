@@ -36,7 +36,7 @@ inline uint32_t quad_properties(uint32_t count, uint32_t offset) {
 struct QuadBoundsFloat {
   static constexpr uint32_t kFormat = MC_TREE_QUADTREE;
   static constexpr uint32_t kNodeBytes = MC_QUAD_NODE_BYTES;
-  static constexpr uint32_t kPropertiesAt = 96;
+  static constexpr uint32_t kPropertiesAt = MC_QUAD_PROPERTIES_AT;
   static void encode(const QuadChild c[4], const BlobHeader&, uint8_t* out) {
     for (int axis = 0; axis < 3; ++axis)
       for (int k = 0; k < 4; ++k) {
@@ -55,7 +55,7 @@ struct QuadBoundsFloat {
 struct QuadBoundsHalf {
   static constexpr uint32_t kFormat = MC_TREE_QUADTREEHALFFLOAT;
   static constexpr uint32_t kNodeBytes = MC_QUADHALF_NODE_BYTES;
-  static constexpr uint32_t kPropertiesAt = 48;
+  static constexpr uint32_t kPropertiesAt = MC_QUADHALF_PROPERTIES_AT;
   static float decode_one(uint16_t h, const BlobHeader& hd, int axis) {
     return std::fma(half_to_float(h), hd.node_scale, hd.node_origin[axis]);
   }

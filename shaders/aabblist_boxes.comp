@@ -23,8 +23,8 @@ void main() {
   const GpuRay r = load_ray(ray);
   if (!r.walkable) return;
   const uint at = list_entry(batch);
-  const vec3 mn = vec3(blob_f32(at), blob_f32(at + 4u), blob_f32(at + 8u));
-  const vec3 mx = vec3(blob_f32(at + 12u), blob_f32(at + 16u), blob_f32(at + 20u));
+  const vec3 mn = blob_vec3(at + MC_LIST_MIN_AT);
+  const vec3 mx = blob_vec3(at + MC_LIST_MAX_AT);
   if (box_test(r, mn, mx, r.tmax) == kInfinity) return;
   const uint k = atomicAdd(control.counter, 1u);
   if (k < pairs.length()) pairs[k] = uvec2(ray, batch);

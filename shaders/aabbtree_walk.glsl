@@ -7,8 +7,8 @@ layout(local_size_x = 64) in;
 
 layout(push_constant) uniform Push { uint ray_base, ray_count, records; } pc;
 
-vec3 node_min(uint at) { return vec3(blob_f32(at), blob_f32(at + 4u), blob_f32(at + 8u)); }
-vec3 node_max(uint at) { return vec3(blob_f32(at + 12u), blob_f32(at + 16u), blob_f32(at + 20u)); }
+vec3 node_min(uint at) { return blob_vec3(at + MC_AABB_MIN_AT); }
+vec3 node_max(uint at) { return blob_vec3(at + MC_AABB_MAX_AT); }
 
 void main() {
   const uint ray = gl_GlobalInvocationID.x;
@@ -22,7 +22,7 @@ void main() {
     int top = -1;
     uint at = 0u;
     for (;;) {
-      const uint props = blob_u32(tree + at + 24u);
+      const uint props = blob_u32(tree + at + MC_AABB_PROPERTIES_AT);
       if ((props & MC_AABB_LEAF_BIT) == 0u) {
         const uint left = at + MC_AABB_NODE_BYTES, right = props & MC_AABB_VALUE_MASK;
         const float lt = box_test(r, node_min(tree + left), node_max(tree + left), c.t);

@@ -10,6 +10,10 @@ layout(std430, set = 0, binding = 0) readonly buffer Blob { uint blob_words[]; }
 
 uint blob_u32(uint byte_offset) { return blob_words[byte_offset >> 2]; }
 float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_words[byte_offset >> 2]); }
+// Three floats in a row (a box corner, a vertex).
+vec3 blob_vec3(uint byte_offset) {
+  return vec3(blob_f32(byte_offset), blob_f32(byte_offset + 4u), blob_f32(byte_offset + 8u));
+}
 uint header(uint word) { return blob_words[word]; }
 
 // remap_entry of layout/blob_format.h: the used-slot bitmap (64-bit words), the

@@ -26,11 +26,11 @@ void main() {
     uint v = 1u, o = 0u, n = 1u;
     for (;;) {
       const uint at = tree + (n - 1u) * MC_LBVH_NODE_BYTES;
-      const vec3 mn = vec3(blob_f32(at), blob_f32(at + 4u), blob_f32(at + 8u));
-      const vec3 mx = vec3(blob_f32(at + 12u), blob_f32(at + 16u), blob_f32(at + 20u));
+      const vec3 mn = blob_vec3(at + MC_LBVH_MIN_AT);
+      const vec3 mx = blob_vec3(at + MC_LBVH_MAX_AT);
       if (box_test(r, mn, mx, c.t) != kInfinity) {
-        const int count = int(blob_u32(at + 24u));
-        const uint position = blob_u32(at + 28u);
+        const int count = int(blob_u32(at + MC_LBVH_COUNT_AT));
+        const uint position = blob_u32(at + MC_LBVH_POSITION_AT);
         if (count < 0) {
           v <<= 1, o = (o << 1) | ((position >> octant) & 1u);
           n = v ^ o;

@@ -77,7 +77,7 @@ void main() {
         uint sp[4];
         int m = 0;
         for (uint k = 0u; k < 4u; ++k) {
-          const uint p = blob_u32(at + 48u + 4u * k);
+          const uint p = blob_u32(at + MC_QUADHALF_PROPERTIES_AT + 4u * k);
           if (p == 0u) continue;  // an unused child
           const vec3 mn = vec3(half_bound(at, 0u, k, 0u), half_bound(at, 1u, k, 1u), half_bound(at, 2u, k, 2u));
           const vec3 mx = vec3(half_bound(at, 3u, k, 0u), half_bound(at, 4u, k, 1u), half_bound(at, 5u, k, 2u));

@@ -33,11 +33,11 @@ void main() {
     int top = -1;
     uint at = 0u;
     for (;;) {
-      const uint props = blob_u32(tree + at);
+      const uint props = blob_u32(tree + at + MC_SKD_PROPERTIES_AT);
       const uint axis = props >> MC_SKD_AXIS_SHIFT;
       if (axis != MC_SKD_LEAF_AXIS) {
-        precise float tl = (blob_f32(tree + at + 4u) - r.org[axis]) * r.inv[axis];
-        precise float tr = (blob_f32(tree + at + 8u) - r.org[axis]) * r.inv[axis];
+        precise float tl = (blob_f32(tree + at + MC_SKD_LEFT_PLANE_AT) - r.org[axis]) * r.inv[axis];
+        precise float tr = (blob_f32(tree + at + MC_SKD_RIGHT_PLANE_AT) - r.org[axis]) * r.inv[axis];
         const uint left = at + MC_SKD_INTERIOR_BYTES, right = props & MC_SKD_VALUE_MASK;
         float ln = tn, lf = tf, rn = tn, rf = tf;
         if (sign_bit(r.dir[axis])) ln = max_keep(tl, tn), rf = min_keep(tr, tf);

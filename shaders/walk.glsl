@@ -56,10 +56,8 @@ void consider(GpuRay r, vec3 a, vec3 b, vec3 d, uint slot, inout Closest c) {
 // from slot0.
 void test_float3_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closest c) {
   for (uint i = 0u; i < count; ++i) {
-    const uint p = block + 36u * i;
-    const vec3 a = vec3(blob_f32(p), blob_f32(p + 4u), blob_f32(p + 8u));
-    const vec3 b = vec3(blob_f32(p + 12u), blob_f32(p + 16u), blob_f32(p + 20u));
-    const vec3 d = vec3(blob_f32(p + 24u), blob_f32(p + 28u), blob_f32(p + 32u));
+    const uint p = block + MC_FLOAT3_TRI_BYTES * i;
+    const vec3 a = blob_vec3(p), b = blob_vec3(p + 12u), d = blob_vec3(p + 24u);  // the 3 corners
     consider(r, a, b, d, slot0 + i, c);
   }
 }

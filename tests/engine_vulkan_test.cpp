@@ -114,7 +114,9 @@ TEST(EngineVulkan, LoaderCallsKeepWorkingBesideCastersOnBothBackends) {
     host::CasterOptions options;
     options.backend = backend;
     host::Caster caster(blob, "sphere", options);
-    if (backend == host::Backend::Vulkan) ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    if (backend == host::Backend::Vulkan) {
+      ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    }
     engine.work();
     cast_and_check(caster, rays, host::backend_name(backend));
     engine.work();

@@ -74,22 +74,31 @@ void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_
   });
 }
 
+// Both zero-byte formats: the header's box-cache flag picks the instantiation.
+template <class Tree>
+void walk_zero_byte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
+  if constexpr (std::is_same_v<Tree, layout::tree::ZeroByteHybrid>)
+    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, outputs)
+                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, outputs);
+  else
+    return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, outputs)
+                 : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, outputs);
+}
+
 }  // namespace
 
+// The zero-byte trees hold the mesh's own indices: Indexed24 is their one codec.
 template <class Codec>
-void walk(layout::tree::ZeroByteTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  static_assert(std::is_same_v<Codec, layout::Indexed24>, "the zero-byte trees hold the mesh's own indices");
-  const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
-  return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, outputs)
-               : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, outputs);
+void walk(layout::tree::ZeroByteTree tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  static_assert(std::is_same_v<Codec, layout::Indexed24>);
+  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, outputs);
 }
 
 template <class Codec>
-void walk(layout::tree::ZeroByteHybrid, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  static_assert(std::is_same_v<Codec, layout::Indexed24>, "the zero-byte trees hold the mesh's own indices");
-  const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
-  return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, outputs)
-               : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, outputs);
+void walk(layout::tree::ZeroByteHybrid tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  static_assert(std::is_same_v<Codec, layout::Indexed24>);
+  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, outputs);
 }
 
 template void walk<layout::Indexed24>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);

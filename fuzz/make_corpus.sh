@@ -31,7 +31,7 @@ awk 'BEGIN {
 
 { printf '0'; cat "$tmp/sphere.off"; } > corpus/mesh/sphere.off
 printf '0OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 2 3\n' > corpus/mesh/quad.off
-printf '1# two groups sharing vertices\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.5\ng a\nf 1 2 3\ng b\nf 2/1 4/2 3/3\nf -3 -1 -2\nl 1 2\n' > corpus/mesh/groups.obj
+printf '1# two groups sharing vertices\nvt 0 0\nvt 1 0\nvt 0 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.5\ng a\nf 1 2 3\ng b\nf 2/1 4/2 3/3\nf -3 -1 -2\nl 1 2\n' > corpus/mesh/groups.obj
 printf '2ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 1e-3\n3 0 1 2\n3 1 3 2\n' > corpus/mesh/ascii.ply
 { printf '2ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
   printf '\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x00\x00'

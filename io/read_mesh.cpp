@@ -167,41 +167,78 @@ Polys scan_off(const std::string& path, std::string_view text) {
   return p;
 }
 
+// OBJ: the positions and faces, every index checked, texture and normal
+// indices too: Assimp reads them without a range check (an out-of-range one
+// made it write freed memory under the mesh fuzzer). Assimp dispatches a
+// line on its first letter, so a statement that starts like one of its own
+// and is not (`f12`, `vx`) is refused rather than read differently by the two.
 Polys scan_obj(const std::string& path, std::string_view text) {
   Lines ln{text};
   std::string_view line;
   Polys p;
-  std::vector<long long> face;  // 1-based indices, checked once all vertices are known
-  std::vector<size_t> face_line;
+  // 1-based references (kind 0 position, 1 texture, 2 normal), checked once
+  // every line is read.
+  struct Ref {
+    long long index;
+    int kind;
+  };
+  std::vector<Ref> refs;
+  std::vector<size_t> face_line, face_refs;
+  size_t counts[3] = {0, 0, 0};
+  static const char* const kKind[3] = {"vertex", "texture coordinate", "normal"};
   while (ln.next(line)) {
     auto t = tokens(line);
     if (t.empty()) continue;
-    if (t[0] == "v") {
+    const std::string_view key = t[0];
+    if (key == "v") {
       p.vertices.push_back(parse_vec(path, ln, t, 1));
-    } else if (t[0] == "f") {
-      for (size_t k = 1; k < t.size(); ++k) {
-        long long i;
-        if (!parse_int(t[k].substr(0, t[k].find('/')), i))
-          fail(path, ln.at() + "malformed file: bad index '" + std::string(t[k]) + "'");
-        if (i < 0) i += (long long)p.vertices.size() + 1;  // relative index
-        if (i <= 0) index_error(path, ln, p.faces(), i, p.vertices.size());
-        face.push_back(i - 1);
-      }
+      ++counts[0];
+    } else if (key == "vt" || key == "vn") {
+      ++counts[key == "vt" ? 1 : 2];
+    } else if (key == "vp") {  // parameter-space vertices: not referenced by faces
+    } else if (key == "f" || key == "l" || key == "p") {
+      // "l" and "p" are kept as cornerless faces, only to tell "points/lines
+      // only" from "empty"; their indices are checked all the same.
       face_line.push_back(ln.number);
-      p.start.push_back(face.size());
-    } else if (t[0] == "l" || t[0] == "p") {  // kept as a cornerless face, only to tell
-      face_line.push_back(ln.number);          // "points/lines only" from "empty"
-      p.start.push_back(face.size());
+      face_refs.push_back(refs.size());
+      for (size_t k = 1; k < t.size(); ++k) {
+        std::string_view rest = t[k];
+        for (int kind = 0; kind < 3 && !rest.empty(); ++kind) {
+          const size_t slash = rest.find('/');
+          const std::string_view part = rest.substr(0, slash);
+          rest = slash == std::string_view::npos ? std::string_view() : rest.substr(slash + 1);
+          if (kind > 0 && part.empty()) continue;  // "1//3", "1/2/"
+          long long i;
+          if (!parse_int(part, i) || (kind == 2 && !rest.empty()))
+            fail(path, ln.at() + "malformed file: bad index '" + std::string(t[k]) + "'");
+          if (i < 0) i += (long long)counts[kind] + 1;  // relative to what precedes the line
+          if (i <= 0)
+            fail(path, ln.at() + "face " + std::to_string(face_line.size() - 1) + " uses " + kKind[kind] + " index " +
+                           std::string(part) + ", out of range");
+          refs.push_back({i, kind});
+        }
+        if (key == "f") p.idx.push_back(0);  // a corner; its vertex is set below
+      }
+      p.start.push_back(p.idx.size());
+    } else if (key.front() == 'v' || key.front() == 'f' || key.front() == 'l' || key.front() == 'p') {
+      fail(path, ln.at() + "malformed file: unknown statement '" + std::string(key) +
+                     "' (Assimp would read it as '" + std::string(1, key.front()) + "')");
     }
   }
-  for (size_t f = 0; f < p.faces(); ++f)
-    for (size_t k = p.start[f]; k < p.start[f + 1]; ++k) {
-      if (face[k] >= (long long)p.vertices.size()) {
+  size_t corner = 0;
+  for (size_t f = 0; f < face_line.size(); ++f) {
+    const size_t end = f + 1 < face_line.size() ? face_refs[f + 1] : refs.size();
+    for (size_t r = face_refs[f]; r < end; ++r) {
+      if (refs[r].index > (long long)counts[refs[r].kind]) {
         ln.number = face_line[f];
-        index_error(path, ln, f, face[k] + 1, p.vertices.size());
+        if (refs[r].kind == 0) index_error(path, ln, f, refs[r].index, counts[0]);
+        fail(path, ln.at() + "face " + std::to_string(f) + " uses " + kKind[refs[r].kind] + " index " +
+                       std::to_string(refs[r].index) + ", out of range (the file has " +
+                       std::to_string(counts[refs[r].kind]) + ")");
       }
-      p.idx.push_back(uint32_t(face[k]));
+      if (refs[r].kind == 0 && p.start[f + 1] > p.start[f]) p.idx[corner++] = uint32_t(refs[r].index - 1);
     }
+  }
   return p;
 }
 

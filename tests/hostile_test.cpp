@@ -153,6 +153,25 @@ TEST(Hostile, DirectoriesAndDevicesAreRefusedBeforeReading) {
   }
 }
 
+// Found by the mesh fuzzer: Assimp reads an OBJ face's texture and normal
+// indices without a range check, and reads any line starting with 'f' as a
+// face; out-of-range references and look-alike statements are refused first.
+TEST(Hostile, ObjReferencesOutOfRangeAndLookAlikeStatementsAreRefused) {
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+  expect_throws<InputError>([&] { read_mesh(make_file("vt.obj", v + "f 1/2 2/1 3/1\n")); },
+                            {"vt.obj", "texture coordinate index 2", "out of range"});
+  expect_throws<InputError>([&] { read_mesh(make_file("vn.obj", v + "f 1//1 2//1 3//5\n")); },
+                            {"vn.obj", "normal index 5"});
+  expect_throws<InputError>([&] { read_mesh(make_file("f12.obj", v + "f 1 2 3\nf12 2/4/ 3/3\n")); },
+                            {"f12.obj", "line 7", "unknown statement 'f12'"});
+  expect_throws<InputError>([&] { read_mesh(make_file("rel.obj", v + "f 1/-2 2 3\n")); },
+                            {"rel.obj", "texture coordinate index -2"});
+  // Every reference in range, relative ones too, reads as before.
+  const Mesh m = read_mesh(make_file("ok.obj", v + "vp 0.5\nf 1/1/1 2/-1/1 -1//-1\n"));
+  ASSERT_EQ(m.triangles.size(), 1u);
+  EXPECT_EQ(m.triangles[0], (Triangle{0, 1, 2}));
+}
+
 // 5. A truncated binary STL got Assimp's "Failed to determine STL storage
 // representation"; the message now gives the facet count and both sizes.
 TEST(Hostile, TruncatedBinaryStlSaysSo) {

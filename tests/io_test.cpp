@@ -73,8 +73,10 @@ TEST(ReadMesh, OffKeepsIndexingAndFanOrder) {
 
 TEST(ReadMesh, ObjRestoresSharedVerticesAcrossGroups) {
   // Assimp splits this into several aiMeshes and unrolls the corners; the
-  // reader must give back the file's 6 vertices and its face order.
-  std::string p = make_file("a.obj", std::string("# test\n") + "v 0.1 0 0\nv 1 0 0\nv 1 1 0.5\n" +
+  // reader must give back the file's 6 vertices and its face order (the
+  // texture and normal references name records the file has).
+  std::string p = make_file("a.obj", std::string("# test\n") + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n" +
+                                           "v 0.1 0 0\nv 1 0 0\nv 1 1 0.5\n" +
                                            "g one\nf 1 2 3\nv 0 1 0\nv 2 0 -3\nv 2 1 0.001\nusemtl m\n" +
                                            "f 1/1 2/2 3/3 4/4\ng two\nl 1 2\nf -6//1 -5//1 5//1 6//1 3//1\n");
   expect_same(read_mesh(p), kVerts, kFanned);

@@ -4,12 +4,12 @@
 #include <cmath>
 
 #include "layout/aabbtree.h"
+#include "layout/tree_walks.h"
 
 namespace meshcast::layout {
 
 namespace {
 
-std::string num(uint64_t v) { return std::to_string(v); }
 
 // Checks the zero-byte tree rooted at position `base` of the triangle area,
 // marking the positions it covers; `end` bounds its positions. Every node
@@ -150,5 +150,32 @@ void for_each_zbt_node(const uint8_t* blob, uint32_t root, std::vector<PathBox> 
     stack.push_back({n.child, path.size()});
   }
 }
+
+namespace {
+
+// Zero-byte trees: every node is a block of its own triangles; a hybrid
+// leaf's box sits above its zero-byte tree.
+void descend_zerobyte(Descent& d, uint32_t root) {
+  for_each_zbt_node(d.blob, root, d.path, [&](uint32_t p, ZbtNode n, const std::vector<PathBox>& boxes) {
+    d.visit(root + p * Indexed24::kSlotDivisor, n.count, boxes);
+  });
+}
+
+void descend_hybrid(Descent& d, uint32_t at) {
+  AABBNode n = load_aabb_node(d.tree + at);
+  d.path.push_back(box_of(n.min, n.max));
+  if (n.is_leaf()) {
+    descend_zerobyte(d, d.h.triangle_base + n.value() * Indexed24::kSlotDivisor);
+  } else {
+    descend_hybrid(d, at + MC_AABB_NODE_BYTES);
+    descend_hybrid(d, n.value());
+  }
+  d.path.pop_back();
+}
+
+}  // namespace
+
+void from_root(Descent& d, tree::ZeroByteTree) { descend_zerobyte(d, d.h.triangle_base); }
+void from_root(Descent& d, tree::ZeroByteHybrid) { descend_hybrid(d, 0); }
 
 }  // namespace meshcast::layout

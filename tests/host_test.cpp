@@ -387,7 +387,9 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
     for (int k = 0; k < 3 && !caster.crossover_known(); ++k) {
       const std::string why = caster.why(1u << 20);
       const host::BatchRecord r = caster.wait(caster.submit(rays), hits);
-      if (why.find("measured in the background") != std::string::npos) EXPECT_EQ(r.ran_on, Backend::Cpu) << why;
+      if (why.find("measured in the background") != std::string::npos) {
+        EXPECT_EQ(r.ran_on, Backend::Cpu) << why;
+      }
     }
     caster.clear_records();
     caster.wait_for_crossover();

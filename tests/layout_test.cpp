@@ -21,6 +21,28 @@ namespace {
 
 using namespace layout;
 
+// Made while this file's statics are initialised, before main(): a blob
+// built from arrays and walked through a BlobView, which needs no other
+// translation unit's statics to be ready (the walker table is made on first
+// use). The answer is checked in StaticInitialisationBuildsAndWalks.
+const std::string g_static_walk = [] {
+  try {
+    const float xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const uint32_t indices[] = {0, 1, 2};
+    MeshView view;
+    view.positions = xyz, view.vertex_count = 3, view.indices = indices, view.triangle_count = 1;
+    const std::vector<uint8_t> blob = build_blob(view, BuildOptions{}, "static");
+    const Ray ray{{0.25f, 0.25f, 1}, {0, 0, -1}, INFINITY};
+    Hit hit;
+    BlobView(blob, "static").trace({&ray, 1}, {&hit, 1});
+    return hit.triangle == 0 && std::fabs(hit.t - 1.0f) < 1e-6f ? std::string() : std::string("wrong hit");
+  } catch (const std::exception& e) {
+    return std::string(e.what());
+  }
+}();
+
+TEST(Layout, StaticInitialisationBuildsAndWalks) { EXPECT_EQ(g_static_walk, ""); }
+
 // Every finite half, in increasing order: the independent reference for the
 // directed conversions.
 std::vector<float> all_finite_halves() {

@@ -28,19 +28,26 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
   records_ = h.node_count;
   blob_.emplace(ctx, blob.size(), "blob of " + name, 0, Memory::DeviceLocal);
   blob_->upload(blob);
-  for (Slot& s : slots_) {
-    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(ctx_.vk().CreateFence(ctx.device(), &fci, nullptr, &s.fence), "vkCreateFence");
-    s.cb = ctx.allocate_command_buffer();
-    if (ctx.has_timestamps()) {
-      VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-      q.queryType = VK_QUERY_TYPE_TIMESTAMP, q.queryCount = 2;
-      check(ctx_.vk().CreateQueryPool(ctx.device(), &q, nullptr, &s.queries), "vkCreateQueryPool");
+  try {
+    for (Slot& s : slots_) {
+      VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+      check(ctx_.vk().CreateFence(ctx.device(), &fci, nullptr, &s.fence), "vkCreateFence");
+      s.cb = ctx.allocate_command_buffer();
+      if (ctx.has_timestamps()) {
+        VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+        q.queryType = VK_QUERY_TYPE_TIMESTAMP, q.queryCount = 2;
+        check(ctx_.vk().CreateQueryPool(ctx.device(), &q, nullptr, &s.queries), "vkCreateQueryPool");
+      }
     }
+  } catch (...) {  // the slots made so far go with it (on an engine's device nothing may leak)
+    release_slots();
+    throw;
   }
 }
 
-BatchMethod::~BatchMethod() {
+BatchMethod::~BatchMethod() { release_slots(); }
+
+void BatchMethod::release_slots() {
   for (Slot& s : slots_) {
     if (s.in_flight) ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000);
     if (s.queries) ctx_.vk().DestroyQueryPool(ctx_.device(), s.queries, nullptr);

@@ -50,6 +50,7 @@ class BatchMethod : public Method {
   uint32_t records_ = 0;  // the header's node_count (BruteForce: its records)
 
  private:
+  void release_slots();
   struct Slot {
     std::unique_ptr<Buffer> rays, keys, hits;
     uint32_t capacity = 0, recorded = 0, n = 0;  // recorded: the batch size its command buffer holds

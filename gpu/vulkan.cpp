@@ -53,6 +53,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::on_message(VkDebugUtilsMessageSeverityFl
                                                    VkDebugUtilsMessageTypeFlagsEXT,
                                                    const VkDebugUtilsMessengerCallbackDataEXT* data, void* self) {
   auto* ctx = static_cast<Context*>(self);
+  std::lock_guard<std::mutex> lock(ctx->message_mutex_);
   ++ctx->messages_;
   ctx->last_message_ = data && data->pMessage ? data->pMessage : "";
   return VK_FALSE;
@@ -192,6 +193,16 @@ Context::Context(const ExternalDevice& external) : owns_device_(false) {
     VkPhysicalDeviceProperties props;
     vk_.GetPhysicalDeviceProperties(physical_, &props);
     name_ = props.deviceName;
+    // The shaders and the feature query need Vulkan 1.2 of the loader and of
+    // the device (the engine's instance must have asked for 1.2 as well).
+    uint32_t loader_version = VK_API_VERSION_1_0;
+    if (vk_.EnumerateInstanceVersion) vk_.EnumerateInstanceVersion(&loader_version);
+    if (loader_version < VK_API_VERSION_1_2)
+      throw GpuError("Vulkan: the loader offers Vulkan 1." + std::to_string(VK_API_VERSION_MINOR(loader_version)) +
+                     ", meshcast needs 1.2");
+    if (props.apiVersion < VK_API_VERSION_1_2)
+      throw GpuError("Vulkan: the engine's device " + name_ + " offers Vulkan 1." +
+                     std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ", meshcast needs 1.2");
     uint32_t families = 0;
     vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
     std::vector<VkQueueFamilyProperties> qf(families);
@@ -309,28 +320,30 @@ Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUs
   if (size_ > ctx.limits().maxStorageBufferRange)
     throw GpuError("Vulkan: the " + what + " of " + std::to_string(size_) + " bytes exceeds " + ctx.device_name() +
                    "'s maxStorageBufferRange (" + std::to_string(ctx.limits().maxStorageBufferRange) + " bytes)");
-  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  bci.size = size_, bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | usage, bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  check(ctx_.vk().CreateBuffer(ctx.device(), &bci, nullptr, &buffer_), "vkCreateBuffer");
-  VkMemoryRequirements req;
-  ctx_.vk().GetBufferMemoryRequirements(ctx.device(), buffer_, &req);
-  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  mai.allocationSize = req.size;
-  // Mapped memory is read back by the host every batch (hits, keys): cached
-  // memory where the device has it, since reading uncached (write-combined)
-  // memory runs at a fraction of the speed; coherent either way.
-  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  mai.memoryTypeIndex = !mapped ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false)
-                        : ctx.has_memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-                            ? ctx.memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-                            : ctx.memory_type(req.memoryTypeBits, host);
-  VkResult r = ctx_.vk().AllocateMemory(ctx.device(), &mai, nullptr, &memory_);
-  if (r != VK_SUCCESS) {
-    ctx_.vk().DestroyBuffer(ctx.device(), buffer_, nullptr);
-    check(r, ("allocating the " + what).c_str());
+  // A refusal part way leaves nothing behind (an engine's device lives on).
+  try {
+    VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    bci.size = size_, bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | usage, bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    check(ctx_.vk().CreateBuffer(ctx.device(), &bci, nullptr, &buffer_), "vkCreateBuffer");
+    VkMemoryRequirements req;
+    ctx_.vk().GetBufferMemoryRequirements(ctx.device(), buffer_, &req);
+    VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    mai.allocationSize = req.size;
+    // Mapped memory is read back by the host every batch (hits, keys): cached
+    // memory where the device has it, since reading uncached (write-combined)
+    // memory runs at a fraction of the speed; coherent either way.
+    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    mai.memoryTypeIndex = !mapped ? ctx.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false)
+                          : ctx.has_memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                              ? ctx.memory_type(req.memoryTypeBits, host | VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                              : ctx.memory_type(req.memoryTypeBits, host);
+    check(ctx_.vk().AllocateMemory(ctx.device(), &mai, nullptr, &memory_), ("allocating the " + what).c_str());
+    check(ctx_.vk().BindBufferMemory(ctx.device(), buffer_, memory_, 0), "vkBindBufferMemory");
+    if (mapped) check(ctx_.vk().MapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+  } catch (...) {
+    release();
+    throw;
   }
-  check(ctx_.vk().BindBufferMemory(ctx.device(), buffer_, memory_, 0), "vkBindBufferMemory");
-  if (mapped) check(ctx_.vk().MapMemory(ctx.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
 }
 
 void Buffer::upload(std::span<const uint8_t> bytes) {
@@ -348,52 +361,62 @@ void Buffer::upload(std::span<const uint8_t> bytes) {
   });
 }
 
-Buffer::~Buffer() {
+Buffer::~Buffer() { release(); }
+
+void Buffer::release() {  // null handles are ignored by Vulkan's destroy calls
   ctx_.vk().DestroyBuffer(ctx_.device(), buffer_, nullptr);
   ctx_.vk().FreeMemory(ctx_.device(), memory_, nullptr);
+  buffer_ = VK_NULL_HANDLE, memory_ = VK_NULL_HANDLE;
 }
 
 Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
                    uint32_t sets, uint32_t hit_outputs)
     : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes) {
-  VkDevice d = ctx.device();
-  std::vector<VkDescriptorSetLayoutBinding> b(bindings);
-  for (uint32_t i = 0; i < bindings; ++i)
-    b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  dl.bindingCount = bindings, dl.pBindings = b.data();
-  check(ctx_.vk().CreateDescriptorSetLayout(d, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
-  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1, pl.pSetLayouts = &set_layout_;
-  if (push_bytes) pl.pushConstantRangeCount = 1, pl.pPushConstantRanges = &range;
-  check(ctx_.vk().CreatePipelineLayout(d, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
-  VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  sm.codeSize = spirv_bytes, sm.pCode = spirv;
-  VkShaderModule module;
-  check(ctx_.vk().CreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
-  VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  // A shader that does not declare constant 0 ignores it (Vulkan spec,
-  // VkSpecializationMapEntry).
-  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-  const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &hit_outputs};
-  cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", &spec};
-  cp.layout = layout_;
-  VkResult r = ctx_.vk().CreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
-  ctx_.vk().DestroyShaderModule(d, module, nullptr);
-  check(r, "vkCreateComputePipelines");
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings * sets};
-  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dp.maxSets = sets, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
-  check(ctx_.vk().CreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
-  std::vector<VkDescriptorSetLayout> layouts(sets, set_layout_);
-  sets_handles_.resize(sets);
-  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  da.descriptorPool = pool_, da.descriptorSetCount = sets, da.pSetLayouts = layouts.data();
-  check(ctx_.vk().AllocateDescriptorSets(d, &da, sets_handles_.data()), "vkAllocateDescriptorSets");
+  try {
+    VkDevice d = ctx.device();
+    std::vector<VkDescriptorSetLayoutBinding> b(bindings);
+    for (uint32_t i = 0; i < bindings; ++i)
+      b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    dl.bindingCount = bindings, dl.pBindings = b.data();
+    check(ctx_.vk().CreateDescriptorSetLayout(d, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
+    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pl.setLayoutCount = 1, pl.pSetLayouts = &set_layout_;
+    if (push_bytes) pl.pushConstantRangeCount = 1, pl.pPushConstantRanges = &range;
+    check(ctx_.vk().CreatePipelineLayout(d, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+    VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    sm.codeSize = spirv_bytes, sm.pCode = spirv;
+    VkShaderModule module;
+    check(ctx_.vk().CreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
+    VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    // A shader that does not declare constant 0 ignores it (Vulkan spec,
+    // VkSpecializationMapEntry).
+    const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
+    const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &hit_outputs};
+    cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", &spec};
+    cp.layout = layout_;
+    VkResult r = ctx_.vk().CreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
+    ctx_.vk().DestroyShaderModule(d, module, nullptr);
+    check(r, "vkCreateComputePipelines");
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings * sets};
+    VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    dp.maxSets = sets, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
+    check(ctx_.vk().CreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
+    std::vector<VkDescriptorSetLayout> layouts(sets, set_layout_);
+    sets_handles_.resize(sets);
+    VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    da.descriptorPool = pool_, da.descriptorSetCount = sets, da.pSetLayouts = layouts.data();
+    check(ctx_.vk().AllocateDescriptorSets(d, &da, sets_handles_.data()), "vkAllocateDescriptorSets");
+  } catch (...) {
+    release();
+    throw;
+  }
 }
 
-Pipeline::~Pipeline() {
+Pipeline::~Pipeline() { release(); }
+
+void Pipeline::release() {  // null handles are ignored by Vulkan's destroy calls
   VkDevice d = ctx_.device();
   ctx_.vk().DestroyDescriptorPool(d, pool_, nullptr);
   ctx_.vk().DestroyPipeline(d, pipeline_, nullptr);

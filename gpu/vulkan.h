@@ -3,8 +3,10 @@
 // deterministically with its compute queue, or an engine's own, and small owners for buffers and compute pipelines. Nothing here knows a blob
 // layout; the methods (gpu/bruteforce.cpp, ...) do.
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <span>
 #include <string>
@@ -57,8 +59,11 @@ class Context {
   VkDevice device() const { return device_; }
   const VulkanFunctions& vk() const { return vk_; }
   const VkPhysicalDeviceLimits& limits() const { return limits_; }
-  uint32_t validation_messages() const { return messages_; }
-  const std::string& last_validation_message() const { return last_message_; }
+  uint32_t validation_messages() const { return messages_.load(); }
+  std::string last_validation_message() const {
+    std::lock_guard<std::mutex> lock(message_mutex_);
+    return last_message_;
+  }
   double timestamp_period_ns() const { return timestamp_ns_; }
   bool has_timestamps() const { return timestamps_; }
   // GpuError naming `method` when the device lacks 64-bit buffer atomics.
@@ -112,8 +117,11 @@ class Context {
   VkFence fence_ = VK_NULL_HANDLE;
   VkPhysicalDeviceLimits limits_{};
   VkPhysicalDeviceMemoryProperties memory_{};
-  std::string name_, last_message_;
-  uint32_t messages_ = 0;
+  std::string name_;
+  // The validation layer may call on_message from any thread that calls Vulkan.
+  mutable std::mutex message_mutex_;
+  std::string last_message_;
+  std::atomic<uint32_t> messages_{0};
   double timestamp_ns_ = 0;
   bool timestamps_ = false;
   bool int64_atomics_ = false;
@@ -144,6 +152,7 @@ class Buffer {
   void upload(std::span<const uint8_t> bytes);
 
  private:
+  void release();
   Context& ctx_;
   VkBuffer buffer_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
@@ -170,6 +179,7 @@ class Pipeline {
 
  private:
   void bind_for(VkCommandBuffer cb, uint32_t set, const void* push) const;
+  void release();
   Context& ctx_;
   uint32_t bindings_, push_bytes_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;

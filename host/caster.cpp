@@ -73,12 +73,14 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
     s->index = i;
     Slot* sp = s.get();
     s->work = [this, sp](uint32_t job) {
+      calls_in_work_.fetch_add(1, std::memory_order_acquire);
       const auto t0 = std::chrono::steady_clock::now();
       const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
       view_.trace(std::span<const Ray>(sp->rays).subspan(first, count), std::span<Hit>(sp->hits).subspan(first, count),
                   options_.hit_outputs);
       sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
       if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu);
+      calls_in_work_.fetch_sub(1, std::memory_order_release);  // the last touch of the caster
     };
     slots_.push_back(std::move(s));
   }
@@ -130,9 +132,12 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
   crossover_note_ = "being measured in the background; the CPU answers meanwhile";
   measuring_ = std::thread([this] {
     try {
-      measure_crossover();
-    } catch (const std::exception& e) {  // the GPU failed while measured: the CPU it is
+      measure_crossover();  // publishes the crossover, its note and crossover_known_ together
+    } catch (const GpuError& e) {  // the GPU failed while measured: the CPU it is
       gpu_failed(std::string("measuring the crossover: ") + e.what());
+    } catch (const std::exception& e) {  // anything else (memory): the GPU stays, the crossover stays unmeasured
+      std::lock_guard<std::mutex> lock(mutex_);
+      crossover_note_ = std::string("not measured: ") + e.what();
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -164,6 +169,12 @@ Caster::~Caster() {
   }
   pending_changed_.notify_all();
   if (completion_.joinable()) completion_.join();
+  // A job that completed its slot may still be returning from the slot's
+  // work: the slots (and the work they own) go only once every call is out,
+  // and our own pool's workers are joined before the slots they call into.
+  while (calls_in_work_.load(std::memory_order_acquire) != 0) std::this_thread::yield();
+  pool_.reset();
+  jobs_ = nullptr;
   method_.reset();
   gpu_.reset();
 }
@@ -249,6 +260,9 @@ void Caster::start_cpu(Slot& s) {
   const uint32_t jobs = (s.n + per - 1) / per;
   s.chunk = per;
   s.jobs_left = jobs;
+  // The game's thread, the measurement and the GPU completions may all start
+  // CPU batches; a JobSystem need not take two run() calls at once.
+  std::lock_guard<std::mutex> lock(jobs_mutex_);
   jobs_->run(jobs, s.work);
 }
 
@@ -487,20 +501,22 @@ void Caster::measure_crossover() {
   note << "at " << sizes[at] << " rays " << device_name() << " took " << gpu[at] << " ms, " << cpu_threads()
        << " CPU threads " << cpu[at] << " ms; measured at start-up";
   const uint32_t crossover = first < sizes.size() ? sizes[first] : ~0u;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    crossover_note_ = note.str();
-    crossover_ = crossover;
+  std::string saved;
+  if (!options_.profile.empty()) {
+    try {
+      OutputText out(options_.profile);
+      out << "meshcast-profile 1\n" << profile_key(device_name(), view_) << "\n" << crossover << "\n" << note.str() << "\n";
+      out.commit();
+    } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
+      saved = std::string("; not saved: ") + e.what();
+    }
   }
-  if (options_.profile.empty()) return;
-  try {
-    OutputText out(options_.profile);
-    out << "meshcast-profile 1\n" << profile_key(device_name(), view_) << "\n" << crossover << "\n" << note.str() << "\n";
-    out.commit();
-  } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
-    std::lock_guard<std::mutex> lock(mutex_);
-    crossover_note_ += std::string("; not saved: ") + e.what();
-  }
+  // Published together, after the profile is written: no reader sees a
+  // crossover without its note, or a known crossover the file lacks.
+  std::lock_guard<std::mutex> lock(mutex_);
+  crossover_note_ = note.str() + saved;
+  crossover_ = crossover;
+  crossover_known_ = true;
 }
 
 }  // namespace meshcast::host

@@ -178,6 +178,8 @@ class Caster {
 
   mutable std::mutex mutex_;            // slots and records
   std::mutex gpu_mutex_;                // the GPU method's begin and finish
+  std::mutex jobs_mutex_;               // one JobSystem::run at a time (game thread, measurement, completions)
+  std::atomic<uint32_t> calls_in_work_{0};  // jobs still inside a slot's work, even after it completed
   std::condition_variable changed_;     // a slot became ready
   std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
   uint32_t game_slots_ = 0;

@@ -10,6 +10,9 @@ namespace meshcast::host {
 // run(count, work) arranges for work(i) to be called once for every i in
 // [0, count), on any threads, and may return before they run. `work` stays
 // alive until every call has returned (the caster keeps it per frame slot).
+// The caster never calls run() from two threads at once (it serializes its
+// own calls), so an implementation need not be thread-safe against itself;
+// it is called from the game's thread and from the caster's own threads.
 class JobSystem {
  public:
   virtual ~JobSystem() = default;

@@ -134,6 +134,19 @@ inline int bits(M8 m) { return _mm256_movemask_ps(m.v); }
 inline M8 lanes_below8(uint32_t n) {
   return {_mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(int(n)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)))};
 }
+inline F8 min(F8 a, F8 b) { return {_mm256_min_ps(a.v, b.v)}; }  // NaN -> b, as F4's
+inline F8 max(F8 a, F8 b) { return {_mm256_max_ps(a.v, b.v)}; }
+inline F8 fma(F8 a, F8 b, F8 c) { return {_mm256_fmadd_ps(a.v, b.v, c.v)}; }
+inline F8 select(M8 m, F8 a, F8 b) { return {_mm256_blendv_ps(b.v, a.v, m.v)}; }  // m ? a : b
+inline F8 from_u8x8(const uint8_t* p) {  // 8 bytes -> 8 floats
+  int64_t x;
+  std::memcpy(&x, p, 8);
+  return {_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_cvtsi64_si128(x)))};
+}
+inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at p is not 0
+  const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+  return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(w, _mm256_setzero_si256()))) ^ 0xFF;
+}
 
 #else  // MESHCAST_SCALAR
 
@@ -180,6 +193,7 @@ template <int N> inline int bits(MN<N> m) { int b = 0; for (int i = 0; i < N; ++
 inline M4 lanes_below(uint32_t n) MC_LANES(M4, uint32_t(i) < n)
 inline M4 lanes_of(uint32_t bits) MC_LANES(M4, (bits >> i & 1) != 0)
 inline M8 lanes_below8(uint32_t n) MC_LANES(M8, uint32_t(i) < n)
+inline F8 from_u8x8(const uint8_t* p) MC_LANES(F8, float(p[i]))
 inline M4 nonzero(I4 a) MC_LANES(M4, a.v[i] != 0)
 inline F4 from_u16(const uint8_t* p) MC_LANES(F4, float(uint32_t(p[2 * i] | p[2 * i + 1] << 8)))
 inline F4 from_half(const uint8_t* p) MC_LANES(F4, layout::half_to_float(uint16_t(p[2 * i] | p[2 * i + 1] << 8)))
@@ -198,6 +212,15 @@ inline void bitpack_gather(const uint8_t* base, I4 index, const float offset[3],
     layout::bitpack_decode(w, offset, scale, v);
     for (int j = 0; j < 3; ++j) out[j].v[i] = v[axis[j]];
   }
+}
+inline int nonzero_bits8(const uint8_t* p) {
+  int b = 0;
+  for (int i = 0; i < 8; ++i) {
+    uint32_t w;
+    std::memcpy(&w, p + 4 * i, 4);
+    b |= int(w != 0) << i;
+  }
+  return b;
 }
 inline F4 gather(const float* base, I4 idx) {
   F4 r;

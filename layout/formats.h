@@ -52,6 +52,7 @@
 #define MC_TREE_AABBLIST 10u           // §7: 256-triangle batches, one box each
 #define MC_TREE_ZEROBYTE 11u           // seed 004: the index buffer is the tree
 #define MC_TREE_ZEROBYTEHYBRID 12u     // seed 004's future work: AABBTree nodes over zero-byte leaves
+#define MC_TREE_OCTTREECOMPRESSED 13u  // issue 19: 8 children a node, 8-bit boxes on power-of-two scales
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
@@ -207,6 +208,35 @@
 #define MC_QUAD_PROPERTIES_AT 96u      // the 4 properties' byte in a QuadTree node
 #define MC_QUADHALF_PROPERTIES_AT 48u  // in a QuadTreeHalfFloat node
 // Offsets are relative to the start of the tree section.
+
+// OctTreeCompressed (issue 19; the 8-wide sibling of QuadTree, named like it
+// for its branching, not a spatial octree): 96-byte nodes of 8 children,
+// each child box coded in 8 bits an axis against the node's frame, as
+// Ylitie, Karras and Laine 2017 code CWBVH's:
+//   Origin (3 floats), Exponents (3 bytes, e + 127: the float 2^e's own
+//   exponent field), 1 byte unused, QLo x[8], y[8], z[8], QHi x[8], y[8],
+//   z[8] (bytes), ChildProperties[8] (uint32)
+//   bound = Origin[a] + q * 2^e[a], a minimum's q rounded down and a
+// maximum's up. The writer picks e and Origin so that every one of the 256
+// values is a float (Origin a multiple of 2^e, and 2^e no finer than the
+// float spacing at the node's largest coordinate): the decode (one fma) is
+// exact, so no bound depends on rounding or on the distance from the origin.
+// A child property is 5 bits of triangle count (0: a node) over 27 bits of
+// tree-section offset in 4-byte units (512 MiB); 0 is an unused child, whose
+// QLo 255 and QHi 0 no ray enters. Children sit in the slots that order them
+// front to back for the ray octant of each slot's index (CWBVH's
+// assignment), which a walker without a sort may follow.
+#define MC_OCT_NODE_BYTES 96u
+#define MC_OCT_WIDTH 8u
+#define MC_OCT_ORIGIN_AT 0u            // Origin's byte in the node
+#define MC_OCT_EXPONENTS_AT 12u        // the 3 exponent bytes
+#define MC_OCT_QLO_AT 16u              // QLo rows: x[8], y[8], z[8]
+#define MC_OCT_QHI_AT 40u              // QHi rows
+#define MC_OCT_PROPERTIES_AT 64u       // the 8 child properties
+#define MC_OCT_COUNT_SHIFT 27u
+#define MC_OCT_OFFSET_MASK 0x07FFFFFFu
+#define MC_OCT_OFFSET_UNIT 4u
+#define MC_OCT_MAX_COUNT 31u
 
 // Triangle blocks.
 #define MC_FLOAT3_TRI_BYTES 36u        // 9 floats a triangle

@@ -30,6 +30,7 @@ enum class TreeFormat : uint32_t {
   AABBList = 10,
   ZeroByteTree = 11,
   ZeroByteHybrid = 12,
+  OctTreeCompressed = 13,  // 8 children a node, boxes in 8 bits on power-of-two scales (issue 19)
 };
 
 // The triangle formats of seed 000 §3, seeds 003 and 004. The BitPack ones

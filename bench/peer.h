@@ -20,8 +20,14 @@ class Peer {
   virtual void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits) const = 0;
 };
 
-// Embree 3 (libembree-dev), default scene flags: its fast mode. nullptr when
-// meshcast was built without Embree.
-std::unique_ptr<Peer> make_embree(const Mesh& mesh);
+// Embree 3 (libembree-dev) builds: Default (its fast mode, the default scene
+// flags), Robust (RTC_SCENE_FLAG_ROBUST: no leaks at edges, slower) and
+// Compact (RTC_SCENE_FLAG_COMPACT: triangle4i leaves that index the mesh),
+// built with `threads` threads (0: all cores); tracing is one thread either
+// way. bytes(): what Embree allocates for the scene plus the mesh it keeps
+// and reads (12 bytes a vertex, 12 a triangle), shared with it, not copied.
+// nullptr when meshcast was built without Embree.
+enum class EmbreeMode { Default, Robust, Compact };
+std::unique_ptr<Peer> make_embree(const Mesh& mesh, EmbreeMode mode = EmbreeMode::Default, uint32_t threads = 1);
 
 }  // namespace meshcast::bench

@@ -1,5 +1,6 @@
-// Embree 3 as a peer: one triangle geometry holding the input mesh as is,
-// rtcIntersect1 per ray, memory counted through the device's memory monitor.
+// Embree 3 as a peer: one triangle geometry over the input mesh, shared
+// (Embree reads our arrays), rtcIntersect1 per ray, Embree's own memory
+// counted through the device's memory monitor.
 #include <embree3/rtcore.h>
 
 #include <atomic>
@@ -13,8 +14,8 @@ namespace {
 
 class Embree final : public Peer {
  public:
-  explicit Embree(const Mesh& mesh) {
-    device_ = rtcNewDevice("threads=1");
+  Embree(const Mesh& mesh, EmbreeMode mode, uint32_t threads) : mode_(mode) {
+    device_ = rtcNewDevice(("threads=" + std::to_string(threads)).c_str());
     if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
     rtcSetDeviceMemoryMonitorFunction(
         device_,
@@ -26,14 +27,20 @@ class Embree final : public Peer {
     auto t0 = std::chrono::steady_clock::now();
     scene_ = rtcNewScene(device_);
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), mesh.vertices.size()));
+    // Embree reads a vertex buffer with 16-byte loads: 4 bytes of padding.
+    vertices_.resize(3 * mesh.vertices.size() + 1, 0.0f);
     for (size_t i = 0; i < mesh.vertices.size(); ++i)
-      v[3 * i] = mesh.vertices[i].x, v[3 * i + 1] = mesh.vertices[i].y, v[3 * i + 2] = mesh.vertices[i].z;
-    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(unsigned), mesh.triangles.size()));
+      for (int a = 0; a < 3; ++a) vertices_[3 * i + size_t(a)] = mesh.vertices[i][a];
+    indices_.resize(3 * mesh.triangles.size());
     for (size_t t = 0; t < mesh.triangles.size(); ++t)
-      for (int c = 0; c < 3; ++c) idx[3 * t + c] = mesh.triangles[t][c];
+      for (int c = 0; c < 3; ++c) indices_[3 * t + size_t(c)] = mesh.triangles[t][size_t(c)];
+    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vertices_.data(), 0,
+                               3 * sizeof(float), mesh.vertices.size());
+    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices_.data(), 0,
+                               3 * sizeof(unsigned), mesh.triangles.size());
+    mesh_bytes_ = 12ull * mesh.vertices.size() + 12ull * mesh.triangles.size();
+    if (mode == EmbreeMode::Robust) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+    if (mode == EmbreeMode::Compact) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_COMPACT);
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(scene_, geometry);
     rtcReleaseGeometry(geometry);
@@ -44,11 +51,13 @@ class Embree final : public Peer {
     rtcReleaseScene(scene_);
     rtcReleaseDevice(device_);
   }
-  std::string name() const override { return "Embree " + std::to_string(RTC_VERSION_MAJOR) + "." +
-                                             std::to_string(RTC_VERSION_MINOR) + "." +
-                                             std::to_string(RTC_VERSION_PATCH); }
+  std::string name() const override {
+    const char* mode = mode_ == EmbreeMode::Robust ? " robust" : mode_ == EmbreeMode::Compact ? " compact" : " default";
+    return "Embree " + std::to_string(RTC_VERSION_MAJOR) + "." + std::to_string(RTC_VERSION_MINOR) + "." +
+           std::to_string(RTC_VERSION_PATCH) + mode;
+  }
   double build_ms() const override { return build_ms_; }
-  uint64_t bytes() const override { return uint64_t(bytes_.load()); }
+  uint64_t bytes() const override { return uint64_t(bytes_.load()) + mesh_bytes_; }
   void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits) const override {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
@@ -65,6 +74,10 @@ class Embree final : public Peer {
   }
 
  private:
+  EmbreeMode mode_;
+  std::vector<float> vertices_;
+  std::vector<unsigned> indices_;
+  uint64_t mesh_bytes_ = 0;
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   double build_ms_ = 0;
@@ -73,6 +86,8 @@ class Embree final : public Peer {
 
 }  // namespace
 
-std::unique_ptr<Peer> make_embree(const Mesh& mesh) { return std::make_unique<Embree>(mesh); }
+std::unique_ptr<Peer> make_embree(const Mesh& mesh, EmbreeMode mode, uint32_t threads) {
+  return std::make_unique<Embree>(mesh, mode, threads);
+}
 
 }  // namespace meshcast::bench

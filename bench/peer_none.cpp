@@ -2,6 +2,6 @@
 
 namespace meshcast::bench {
 
-std::unique_ptr<Peer> make_embree(const Mesh&) { return nullptr; }
+std::unique_ptr<Peer> make_embree(const Mesh&, EmbreeMode, uint32_t) { return nullptr; }
 
 }  // namespace meshcast::bench

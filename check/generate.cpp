@@ -1,7 +1,9 @@
 #include "check/generate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace meshcast {
 namespace {
@@ -101,6 +103,94 @@ Mesh make_terrain(int nx, int ny, uint32_t seed) {
     }
   grid_triangles(m, nx, ny);
   return m;
+}
+
+namespace {
+
+void append(Mesh& to, const Mesh& from) {
+  const uint32_t base = uint32_t(to.vertices.size());
+  to.vertices.insert(to.vertices.end(), from.vertices.begin(), from.vertices.end());
+  for (const Triangle& t : from.triangles) to.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+}
+
+// A closed box [lo, hi] whose faces are grids of cells of about `cell`,
+// outward-facing; the edges are shared, so the box is watertight.
+Mesh make_box(Vec3 lo, Vec3 hi, float cell) {
+  Mesh m;
+  const float size[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+  int n[3];
+  for (int a = 0; a < 3; ++a) n[a] = std::max(1, int(std::lround(size[a] / cell)));
+  // Vertices on the box surface: every lattice point with one coordinate at
+  // its minimum or maximum, numbered through a map of lattice coordinates.
+  std::vector<int32_t> index(size_t(n[0] + 1) * (n[1] + 1) * (n[2] + 1), -1);
+  auto vertex = [&](int i, int j, int k) {
+    int32_t& at = index[(size_t(k) * (n[1] + 1) + j) * (n[0] + 1) + i];
+    if (at < 0) {
+      at = int32_t(m.vertices.size());
+      m.vertices.push_back({lo.x + size[0] * float(i) / float(n[0]), lo.y + size[1] * float(j) / float(n[1]),
+                            lo.z + size[2] * float(k) / float(n[2])});
+    }
+    return uint32_t(at);
+  };
+  // Face of axis a at side s (0 min, 1 max), spanned by axes u, v.
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (a + 1) % 3, v = (a + 2) % 3;
+      for (int y = 0; y < n[v]; ++y)
+        for (int x = 0; x < n[u]; ++x) {
+          auto at = [&](int du, int dv) {
+            int c[3];
+            c[a] = side * n[a], c[u] = x + du, c[v] = y + dv;
+            return vertex(c[0], c[1], c[2]);
+          };
+          // (u, v, a) is right-handed: counter-clockwise in (u, v) faces +a.
+          if (side) quad(m, at(0, 0), at(1, 0), at(0, 1), at(1, 1));
+          else quad(m, at(0, 0), at(0, 1), at(1, 0), at(1, 1));
+        }
+    }
+  return m;
+}
+
+}  // namespace
+
+Mesh make_city(size_t triangles, uint32_t seed) {
+  require(triangles >= 10000, "make_city: needs at least 10,000 triangles");
+  uint64_t state = seed;
+  constexpr float kSide = 2000.0f, kBlock = 50.0f, kStreet = 12.0f;
+  // The ground: a gentle terrain a tenth of the budget, stretched over the city.
+  const int cells = std::max(8, int(std::sqrt(double(triangles) / 20.0)));
+  Mesh city = make_terrain(cells, cells, seed);
+  const float stretch = kSide / float(cells);
+  for (Vec3& v : city.vertices) v = {v.x * stretch, v.y * stretch, v.z * 0.25f - 3.0f};
+  // Buildings to half the budget, block by block in a random order of blocks.
+  const int blocks = int(kSide / kBlock);
+  std::vector<float> roofs;  // x, y, z of roof tops, for objects on them
+  while (city.triangles.size() < triangles / 2) {
+    const int bx = int(unit(state) * blocks), by = int(unit(state) * blocks);
+    const float x0 = float(bx) * kBlock + kStreet / 2, y0 = float(by) * kBlock + kStreet / 2;
+    const float room = kBlock - kStreet;
+    const float w = 3.0f + float(unit(state)) * (room - 3.0f), d = 3.0f + float(unit(state)) * (room - 3.0f);
+    const float h = 3.0f + float(std::pow(unit(state), 3.0)) * 150.0f;  // mostly low, some towers
+    const float x = x0 + float(unit(state)) * (room - w), y = y0 + float(unit(state)) * (room - d);
+    append(city, make_box({x, y, 0.0f}, {x + w, y + d, h}, 2.5f));
+    roofs.insert(roofs.end(), {x + w / 2, y + d / 2, h});
+  }
+  // Detailed objects to the budget: in the streets or on a roof.
+  while (city.triangles.size() < triangles) {
+    const int rings = 8 + int(unit(state) * 88);
+    const float radius = 0.15f + float(unit(state)) * 3.0f;
+    Vec3 at;
+    if (!roofs.empty() && unit(state) < 0.3) {
+      const size_t r = size_t(unit(state) * double(roofs.size() / 3)) * 3;
+      at = {roofs[r], roofs[r + 1], roofs[r + 2] + radius};
+    } else {
+      const float street = float(int(unit(state) * blocks)) * kBlock + float(unit(state)) * kStreet / 2;
+      const float along = float(unit(state)) * kSide;
+      at = unit(state) < 0.5 ? Vec3{street, along, radius} : Vec3{along, street, radius};
+    }
+    append(city, make_sphere(rings, 2 * rings, radius, at));
+  }
+  return city;
 }
 
 }  // namespace meshcast

@@ -21,4 +21,12 @@ Mesh make_grid_plane(int nx, int ny);
 // frequencies and phases come from the seed). Same arguments, same mesh.
 Mesh make_terrain(int nx, int ny, uint32_t seed);
 
+// A city-like scene of about `triangles` triangles over a square of 2 km: a
+// terrain ground, buildings (closed boxes of many sizes, their walls split
+// into cells of about 2.5 m, so a tower has thousands of triangles and a
+// shed a few dozen) on a street grid, and among them detailed objects (UV
+// spheres of 8 to 96 rings, 0.3 to 6 m across) scattered in the streets and
+// on the roofs: large and tiny triangles side by side, as in a game level.
+Mesh make_city(size_t triangles, uint32_t seed);
+
 }  // namespace meshcast

@@ -27,6 +27,7 @@ namespace meshcast::tools {
 Mesh bench_mesh(const std::string& input) {
   if (input == "terrain_2M") return make_terrain(1024, 1024, 5);
   if (input == "terrain_66k") return make_terrain(256, 256, 5);
+  if (input == "city_1M") return make_city(1000000, 7);
   return read_mesh(input);
 }
 
@@ -424,6 +425,7 @@ void add_bench(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "reproduce the source documents' tables");
   bench->require_subcommand(1);
   add_bench_auto(bench);
+  add_bench_peers(bench);
   add_bench_encodings(bench);
   add_bench_tables(bench);
   add_bench_gpu(bench);

@@ -1,0 +1,34 @@
+// `meshcast bench peers` (issue 19): meshcast's layouts beside Embree's
+// default, robust and compact builds on the same rays in one run: rounds
+// interleave every contender and ray kind, the median of the rounds is
+// reported, tracing on one thread.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "meshcast/mesh.h"
+
+namespace meshcast::bench {
+
+struct PeerRow {
+  std::string mesh, kind, contender;
+  bool is_peer = false;       // an Embree build
+  double ns_per_ray = 0;      // median of the rounds
+  double ratio = 0;           // to Embree default on the same mesh and rays (0 without Embree)
+  double bytes_per_triangle;  // all included: the blob with its remap; Embree's scene and the mesh it keeps
+  double build_ms_one = 0;    // one thread
+  double build_ms_all = 0;    // all cores (meshcast's builder is serial: the same build)
+};
+
+struct PeersOptions {
+  std::vector<std::string> layouts;  // meshcast layouts to measure
+  size_t rays = 10000;               // a set, for each of long, probe and radial
+  uint32_t rounds = 7;
+};
+
+// The meshcast layouts `bench peers` measures unless told otherwise.
+std::vector<std::string> default_peer_layouts();
+
+std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& options);
+
+}  // namespace meshcast::bench

@@ -1,0 +1,111 @@
+// `meshcast bench peers` (issue 19): meshcast's layouts beside Embree's
+// builds on the test meshes, the 2M terrain and the 1M city; Markdown, CSV
+// and a plot of time against bytes, one point per layout and peer.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "bench/peers.h"
+#include "bench/plot.h"
+#include "layout/files.h"
+#include "tools/commands.h"
+#include "tools/common.h"
+
+namespace meshcast::tools {
+
+namespace {
+
+// The processor, as /proc/cpuinfo names it (figures count only with it).
+std::string processor_name() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  std::string flags;
+  std::string name = "unknown processor";
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0 && name == "unknown processor") name = line.substr(line.find(':') + 2);
+    if (line.rfind("flags", 0) == 0 && flags.empty()) flags = line;
+  }
+  const bool avx512 = flags.find(" avx512f") != std::string::npos, avx2 = flags.find(" avx2") != std::string::npos;
+  return name + (avx512 ? " (AVX-512)" : avx2 ? " (AVX2, no AVX-512)" : " (no AVX2)");
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string part; std::getline(in, part, ',');)
+    if (!part.empty()) out.push_back(part);
+  return out;
+}
+
+}  // namespace
+
+void add_bench_peers(CLI::App* bench) {
+  struct Args {
+    std::string meshes = "data/bunny00.off,data/armadillo.off,data/refined_elephant.off,data/ChineseDragon-10kv.off,"
+                         "terrain_2M,city_1M";
+    std::string layouts, out_dir = "out";
+    size_t rays = 10000;
+    uint32_t rounds = 7;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = bench->add_subcommand("peers", "issue 19: meshcast's layouts beside Embree default, robust and compact");
+  cmd->add_option("--meshes", args->meshes, "comma-separated mesh files, terrain_2M or city_1M (default: all six)");
+  cmd->add_option("--layouts", args->layouts, "comma-separated meshcast layouts (default: the OctTree and QuadTree ones)");
+  cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(CLI::Range(size_t(100), size_t(1000000)));
+  cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(CLI::Range(1, 100));
+  cmd->add_option("--out-dir", args->out_dir, "where peers.csv and peers.png go");
+  cmd->callback([args] {
+    bench::PeersOptions o;
+    o.layouts = args->layouts.empty() ? bench::default_peer_layouts() : split(args->layouts);
+    o.rays = args->rays, o.rounds = args->rounds;
+    std::filesystem::create_directories(args->out_dir);
+    std::vector<bench::PeerRow> rows;
+    for (const std::string& input : split(args->meshes)) {
+      Mesh mesh = bench_mesh(input);
+      std::fprintf(stderr, "%s: %zu triangles\n", input.c_str(), mesh.triangles.size());
+      std::vector<bench::PeerRow> r = bench::bench_peers(mesh, std::filesystem::path(input).stem().string(), o);
+      rows.insert(rows.end(), r.begin(), r.end());
+    }
+    std::printf("\n%s; one thread tracing, %zu rays a set, median of %u interleaved rounds; ratio: to Embree default "
+                "on the same rays; bytes a triangle all included (meshcast: the whole blob with its remap; Embree: "
+                "its scene plus the mesh it keeps); build: one thread / all cores (meshcast's builder is serial)\n\n"
+                "| mesh | rays | layout or peer | ns/ray | ratio | B/tri | build ms (1 / all) |\n"
+                "|---|---|---|---:|---:|---:|---:|\n",
+                processor_name().c_str(), o.rays, o.rounds);
+    OutputText csv(args->out_dir + "/peers.csv");
+    csv << "mesh,rays,contender,peer,ns_per_ray,ratio_to_embree_default,bytes_per_triangle,build_ms_one_thread,"
+           "build_ms_all_cores\n";
+    // The plot: each contender's geometric mean ratio over the rows against
+    // its mean bytes a triangle.
+    std::map<std::string, std::pair<double, double>> log_ratio_bytes;
+    std::map<std::string, int> counted;
+    std::vector<std::string> order;
+    for (const bench::PeerRow& r : rows) {
+      std::printf("| %s | %s | %s | %.0f | %.2f | %.1f | %.0f / %.0f |\n", r.mesh.c_str(), r.kind.c_str(),
+                  r.contender.c_str(), r.ns_per_ray, r.ratio, r.bytes_per_triangle, r.build_ms_one, r.build_ms_all);
+      csv << r.mesh << "," << r.kind << "," << r.contender << "," << (r.is_peer ? 1 : 0) << "," << r.ns_per_ray << ","
+          << r.ratio << "," << r.bytes_per_triangle << "," << r.build_ms_one << "," << r.build_ms_all << "\n";
+      if (!counted.count(r.contender)) order.push_back(r.contender);
+      auto& [lr, b] = log_ratio_bytes[r.contender];
+      lr += std::log(r.ratio > 0 ? r.ratio : 1.0), b += r.bytes_per_triangle;
+      ++counted[r.contender];
+    }
+    csv.commit();
+    bench::Series meshcast{"meshcast", {}}, embree{"Embree", {}};
+    for (const std::string& c : order) {
+      const double n = counted[c];
+      const bench::Point p{log_ratio_bytes[c].second / n, std::exp(log_ratio_bytes[c].first / n), c};
+      (c.rfind("Embree", 0) == 0 ? embree : meshcast).points.push_back(p);
+    }
+    const std::string png = args->out_dir + "/peers.png";
+    const std::string why = bench::plot_scatter(png, "time against bytes, geometric mean over the rows",
+                                                "bytes a triangle, all included", "time a ray / Embree default time a ray",
+                                                {meshcast, embree}, false);
+    std::printf("\ncsv: %s/peers.csv\nplot: %s\n", args->out_dir.c_str(), why.empty() ? png.c_str() : why.c_str());
+  });
+}
+
+}  // namespace meshcast::tools

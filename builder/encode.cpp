@@ -272,13 +272,9 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
                        std::to_string(MC_LBVH_MAX_DEPTH + 1) + " (2^26 node slots)");
     depth_limit = d - 1;
   }
-  std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
-  BuildOptions binary = o;
-  binary.leaf_size = tree_writer->binary_leaf_size(o.leaf_size);
   BuildTree tree;
   try {
-    tree = build_for(mesh, binary, boxes, codec, depth_limit, report);
-    tree_writer->reshape(tree, codec, o.leaf_size);
+    tree = build_for(mesh, o, boxes, codec, depth_limit, report);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());
   }
@@ -287,6 +283,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const s
   BlobHeader& hd = writer.h;
   writer.measure_leaves();
 
+  std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
   try {
     tree_writer->plan(writer);
   } catch (const InputError& e) {

@@ -1,8 +1,10 @@
-// OctTreeCompressed (issue 19): the binary SAH tree, built with leaves of at
-// most two triangles, has its leaves chosen again by an SAH collapse that
-// counts a leaf's cost in whole triangle blocks; the wide plan then gives
-// every node up to 8 children, which sit in the slots that order them for
-// the rays of each octant.
+// OctTreeCompressed (issue 19): the binary SAH tree with the caller's leaves;
+// the wide plan gives every node up to 8 children (the largest interior
+// descendants opened first), which sit in the slots that order them for the
+// rays of each octant. An SAH collapse that chose the leaves again, counting
+// a leaf in whole triangle blocks (from a tree of 2-triangle leaves), was
+// measured and left out: no faster, and 20-22 bytes a triangle against 16
+// (bench/RESULTS.md).
 #include <array>
 #include <limits>
 
@@ -12,62 +14,6 @@
 namespace meshcast {
 
 namespace {
-
-// The collapse's costs, in units of one triangle block test: an 8-box node
-// test costs about one block test, and an 8-wide node stands in for about
-// seven binary ones, so a binary node is charged a seventh of it.
-constexpr double kBlockCost = 1.0;
-constexpr double kBinaryNodeCost = 1.0 / 7.0;
-
-// Bottom-up SAH choice for every binary node: a leaf of all its triangles
-// (when they are at most `cap`, contiguous in the order, and blocks of
-// `lanes` cost less) or a node over its two children's best; then the tree
-// rebuilt, parents before children, with the chosen leaves.
-BuildTree collapse_leaves(const BuildTree& t, uint32_t lanes, uint32_t cap) {
-  const size_t n = t.nodes.size();
-  std::vector<uint32_t> first(n), count(n);
-  std::vector<double> best(n);
-  std::vector<char> leaf(n, 0);
-  auto blocks = [&](uint32_t c) { return double((c + lanes - 1) / lanes); };
-  for (size_t i = n; i-- > 0;) {  // children follow their parent in the builder's order
-    const BuildNode& b = t.nodes[i];
-    const double area = b.box.half_area();
-    if (b.leaf()) {
-      first[i] = b.first, count[i] = b.count, best[i] = area * blocks(b.count) * kBlockCost, leaf[i] = 1;
-      continue;
-    }
-    const uint32_t l = b.left, r = b.right;
-    count[i] = count[l] + count[r];
-    first[i] = std::min(first[l], first[r]);
-    const bool contiguous = first[r] == first[l] + count[l] || first[l] == first[r] + count[r];
-    const double split = area * kBinaryNodeCost + best[l] + best[r];
-    const double as_leaf = count[i] <= cap && contiguous ? area * blocks(count[i]) * kBlockCost
-                                                          : std::numeric_limits<double>::infinity();
-    leaf[i] = as_leaf <= split;
-    best[i] = std::min(as_leaf, split);
-  }
-  BuildTree out;
-  out.order = t.order;
-  out.sah_cost = t.sah_cost;
-  struct Item { uint32_t binary, parent, depth; bool right; };
-  std::vector<Item> stack{{0, 0, 0, false}};
-  while (!stack.empty()) {
-    const Item it = stack.back();
-    stack.pop_back();
-    const uint32_t at = uint32_t(out.nodes.size());
-    BuildNode node;
-    node.box = t.nodes[it.binary].box;
-    if (leaf[it.binary]) node.first = first[it.binary], node.count = count[it.binary];
-    out.nodes.push_back(node);
-    out.depth = std::max(out.depth, it.depth);
-    if (at != 0) (it.right ? out.nodes[it.parent].right : out.nodes[it.parent].left) = at;
-    if (!leaf[it.binary]) {
-      stack.push_back({t.nodes[it.binary].right, at, it.depth + 1, true});
-      stack.push_back({t.nodes[it.binary].left, at, it.depth + 1, false});
-    }
-  }
-  return out;
-}
 
 // CWBVH's slot order: bit a of a slot stands for the positive side of axis
 // a, so a ray whose octant has bit a set when its direction is negative
@@ -125,10 +71,6 @@ void write_oct_node(const BuildTree& t, const WidePlan& p, uint32_t q, uint8_t* 
 class OctWriter : public TreeWriter {
  public:
   explicit OctWriter(NodeOrder order) : order_(order == NodeOrder::Default ? NodeOrder::DepthFirstTrianglesLast : order) {}
-  uint32_t binary_leaf_size(uint32_t asked) const override { return std::min(asked, 2u); }
-  void reshape(BuildTree& t, const CodecOps& codec, uint32_t asked) override {
-    t = collapse_leaves(t, codec.lanes, std::min(asked, MC_OCT_MAX_COUNT));
-  }
   void plan(Writer& w) override {
     plan_ = plan_wide(w.tree, MC_OCT_WIDTH);
     place_wide(w, plan_, order_, MC_OCT_NODE_BYTES, uint64_t(MC_OCT_OFFSET_MASK) * MC_OCT_OFFSET_UNIT,

@@ -150,12 +150,6 @@ struct TreeWriter {
   virtual void fill(Writer& w) = 0;
   // Deepest node a walker's stack must hold (the wide trees' is their own).
   virtual uint32_t depth(const BuildTree& t) const { return t.depth; }
-  // The leaf size the binary tree is built with for a caller's leaf size,
-  // and a reshaping of that tree before its leaves are measured: a format
-  // that decides its own leaves (OctTreeCompressed's SAH collapse) builds
-  // finer and merges.
-  virtual uint32_t binary_leaf_size(uint32_t asked) const { return asked; }
-  virtual void reshape(BuildTree&, const CodecOps&, uint32_t /*asked leaf size*/) {}
 };
 
 // Each tree format's writer (a make_writer overload on its catalog tag, in

@@ -207,10 +207,48 @@ inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t bl
   return at;
 }
 
+// Cluster leaves (layout/cluster.h): each cluster's 16 vertices decoded into
+// registers once, a row of 8 corners permuted out of them per corner and
+// axis, 8 triangles a test. The leaf's triangles are numbered cluster by
+// cluster. Returns the leaf's bytes (what the decode read, padded to 4).
+template <class Codec>
+inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
+                              Closest& c) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  uint32_t at = block, made = 0;
+  while (made < count) {
+    const uint64_t origin = layout::load<uint64_t>(blob + at);
+    const uint32_t vertices = Codec::vertex_count(blob, at), triangles = Codec::triangle_count(blob, at);
+    const bool wide = Codec::wide(blob, at);
+    const uint32_t rows = Codec::rows_at(blob, at), row_bytes = (wide ? 4 : 2) * vertices;
+    simd::V16 corner_axis[3];  // vertex coordinates in the ray's axis order
+    for (int j = 0; j < 3; ++j) {
+      const int a = r.axis[j];
+      corner_axis[j] = simd::cluster_decode(blob + rows + uint32_t(a) * row_bytes, vertices, wide, layout::bitpack_component(origin, a),
+                                            h.quant_scale[a], h.quant_offset[a]);
+    }
+    const uint8_t* index = blob + Codec::index_at(at);
+    for (uint32_t first = 0; first < triangles; first += 8, index += MC_CLUSTER_INDEX_BLOCK_BYTES) {
+      simd::F8 v[3][3];
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t nibbles = layout::load<uint32_t>(index + 4 * k);
+        for (int j = 0; j < 3; ++j) v[k][j] = simd::cluster_pick(corner_axis[j], nibbles);
+      }
+      LaneHit hit = triangle_test(r, v, simd::lanes_below8(triangles - first), c.t);
+      if (hit.lane >= 0 && hit.t <= c.t) c = {hit.t, slot0 + made + first + uint32_t(hit.lane), hit.u, hit.v};
+    }
+    made += triangles;
+    at += Codec::bytes_of(blob, at);
+  }
+  return (at - block + 3) / 4 * 4;
+}
+
 template <class Codec>
 inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                       Closest& c) {
-  if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
+  if constexpr (requires { Codec::kClusters; }) {
+    test_cluster_leaf<Codec>(blob, r, block, count, slot0, c);
+  } else if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
     test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
   } else if constexpr (requires { Codec::kPairLanes; }) {
     test_pair_leaf<Codec>(blob, r, block, count, slot0, c);

@@ -16,6 +16,8 @@ inline void test_records(const uint8_t* blob, const layout::BlobHeader& h, const
     if constexpr (requires { Codec::kSequential; }) {  // strips: the decode tells the length
       at = block + uint32_t(test_sequential_leaf<Codec>(blob, r, h.tree_offset + block, count,
                                                         layout::slot_of(h, block, 0), c));
+    } else if constexpr (requires { Codec::kClusters; }) {  // clusters: the headers tell the length
+      at = block + uint32_t(test_cluster_leaf<Codec>(blob, r, h.tree_offset + block, count, layout::slot_of(h, block, 0), c));
     } else if constexpr (requires { Codec::kPairLanes; }) {  // pairs: the headers tell the length
       at = block + uint32_t(test_pair_leaf<Codec>(blob, r, h.tree_offset + block, count, layout::slot_of(h, block, 0), c));
     } else {

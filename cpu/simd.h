@@ -143,6 +143,40 @@ inline F8 from_u8x8(const uint8_t* p) {  // 8 bytes -> 8 floats
   std::memcpy(&x, p, 8);
   return {_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_cvtsi64_si128(x)))};
 }
+// A cluster's vertex coordinates of one axis (layout/cluster.h), lanes 0-7
+// and 8-15: the row's `count` offsets (uint16, or uint32 when wide) plus the
+// origin's code, decoded with BitPack's fma (lanes past count: the origin);
+// and a row of 8 corners picked from them by 4-bit vertex numbers (nibble i:
+// lane i), by permutes.
+struct V16 { F8 lo, hi; };
+inline V16 cluster_decode(const uint8_t* row, uint32_t count, bool wide, uint32_t origin, float scale, float offset) {
+  // Only the row's own words are read (masked loads never touch the others).
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const int* p = reinterpret_cast<const int*>(row);
+  __m256i lo, hi;
+  if (wide) {
+    lo = _mm256_maskload_epi32(p, _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)), lane));
+    hi = _mm256_maskload_epi32(p + 8, _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count) - 8), lane));
+  } else {
+    const __m256i w = _mm256_maskload_epi32(p, _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count + 1) / 2), lane));
+    lo = _mm256_cvtepu16_epi32(_mm256_castsi256_si128(w));
+    hi = _mm256_cvtepu16_epi32(_mm256_extracti128_si256(w, 1));
+  }
+  const __m256i o = _mm256_set1_epi32(int(origin));
+  const __m256 s = _mm256_set1_ps(scale), b = _mm256_set1_ps(offset);
+  return {{_mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(lo, o)), s, b)},
+          {_mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(hi, o)), s, b)}};
+}
+inline F8 cluster_pick(const V16& v, uint32_t nibbles) {
+  const __m256i idx = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(nibbles)), _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
+                                       _mm256_set1_epi32(15));
+#if defined(__AVX512VL__)
+  return {_mm256_permutex2var_ps(v.lo.v, idx, v.hi.v)};  // one permute over both halves
+#else
+  const __m256 from_lo = _mm256_permutevar8x32_ps(v.lo.v, idx), from_hi = _mm256_permutevar8x32_ps(v.hi.v, idx);
+  return {_mm256_blendv_ps(from_lo, from_hi, _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7))))};
+#endif
+}
 inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at p is not 0
   const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
   return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(w, _mm256_setzero_si256()))) ^ 0xFF;
@@ -221,6 +255,21 @@ inline int nonzero_bits8(const uint8_t* p) {
     b |= int(w != 0) << i;
   }
   return b;
+}
+struct V16 { float v[16]; };
+inline V16 cluster_decode(const uint8_t* row, uint32_t count, bool wide, uint32_t origin, float scale, float offset) {
+  V16 r;
+  for (uint32_t i = 0; i < 16; ++i) {
+    uint32_t q = 0;
+    if (i < count) std::memcpy(&q, row + (wide ? 4 : 2) * i, wide ? 4 : 2);
+    r.v[i] = __builtin_fmaf(float(q + origin), scale, offset);
+  }
+  return r;
+}
+inline F8 cluster_pick(const V16& v, uint32_t nibbles) {
+  F8 r;
+  for (int i = 0; i < 8; ++i) r.v[i] = v.v[nibbles >> (4 * i) & 15];
+  return r;
 }
 inline F4 gather(const float* base, I4 idx) {
   F4 r;

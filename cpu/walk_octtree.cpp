@@ -51,6 +51,15 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
         const simd::F8 entry = oct_box_test(node, r, c.t);
         int hit = simd::bits(entry != simd::F8::splat(INFINITY)) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT);
         if (hit) {
+          // Ask for every hit child's first lines now: the one walked next is
+          // needed at once, the others by the time they are popped.
+          for (int m = hit; m; m &= m - 1) {
+            const uint32_t p = layout::oct_child_properties(node, __builtin_ctz(unsigned(m)));
+            const uint8_t* child = tree + layout::oct_offset(p);
+            __builtin_prefetch(child);
+            __builtin_prefetch(child + 64);
+            if (layout::oct_count(p)) __builtin_prefetch(child + 128), __builtin_prefetch(child + 192);
+          }
           alignas(32) float e[8];
           entry.store(e);
           if ((hit & (hit - 1)) == 0) {  // one child: walk it next, no stack traffic

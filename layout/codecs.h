@@ -2,6 +2,7 @@
 // dispatch table and the layout names are all generated from it.
 #pragma once
 #include "layout/bitpack.h"
+#include "layout/cluster.h"
 #include "layout/float3.h"
 #include "layout/soa.h"
 #include "layout/strip.h"
@@ -27,7 +28,8 @@
   X(BitPack, "BitPack")                                \
   X(UncompressedStrip, "UncompressedStrip")            \
   X(CompressedStrip, "CompressedStrip")                \
-  X(Float3PairSOA4, "Float3PairSOA4")
+  X(Float3PairSOA4, "Float3PairSOA4")                  \
+  X(ClusterBitPackSOA8, "ClusterBitPackSOA8")
 
 namespace meshcast::layout {
 #define MC_CHECK_CODEC(Codec, name) static_assert(TriangleCodec<Codec>, name " meets the codec contract");

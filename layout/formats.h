@@ -95,6 +95,28 @@
 #define MC_TRI_COMPRESSEDSTRIP 16u     // §3.10
 #define MC_TRI_FLOAT3PAIRSOA4 18u      // seed 003: triangle pairs, the shared edge stored once
 #define MC_TRI_INDEXED24 17u           // seed 004: 32-bit index words, 24 bits of vertex index, 8 of tree
+#define MC_TRI_CLUSTERBITPACKSOA8 19u  // issue 19: clusters of mesh-grid vertices stored once, 4-bit indices
+
+// ClusterBitPackSOA8 (issue 19): a leaf is a run of clusters, each
+//   Origin     uint64 BitPack word: the mesh-grid codes (21 bits an axis) of
+//              the cluster's smallest corner
+//   Vertices   byte: the cluster's vertex count (1..16); bit 7: wide offsets
+//   Triangles  byte: its triangle count (1..16)
+//   Indices    per block of 8 triangles, corner rows 1, 2, 3 of 8 4-bit
+//              vertex numbers (nibble i: triangle i of the block), a uint32 each;
+//              a last block's unused lanes repeat its last triangle
+//   Offsets    rows X[v], Y[v], Z[v]: uint16 each (uint32 when wide), a
+//              vertex's grid code less the Origin's; an odd v pads Z by one
+// A vertex decodes as fma(float(Origin + offset), quant_scale, quant_offset),
+// BitPack's own decode of the same grid code, so a vertex shared by two
+// clusters (or two leaves) decodes to the same bits in each. Walkers read a
+// row in 4-byte words under a mask, never past the cluster.
+#define MC_CLUSTER_HEADER_BYTES 10u
+#define MC_CLUSTER_MAX_VERTICES 16u
+#define MC_CLUSTER_MAX_TRIANGLES 16u
+#define MC_CLUSTER_WIDE 0x80u
+#define MC_CLUSTER_BLOCK_LANES 8u
+#define MC_CLUSTER_INDEX_BLOCK_BYTES 12u
 
 // Zero-byte tree (seed 004). Triangle P starts a node when a walk reaches
 // it: the top bytes of its three index words, low byte first, hold the

@@ -54,6 +54,7 @@ enum class TriangleFormat : uint32_t {
   CompressedStrip = 16,
   Indexed24 = 17,
   Float3PairSOA4 = 18,
+  ClusterBitPackSOA8 = 19,  // clusters of up to 16 mesh-grid vertices stored once, 4-bit indices (issue 19)
 };
 
 // A tree format with a triangle format. The default is the recommended

@@ -1,0 +1,86 @@
+// ClusterBitPackSOA8 (issue 19; formats.h gives the bytes): a leaf's
+// triangles in clusters of at most 16 triangles over at most 16 vertices,
+// each vertex stored once a cluster as offsets from the cluster's origin on
+// the mesh grid (kGridPowerOfTwo, as BitPack), corners as 4-bit vertex
+// numbers. A walker decodes a cluster's 16 vertices into registers once and
+// builds each block of 8 triangles' corner rows by permutes (cpu/simd.h).
+//
+// Precision: BitPack's: a vertex moves to the nearest mesh-grid point (half a
+// grid step, at most 2^-21 of the mesh extent) plus one rounding of the
+// decode; shared vertices decode to the same bits everywhere, so the
+// watertight test stays watertight across clusters and leaves.
+#pragma once
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "layout/block.h"
+
+namespace meshcast::layout {
+
+struct ClusterBitPackSOA8 {
+  static constexpr uint32_t kFormat = MC_TRI_CLUSTERBITPACKSOA8;
+  static constexpr uint32_t kSlotDivisor = 4;  // see cluster_bytes
+  static constexpr uint32_t kLanes = MC_CLUSTER_BLOCK_LANES;
+  static constexpr GridKind kGrid = kGridPowerOfTwo;
+  static constexpr bool kClusters = true;  // cpu/leaf.h: tested cluster by cluster
+
+  // One cluster's place in a leaf, as the encoder plans it.
+  struct Plan {
+    uint32_t first, count;          // triangles of the leaf
+    std::vector<uint64_t> vertices; // their grid words, in vertex-number order
+    std::vector<uint8_t> corner;    // 3 a triangle: vertex numbers
+    uint64_t origin;                // grid word of the smallest codes
+    bool wide;                      // an offset above 16 bits
+  };
+  // Greedy, in the leaf's order: a cluster takes triangles while it keeps
+  // within 16 triangles and 16 vertices.
+  static std::vector<Plan> plan(const TriCorners* tris, uint32_t count);
+
+  // A cluster's bytes: at least 4 a triangle (only a cluster of many
+  // triangles over very few vertices pads to reach it), so slot numbers of
+  // 4 bytes never collide.
+  static uint32_t cluster_bytes(uint32_t vertices, uint32_t triangles, bool wide) {
+    return std::max(4 * triangles, MC_CLUSTER_HEADER_BYTES + (triangles + 7) / 8 * MC_CLUSTER_INDEX_BLOCK_BYTES +
+                                       (wide ? 12 * vertices : 2 * (3 * vertices + (vertices & 1))));
+  }
+  // The most a leaf of `count` takes (each triangle a wide cluster of its own).
+  static uint64_t block_bytes(uint32_t count) { return (uint64_t(cluster_bytes(3, 1, true)) * count + 3) / 4 * 4; }
+  static uint32_t measure(TriCorners* tris, uint32_t count);
+  static void encode(TriCorners* tris, uint32_t count, BlockContext& ctx, uint8_t* out);
+
+  // A cluster's fields at blob offset `at`.
+  static uint32_t vertex_count(const uint8_t* blob, uint32_t at) { return blob[at + 8] & 31; }
+  static bool wide(const uint8_t* blob, uint32_t at) { return (blob[at + 8] & MC_CLUSTER_WIDE) != 0; }
+  static uint32_t triangle_count(const uint8_t* blob, uint32_t at) { return blob[at + 9]; }
+  static uint32_t index_at(uint32_t at) { return at + MC_CLUSTER_HEADER_BYTES; }
+  static uint32_t rows_at(const uint8_t* blob, uint32_t at) {
+    return index_at(at) + (triangle_count(blob, at) + 7) / 8 * MC_CLUSTER_INDEX_BLOCK_BYTES;
+  }
+  static uint32_t bytes_of(const uint8_t* blob, uint32_t at) {
+    return cluster_bytes(vertex_count(blob, at), triangle_count(blob, at), wide(blob, at));
+  }
+  // Vertex number of corner c of triangle i (< 16) of the cluster at `at`.
+  static uint32_t corner(const uint8_t* blob, uint32_t at, uint32_t i, int c) {
+    const uint32_t word = load<uint32_t>(blob + index_at(at) + (i / 8) * MC_CLUSTER_INDEX_BLOCK_BYTES + 4 * uint32_t(c));
+    return word >> (4 * (i % 8)) & 15;
+  }
+  // Grid code of vertex k on axis a of the cluster at `at`.
+  static uint32_t code(const uint8_t* blob, uint32_t at, uint32_t k, int a) {
+    const uint64_t origin = load<uint64_t>(blob + at);
+    const uint32_t rows = rows_at(blob, at), v = vertex_count(blob, at);
+    const uint32_t offset = wide(blob, at) ? load<uint32_t>(blob + rows + 4 * (uint32_t(a) * v + k))
+                                           : load<uint16_t>(blob + rows + 2 * (uint32_t(a) * v + k));
+    return bitpack_component(origin, a) + offset;
+  }
+
+  // Bytes of the leaf's clusters (padded to 4), or 0 when they are broken,
+  // do not hold exactly `count` triangles, or end past `limit`.
+  static uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit);
+  static void decode(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]);
+  // Every corner number of every lane (padding too: walkers decode them)
+  // names a vertex of its cluster, and every code stays on the 21-bit grid.
+  static bool check(const uint8_t* blob, uint32_t block, uint32_t count, std::string* why);
+};
+
+}  // namespace meshcast::layout

@@ -59,6 +59,7 @@ class Method {
 //   aabbtree    AABBTree/Float3 or AABBTree/UncompressedStrip
 //   skdtree     SKDTree/Float3               lbvh      StacklessLBVH/Float3
 //   quadtree    QuadTreeHalfFloat/Indexed8BitPackSOA4
+//   octtree     OctTreeCompressed/ClusterBitPackSOA8
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout
 // the method does not read, naming both).
 // `outputs`: the per-hit outputs (MC_HIT_UV, MC_HIT_POINT) its shaders

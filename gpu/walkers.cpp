@@ -11,6 +11,7 @@
 #include "shaders/aabbtree_float3.h"
 #include "shaders/aabbtree_strip.h"
 #include "shaders/lbvh_float3.h"
+#include "shaders/octtree_cluster.h"
 #include "shaders/quadtree_i8.h"
 #include "shaders/skdtree_float3.h"
 
@@ -31,6 +32,7 @@ const Walker kWalkers[] = {
     {"skdtree", MC_TREE_SKDTREE, MC_TRI_FLOAT3, skdtree_float3_spv, sizeof skdtree_float3_spv},
     {"lbvh", MC_TREE_STACKLESSLBVH, MC_TRI_FLOAT3, lbvh_float3_spv, sizeof lbvh_float3_spv},
     {"quadtree", MC_TREE_QUADTREEHALFFLOAT, MC_TRI_INDEXED8BITPACKSOA4, quadtree_i8_spv, sizeof quadtree_i8_spv},
+    {"octtree", MC_TREE_OCTTREECOMPRESSED, MC_TRI_CLUSTERBITPACKSOA8, octtree_cluster_spv, sizeof octtree_cluster_spv},
 };
 
 class WalkMethod : public BatchMethod {
@@ -67,6 +69,7 @@ std::span<const MethodLayout> method_layouts() {
   static const MethodLayout kAll[] = {{"aabbtree", "AABBTree/Float3"},
                                       {"aabbtree", "AABBTree/UncompressedStrip"},
                                       {"quadtree", "QuadTreeHalfFloat/Indexed8BitPackSOA4"},
+                                      {"octtree", "OctTreeCompressed/ClusterBitPackSOA8"},
                                       {"aabblist", "AABBList/Float3SOA128"},
                                       {"aabblist", "AABBList/BitPackSOA128"},
                                       {"skdtree", "SKDTree/Float3"},

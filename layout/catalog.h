@@ -31,7 +31,7 @@
   X(StacklessLBVH, MC_TREE_STACKLESSLBVH, MC_LBVH_NODE_BYTES, AllCodecs, Heap, "lbvh")                            \
   X(QuadTree, MC_TREE_QUADTREE, MC_QUAD_NODE_BYTES, AllCodecs, AnyOrder, "")                                      \
   X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT, MC_QUADHALF_NODE_BYTES, AllCodecs, AnyOrder, "quadtree")        \
-  X(OctTreeCompressed, MC_TREE_OCTTREECOMPRESSED, MC_OCT_NODE_BYTES, AllCodecs, AnyOrder, "")                   \
+  X(OctTreeCompressed, MC_TREE_OCTTREECOMPRESSED, MC_OCT_NODE_BYTES, AllCodecs, AnyOrder, "octtree")            \
   X(BruteForce, MC_TREE_BRUTEFORCE, MC_BRUTE_RECORD_BYTES, AllCodecs, NoTree, "bruteforce")                      \
   X(AABBList, MC_TREE_AABBLIST, MC_LIST_ENTRY_BYTES, AllCodecs, NoTree, "aabblist")                               \
   X(ZeroByteTree, MC_TREE_ZEROBYTE, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "")                         \

@@ -7,6 +7,7 @@
 #include "layout/aabbtree.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 template <class Leaf>
 inline void walk_aabb_nodes(const uint8_t* tree, const RayPre& r, Closest& c, Leaf&& leaf) {
@@ -41,4 +42,5 @@ inline void walk_aabb_nodes(const uint8_t* tree, const RayPre& r, Closest& c, Le
   }
 }
 
+MC_ISA_END
 }  // namespace meshcast

@@ -10,7 +10,10 @@
 #include <cstring>
 #include <memory>
 
+#include "cpu/isa.h"
+
 namespace meshcast {
+MC_ISA_BEGIN
 
 class BoxCache {
  public:
@@ -45,4 +48,5 @@ class BoxCache {
   Entry entries_[kEntries];
 };
 
+MC_ISA_END
 }  // namespace meshcast

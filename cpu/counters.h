@@ -5,6 +5,8 @@
 #pragma once
 #include <cstdint>
 
+#include "cpu/isa.h"
+
 namespace meshcast {
 
 struct TestCounts {
@@ -19,11 +21,13 @@ inline constexpr bool kCountTests = false;
 inline TestCounts test_counts;  // never written
 #endif
 
+MC_ISA_BEGIN
 inline void count_boxes(uint64_t n) {
   if constexpr (kCountTests) test_counts.boxes += n;
 }
 inline void count_triangles(uint64_t n) {
   if constexpr (kCountTests) test_counts.triangles += n;
 }
+MC_ISA_END
 
 }  // namespace meshcast

@@ -30,6 +30,29 @@ static_assert(kNoHit == MC_NO_HIT && uint32_t(HitOutputs::Uv) == MC_HIT_UV &&
                   uint32_t(HitOutputs::Point) == MC_HIT_POINT,
               "the public names are layout/formats.h's values, which the shaders read");
 
+// What every instruction set shares (cpu/isa.h): compiled once, outside
+// the per-set namespace.
+// Closest accepted lane of four triangles, corners v[corner][axis].
+struct LaneHit {
+  int lane = -1;
+  float t = 0, u = 0, v = 0;
+};
+
+// Double-precision redo of one lane float could not settle. Corners in ray
+// space (sheared x, y; z not yet scaled by sz): every product of two floats
+// is exact in double, so an edge function's sign is exact.
+bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
+                            const float cy, const float az, const float bz, const float cz, const float sz,
+                            float closest, LaneHit* out);
+
+// Which test the walkers run: the watertight one unless a benchmark asks
+// for the plain one (process-wide; set it before tracing, not during).
+enum class TriangleTest { Watertight, MollerTrumbore };
+inline std::atomic<TriangleTest> triangle_test_choice{TriangleTest::Watertight};
+void set_triangle_test(TriangleTest t);  // cpu/trace.cpp
+
+MC_ISA_BEGIN
+
 // 1 + 2 * gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (Ize 2013).
 constexpr float kFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
 
@@ -109,11 +132,6 @@ inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::
   return simd::select(tn <= tf, tn, F4::splat(INFINITY));
 }
 
-// Closest accepted lane of four triangles, corners v[corner][axis].
-struct LaneHit {
-  int lane = -1;
-  float t = 0, u = 0, v = 0;
-};
 
 // Below this a determinant or T has lost bits to underflow (products of
 // coordinates near 1e-20 and smaller): such lanes are settled in double.
@@ -124,13 +142,6 @@ constexpr float kSettleTiny = 0x1p-100f;
 // A determinant from this up is settled in double too: Vulkan bounds a float
 // division's error only for divisors below 2^126 (see float_settles).
 constexpr float kSettleHuge = 0x1p126f;
-
-// Double-precision redo of one lane float could not settle. Corners in ray
-// space (sheared x, y; z not yet scaled by sz): every product of two floats
-// is exact in double, so an edge function's sign is exact.
-bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
-                            const float cy, const float az, const float bz, const float cz, const float sz,
-                            float closest, LaneHit* out);
 
 // Lanes whose float det and T can be trusted: T finite (no overflow, no
 // inf - inf), det below 2^126 (Vulkan bounds a float division's error only
@@ -198,11 +209,6 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
   return best;
 }
 
-// Which test the walkers run: the watertight one unless a benchmark asks
-// for the plain one (process-wide; set it before tracing, not during).
-enum class TriangleTest { Watertight, MollerTrumbore };
-inline std::atomic<TriangleTest> triangle_test_choice{TriangleTest::Watertight};
-inline void set_triangle_test(TriangleTest t) { triangle_test_choice.store(t, std::memory_order_relaxed); }
 
 // Corners come in the ray's axis order, v[corner][j] = axis r.axis[j], so the
 // test indexes registers with constants. One source for every width: F4 (SSE,
@@ -330,4 +336,5 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
   return best;
 }
 
+MC_ISA_END
 }  // namespace meshcast

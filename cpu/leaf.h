@@ -10,6 +10,7 @@
 #include "layout/zerobyte.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 struct Closest {
   float t;
@@ -270,4 +271,5 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
   }
 }
 
+MC_ISA_END
 }  // namespace meshcast

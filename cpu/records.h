@@ -6,6 +6,7 @@
 #include "cpu/walk.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 template <class Codec>
 inline void test_records(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, uint32_t at,
@@ -27,4 +28,5 @@ inline void test_records(const uint8_t* blob, const layout::BlobHeader& h, const
   }
 }
 
+MC_ISA_END
 }  // namespace meshcast

@@ -10,16 +10,19 @@
 #include <cstdint>
 #include <cstring>
 
+#include "cpu/isa.h"
 #include "layout/block.h"
 #include "layout/half.h"
 
-#if !defined(MESHCAST_SCALAR)
+#if MC_ISA_SIMD
 #include <immintrin.h>
 #endif
 
-namespace meshcast::simd {
+namespace meshcast {
+MC_ISA_BEGIN
+namespace simd {
 
-#if !defined(MESHCAST_SCALAR)
+#if MC_ISA_SIMD
 
 struct F4 {
   static constexpr int kLanes = 4;
@@ -182,7 +185,7 @@ inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at 
   return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(w, _mm256_setzero_si256()))) ^ 0xFF;
 }
 
-#else  // MESHCAST_SCALAR
+#else  // scalar
 
 // One template for both widths: N plain lanes.
 template <int N>
@@ -279,4 +282,6 @@ inline F4 gather(const float* base, I4 idx) {
 
 #endif
 
-}  // namespace meshcast::simd
+}  // namespace simd
+MC_ISA_END
+}  // namespace meshcast

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
+#include <cstdlib>
+#include <span>
 #include <vector>
 
 #include "cpu/walk.h"
+#include "cpu/walk_table.h"
 #include "layout/blob_format.h"
 #include "layout/codecs.h"
 #include "layout/zerobyte.h"
@@ -13,44 +17,86 @@ namespace meshcast {
 
 namespace {
 
-struct Entry {
-  uint32_t tree, triangles;
-  WalkFn walk;
+
+struct IsaChoice {
+  WalkerIsa isa;
+  std::span<const WalkEntry> table;
 };
 
-template <class Tree, class Codec>
-void walk_as(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  walk<Codec>(Tree{}, blob, rays, hits, n, skipped, outputs);
+// Whether this build has the set and the processor runs it.
+bool cpu_has(WalkerIsa isa) {
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+  const bool avx512 = avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+#if MESHCAST_HAS_ISA_AVX2
+  if (isa == WalkerIsa::Avx2) return avx2;
+#endif
+#if MESHCAST_HAS_ISA_AVX512
+  if (isa == WalkerIsa::Avx512) return avx512;
+#endif
+  (void)avx2, (void)avx512;
+#endif
+  return isa == WalkerIsa::Scalar;
 }
 
-// Every (tree, triangle format) pair the catalog allows: every codec under
-// the trees that take them all, Indexed24 under the zero-byte trees.
-std::vector<Entry> make_walkers() {
-  std::vector<Entry> entries;
-  auto add = [&](auto tree) {
-    using Tree = decltype(tree);
-    if constexpr (Tree::kTriangles == layout::TreeTriangles::AllCodecs) {
-#define MC_CODEC_ENTRY(Codec, name) entries.push_back({Tree::kId, layout::Codec::kFormat, &walk_as<Tree, layout::Codec>});
-      MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRY)
-#undef MC_CODEC_ENTRY
-    } else {
-      entries.push_back({Tree::kId, layout::Indexed24::kFormat, &walk_as<Tree, layout::Indexed24>});
-    }
-  };
-#define MC_TREE_ENTRIES(Name, ...) add(layout::tree::Name{});
-  MC_FOR_EACH_TREE_FORMAT(MC_TREE_ENTRIES)
-#undef MC_TREE_ENTRIES
-  return entries;
+std::span<const WalkEntry> table_of(WalkerIsa isa) {
+#if MESHCAST_HAS_ISA_AVX512
+  if (isa == WalkerIsa::Avx512) return isa_avx512::walk_table();
+#endif
+#if MESHCAST_HAS_ISA_AVX2
+  if (isa == WalkerIsa::Avx2) return isa_avx2::walk_table();
+#endif
+  (void)isa;
+  return isa_scalar::walk_table();
 }
 
-// Made on first use, not at static initialisation: a BlobView made by
-// another translation unit's static initialiser finds it ready.
-const std::vector<Entry>& walkers() {
-  static const std::vector<Entry> table = make_walkers();
-  return table;
+// Chosen once, on first use: the widest set the processor has, or the one
+// MESHCAST_ISA names (scalar, avx2, avx512) when the processor has it.
+IsaChoice choose_isa() {
+  WalkerIsa isa = cpu_has(WalkerIsa::Avx512) ? WalkerIsa::Avx512 : cpu_has(WalkerIsa::Avx2) ? WalkerIsa::Avx2 : WalkerIsa::Scalar;
+  if (const char* asked = std::getenv("MESHCAST_ISA")) {
+    for (WalkerIsa named : {WalkerIsa::Scalar, WalkerIsa::Avx2, WalkerIsa::Avx512})
+      if (walker_isa_name(named) == asked) {
+        if (!cpu_has(named))
+          throw UsageError(std::string("MESHCAST_ISA=") + asked + ": this processor or build lacks it (it has " +
+                           std::string(walker_isa_name(isa)) + ")");
+        isa = named;
+      }
+    if (std::string(asked) != walker_isa_name(isa))
+      throw UsageError(std::string("MESHCAST_ISA=") + asked + ": not one of scalar, avx2, avx512");
+  }
+  return {isa, table_of(isa)};
+}
+
+const IsaChoice& chosen() {
+  static const IsaChoice choice = choose_isa();
+  return choice;
 }
 
 }  // namespace
+
+std::string_view walker_isa_name(WalkerIsa isa) {
+  switch (isa) {
+    case WalkerIsa::Scalar: return "scalar";
+    case WalkerIsa::Avx2: return "avx2";
+    case WalkerIsa::Avx512: return "avx512";
+  }
+  return "";
+}
+
+WalkerIsa walker_isa() { return chosen().isa; }
+
+bool ray_is_walkable(const Ray& r) {
+  for (int a = 0; a < 3; ++a)
+    if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !(std::fabs(r.dir[a]) <= kMaxDirection)) return false;
+  const float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
+  if (!(m >= 0x1p-126f)) return false;
+  return !std::isnan(r.tmax) && r.tmax >= 0;
+}
+
+void set_triangle_test(TriangleTest t) { triangle_test_choice.store(t, std::memory_order_relaxed); }
 
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
@@ -75,7 +121,7 @@ BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : by
   std::string why = layout::validate(bytes);
   if (!why.empty()) throw InputError(name + ": " + why);
   const layout::BlobHeader& h = layout::header_of(bytes.data());
-  for (const Entry& e : walkers())
+  for (const WalkEntry& e : chosen().table)
     if (e.tree == h.tree_format && e.triangles == h.triangle_format) walk_ = e.walk;
   if (!walk_) throw InputError(name + ": no walker for this layout");
 }

@@ -8,6 +8,7 @@
 #include "layout/catalog.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 // Walks `n` rays through a validated blob. Unwalkable rays (ray_is_walkable)
 // are answered as misses and counted in *skipped. `outputs`: the MC_HIT_*
@@ -55,4 +56,5 @@ inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t
   }
 }
 
+MC_ISA_END
 }  // namespace meshcast

@@ -7,6 +7,7 @@
 #include "layout/aabbtree.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 template <class Codec>
 void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
@@ -87,4 +88,5 @@ void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* 
   template void walk<layout::Codec>(layout::tree::AABBTreeSplitAxis, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
+MC_ISA_END
 }  // namespace meshcast

@@ -3,6 +3,7 @@
 #include "cpu/records.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 template <class Codec>
 void walk(layout::tree::BruteForce, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
@@ -15,4 +16,5 @@ void walk(layout::tree::BruteForce, const uint8_t* blob, const Ray* rays, Hit* h
   template void walk<layout::Codec>(layout::tree::BruteForce, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
+MC_ISA_END
 }  // namespace meshcast

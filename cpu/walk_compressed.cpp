@@ -6,6 +6,7 @@
 #include "layout/compressed.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 template <class Codec>
 void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
@@ -54,4 +55,5 @@ void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays
   template void walk<layout::Codec>(layout::tree::AABBTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
+MC_ISA_END
 }  // namespace meshcast

@@ -8,6 +8,7 @@
 #include "layout/octtree.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 namespace {
 
@@ -97,4 +98,5 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 #undef MC_INSTANTIATE
 
+MC_ISA_END
 }  // namespace meshcast

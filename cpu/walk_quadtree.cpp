@@ -8,6 +8,7 @@
 #include "layout/quadtree.h"
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 namespace {
 
@@ -107,4 +108,5 @@ void walk(layout::tree::QuadTreeHalfFloat, const uint8_t* blob, const Ray* rays,
   template void walk<layout::Codec>(layout::tree::QuadTreeHalfFloat, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
+MC_ISA_END
 }  // namespace meshcast

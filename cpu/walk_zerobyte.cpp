@@ -15,6 +15,7 @@
 #include <type_traits>
 
 namespace meshcast {
+MC_ISA_BEGIN
 
 namespace {
 
@@ -104,4 +105,5 @@ void walk(layout::tree::ZeroByteHybrid tree, const uint8_t* blob, const Ray* ray
 template void walk<layout::Indexed24>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 template void walk<layout::Indexed24>(layout::tree::ZeroByteHybrid, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
 
+MC_ISA_END
 }  // namespace meshcast

@@ -41,7 +41,8 @@ inline uint32_t pns_leaf_block(const AABBNode& n, const BlobHeader& h) {
   return h.triangle_base + 4 * (n.properties & MC_PNS_BLOCK_MASK);
 }
 // The octant bit of seed 002: sign bits of the direction, z | y << 1 | x << 2.
-inline uint32_t pns_octant(const float dir[3]) {
+// Always inlined: the walkers' instruction sets must not share a copy (cpu/isa.h).
+[[gnu::always_inline]] inline uint32_t pns_octant(const float dir[3]) {
   return uint32_t(std::signbit(dir[2])) | uint32_t(std::signbit(dir[1])) << 1 | uint32_t(std::signbit(dir[0])) << 2;
 }
 

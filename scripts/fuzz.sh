@@ -17,8 +17,9 @@ declare -A runs=([blob]=400000 [mesh]=30000)  # about 60 and 75 s on this projec
 source scripts/packages.sh
 install_missing clang libclang-rt-14-dev
 
+source scripts/isa.sh
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
-      -DMESHCAST_FUZZ=ON >/dev/null
+      -DMESHCAST_FUZZ=ON "-DMESHCAST_ISAS=$(sanitizer_isas)" >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target blob_fuzz mesh_fuzz
 
 for target in blob mesh; do

@@ -43,8 +43,19 @@ stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
 # doubled these builds' time.
 sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG")
 
-stage "Release (AVX2): the CPU suites"
+# The walkers' instruction sets (cpu/isa.h): the Release build has them all
+# and runs the widest this processor has; the sanitizer builds take the
+# scalar set and that widest one.
+source scripts/isa.sh
+widest=$(widest_isa)
+sanitizer_flags+=("-DMESHCAST_ISAS=$(sanitizer_isas)")
+
+stage "Release ($widest walkers): the CPU suites"
 run_suites build full "${cpu_suites[@]}"
+if [[ $widest == avx512 ]]; then
+  stage "Release, the AVX2 walkers this processor also runs (MESHCAST_ISA=avx2): the suites that walk"
+  MESHCAST_ISA=avx2 run_suites build quick "${walk_suites[@]}"
+fi
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
@@ -67,8 +78,8 @@ cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 
-stage "Portable scalar path without the Vulkan backend, the test counters compiled in: the suites that walk, the host layer"
-# The scalar build changes only cpu/simd.h's lanes: the suites that walk
+stage "Portable scalar build (MESHCAST_SCALAR: the scalar walkers alone) without the Vulkan backend, the test counters compiled in: the suites that walk, the host layer"
+# The scalar walkers differ only in cpu/simd.h's lanes: the suites that walk
 # (quick, as under ASan) cover it; the Vulkan suites read the same shaders.
 # Built with MESHCAST_VULKAN=OFF, it also builds and tests the CPU-only host
 # layer (host_test: a caster asked for Vulkan answers on the CPU).

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "meshcast/build.h"
@@ -43,6 +44,15 @@ class BlobView {
 // A blob file read whole into memory (not validated: give it to a BlobView
 // or a Caster). InputError naming the path for a missing, unreadable or
 // non-regular file.
+// The instruction set the CPU walkers run on, chosen once per process: the
+// widest this processor has among those built (AVX-512, AVX2, scalar on
+// x86-64; scalar elsewhere), or the one the environment variable
+// MESHCAST_ISA names (scalar, avx2, avx512); UsageError on first use when it
+// names one the processor or build lacks.
+enum class WalkerIsa { Scalar, Avx2, Avx512 };
+WalkerIsa walker_isa();
+std::string_view walker_isa_name(WalkerIsa isa);
+
 std::vector<uint8_t> load_blob(const std::string& path);
 
 // Writes the blob beside `path`, then renames it over `path`, so a failed

@@ -46,12 +46,6 @@ constexpr float kMaxDirection = 0x1p126f;
 // 0) and not all below FLT_MIN (such a direction counts as zero), tmax not
 // NaN and not negative (infinity allowed). Any other ray is answered as a
 // miss and counted.
-inline bool ray_is_walkable(const Ray& r) {
-  for (int a = 0; a < 3; ++a)
-    if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !(std::fabs(r.dir[a]) <= kMaxDirection)) return false;
-  const float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
-  if (!(m >= 0x1p-126f)) return false;
-  return !std::isnan(r.tmax) && r.tmax >= 0;
-}
+bool ray_is_walkable(const Ray& r);  // defined once in the library (cpu/trace.cpp)
 
 }  // namespace meshcast

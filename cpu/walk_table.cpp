@@ -1,0 +1,57 @@
+#include "cpu/walk_table.h"
+
+#include <array>
+
+#include "layout/codecs.h"
+#include "layout/zerobyte.h"
+
+namespace meshcast {
+MC_ISA_BEGIN
+
+namespace {
+
+template <class Tree, class Codec>
+void walk_as(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+  walk<Codec>(Tree{}, blob, rays, hits, n, skipped, outputs);
+}
+
+// Every (tree, triangle format) pair the catalog allows: every codec under
+// the trees that take them all, Indexed24 under the zero-byte trees. A plain
+// array, no container: no library code is compiled for this set (cpu/isa.h).
+#define MC_COUNT_ONE(...) +1
+constexpr size_t kCodecs = 0 MC_FOR_EACH_TRIANGLE_CODEC(MC_COUNT_ONE);
+#define MC_COUNT_TREE(Name, ...) +(layout::tree::Name::kTriangles == layout::TreeTriangles::AllCodecs ? kCodecs : 1)
+constexpr size_t kEntries = 0 MC_FOR_EACH_TREE_FORMAT(MC_COUNT_TREE);
+#undef MC_COUNT_TREE
+#undef MC_COUNT_ONE
+
+std::array<WalkEntry, kEntries> make_walkers() {
+  std::array<WalkEntry, kEntries> entries{};
+  size_t n = 0;
+  auto add = [&](auto tree) {
+    using Tree = decltype(tree);
+    if constexpr (Tree::kTriangles == layout::TreeTriangles::AllCodecs) {
+#define MC_CODEC_ENTRY(Codec, name) entries[n++] = {Tree::kId, layout::Codec::kFormat, &walk_as<Tree, layout::Codec>};
+      MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRY)
+#undef MC_CODEC_ENTRY
+    } else {
+      entries[n++] = {Tree::kId, layout::Indexed24::kFormat, &walk_as<Tree, layout::Indexed24>};
+    }
+  };
+#define MC_TREE_ENTRIES(Name, ...) add(layout::tree::Name{});
+  MC_FOR_EACH_TREE_FORMAT(MC_TREE_ENTRIES)
+#undef MC_TREE_ENTRIES
+  return entries;
+}
+
+}  // namespace
+
+// Made on first use, not at static initialisation: a BlobView made by
+// another translation unit's static initialiser finds it ready.
+std::span<const WalkEntry> walk_table() {
+  static const std::array<WalkEntry, kEntries> table = make_walkers();
+  return table;
+}
+
+MC_ISA_END
+}  // namespace meshcast

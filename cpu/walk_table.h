@@ -1,0 +1,30 @@
+// The walkers' dispatch table, one a instruction set (cpu/walk_table.cpp is
+// compiled for each, cpu/isa.h): every (tree, triangle format) pair of the
+// catalog with its walker.
+#pragma once
+#include <cstdint>
+#include <span>
+
+#include "cpu/walk.h"
+
+namespace meshcast {
+
+struct WalkEntry {
+  uint32_t tree, triangles;
+  WalkFn walk;
+};
+
+// This translation unit's set's table (the one cpu/walk.h's inline
+// namespace names), and by name the others a multi-set build has.
+MC_ISA_BEGIN
+std::span<const WalkEntry> walk_table();
+MC_ISA_END
+namespace isa_scalar { std::span<const WalkEntry> walk_table(); }
+#if MESHCAST_HAS_ISA_AVX2
+namespace isa_avx2 { std::span<const WalkEntry> walk_table(); }
+#endif
+#if MESHCAST_HAS_ISA_AVX512
+namespace isa_avx512 { std::span<const WalkEntry> walk_table(); }
+#endif
+
+}  // namespace meshcast

@@ -1,0 +1,19 @@
+# widest_isa: the widest walker instruction set (cpu/isa.h) this processor
+# runs: avx512, avx2 or scalar. Sourced by test.sh and fuzz.sh, whose
+# sanitizer builds take the scalar set and this one only.
+widest_isa() {
+  local flags
+  flags=$(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null || true)
+  has() { [[ " $flags " == *" $1 "* ]]; }
+  if has avx2 && has fma && has f16c; then
+    if has avx512f && has avx512vl && has avx512bw && has avx512dq; then echo avx512; else echo avx2; fi
+  else
+    echo scalar
+  fi
+}
+# The sets a sanitizer build compiles: scalar and the widest (once).
+sanitizer_isas() {
+  local w
+  w=$(widest_isa)
+  if [[ $w == scalar ]]; then echo scalar; else echo "scalar;$w"; fi
+}

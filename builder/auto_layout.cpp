@@ -103,6 +103,7 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
   if (!l.readers.empty()) {
     reasons.push_back("CPU and GPU: only the layouts a Vulkan method reads, in the order of their CPU walkers' "
                       "speed (bench combos); the GPU's own order depends on the device (bench gpu)");
+    add("OctTreeCompressed/ClusterBitPackSOA8", "read by a Vulkan method; the fastest CPU walker of bench peers", 16);
     for (const char* layout : {"QuadTreeHalfFloat/Indexed8BitPackSOA4", "AABBTree/Float3", "StacklessLBVH/Float3",
                                "AABBTree/UncompressedStrip", "SKDTree/Float3", "AABBList/Float3SOA128",
                                "AABBList/BitPackSOA128", "BruteForce/Float3SOA128", "BruteForce/BitPackSOA128"})
@@ -112,6 +113,11 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
     return out;
   }
   const std::string w = index_width(s, reasons);
+  // The 8-wide tree first, over clusters then 8-wide float blocks: the
+  // fastest in bench peers on every mesh there (bench/RESULTS.md).
+  reasons.push_back("the 8-wide compressed tree first (bench peers: fastest on every mesh), leaves of 16");
+  add("OctTreeCompressed/ClusterBitPackSOA8", "8 children a node, clusters of shared grid vertices: fast and small", 16);
+  add("OctTreeCompressed/Float3SOA8", "8 children a node over exact 8-wide float blocks", 16);
   // Half-float nodes are half the bytes of a float node: once the nodes of
   // a mesh of millions of triangles outgrow the caches they win (terrain_2M:
   // QuadTreeHalfFloat first in bench combos); below that, float nodes (bunny00
@@ -158,6 +164,8 @@ std::vector<AutoCandidate> memory_list(const MeshStats& s, const AutoLimits& l, 
   }
   if (s.corners_per_vertex >= 2) {
     reasons.push_back(format("%.1f corners a vertex (>= 2): indexed encodings store each vertex once", s.corners_per_vertex, 0));
+    if (worth_trying(l, s, "OctTreeCompressed/ClusterBitPackSOA8"))
+      out.push_back(candidate(l, "OctTreeCompressed/ClusterBitPackSOA8", 16, "clusters of shared grid vertices under 8-wide nodes"));
     const std::string w = index_width(s, reasons);
     add("AABBTreeCompressed/Indexed8BitPackSOA4", "12-byte nodes, 8-bit indices into a block's quantized vertices");
     add("SKDTree/Indexed8BitPackSOA4", "the smallest nodes (one plane pair)");

@@ -198,9 +198,11 @@ std::vector<uint8_t> build_blob(const MeshView& mesh, const BuildOptions& option
   return build_blob(copy_mesh(mesh, name), options, name, report);
 }
 
-std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
+std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, const std::string& name,
                                 BuildReport* report) {
   auto start = std::chrono::steady_clock::now();
+  BuildOptions o = options;
+  if (o.leaf_size == 0) o.leaf_size = default_leaf_size(o.layout);
   check_mesh(mesh, name);
   if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
     return build_zerobyte_blob(mesh, o, name, report);

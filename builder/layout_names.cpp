@@ -34,6 +34,8 @@ std::vector<Layout> all_layouts() {
   return all;
 }
 
+uint32_t default_leaf_size(Layout layout) { return layout.tree == TreeFormat::OctTreeCompressed ? 16 : 8; }
+
 std::vector<std::string> layout_names() {
   std::vector<std::string> names;
   for (Layout l : all_layouts()) names.push_back(layout_name(l));
@@ -57,6 +59,7 @@ BuildOptions parse_layout(const std::string& text) {
     if (lower(layout_name(l)) == lower(text)) {
       BuildOptions o;
       o.layout = l;
+      o.leaf_size = default_leaf_size(l);
       // The seed 001 heap is built by Morton-code middle split.
       if (l.tree == TreeFormat::StacklessLBVH) o.splitter = Splitter::Morton;
       return o;

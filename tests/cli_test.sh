@@ -61,7 +61,7 @@ check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitte
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
 check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
 check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
-check auto-speed 0 "chose QuadTree" -- "$meshcast" build "$mesh" --layout auto --out "$work/auto.blob"
+check auto-speed 0 "chose OctTreeCompressed" -- "$meshcast" build "$mesh" --layout auto --out "$work/auto.blob"
 check auto-blob 0 "remap: " -- "$meshcast" info "$work/auto.blob"
 check auto-memory 0 "the fewest bytes that meet the limits" -- "$meshcast" info "$mesh" --layout auto --goal memory --max-error 2e-6
 check auto-trial 0 "fastest in the trial" -- "$meshcast" build "$mesh" --layout auto --trial 64 --out "$work/auto2.blob"
@@ -152,7 +152,7 @@ check json-stdout-full 4 "standard output: cannot write" -- bash -c 'exec "$0" i
 ln -s "$work/target.blob" "$work/link.blob"
 check link-out 0 "bytes/triangle" -- "$meshcast" build "$work/tiny_square.off" --out "$work/link.blob"
 [[ -L $work/link.blob ]] || { echo "FAIL link.blob was replaced"; failures=$((failures + 1)); }
-check link-target 0 "QuadTreeHalfFloat" -- "$meshcast" info "$work/target.blob"
+check link-target 0 "OctTreeCompressed" -- "$meshcast" info "$work/target.blob"
 # Unclear failures: a message naming the input and the limit, exit 2 (input)
 # or 3 (device).
 mkdir -p "$work/adir.off"

@@ -23,7 +23,7 @@ void add_demo(CLI::App& app) {
   struct Args {
     std::string input, png = "out/render.png";
     size_t count = 10000, gpu_count = 10000;
-    uint32_t repeat = 5, leaf = 8;
+    uint32_t repeat = 5, leaf = 0;  // 0: each layout's own
     std::string device;
     int width = 800, height = 600;
   };
@@ -32,7 +32,7 @@ void add_demo(CLI::App& app) {
   cmd->add_option("input", args->input, "mesh file")->required();
   cmd->add_option("--count", args->count, "rays of each kind")->check(CLI::Range(size_t(1), size_t(10000000)));
   cmd->add_option("--repeat", args->repeat, "timed passes; the median is reported")->check(CLI::Range(1, 100));
-  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf (default: each layout's own)")->check(CLI::Range(1, 31));
   cmd->add_option("--png", args->png, "picture to write");
   cmd->add_option("--gpu-count", args->gpu_count, "rays of each kind for the Vulkan row (0: no GPU row)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
@@ -77,7 +77,7 @@ void add_demo(CLI::App& app) {
       }
     };
     std::vector<uint8_t> picture_blob;
-    for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
+    for (const char* name : {"AABBTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4", "OctTreeCompressed/ClusterBitPackSOA8"}) {
       BuildOptions o = layout_options(name, args->leaf);
       BuildReport report;
       std::vector<uint8_t> blob = build_blob(mesh, o, args->input, &report);
@@ -99,8 +99,8 @@ void add_demo(CLI::App& app) {
       rows.push_back(row);
       picture_blob = std::move(blob);
     }
-    // The GPU: method 6 of seed 000 7 on the very bytes of the CPU's
-    // recommended layout (QuadTreeHalfFloat/Indexed8BitPackSOA4), the first
+    // The GPU: the octtree method on the very bytes of the CPU's
+    // recommended layout (OctTreeCompressed/ClusterBitPackSOA8), the first
     // gpu_count rays of each kind, timed from submission to read-back (the
     // device's own time beside it), judged by the same oracle.
     std::string gpu_note;
@@ -109,12 +109,12 @@ void add_demo(CLI::App& app) {
         gpu::Context ctx(gpu::DeviceChoice{args->device, false});
         BuildReport report;
         std::vector<uint8_t> blob =
-            build_blob(mesh, layout_options("QuadTreeHalfFloat/Indexed8BitPackSOA4", args->leaf), args->input, &report);
-        std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, "quadtree", blob, args->input);
+            build_blob(mesh, layout_options("OctTreeCompressed/ClusterBitPackSOA8", args->leaf), args->input, &report);
+        std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, "octtree", blob, args->input);
         Mesh stored = stored_mesh(blob);  // quantized: judged on what it stores, as the CPU row
         OracleTree stored_tree(stored);
         SectionBytes s = section_bytes(blob);
-        Row row{"Vulkan QuadTreeHalfFloat/Indexed8BitPackSOA4", report.build_ms, s.walked() / n, s.remap / n, {}, 0};
+        Row row{"Vulkan OctTreeCompressed/ClusterBitPackSOA8", report.build_ms, s.walked() / n, s.remap / n, {}, 0};
         double device_ns[3] = {};
         for (int k = 0; k < 3; ++k) {
           size_t m = std::min(args->gpu_count, rays[k].size());
@@ -169,7 +169,7 @@ void add_demo(CLI::App& app) {
         if (rows[i].name.find("(peer)") == std::string::npos && rows[i].name.find("Vulkan") == std::string::npos)
           std::printf("  %s %.2f %.2f %.2f;", rows[i].name.c_str(), rows[i].ns[0] / peer_row.ns[0],
                       rows[i].ns[1] / peer_row.ns[1], rows[i].ns[2] / peer_row.ns[2]);
-      std::printf("\n%s bytes/tri: the memory its device reported for the scene (vertices, indices, BVH)\n",
+      std::printf("\n%s bytes/tri: the memory its device reported for the scene, plus the mesh it reads (vertices, indices)\n",
                   peer->name().c_str());
     } else {
       std::printf("no peer: meshcast was built without Embree (apt-get install libembree-dev)\n");
@@ -178,7 +178,7 @@ void add_demo(CLI::App& app) {
     BlobView(picture_blob, "picture").trace(rays[0], long_hits);
     Picture p = render(picture_blob, args->width, args->height, rays[0], long_hits);
     write_png(args->png, p.width, p.height, p.rgb);
-    std::printf("picture: %s (%dx%d, QuadTreeHalfFloat/Indexed8BitPackSOA4, %.0f ns/ray; green: long-ray hits)\n",
+    std::printf("picture: %s (%dx%d, OctTreeCompressed/ClusterBitPackSOA8, %.0f ns/ray; green: long-ray hits)\n",
                 args->png.c_str(), p.width, p.height, p.ns_per_ray);
     if (disagreements_total) throw std::runtime_error("the walkers disagree with the oracle");
   });

@@ -31,7 +31,7 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
                                             "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
-                                            "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4)");
+                                            "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4), octtree (OctTreeCompressed/ClusterBitPackSOA8)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {
@@ -88,7 +88,7 @@ void add_trace(CLI::App& app) {
 
 void add_render(CLI::App& app) {
   struct Args {
-    std::string input, png = "out/render.png", backend = "cpu", method = "quadtree", device;
+    std::string input, png = "out/render.png", backend = "cpu", method, device;  // method "": the blob's
     LayoutArgs layout;
     int width = 800, height = 600;
   };
@@ -100,13 +100,13 @@ void add_render(CLI::App& app) {
   cmd->add_option("--width", args->width)->check(CLI::Range(16, 8192));
   cmd->add_option("--height", args->height)->check(CLI::Range(16, 8192));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
-  cmd->add_option("--method", args->method, "GPU method for the blob's layout (see trace --help)");
+  cmd->add_option("--method", args->method, "GPU method (see trace --help; default: the one that reads the layout)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->callback([args] {
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
     Loaded in = load_input(args->input, args->layout);
-    if (vulkan_auto) args->method = gpu::method_reading(in.blob);
+    if (vulkan_auto || args->method.empty()) args->method = gpu::method_reading(in.blob);
     std::string device = "CPU, one thread";
     Picture p;
     if (args->backend == "vulkan") {

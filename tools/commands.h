@@ -27,9 +27,9 @@ Mesh bench_mesh(const std::string& input);
 // The layout options trace, build and info share: --layout, --leaf,
 // --splitter, --order, --lbvh-depth, --lbvh-left-first, --grouping, --pairing.
 struct LayoutArgs {
-  std::string layout = "QuadTreeHalfFloat/Indexed8BitPackSOA4";
+  std::string layout = "OctTreeCompressed/ClusterBitPackSOA8";
   std::string splitter, order, grouping;  // empty: the layout's own
-  uint32_t leaf = 8, lbvh_depth = 0;
+  uint32_t leaf = 0, lbvh_depth = 0;  // leaf 0: the layout's own
   bool lbvh_left_first = false;
   bool pairing = false;
   bool no_triangle_ids = false;  // BuildOptions::triangle_ids

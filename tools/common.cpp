@@ -39,7 +39,7 @@ Loaded load_mesh_or_blob(const std::string& path, const MeshBuilder& build) {
 
 BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter) {
   BuildOptions o = parse_layout(layout);
-  o.leaf_size = leaf;
+  if (leaf) o.leaf_size = leaf;  // 0: the layout's own
   if (!splitter.empty()) o.splitter = parse_splitter(splitter);  // else the layout's (Morton for StacklessLBVH)
   return o;
 }
@@ -68,7 +68,8 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_flag("--gpu", a.gpu, "auto: only layouts a Vulkan method reads as well (CPU and GPU)");
   cmd->add_option("--trial", a.trial, "auto, speed first: time the candidates on this many rays (0: rules only)")
       ->check(CLI::Range(0u, 1u << 20));
-  cmd->add_option("--leaf", a.leaf, "largest triangle count of a leaf")->check(CLI::Range(1, 31));
+  cmd->add_option("--leaf", a.leaf, "largest triangle count of a leaf (default: 16 for OctTreeCompressed, 8 for the others)")
+      ->check(CLI::Range(1, 31));
   cmd->add_option("--splitter", a.splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
   cmd->add_option("--order", a.order,
                   "node order (seed 000 4.3): DepthFirst, DepthFirstTrianglesLast, BreadthFirst or "

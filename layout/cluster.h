@@ -5,10 +5,14 @@
 // numbers. A walker decodes a cluster's 16 vertices into registers once and
 // builds each block of 8 triangles' corner rows by permutes (cpu/simd.h).
 //
-// Precision: BitPack's: a vertex moves to the nearest mesh-grid point (half a
-// grid step, at most 2^-21 of the mesh extent) plus one rounding of the
-// decode; shared vertices decode to the same bits everywhere, so the
-// watertight test stays watertight across clusters and leaves.
+// Precision: the mesh grid here has 18 bits an axis (not BitPack's 21), so
+// that a cluster of a coarse mesh still fits 16-bit offsets (a cluster
+// spanning up to 1/4 of the mesh; wider ones take 32-bit rows): a vertex
+// moves to the nearest grid point, at most half a step (2^-18 to 2^-19 of
+// the mesh extent), plus one rounding of the decode; shared vertices decode
+// to the same bits everywhere, so the watertight test stays watertight
+// across clusters and leaves. (At 21 bits the dragon's clusters went wide:
+// 20.8 bytes a triangle against 14.4.)
 #pragma once
 #include <algorithm>
 #include <string>
@@ -24,6 +28,7 @@ struct ClusterBitPackSOA8 {
   static constexpr uint32_t kLanes = MC_CLUSTER_BLOCK_LANES;
   static constexpr GridKind kGrid = kGridPowerOfTwo;
   static constexpr bool kClusters = true;  // cpu/leaf.h: tested cluster by cluster
+  static constexpr uint32_t kGridBits = 18;  // see Precision above
 
   // One cluster's place in a leaf, as the encoder plans it.
   struct Plan {

@@ -98,8 +98,8 @@
 #define MC_TRI_CLUSTERBITPACKSOA8 19u  // issue 19: clusters of mesh-grid vertices stored once, 4-bit indices
 
 // ClusterBitPackSOA8 (issue 19): a leaf is a run of clusters, each
-//   Origin     uint64 BitPack word: the mesh-grid codes (21 bits an axis) of
-//              the cluster's smallest corner
+//   Origin     uint64 BitPack word: the mesh-grid codes (18 bits used of
+//              each 21-bit field) of the cluster's smallest corner
 //   Vertices   byte: the cluster's vertex count (1..16); bit 7: wide offsets
 //   Triangles  byte: its triangle count (1..16)
 //   Indices    per block of 8 triangles, corner rows 1, 2, 3 of 8 4-bit

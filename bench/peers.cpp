@@ -18,7 +18,7 @@
 namespace meshcast::bench {
 
 std::vector<std::string> default_peer_layouts() {
-  return {"OctTreeCompressed/ClusterBitPackSOA8@16", "OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/Float3SOA8",
+  return {"OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/ClusterBitPackSOA8@8", "OctTreeCompressed/Float3SOA8",
           "QuadTreeHalfFloat/Indexed8BitPackSOA4", "QuadTree/Float3SOA8"};
 }
 

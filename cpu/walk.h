@@ -2,6 +2,7 @@
 // (include/meshcast/blob.h) picks the instantiation from the blob header once per batch.
 #pragma once
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
 
 #include "cpu/leaf.h"
@@ -25,34 +26,51 @@ using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
 MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WALK)
 #undef MC_DECLARE_WALK
 
-// Turns the closest slot into the caller's hit, with the outputs asked for.
-inline Hit finish_hit(const uint8_t* blob, const layout::BlobHeader& h, const Closest& c, const RayPre& r) {
-  Hit hit;
-  if (c.slot == MC_NO_HIT) return hit;
+// A walked ray's answer with its triangle still a slot: finish_hits turns
+// slots into the caller's triangles afterwards.
+inline void keep_slot(Hit& hit, const Closest& c, uint32_t outputs) {
+  if (c.slot == MC_NO_HIT) return;
   hit.t = c.t;
-  hit.triangle = layout::remap_entry(blob, h, c.slot);
-  if (r.outputs & MC_HIT_UV) hit.u = c.u, hit.v = c.v;
-  if (r.outputs & MC_HIT_POINT)
-    for (int a = 0; a < 3; ++a) hit.point[a] = r.org[a] + c.t * r.dir[a];
-  return hit;
+  hit.triangle = c.slot;
+  if (outputs & MC_HIT_UV) hit.u = c.u, hit.v = c.v;
+}
+
+// Hits [begin, end) from slots to the caller's triangles, with the point if
+// asked for. A remap lookup is two dependent loads that miss the cache on
+// large meshes: made at the end of each walk they stalled every ray, made
+// here side by side for many rays they overlap.
+inline void finish_hits(const uint8_t* blob, const Ray* rays, Hit* hits, size_t begin, size_t end, uint32_t outputs) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  for (size_t i = begin; i < end; ++i) {
+    Hit& hit = hits[i];
+    if (hit.triangle == kNoHit) continue;
+    hit.triangle = layout::remap_entry(blob, h, hit.triangle);
+    if (outputs & MC_HIT_POINT)
+      for (int a = 0; a < 3; ++a) hit.point[a] = rays[i].org[a] + hit.t * rays[i].dir[a];
+  }
 }
 
 // The batch loop every walker shares: an unwalkable ray becomes a counted
-// miss; walk_one(r, c) walks one ray, shortening c on every hit.
+// miss; walk_one(r, c) walks one ray, shortening c on every hit. Rays go in
+// chunks, walked first, then finished (finish_hits).
 template <class WalkOne>
 inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
                          uint32_t outputs, WalkOne&& walk_one) {
-  const layout::BlobHeader& h = layout::header_of(blob);
-  for (size_t i = 0; i < n; ++i) {
-    if (!ray_is_walkable(rays[i])) {
+  constexpr size_t kChunk = 32;
+  for (size_t begin = 0; begin < n; begin += kChunk) {
+    const size_t end = std::min(n, begin + kChunk);
+    for (size_t i = begin; i < end; ++i) {
       hits[i] = Hit{};
-      ++*skipped;
-      continue;
+      if (!ray_is_walkable(rays[i])) {
+        ++*skipped;
+        continue;
+      }
+      const RayPre r(rays[i], outputs);
+      Closest c{rays[i].tmax};
+      walk_one(r, c);
+      keep_slot(hits[i], c, outputs);
     }
-    const RayPre r(rays[i], outputs);
-    Closest c{rays[i].tmax};
-    walk_one(r, c);
-    hits[i] = finish_hit(blob, h, c, r);
+    finish_hits(blob, rays, hits, begin, end, outputs);
   }
 }
 

@@ -161,7 +161,7 @@ inline auto float_settles(const F4& det, const F4& T) {
 // three corners, then their unscaled z) stored, each lane redone by
 // watertight_lane_double against limit(); take(lane, hit) for each hit.
 template <class F4, class Limit, class Take>
-inline void settle_in_double(int redo, const F4 (&p)[9], float sz, Limit&& limit, Take&& take) {
+[[gnu::noinline, gnu::cold]] void settle_in_double(int redo, const F4 (&p)[9], float sz, Limit&& limit, Take&& take) {
   float l[9][F4::kLanes];
   for (int k = 0; k < 9; ++k) p[k].store(l[k]);
   for (int m = redo; m; m &= m - 1) {
@@ -214,7 +214,7 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
 // test indexes registers with constants. One source for every width: F4 (SSE,
 // 4 triangles) and F8 (AVX2, 8 triangles).
 template <class F4, class M4>
-inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
+[[gnu::always_inline]] inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
   constexpr int kW = F4::kLanes;
   if constexpr (kCountTests) count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(valid)))));
   if (triangle_test_choice.load(std::memory_order_relaxed) == TriangleTest::MollerTrumbore) [[unlikely]]

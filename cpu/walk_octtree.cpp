@@ -32,20 +32,31 @@ struct OctRows {
   }
 };
 
-// Entry distances of the 8 children, +inf for a child the ray misses.
-inline simd::F8 oct_box_test(const uint8_t* node, const RayPre& r, const OctRows& rows, float closest) {
+// The 8 children's entry distances and which of them the ray hits. The
+// distances of each axis are taken together as trees, not one axis after
+// another, and the hits come from the comparison itself: the walk waits on
+// this test node after node, so its chain of dependent instructions is kept
+// short. min/max keep their second operand on NaN (see cpu/intersect.h), and
+// each axis meets a constant first, so a NaN slab still constrains nothing.
+struct OctHits {
+  simd::F8 entry;  // meaningful in the hit lanes only
+  int bits;
+};
+inline OctHits oct_box_test(const uint8_t* node, const RayPre& r, const OctRows& rows, float closest) {
   count_boxes(8);
   using simd::F8;
-  F8 tn = F8::splat(0.0f), tf = F8::splat(INFINITY);
+  F8 tn[3], tf[3];
+  const F8 zero = F8::splat(0.0f), cut = F8::splat(closest);
   for (int a = 0; a < 3; ++a) {
     const F8 origin = F8::splat(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a));
     const F8 scale = F8::splat(layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));
     const F8 o = F8::splat(r.org[a]), inv = F8::splat(r.inv[a]);
-    tn = simd::max((simd::fma(simd::from_u8x8(node + rows.near_at[a]), scale, origin) - o) * inv, tn);
-    tf = simd::min((simd::fma(simd::from_u8x8(node + rows.far_at[a]), scale, origin) - o) * inv, tf);
+    tn[a] = simd::max((simd::fma(simd::from_u8x8(node + rows.near_at[a]), scale, origin) - o) * inv, zero);
+    tf[a] = simd::min((simd::fma(simd::from_u8x8(node + rows.far_at[a]), scale, origin) - o) * inv, cut);
   }
-  tf = simd::min(tf, F8::splat(closest)) * F8::splat(kFarScale);
-  return simd::select(tn <= tf, tn, F8::splat(INFINITY));
+  const F8 entry = simd::max(simd::max(tn[0], tn[1]), tn[2]);
+  const F8 exit = simd::min(simd::min(tf[0], tf[1]), tf[2]) * F8::splat(kFarScale);
+  return {entry, simd::bits(entry <= exit) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT)};
 }
 
 // Asks for a child's first four lines: a node's two and the next two, or a
@@ -74,8 +85,8 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
       const uint32_t count = layout::oct_count(properties), offset = layout::oct_offset(properties);
       if (count == 0) {
         const uint8_t* node = tree + offset;
-        const simd::F8 entry = oct_box_test(node, r, rows, c.t);
-        int hit = simd::bits(entry != simd::F8::splat(INFINITY)) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT);
+        const OctHits test = oct_box_test(node, r, rows, c.t);
+        int hit = test.bits;
         if (hit) {
           int k = __builtin_ctz(unsigned(hit));
           properties = layout::oct_child_properties(node, k);
@@ -87,7 +98,7 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
           // insertion into the stack's top (at most 8); the nearest is walked
           // next.
           alignas(32) float e[8];
-          entry.store(e);
+          test.entry.store(e);
           entry_stack[top] = e[k], node_stack[top] = properties, ++top;
           const int base = top - 1;
           do {

@@ -12,12 +12,15 @@
     !defined(__F16C__)
 #define MC_ISA_SIMD 0
 #define MC_ISA_NS isa_scalar
+#define MC_ISA_ID 0
 #elif defined(__AVX512F__) && defined(__AVX512VL__) && defined(__AVX512BW__) && defined(__AVX512DQ__)
 #define MC_ISA_SIMD 1
 #define MC_ISA_NS isa_avx512
+#define MC_ISA_ID 2
 #else
 #define MC_ISA_SIMD 1
 #define MC_ISA_NS isa_avx2
+#define MC_ISA_ID 1
 #endif
 
 #define MC_ISA_BEGIN inline namespace MC_ISA_NS {

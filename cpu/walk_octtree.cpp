@@ -36,7 +36,7 @@ struct OctRows {
 // distances of each axis are taken together as trees, not one axis after
 // another, and the hits come from the comparison itself: the walk waits on
 // this test node after node, so its chain of dependent instructions is kept
-// short. min/max keep their second operand on NaN (see cpu/intersect.h), and
+// short. The hit lanes are those of the old select-then-compare exactly. min/max keep their second operand on NaN (see cpu/intersect.h), and
 // each axis meets a constant first, so a NaN slab still constrains nothing.
 struct OctHits {
   simd::F8 entry;  // meaningful in the hit lanes only
@@ -56,11 +56,15 @@ inline OctHits oct_box_test(const uint8_t* node, const RayPre& r, const OctRows&
   }
   const F8 entry = simd::max(simd::max(tn[0], tn[1]), tn[2]);
   const F8 exit = simd::min(simd::min(tf[0], tf[1]), tf[2]) * F8::splat(kFarScale);
-  return {entry, simd::bits(entry <= exit) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT)};
+  // An entry of +inf is a miss even where the exit is +inf too (a slab the
+  // ray never reaches along a zero direction, with no hit yet).
+  const F8 inf = F8::splat(INFINITY);
+  return {entry, simd::bits((entry <= exit) & (entry < inf)) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT)};
 }
 
-// Asks for a child's first four lines: a node's two and the next two, or a
-// leaf's first four (leaves span three to four). No branch on which it is.
+// Asks for a child's first four lines: a node's (96 bytes: two or three
+// lines) and what follows, or a leaf's first four (leaves span three to
+// four). No branch on which it is.
 inline void prefetch_child(const uint8_t* child) {
   __builtin_prefetch(child);
   __builtin_prefetch(child + 64);

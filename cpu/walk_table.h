@@ -15,15 +15,19 @@ struct WalkEntry {
 };
 
 // This translation unit's set's table (the one cpu/walk.h's inline
-// namespace names), and by name the others a multi-set build has.
+// namespace names), and by name the others a multi-set build has (not the
+// unit's own again: clang warns when an inline namespace is reopened as a
+// plain one).
 MC_ISA_BEGIN
 std::span<const WalkEntry> walk_table();
 MC_ISA_END
+#if MC_ISA_ID != 0
 namespace isa_scalar { std::span<const WalkEntry> walk_table(); }
-#if MESHCAST_HAS_ISA_AVX2
+#endif
+#if MESHCAST_HAS_ISA_AVX2 && MC_ISA_ID != 1
 namespace isa_avx2 { std::span<const WalkEntry> walk_table(); }
 #endif
-#if MESHCAST_HAS_ISA_AVX512
+#if MESHCAST_HAS_ISA_AVX512 && MC_ISA_ID != 2
 namespace isa_avx512 { std::span<const WalkEntry> walk_table(); }
 #endif
 

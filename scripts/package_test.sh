@@ -25,6 +25,9 @@ g++ -O2 -o "$tmp/pc_build_and_trace" examples/build_and_trace.cpp $(pkg-config -
 g++ -O2 -o "$tmp/pc_frame_ahead" examples/frame_ahead.cpp $(pkg-config --cflags --libs meshcast-host)
 for e in build_and_trace frame_ahead; do echo "  pkg-config: $("$tmp/pc_$e" | tail -1)"; done
 
-cmake -S tests/consumer -B "$tmp/consumer" -DMESHCAST_SOURCE="$PWD" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# The subproject with the scalar walkers alone: what is checked here is the
+# subproject's configuration and targets (the installed package above has
+# every instruction set), and one set compiles in a third of the time.
+cmake -S tests/consumer -B "$tmp/consumer" -DMESHCAST_SOURCE="$PWD" -DCMAKE_BUILD_TYPE=Release -DMESHCAST_ISAS=scalar >/dev/null
 cmake --build "$tmp/consumer" -j"$jobs" >/dev/null
 for e in build_and_trace frame_ahead; do echo "  add_subdirectory: $("$tmp/consumer/$e" | tail -1)"; done

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite (README.md lists the stages and their time): the
-# Release build, every CPU suite under AddressSanitizer/UBSan, the host layer
-# under ThreadSanitizer, the suites that walk on the portable scalar build
-# (MESHCAST_SCALAR), the installed package, and last the fuzz targets under
-# libFuzzer for a bounded time (scripts/fuzz.sh).
+# Release build, every CPU suite on the portable scalar walkers under
+# AddressSanitizer/UBSan, the host layer under ThreadSanitizer, the installed
+# package, and last the fuzz targets under libFuzzer for a bounded time
+# (scripts/fuzz.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -13,13 +13,14 @@ jobs=$(nproc)
 # time: CTest's one process a test would load the meshes and compute the
 # oracle's answers again for each of its 2,000-odd tests. `quick` sets
 # MESHCAST_TEST_QUICK: bunny00, the sphere and the grid only, fewer rays a
-# set (the sanitizer and scalar builds; Release walks everything). A failing
+# set (the sanitizer builds and the second instruction set; Release walks
+# everything). A failing
 # suite prints its log; xargs waits for the others and fails the pipeline.
 # The longest first; walker_test (every layout) in two shards, so the two
 # cores finish together.
 cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test
             hostile_test oracle_test io_test)
-# What the scalar build changes (cpu/simd.h's lanes): the suites that walk.
+# What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
 walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
   local dir=$1 quick=()
@@ -44,11 +45,15 @@ stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
 sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG")
 
 # The walkers' instruction sets (cpu/isa.h): the Release build has them all
-# and runs the widest this processor has; the sanitizer builds take the
-# scalar set and that widest one.
+# and runs the widest this processor has (and AVX2 where that is AVX-512);
+# the AddressSanitizer build is the portable scalar build (MESHCAST_SCALAR:
+# the scalar walkers alone), so the scalar set runs every CPU suite under
+# ASan and UBSan; the SIMD walkers run under ASan and UBSan in the libFuzzer
+# stage (scripts/fuzz.sh), which walks every fuzzed blob on the widest set.
+# The ThreadSanitizer build, for the host layer's threads, takes the scalar
+# set alone too.
 source scripts/isa.sh
 widest=$(widest_isa)
-sanitizer_flags+=("-DMESHCAST_ISAS=$(sanitizer_isas)")
 
 stage "Release ($widest walkers): the CPU suites"
 run_suites build full "${cpu_suites[@]}"
@@ -59,7 +64,7 @@ fi
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
-stage "AddressSanitizer + UBSan, without the Vulkan backend: every CPU test suite and the CPU host layer"
+stage "AddressSanitizer + UBSan, the portable scalar walkers (MESHCAST_SCALAR) with the test counters, without the Vulkan backend: every CPU test suite and the CPU host layer"
 # The Vulkan suites stay out of this build: lavapipe and the loader are not
 # instrumented (their own allocations would read as leaks); they run in the
 # Release build above and the host layer under TSan below.
@@ -67,26 +72,19 @@ stage "AddressSanitizer + UBSan, without the Vulkan backend: every CPU test suit
 # libFuzzer stage (and without sanitizers in Release's CTest).
 # Built without the Vulkan backend (MESHCAST_VULKAN=OFF): every CPU suite
 # and the CPU-only host layer pass there too.
-cmake -S . -B build-asan "${sanitizer_flags[@]}" -DMESHCAST_SANITIZE=ON -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
+# The test counters (MESHCAST_COUNT_TESTS) are compiled in here: the
+# suites' counted-test checks run in this build alone.
+cmake -S . -B build-asan "${sanitizer_flags[@]}" -DMESHCAST_SANITIZE=ON -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON \
+      -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
 cmake --build build-asan -j"$jobs" --target "${cpu_suites[@]}" host_test
 run_suites build-asan quick "${cpu_suites[@]}" host_test
 
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan)"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
 # (uninstrumented) threads ever make TSan report what it cannot see.
-cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON >/dev/null
+cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON -DMESHCAST_SCALAR=ON >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
-
-stage "Portable scalar build (MESHCAST_SCALAR: the scalar walkers alone) without the Vulkan backend, the test counters compiled in: the suites that walk, the host layer"
-# The scalar walkers differ only in cpu/simd.h's lanes: the suites that walk
-# (quick, as under ASan) cover it; the Vulkan suites read the same shaders.
-# Built with MESHCAST_VULKAN=OFF, it also builds and tests the CPU-only host
-# layer (host_test: a caster asked for Vulkan answers on the CPU).
-cmake -S . -B build-scalar -DCMAKE_BUILD_TYPE=Release -DMESHCAST_SCALAR=ON -DMESHCAST_COUNT_TESTS=ON \
-      -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
-cmake --build build-scalar -j"$jobs" --target "${walk_suites[@]}" host_test
-run_suites build-scalar quick "${walk_suites[@]}" host_test
 
 stage "The package: installed and used by the examples (CMake and pkg-config), and as a subproject"
 bash scripts/package_test.sh

@@ -1,7 +1,6 @@
 # widest_isa: the widest walker instruction set (cpu/isa.h) this processor
-# runs: avx512, avx2 or scalar. Sourced by test.sh (which also runs the
-# Release build's AVX2 set where this is avx512) and fuzz.sh, whose build
-# takes the scalar set and this one only.
+# runs: avx512, avx2 or scalar. Sourced by test.sh and fuzz.sh, whose
+# sanitizer builds take the scalar set and this one only.
 widest_isa() {
   local flags
   flags=$(grep -m1 '^flags' /proc/cpuinfo 2>/dev/null || true)
@@ -12,7 +11,7 @@ widest_isa() {
     echo scalar
   fi
 }
-# The sets the fuzz build compiles: scalar and the widest (once).
+# The sets a sanitizer build compiles: scalar and the widest (once).
 sanitizer_isas() {
   local w
   w=$(widest_isa)

@@ -312,6 +312,14 @@ void check_ply_layout(const std::string& path, std::string_view text) {
     if (t == "double" || t == "float64") return 8;
     return 0;
   };
+  // PLY names are words. Assimp 5.2.5 reads an element named with leading
+  // digits as a count of about 2^32 records and asks for 64 GB (found by
+  // fuzz/mesh_fuzz: `element 666...6face 1`); a name must start with a letter
+  // or '_'.
+  auto is_name = [](std::string_view n) {
+    return !n.empty() && (std::isalpha((unsigned char)n[0]) || n[0] == '_') &&
+           std::all_of(n.begin(), n.end(), [](char c) { return std::isalnum((unsigned char)c) || c == '_' || c == '-'; });
+  };
   Lines ln{text};
   std::string_view line, format;
   size_t end = std::string_view::npos;
@@ -344,6 +352,9 @@ void check_ply_layout(const std::string& path, std::string_view text) {
       // is malformed (and would overflow the record total below).
       if (t.size() != 3 || !parse_int(t[2], n) || n < 0 || uint64_t(n) > text.size())
         fail(path, ln.at() + "malformed file: bad element line");
+      if (!is_name(t[1]))
+        fail(path, ln.at() + "malformed file: PLY element name '" + std::string(t[1].substr(0, 32)) +
+                       "' is not a word (a letter or '_', then letters, digits, '_' or '-')");
       // Assimp reads `tristrips` but drops triangles of every strip (1 of 2;
       // restarts at -1 lose more): refused rather than read wrong.
       if (t[1] == "tristrips")
@@ -358,6 +369,9 @@ void check_ply_layout(const std::string& path, std::string_view text) {
       const bool integer_count = !list || (t[2] != "float" && t[2] != "float32" && t[2] != "double" && t[2] != "float64");
       if (p.size == 0 || (list && p.count_size == 0) || !integer_count)
         fail(path, ln.at() + "malformed file: bad property line");
+      if (!is_name(p.name))
+        fail(path, ln.at() + "malformed file: PLY property name '" + std::string(p.name.substr(0, 32)) +
+                       "' is not a word (a letter or '_', then letters, digits, '_' or '-')");
       elements.back().props.push_back(p);
     } else {
       fail(path, ln.at() + "malformed file: unknown PLY header line '" + std::string(t[0].substr(0, 32)) + "'");

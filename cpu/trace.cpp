@@ -46,7 +46,11 @@ bool cpu_has(WalkerIsa isa) {
 #endif
   (void)avx2, (void)avx512;
 #endif
+#if MESHCAST_HAS_ISA_SCALAR
   return isa == WalkerIsa::Scalar;
+#else
+  return false;
+#endif
 }
 
 std::span<const WalkEntry> table_of(WalkerIsa isa) {
@@ -57,13 +61,23 @@ std::span<const WalkEntry> table_of(WalkerIsa isa) {
   if (isa == WalkerIsa::Avx2) return isa_avx2::walk_table();
 #endif
   (void)isa;
+#if MESHCAST_HAS_ISA_SCALAR
   return isa_scalar::walk_table();
+#else
+  return {};  // not reached: choose_isa picks a set this build has
+#endif
 }
 
 // Chosen once, on first use: the widest set the processor has, or the one
-// MESHCAST_ISA names (scalar, avx2, avx512) when the processor has it.
+// MESHCAST_ISA names (scalar, avx2, avx512) when the processor has it. A
+// build without the scalar set (MESHCAST_ISAS, the test scripts' sanitizer
+// builds) refuses a processor that runs none of its sets.
 IsaChoice choose_isa() {
-  WalkerIsa isa = cpu_has(WalkerIsa::Avx512) ? WalkerIsa::Avx512 : cpu_has(WalkerIsa::Avx2) ? WalkerIsa::Avx2 : WalkerIsa::Scalar;
+  WalkerIsa isa = WalkerIsa::Scalar;
+  bool found = false;
+  for (WalkerIsa widest_first : {WalkerIsa::Avx512, WalkerIsa::Avx2, WalkerIsa::Scalar})
+    if (!found && cpu_has(widest_first)) isa = widest_first, found = true;
+  if (!found) throw UsageError("meshcast was built without the scalar walkers, and this processor runs none of its sets");
   if (const char* asked = std::getenv("MESHCAST_ISA")) {
     for (WalkerIsa named : {WalkerIsa::Scalar, WalkerIsa::Avx2, WalkerIsa::Avx512})
       if (walker_isa_name(named) == asked) {

@@ -1,8 +1,8 @@
 // Walkers: one per tree family, instantiated per triangle codec. trace()
 // (include/meshcast/blob.h) picks the instantiation from the blob header once per batch.
 #pragma once
-#include <cstddef>
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 
 #include "cpu/leaf.h"

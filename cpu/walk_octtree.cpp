@@ -34,10 +34,11 @@ struct OctRows {
 
 // The 8 children's entry distances and which of them the ray hits. The
 // distances of each axis are taken together as trees, not one axis after
-// another, and the hits come from the comparison itself: the walk waits on
-// this test node after node, so its chain of dependent instructions is kept
-// short. The hit lanes are those of the old select-then-compare exactly. min/max keep their second operand on NaN (see cpu/intersect.h), and
-// each axis meets a constant first, so a NaN slab still constrains nothing.
+// another, and the hits come from the comparisons themselves: the walk waits
+// on this test node after node, so its chain of dependent instructions is
+// kept short. min/max keep their second operand on NaN (see
+// cpu/intersect.h), and each axis meets a constant first, so a NaN slab
+// still constrains nothing.
 struct OctHits {
   simd::F8 entry;  // meaningful in the hit lanes only
   int bits;

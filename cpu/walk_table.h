@@ -21,7 +21,7 @@ struct WalkEntry {
 MC_ISA_BEGIN
 std::span<const WalkEntry> walk_table();
 MC_ISA_END
-#if MC_ISA_ID != 0
+#if MESHCAST_HAS_ISA_SCALAR && MC_ISA_ID != 0
 namespace isa_scalar { std::span<const WalkEntry> walk_table(); }
 #endif
 #if MESHCAST_HAS_ISA_AVX2 && MC_ISA_ID != 1

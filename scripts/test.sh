@@ -47,10 +47,8 @@ sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEB
 # The walkers' instruction sets (cpu/isa.h): the Release build has them all
 # and runs the widest this processor has, then the suites that walk again
 # on AVX2 (where the widest is AVX-512) and on the scalar set, quick; the
-# AddressSanitizer build takes the scalar set and the widest (and runs the
-# widest: the scalar walkers under ASan took over 6 minutes a walker_test
-# shard); the ThreadSanitizer build, for the host layer's threads, the
-# scalar set alone.
+# sanitizer builds compile the widest set alone (one walker set is most of
+# their build time).
 source scripts/isa.sh
 widest=$(widest_isa)
 
@@ -67,7 +65,7 @@ fi
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
-stage "AddressSanitizer + UBSan, the test counters compiled in, without the Vulkan backend: every CPU test suite and the CPU host layer"
+stage "AddressSanitizer + UBSan ($widest walkers), the test counters compiled in, without the Vulkan backend: every CPU test suite and the CPU host layer"
 # The Vulkan suites stay out of this build: lavapipe and the loader are not
 # instrumented (their own allocations would read as leaks); they run in the
 # Release build above and the host layer under TSan below.
@@ -77,7 +75,7 @@ stage "AddressSanitizer + UBSan, the test counters compiled in, without the Vulk
 # and the CPU-only host layer pass there too.
 # The test counters (MESHCAST_COUNT_TESTS) are compiled in here: the
 # suites' counted-test checks run in this build alone.
-cmake -S . -B build-asan "${sanitizer_flags[@]}" "-DMESHCAST_ISAS=$(sanitizer_isas)" -DMESHCAST_SANITIZE=ON -DMESHCAST_COUNT_TESTS=ON \
+cmake -S . -B build-asan "${sanitizer_flags[@]}" "-DMESHCAST_ISAS=$widest" -DMESHCAST_SANITIZE=ON -DMESHCAST_COUNT_TESTS=ON \
       -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
 cmake --build build-asan -j"$jobs" --target "${cpu_suites[@]}" host_test
 run_suites build-asan quick "${cpu_suites[@]}" host_test
@@ -85,7 +83,7 @@ run_suites build-asan quick "${cpu_suites[@]}" host_test
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan)"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
 # (uninstrumented) threads ever make TSan report what it cannot see.
-cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON -DMESHCAST_SCALAR=ON >/dev/null
+cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" build-tsan/bin/host_test
 

@@ -33,10 +33,14 @@ std::filesystem::path scratch_dir();
 std::string make_file(const std::string& name, const std::string& bytes);
 
 // Generated meshes plus the four public ones when present. `large` adds the
-// 1M+ triangle terrain. Under sanitizers (MESHCAST_TEST_QUICK set, see
-// scripts/test.sh) the three larger public meshes and the 64k terrain are
-// left out.
+// 1M+ triangle terrain. In the quick runs (MESHCAST_TEST_QUICK set: the
+// sanitizer builds and the second and third instruction sets, see
+// scripts/test.sh) the 64k terrain and every public mesh but the smallest,
+// ChineseDragon-10kv (20k triangles), are left out.
 std::vector<NamedMesh> test_meshes(bool large);
+// The public mesh that suites walking a chosen few meshes take: bunny00, or
+// in the quick runs the one public mesh they have.
+bool is_chosen_public_mesh(const std::string& name);
 // True when MESHCAST_TEST_QUICK is set: the suites walk fewer rays a set.
 bool quick();
 

@@ -71,7 +71,7 @@ uint64_t oracle_mistakes(const std::vector<uint8_t>& blob, const NamedMesh& m, c
 TEST(WalkerVsOracleSplitters, EverySplitterOnTheFoundationLayouts) {
   for (Splitter s : all_splitters())
     for (const NamedMesh& m : test_meshes(false)) {
-      if (m.name != "sphere" && m.name != "terrain_64k" && m.name != "bunny00") continue;
+      if (m.name != "sphere" && m.name != "terrain_64k" && !is_chosen_public_mesh(m.name)) continue;
       for (const char* name : {"AABBTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
         BuildOptions o = parse_layout(name);
         o.splitter = s;
@@ -87,7 +87,7 @@ TEST(WalkerVsOracleSplitters, EverySplitterOnTheFoundationLayouts) {
 TEST(WalkerVsOracleNodeOrders, EveryOrderOnTheQuadTrees) {
   for (NodeOrder order : all_node_orders())
     for (const NamedMesh& m : test_meshes(false)) {
-      if (m.name != "sphere" && m.name != "terrain_64k" && m.name != "bunny00") continue;
+      if (m.name != "sphere" && m.name != "terrain_64k" && !is_chosen_public_mesh(m.name)) continue;
       for (const char* name : {"QuadTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
         BuildOptions o = parse_layout(name);
         o.node_order = order;
@@ -109,7 +109,7 @@ TEST(WalkerVsOracleNodeOrders, EveryOrderOnTheQuadTrees) {
 // answers; so does a tight depth limit, which forces median splits.
 TEST(WalkerVsOracleLBVH, LeftFirstNearFirstAndDepthLimits) {
   for (const NamedMesh& m : test_meshes(false)) {
-    if (m.name != "sphere" && m.name != "bunny00") continue;
+    if (m.name != "sphere" && !is_chosen_public_mesh(m.name)) continue;
     for (int variant = 0; variant < 3; ++variant) {
       BuildOptions o = parse_layout("StacklessLBVH/Float3");
       o.lbvh_near_first = variant != 1;
@@ -145,7 +145,7 @@ INSTANTIATE_TEST_SUITE_P(Layouts, WalkerVsOracle, ::testing::ValuesIn(layout_nam
 // The layouts of the foundation issue and every tree with Float3 on the
 // 1M-triangle terrain.
 TEST(WalkerVsOracleLarge, Terrain1M) {
-  if (quick()) GTEST_SKIP() << "large scenes: the Release and scalar runs walk them";
+  if (quick()) GTEST_SKIP() << "large scenes: the Release run walks them";
   for (const char* name : {"AABBTree/Float3", "QuadTree/Float3SOA4", "QuadTreeHalfFloat/Indexed8BitPackSOA4",
                            "AABBTreeSplitAxis/Float3", "AABBTreePNS/Float3", "AABBTreeCompressed/Float3",
                            "SKDTree/Float3", "StacklessLBVH/Float3"})
@@ -155,7 +155,7 @@ TEST(WalkerVsOracleLarge, Terrain1M) {
 // Seed 000 6: the source's AABBTreePNS ran out of offset bits on its
 // 2,264,303-triangle scene. This one holds a larger terrain and walks it.
 TEST(WalkerVsOracleLarge, PNSHoldsTheSourcesLargestScene) {
-  if (quick()) GTEST_SKIP() << "large scenes: the Release and scalar runs walk them";
+  if (quick()) GTEST_SKIP() << "large scenes: the Release run walks them";
   Mesh terrain = make_terrain(1088, 1056, 13);  // 2,297,856 triangles
   ASSERT_GT(terrain.triangles.size(), 2264303u);
   std::vector<uint8_t> blob = build_blob(terrain, parse_layout("AABBTreePNS/Float3"), "terrain_2.3M");
@@ -262,7 +262,7 @@ namespace {
 TEST(TriangleTests, MollerTrumboreIsAnOptionOffByDefault) {
   EXPECT_EQ(triangle_test_choice.load(), TriangleTest::Watertight);
   for (const NamedMesh& m : test_meshes(false)) {
-    if (m.name != "sphere" && m.name != "bunny00") continue;
+    if (m.name != "sphere" && !is_chosen_public_mesh(m.name)) continue;
     const std::vector<Ray>& rays = test_rays(m, RayKind::Long, 2000);
     for (const char* layout : {"AABBTree/Float3", "AABBTree/Float3SOA8", "QuadTree/Float3SOA4"}) {
       std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout), m.name);

@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -73,11 +74,14 @@ std::span<const WalkEntry> table_of(WalkerIsa isa) {
 // build without the scalar set (MESHCAST_ISAS, the test scripts' sanitizer
 // builds) refuses a processor that runs none of its sets.
 IsaChoice choose_isa() {
-  WalkerIsa isa = WalkerIsa::Scalar;
-  bool found = false;
-  for (WalkerIsa widest_first : {WalkerIsa::Avx512, WalkerIsa::Avx2, WalkerIsa::Scalar})
-    if (!found && cpu_has(widest_first)) isa = widest_first, found = true;
-  if (!found) throw UsageError("meshcast was built without the scalar walkers, and this processor runs none of its sets");
+  std::optional<WalkerIsa> widest;
+  for (WalkerIsa candidate : {WalkerIsa::Avx512, WalkerIsa::Avx2, WalkerIsa::Scalar})
+    if (cpu_has(candidate)) {
+      widest = candidate;
+      break;
+    }
+  if (!widest) throw UsageError("meshcast was built without the scalar walkers, and this processor runs none of its sets");
+  WalkerIsa isa = *widest;
   if (const char* asked = std::getenv("MESHCAST_ISA")) {
     for (WalkerIsa named : {WalkerIsa::Scalar, WalkerIsa::Avx2, WalkerIsa::Avx512})
       if (walker_isa_name(named) == asked) {

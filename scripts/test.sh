@@ -13,7 +13,7 @@ jobs=$(nproc)
 # time: CTest's one process a test would load the meshes and compute the
 # oracle's answers again for each of its 2,000-odd tests. `quick` sets
 # MESHCAST_TEST_QUICK: bunny00, the sphere and the grid only, fewer rays a
-# set (the sanitizer builds and the second instruction set; Release walks
+# set (the sanitizer builds and the other instruction sets; Release walks
 # everything). A failing
 # suite prints its log; xargs waits for the others and fails the pipeline.
 # The longest first; walker_test (every layout) in two shards, so the two

@@ -408,7 +408,7 @@ std::vector<std::string> gpu_cases() {
 }
 INSTANTIATE_TEST_SUITE_P(Vulkan, Robustness, ::testing::ValuesIn(gpu_cases()), param_name);
 #else
-INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(layout_names()), param_name);
+INSTANTIATE_TEST_SUITE_P(Layouts, Robustness, ::testing::ValuesIn(covering_layouts(layout_names())), param_name);
 
 // The automatic layout's choice for each probe mesh, under each setting.
 std::vector<std::string> auto_cases() {
@@ -431,7 +431,7 @@ std::vector<std::string> paired_layouts() {
   }
   return names;
 }
-INSTANTIATE_TEST_SUITE_P(Paired, Robustness, ::testing::ValuesIn(paired_layouts()), param_name);
+INSTANTIATE_TEST_SUITE_P(Paired, Robustness, ::testing::ValuesIn(covering_layouts(paired_layouts())), param_name);
 
 #endif
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -24,6 +25,19 @@ std::optional<Mesh> data_mesh(const std::string& name) {
 }
 
 bool quick() { return std::getenv("MESHCAST_TEST_QUICK") != nullptr; }
+
+std::vector<std::string> covering_layouts(const std::vector<std::string>& names) {
+  if (!quick()) return names;
+  std::vector<std::string> chosen;
+  std::set<uint32_t> trees, triangles;
+  for (const std::string& n : names) {
+    const BuildOptions o = parse_layout(n.substr(0, n.find_first_of("+@")));
+    const bool new_tree = trees.insert(uint32_t(o.layout.tree)).second;
+    const bool new_triangles = triangles.insert(uint32_t(o.layout.triangles)).second;
+    if (new_tree || new_triangles) chosen.push_back(n);
+  }
+  return chosen;
+}
 
 namespace {
 

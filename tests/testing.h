@@ -43,6 +43,11 @@ std::vector<NamedMesh> test_meshes(bool large);
 bool is_chosen_public_mesh(const std::string& name);
 // True when MESHCAST_TEST_QUICK is set: the suites walk fewer rays a set.
 bool quick();
+// The layouts of `names` a suite runs: all of them, or in the quick runs a
+// few that still take every tree format and every triangle format at least
+// once (the first layout of each that is not yet covered): each walker's
+// node code and each codec's leaf code run, not every pairing of the two.
+std::vector<std::string> covering_layouts(const std::vector<std::string>& names);
 
 // Oracle answers (tree oracle) for a ray set, cached per (mesh, kind).
 const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays);

@@ -5,7 +5,9 @@
 // a leaf in whole triangle blocks (from a tree of 2-triangle leaves), was
 // measured and left out: no faster, and 20-22 bytes a triangle against 16
 // (bench/RESULTS.md).
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 
 #include "builder/wide_plan.h"
@@ -80,8 +82,15 @@ class OctWriter : public TreeWriter {
     const BuildTree& t = w.tree;
     for (uint32_t leaf : plan_.leaves) w.write_leaf(leaf, plan_.leaf_offset[leaf]);
     w.refit();
-    for (uint32_t q = 0; q < plan_.binary_of.size(); ++q)
-      write_oct_node(t, plan_, q, w.bytes.data() + w.h.tree_offset + plan_.node_offset[q]);
+    for (uint32_t q = 0; q < plan_.binary_of.size(); ++q) {
+      uint8_t* node = w.bytes.data() + w.h.tree_offset + plan_.node_offset[q];
+      write_oct_node(t, plan_, q, node);
+      // The header's reach of the nodes' frames (layout/octtree.h).
+      for (int a = 0; a < 3; ++a) {
+        w.h.node_origin[a] = std::max(w.h.node_origin[a], std::fabs(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a)));
+        w.h.node_scale = std::max(w.h.node_scale, layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));
+      }
+    }
     w.h.root = layout::oct_properties(t.nodes[0].leaf() ? t.nodes[0].count : 0, wide_child_offset(t, plan_, 0));
   }
   uint32_t depth(const BuildTree&) const override { return plan_.depth; }

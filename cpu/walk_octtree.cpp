@@ -1,9 +1,13 @@
-// OctTreeCompressed walker (issue 19): the 8 child boxes of a node decoded
-// (one exact fma a plane) and tested at once, the near and far planes picked
-// by the ray's direction signs; one hit child is walked next without touching
+// OctTreeCompressed walker (issue 19): the 8 child boxes of a node tested at
+// once, one fma a plane (the fused form below, the exact decode where a ray
+// needs it), the near and far planes picked by the ray's direction signs; one hit child is walked next without touching
 // the stack, several are pushed farthest first with their entry distances,
 // and popped entries are skipped once the closest hit is nearer. Every hit
 // child's first lines are asked for when its parent is tested.
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+
 #include "cpu/walk.h"
 #include "layout/codecs.h"
 #include "layout/octtree.h"
@@ -32,18 +36,60 @@ struct OctRows {
   }
 };
 
+// The node test's two forms. The exact form decodes each plane (exact),
+// subtracts the ray origin and multiplies by the inverse direction: four
+// dependent operations a plane, each rounded relative to the distance, which
+// kFarScale (Ize) covers. The fused form writes the same distance as
+//   (Origin + q 2^e - o) inv  =  q (2^e inv) + (Origin inv - o inv)
+// and takes one fma a plane once the node's three axis terms are formed:
+// 2^e inv is exact (a power of two times inv), and Origin inv - o inv is one
+// fma from -(o inv), rounded once a ray. Those two terms are rounded relative
+// to |Origin inv| and |o inv|, not to the distance (they may nearly cancel):
+// together at most u |Origin inv| + 3u |o inv| and a little (u = 2^-24). The
+// header bounds |Origin| over the blob's nodes (its reach, checked node by
+// node when the blob is validated), so one pad a ray covers them: near
+// planes are moved nearer and far planes farther by
+// 4u (reach + |o|) |inv|, at least FLT_MIN (which covers every underflow on
+// the way). What rounding is left is relative to the distance, as in the
+// exact form, and kFarScale covers it: the box stays conservative. In space
+// the pad is 2^-22 of reach + |o|, a few ulps of the coordinates (a node's
+// quantization step is 2^-8 of its extent). A ray takes the fused form where no term can
+// overflow or fall below FLT_MIN: 2^-40 <= |inv| <= 2^40, |o|, the reach and
+// the largest scale at most 2^40. Otherwise, and for a zero direction
+// component (an infinite inverse, which the exact form's NaN rule handles),
+// the exact form.
+struct OctFused {
+  bool applies = true;
+  float near_bias[3], far_bias[3];  // -(o inv) -+ pad
+  OctFused(const RayPre& r, const layout::BlobHeader& h) {
+    constexpr float kBig = 0x1p40f, kSmall = 0x1p-40f;
+    for (int a = 0; a < 3; ++a) {
+      const float inv = std::fabs(r.inv[a]), reach = h.node_origin[a];
+      applies &= inv <= kBig && inv >= kSmall && std::fabs(r.org[a]) <= kBig && reach <= kBig && h.node_scale <= kBig;
+      const float pad = std::max(0x1p-22f * (reach + std::fabs(r.org[a])) * inv, FLT_MIN);
+      const float o_inv = r.org[a] * r.inv[a];
+      near_bias[a] = -o_inv - pad;
+      far_bias[a] = -o_inv + pad;
+    }
+  }
+};
+
 // The 8 children's entry distances and which of them the ray hits. The
 // distances of each axis are taken together as trees, not one axis after
 // another, and the hits come from the comparisons themselves: the walk waits
 // on this test node after node, so its chain of dependent instructions is
-// kept short. min/max keep their second operand on NaN (see
-// cpu/intersect.h), and each axis meets a constant first, so a NaN slab
-// still constrains nothing.
+// kept short. In the exact form min/max keep their second operand on NaN
+// (see cpu/intersect.h), and each axis meets a constant first, so a NaN slab
+// still constrains nothing; the fused form has no NaN or infinity but the
+// closest hit's cut (every term finite), so its reduction is one level
+// shorter.
 struct OctHits {
   simd::F8 entry;  // meaningful in the hit lanes only
   int bits;
 };
-inline OctHits oct_box_test(const uint8_t* node, const RayPre& r, const OctRows& rows, float closest) {
+template <bool Fused>
+inline OctHits oct_box_test(const uint8_t* node, const RayPre& r, const OctRows& rows, const OctFused& fused,
+                            float closest) {
   count_boxes(8);
   using simd::F8;
   F8 tn[3], tf[3];
@@ -51,16 +97,31 @@ inline OctHits oct_box_test(const uint8_t* node, const RayPre& r, const OctRows&
   for (int a = 0; a < 3; ++a) {
     const F8 origin = F8::splat(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a));
     const F8 scale = F8::splat(layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));
-    const F8 o = F8::splat(r.org[a]), inv = F8::splat(r.inv[a]);
-    tn[a] = simd::max((simd::fma(simd::from_u8x8(node + rows.near_at[a]), scale, origin) - o) * inv, zero);
-    tf[a] = simd::min((simd::fma(simd::from_u8x8(node + rows.far_at[a]), scale, origin) - o) * inv, cut);
+    const F8 inv = F8::splat(r.inv[a]);
+    const F8 near_q = simd::from_u8x8(node + rows.near_at[a]), far_q = simd::from_u8x8(node + rows.far_at[a]);
+    if constexpr (Fused) {
+      const F8 step = scale * inv;
+      tn[a] = simd::fma(near_q, step, simd::fma(origin, inv, F8::splat(fused.near_bias[a])));
+      tf[a] = simd::fma(far_q, step, simd::fma(origin, inv, F8::splat(fused.far_bias[a])));
+    } else {
+      const F8 o = F8::splat(r.org[a]);
+      tn[a] = simd::max((simd::fma(near_q, scale, origin) - o) * inv, zero);
+      tf[a] = simd::min((simd::fma(far_q, scale, origin) - o) * inv, cut);
+    }
   }
-  const F8 entry = simd::max(simd::max(tn[0], tn[1]), tn[2]);
-  const F8 exit = simd::min(simd::min(tf[0], tf[1]), tf[2]) * F8::splat(kFarScale);
-  // An entry of +inf is a miss even where the exit is +inf too (a slab the
-  // ray never reaches along a zero direction, with no hit yet).
-  const F8 inf = F8::splat(INFINITY);
-  return {entry, simd::bits((entry <= exit) & (entry < inf)) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT)};
+  F8 entry, exit;
+  if constexpr (Fused) {
+    entry = simd::max(simd::max(tn[0], tn[1]), simd::max(tn[2], zero));
+    exit = simd::min(simd::min(tf[0], tf[1]), simd::min(tf[2], cut)) * F8::splat(kFarScale);
+    return {entry, simd::bits(entry <= exit) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT)};
+  } else {
+    entry = simd::max(simd::max(tn[0], tn[1]), tn[2]);
+    exit = simd::min(simd::min(tf[0], tf[1]), tf[2]) * F8::splat(kFarScale);
+    // An entry of +inf is a miss even where the exit is +inf too (a slab the
+    // ray never reaches along a zero direction, with no hit yet).
+    const F8 inf = F8::splat(INFINITY);
+    return {entry, simd::bits((entry <= exit) & (entry < inf)) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT)};
+  }
 }
 
 // Asks for a child's first four lines: a node's (96 bytes: two or three
@@ -73,61 +134,72 @@ inline void prefetch_child(const uint8_t* child) {
   __builtin_prefetch(child + 192);
 }
 
+// One ray's walk with the node test's exact or fused form.
+template <class Codec, bool Fused>
+inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, const OctFused& fused,
+                     Closest& c) {
+  const uint8_t* tree = blob + h.tree_offset;
+  const OctRows rows(r);
+  uint32_t node_stack[kStackSize];
+  float entry_stack[kStackSize];
+  int top = 0;
+  uint32_t properties = h.root;
+  for (;;) {
+    const uint32_t count = layout::oct_count(properties), offset = layout::oct_offset(properties);
+    if (count == 0) {
+      const uint8_t* node = tree + offset;
+      const OctHits test = oct_box_test<Fused>(node, r, rows, fused, c.t);
+      int hit = test.bits;
+      if (hit) {
+        int k = __builtin_ctz(unsigned(hit));
+        properties = layout::oct_child_properties(node, k);
+        prefetch_child(tree + layout::oct_offset(properties));
+        hit &= hit - 1;
+        if (hit == 0) continue;  // one child: walk it next, no stack traffic
+        // Several: each pushed with its entry distance (and its lines asked
+        // for now, to be there when it is popped), kept farthest first by
+        // insertion into the stack's top (at most 8); the nearest is walked
+        // next.
+        alignas(32) float e[8];
+        test.entry.store(e);
+        entry_stack[top] = e[k], node_stack[top] = properties, ++top;
+        const int base = top - 1;
+        do {
+          k = __builtin_ctz(unsigned(hit));
+          const float d = e[k];
+          const uint32_t p = layout::oct_child_properties(node, k);
+          prefetch_child(tree + layout::oct_offset(p));
+          int j = top++;
+          while (j > base && entry_stack[j - 1] < d) entry_stack[j] = entry_stack[j - 1], node_stack[j] = node_stack[j - 1], --j;
+          entry_stack[j] = d, node_stack[j] = p;
+          hit &= hit - 1;
+        } while (hit);
+        properties = node_stack[--top];
+        continue;
+      }
+    } else {
+      test_leaf<Codec>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
+    }
+    do {
+      if (top == 0) return;
+      --top;
+    } while (entry_stack[top] > c.t * kFarScale);
+    properties = node_stack[top];
+  }
+}
+
 }  // namespace
 
 template <class Codec>
 void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
           uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
-  const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
-    const OctRows rows(r);
-    uint32_t node_stack[kStackSize];
-    float entry_stack[kStackSize];
-    int top = 0;
-    uint32_t properties = h.root;
-    for (;;) {
-      const uint32_t count = layout::oct_count(properties), offset = layout::oct_offset(properties);
-      if (count == 0) {
-        const uint8_t* node = tree + offset;
-        const OctHits test = oct_box_test(node, r, rows, c.t);
-        int hit = test.bits;
-        if (hit) {
-          int k = __builtin_ctz(unsigned(hit));
-          properties = layout::oct_child_properties(node, k);
-          prefetch_child(tree + layout::oct_offset(properties));
-          hit &= hit - 1;
-          if (hit == 0) continue;  // one child: walk it next, no stack traffic
-          // Several: each pushed with its entry distance (and its lines asked
-          // for now, to be there when it is popped), kept farthest first by
-          // insertion into the stack's top (at most 8); the nearest is walked
-          // next.
-          alignas(32) float e[8];
-          test.entry.store(e);
-          entry_stack[top] = e[k], node_stack[top] = properties, ++top;
-          const int base = top - 1;
-          do {
-            k = __builtin_ctz(unsigned(hit));
-            const float d = e[k];
-            const uint32_t p = layout::oct_child_properties(node, k);
-            prefetch_child(tree + layout::oct_offset(p));
-            int j = top++;
-            while (j > base && entry_stack[j - 1] < d) entry_stack[j] = entry_stack[j - 1], node_stack[j] = node_stack[j - 1], --j;
-            entry_stack[j] = d, node_stack[j] = p;
-            hit &= hit - 1;
-          } while (hit);
-          properties = node_stack[--top];
-          continue;
-        }
-      } else {
-        test_leaf<Codec>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
-      }
-      do {
-        if (top == 0) return;
-        --top;
-      } while (entry_stack[top] > c.t * kFarScale);
-      properties = node_stack[top];
-    }
+    const OctFused fused(r, h);
+    if (fused.applies)
+      walk_ray<Codec, true>(blob, h, r, fused, c);
+    else
+      walk_ray<Codec, false>(blob, h, r, fused, c);
   });
 }
 

@@ -34,8 +34,8 @@ struct BlobHeader {
   float bounds_max[3];
   float quant_offset[3];    // BitPack vertices: v = q * quant_scale + quant_offset
   float quant_scale[3];
-  float node_origin[3];     // QuadTreeHalfFloat: bound = half * node_scale + node_origin
-  float node_scale;
+  float node_origin[3];     // QuadTreeHalfFloat: bound = half * node_scale + node_origin;
+  float node_scale;         // OctTreeCompressed: the nodes' largest |Origin| an axis and 2^e (octtree.h)
   uint32_t tree_offset, tree_size;
   uint32_t node_bytes;      // bytes of nodes in the tree section (rest: triangle blocks)
   uint32_t triangle_base;   // tree-section offset where slot numbering starts

@@ -74,7 +74,8 @@ void descend_octtree(Descent& d, uint32_t properties) {
 }  // namespace
 
 // Nodes lie in the node area, each after its parent (so no walk loops), with
-// finite origins and normal scales; every leaf passes check_leaf.
+// finite origins and normal scales within the header's reach; every leaf
+// passes check_leaf.
 template <class Codec>
 std::string validate_tree(tree::OctTreeCompressed, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   struct Item { uint32_t properties, parent, depth; };
@@ -101,8 +102,11 @@ std::string validate_tree(tree::OctTreeCompressed, const uint8_t* blob, const Bl
     const uint8_t* node = blob + h.tree_offset + offset;
     for (int a = 0; a < 3; ++a) {
       const uint8_t e = node[MC_OCT_EXPONENTS_AT + a];
-      if (e == 0 || e == 255 || !std::isfinite(load<float>(node + MC_OCT_ORIGIN_AT + 4 * a)))
+      const float origin = load<float>(node + MC_OCT_ORIGIN_AT + 4 * a);
+      if (e == 0 || e == 255 || !std::isfinite(origin))
         return name + " has a frame that is not a finite origin and a normal power of two (axis " + num(uint32_t(a)) + ")";
+      if (!(std::fabs(origin) <= h.node_origin[a]) || !(oct_scale(e) <= h.node_scale))
+        return name + "'s frame (axis " + num(uint32_t(a)) + ") lies beyond the header's node reach (node_origin, node_scale)";
     }
     for (int k = 0; k < int(MC_OCT_WIDTH); ++k)
       if (const uint32_t p = oct_child_properties(node, k)) stack.push_back({p, offset, it.depth + 1});

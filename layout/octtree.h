@@ -3,6 +3,11 @@
 // Origin + q * 2^e is exact in float for every code: a minimum coded down and
 // a maximum coded up then bound the child exactly as the writer meant, on
 // every walker and shader, whatever the distance from the origin.
+//
+// The header's node_origin[a] holds the largest |Origin| of axis a over the
+// nodes and node_scale the largest 2^e of any axis (0 where the root is a
+// leaf): the CPU walker's fused box test (cpu/walk_octtree.cpp) bounds its
+// rounding with them, and validation checks every node against them.
 #pragma once
 #include <bit>
 #include <cmath>

@@ -2,7 +2,9 @@
 // corrupted blobs (run under AddressSanitizer by the CI's sanitizer job).
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstddef>
 #include <random>
 #include <set>
 
@@ -10,6 +12,7 @@
 #include "layout/blob_format.h"
 #include "layout/block.h"
 #include "layout/half.h"
+#include "layout/octtree.h"
 #include "tests/testing.h"
 
 #if defined(__x86_64__)
@@ -413,6 +416,31 @@ TEST(Corruption, NewTreesRefuseBrokenLinks) {
   EXPECT_NE(why.find("hole"), std::string::npos) << why;
   // An interior node whose children lie past the node array.
   EXPECT_NE(corrupt(two_apart("StacklessLBVH/Float3"), tree + 32 + 24, uint32_t(-1)), "");
+}
+
+// OctTreeCompressed's header bounds its nodes' frames (the CPU walker's
+// fused box test pads its rounding with them): a header that claims a
+// smaller reach than a node's origin or scale, or one that is not finite,
+// is refused.
+TEST(Corruption, OctTreeNodesBeyondTheHeaderReachAreRefused) {
+  const Mesh sphere = make_sphere(12, 24, 1.0f, {5.0f, -3.0f, 2.0f});
+  std::vector<uint8_t> b = build_blob(sphere, parse_layout("OctTreeCompressed/Float3"), "s");
+  const BlobHeader& h = header_of(b.data());
+  ASSERT_EQ(oct_count(h.root), 0u) << "the root is a node";
+  const uint8_t* root = b.data() + h.tree_offset + oct_offset(h.root);
+  for (int a = 0; a < 3; ++a) {
+    const float origin = std::fabs(load<float>(root + MC_OCT_ORIGIN_AT + 4 * a));
+    EXPECT_GE(h.node_origin[a], origin) << a;
+    EXPECT_GE(h.node_scale, oct_scale(root[MC_OCT_EXPONENTS_AT + a])) << a;
+    const size_t field = offsetof(BlobHeader, node_origin) + 4 * size_t(a);
+    EXPECT_NE(corrupt(b, field, std::bit_cast<uint32_t>(std::nextafter(origin, 0.0f))).find("node reach"),
+              std::string::npos) << a;
+    EXPECT_NE(corrupt(b, field, std::bit_cast<uint32_t>(NAN)).find("node reach"), std::string::npos) << a;
+  }
+  EXPECT_NE(corrupt(b, offsetof(BlobHeader, node_scale), std::bit_cast<uint32_t>(h.node_scale / 2)).find("node reach"),
+            std::string::npos);
+  EXPECT_NE(corrupt(b, offsetof(BlobHeader, node_scale), std::bit_cast<uint32_t>(-1.0f)).find("node reach"),
+            std::string::npos);
 }
 
 TEST(GoldenBytes, AABBListIsSeed7) {

@@ -16,8 +16,8 @@ jobs=$(nproc)
 # set (the sanitizer builds and the other instruction sets; Release walks
 # everything). A failing
 # suite prints its log; xargs waits for the others and fails the pipeline.
-# The longest first; walker_test (every layout) in two shards, so the two
-# cores finish together.
+# The longest first; walker_test and robustness_test (every layout) in two
+# shards each, so the two cores finish together.
 cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test
             hostile_test oracle_test io_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
@@ -28,7 +28,7 @@ run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
   shift 2
   local items=() s
   for s in "$@"; do
-    if [[ $s == walker_test ]]; then items+=(walker_test#0 walker_test#1); else items+=("$s"); fi
+    if [[ $s == walker_test || $s == robustness_test ]]; then items+=("$s#0" "$s#1"); else items+=("$s"); fi
   done
   printf '%s\n' "${items[@]}" |
     env MESHCAST_DATA="$PWD/data" "${quick[@]}" LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp" \

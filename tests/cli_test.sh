@@ -50,7 +50,7 @@ check bench-trees 0 "AABBTreePNS/Float3" -- "$meshcast" bench trees "$mesh" --ra
 check bench-splitters 0 "FixedLeafSize" -- "$meshcast" bench splitters "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check bench-trees-all 0 "StacklessLBVH left first" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check bench-order 0 "BreadthFirstTrianglesLast" -- "$meshcast" bench order "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --only SKDTree,OctTree --out-dir "$work"
 check bench-pairing 0 "bunny00 rotated 45, pairs baked|terrain_2M" -- "$meshcast" bench pairing --data "$data" --rays 8 --repeat 1 --out-dir "$work"
 check bench-latency 0 "crossover \\(automatic backend" -- "$meshcast" bench latency "$mesh" --frame-ms 1 --out-dir "$work"
 check bench-robustness 0 "leaks plain" -- "$meshcast" bench robustness "$mesh" --rays 8 --repeat 1

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "builder/wide_plan.h"
@@ -82,10 +83,13 @@ class OctWriter : public TreeWriter {
     const BuildTree& t = w.tree;
     for (uint32_t leaf : plan_.leaves) w.write_leaf(leaf, plan_.leaf_offset[leaf]);
     w.refit();
+    // The header's reach of the nodes' frames (layout/octtree.h): refit
+    // left the half-float frame there, which this tree does not use.
+    std::fill(std::begin(w.h.node_origin), std::end(w.h.node_origin), 0.0f);
+    w.h.node_scale = 0;
     for (uint32_t q = 0; q < plan_.binary_of.size(); ++q) {
       uint8_t* node = w.bytes.data() + w.h.tree_offset + plan_.node_offset[q];
       write_oct_node(t, plan_, q, node);
-      // The header's reach of the nodes' frames (layout/octtree.h).
       for (int a = 0; a < 3; ++a) {
         w.h.node_origin[a] = std::max(w.h.node_origin[a], std::fabs(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a)));
         w.h.node_scale = std::max(w.h.node_scale, layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));

@@ -1,6 +1,6 @@
-// OctTreeCompressed walker (issue 19): the 8 child boxes of a node tested at
-// once, one fma a plane (the fused form below, the exact decode where a ray
-// needs it), the near and far planes picked by the ray's direction signs; one hit child is walked next without touching
+// OctTreeCompressed walker (issue 19): the 8 child boxes of a node tested
+// at once, one fma a plane (the fused form below; the exact decode where a
+// ray needs it), near and far planes picked by the ray's direction signs; one hit child is walked next without touching
 // the stack, several are pushed farthest first with their entry distances,
 // and popped entries are skipped once the closest hit is nearer. Every hit
 // child's first lines are asked for when its parent is tested.
@@ -42,35 +42,46 @@ struct OctRows {
 // kFarScale (Ize) covers. The fused form writes the same distance as
 //   (Origin + q 2^e - o) inv  =  q (2^e inv) + (Origin inv - o inv)
 // and takes one fma a plane once the node's three axis terms are formed:
-// 2^e inv is exact (a power of two times inv), and Origin inv - o inv is one
-// fma from -(o inv), rounded once a ray. Those two terms are rounded relative
-// to |Origin inv| and |o inv|, not to the distance (they may nearly cancel):
-// together at most u |Origin inv| + 3u |o inv| and a little (u = 2^-24). The
-// header bounds |Origin| over the blob's nodes (its reach, checked node by
-// node when the blob is validated), so one pad a ray covers them: near
-// planes are moved nearer and far planes farther by
-// 4u (reach + |o|) |inv|, at least FLT_MIN (which covers every underflow on
-// the way). What rounding is left is relative to the distance, as in the
-// exact form, and kFarScale covers it: the box stays conservative. In space
-// the pad is 2^-22 of reach + |o|, a few ulps of the coordinates (a node's
-// quantization step is 2^-8 of its extent). A ray takes the fused form where no term can
-// overflow or fall below FLT_MIN: 2^-40 <= |inv| <= 2^40, |o|, the reach and
-// the largest scale at most 2^40. Otherwise, and for a zero direction
-// component (an infinite inverse, which the exact form's NaN rule handles),
-// the exact form.
+// 2^e inv is exact (a power of two times inv, unless it falls below FLT_MIN),
+// and Origin inv - o inv is one fma from -(o inv) -+ pad, which a ray forms
+// once (two roundings). Those terms are rounded relative to |Origin inv| and
+// |o inv|, not to the distance (they may nearly cancel): together at most
+// u |Origin inv| + 3u |o inv| and a little (u = 2^-24). The header bounds
+// |Origin| over the blob's nodes (its reach, checked node by node when the
+// blob is validated), so one pad a ray covers them: near planes are moved
+// nearer and far planes farther by 4u (reach + |o|) |inv|, at least FLT_MIN,
+// which also covers what underflow loses on the way (at most 256 2^-150
+// from a product below FLT_MIN). What rounding is left is relative to the
+// distance, as in the exact form, and kFarScale covers it: the box stays
+// conservative. In space the pad is 2^-22 of reach + |o|, a few ulps of the
+// coordinates (a node's quantization step is 2^-8 of its extent). A ray
+// takes the fused form where no term can overflow: 2^-40 <= |inv| <= 2^40
+// and |o| <= 2^40, on a blob whose reach and largest scale are at most 2^40.
+// Otherwise, and for a zero direction component (an infinite inverse, which
+// the exact form's NaN rule handles), the exact form.
 struct OctFused {
-  bool applies = true;
+  bool applies = false;
   float near_bias[3], far_bias[3];  // -(o inv) -+ pad
-  OctFused(const RayPre& r, const layout::BlobHeader& h) {
+  // `blob_fits`: the blob's reach and largest scale are at most 2^40.
+  OctFused(const RayPre& r, const layout::BlobHeader& h, bool blob_fits) {
     constexpr float kBig = 0x1p40f, kSmall = 0x1p-40f;
+    applies = blob_fits;
     for (int a = 0; a < 3; ++a) {
-      const float inv = std::fabs(r.inv[a]), reach = h.node_origin[a];
-      applies &= inv <= kBig && inv >= kSmall && std::fabs(r.org[a]) <= kBig && reach <= kBig && h.node_scale <= kBig;
-      const float pad = std::max(0x1p-22f * (reach + std::fabs(r.org[a])) * inv, FLT_MIN);
+      const float inv = std::fabs(r.inv[a]);
+      applies &= inv <= kBig && inv >= kSmall && std::fabs(r.org[a]) <= kBig;
+    }
+    if (!applies) return;
+    for (int a = 0; a < 3; ++a) {
+      // (reach + |o|) |inv| first: scaled by 2^-22 last, it cannot underflow.
+      const float pad = std::max((h.node_origin[a] + std::fabs(r.org[a])) * std::fabs(r.inv[a]) * 0x1p-22f, FLT_MIN);
       const float o_inv = r.org[a] * r.inv[a];
       near_bias[a] = -o_inv - pad;
       far_bias[a] = -o_inv + pad;
     }
+  }
+  static bool blob_fits(const layout::BlobHeader& h) {
+    constexpr float kBig = 0x1p40f;
+    return h.node_origin[0] <= kBig && h.node_origin[1] <= kBig && h.node_origin[2] <= kBig && h.node_scale <= kBig;
   }
 };
 
@@ -194,8 +205,9 @@ template <class Codec>
 void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
           uint32_t outputs) {
   const layout::BlobHeader& h = layout::header_of(blob);
+  const bool blob_fits = OctFused::blob_fits(h);
   for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
-    const OctFused fused(r, h);
+    const OctFused fused(r, h, blob_fits);
     if (fused.applies)
       walk_ray<Codec, true>(blob, h, r, fused, c);
     else

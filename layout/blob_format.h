@@ -34,8 +34,11 @@ struct BlobHeader {
   float bounds_max[3];
   float quant_offset[3];    // BitPack vertices: v = q * quant_scale + quant_offset
   float quant_scale[3];
-  float node_origin[3];     // QuadTreeHalfFloat: bound = half * node_scale + node_origin;
-  float node_scale;         // OctTreeCompressed: the nodes' largest |Origin| an axis and 2^e (octtree.h)
+  // QuadTreeHalfFloat: bound = half * node_scale + node_origin (quadtree.h).
+  // OctTreeCompressed: node_origin[a] the nodes' largest |Origin| of axis a,
+  // node_scale their largest 2^e (octtree.h). Unused by the other trees.
+  float node_origin[3];
+  float node_scale;
   uint32_t tree_offset, tree_size;
   uint32_t node_bytes;      // bytes of nodes in the tree section (rest: triangle blocks)
   uint32_t triangle_base;   // tree-section offset where slot numbering starts

@@ -7,7 +7,7 @@
 #define MESHCAST_LAYOUT_FORMATS_H
 
 #define MC_BLOB_MAGIC 0x424C434Du   // "MCLB" little-endian
-#define MC_BLOB_VERSION 1u
+#define MC_BLOB_VERSION 2u
 #define MC_BLOB_HEADER_BYTES 160u
 
 // Per-hit outputs a trace may ask for beyond t and the triangle (issue 9);

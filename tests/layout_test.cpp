@@ -443,6 +443,21 @@ TEST(Corruption, OctTreeNodesBeyondTheHeaderReachAreRefused) {
             std::string::npos);
 }
 
+// A root that is a leaf (16 triangles or fewer) leaves no node to reach:
+// the header says 0 for every field, wherever the mesh lies.
+TEST(Corruption, OctTreeLeafRootHasNoReach) {
+  const Mesh small = make_sphere(3, 4, 1.0f, {-2.0f, 0.5f, -1.0f});  // a negative centre
+  ASSERT_LE(small.triangles.size(), 16u);
+  std::vector<uint8_t> b = build_blob(small, parse_layout("OctTreeCompressed/Float3"), "small sphere");
+  EXPECT_EQ(validate(b), "");
+  const BlobHeader& h = header_of(b.data());
+  EXPECT_NE(oct_count(h.root), 0u) << "the root is a leaf";
+  EXPECT_EQ(h.node_origin[0], 0.0f);
+  EXPECT_EQ(h.node_origin[1], 0.0f);
+  EXPECT_EQ(h.node_origin[2], 0.0f);
+  EXPECT_EQ(h.node_scale, 0.0f);
+}
+
 TEST(GoldenBytes, AABBListIsSeed7) {
   std::vector<uint8_t> b = two_apart("AABBList/Float3");
   const size_t tree = 192;

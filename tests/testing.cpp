@@ -28,14 +28,21 @@ bool quick() { return std::getenv("MESHCAST_TEST_QUICK") != nullptr; }
 
 std::vector<std::string> covering_layouts(const std::vector<std::string>& names) {
   if (!quick()) return names;
+  // Three passes: layouts whose tree and triangle format are both new first
+  // (so the trees take different formats, not all the first one), then
+  // those with a new triangle format, then those with a new tree.
   std::vector<std::string> chosen;
   std::set<uint32_t> trees, triangles;
-  for (const std::string& n : names) {
-    const BuildOptions o = parse_layout(n.substr(0, n.find_first_of("+@")));
-    const bool new_tree = trees.insert(uint32_t(o.layout.tree)).second;
-    const bool new_triangles = triangles.insert(uint32_t(o.layout.triangles)).second;
-    if (new_tree || new_triangles) chosen.push_back(n);
-  }
+  for (int pass = 0; pass < 3; ++pass)
+    for (const std::string& n : names) {
+      const BuildOptions o = parse_layout(n.substr(0, n.find_first_of("+@")));
+      const uint32_t tree = uint32_t(o.layout.tree), tri = uint32_t(o.layout.triangles);
+      const bool new_tree = !trees.count(tree), new_triangles = !triangles.count(tri);
+      if (pass == 0 ? new_tree && new_triangles : pass == 1 ? new_triangles : new_tree) {
+        trees.insert(tree), triangles.insert(tri);
+        chosen.push_back(n);
+      }
+    }
   return chosen;
 }
 

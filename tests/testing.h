@@ -45,8 +45,8 @@ bool is_chosen_public_mesh(const std::string& name);
 bool quick();
 // The layouts of `names` a suite runs: all of them, or in the quick runs a
 // few that still take every tree format and every triangle format at least
-// once (the first layout of each that is not yet covered): each walker's
-// node code and each codec's leaf code run, not every pairing of the two.
+// once, the trees on different formats where the names allow: each
+// walker's node code and each codec's leaf code run, not every pairing.
 std::vector<std::string> covering_layouts(const std::vector<std::string>& names);
 
 // Oracle answers (tree oracle) for a ray set, cached per (mesh, kind).

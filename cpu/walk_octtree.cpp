@@ -1,9 +1,10 @@
 // OctTreeCompressed walker (issue 19): the 8 child boxes of a node tested
 // at once, one fma a plane (the fused form below; the exact decode where a
-// ray needs it), near and far planes picked by the ray's direction signs; one hit child is walked next without touching
-// the stack, several are pushed farthest first with their entry distances,
-// and popped entries are skipped once the closest hit is nearer. Every hit
-// child's first lines are asked for when its parent is tested.
+// ray needs it), near and far planes picked by the ray's direction signs;
+// one hit child is walked next without touching the stack, several are
+// pushed farthest first with their entry distances, and popped entries are
+// skipped once the closest hit is nearer. Every hit child's first lines are
+// asked for when its parent is tested.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -59,16 +60,17 @@ struct OctRows {
 // and |o| <= 2^40, on a blob whose reach and largest scale are at most 2^40.
 // Otherwise, and for a zero direction component (an infinite inverse, which
 // the exact form's NaN rule handles), the exact form.
+// The magnitudes past which a ray or blob takes the exact form.
+constexpr float kFusedBig = 0x1p40f, kFusedSmall = 0x1p-40f;
 struct OctFused {
   bool applies = false;
   float near_bias[3], far_bias[3];  // -(o inv) -+ pad
   // `blob_fits`: the blob's reach and largest scale are at most 2^40.
   OctFused(const RayPre& r, const layout::BlobHeader& h, bool blob_fits) {
-    constexpr float kBig = 0x1p40f, kSmall = 0x1p-40f;
     applies = blob_fits;
     for (int a = 0; a < 3; ++a) {
       const float inv = std::fabs(r.inv[a]);
-      applies &= inv <= kBig && inv >= kSmall && std::fabs(r.org[a]) <= kBig;
+      applies &= inv <= kFusedBig && inv >= kFusedSmall && std::fabs(r.org[a]) <= kFusedBig;
     }
     if (!applies) return;
     for (int a = 0; a < 3; ++a) {
@@ -80,8 +82,8 @@ struct OctFused {
     }
   }
   static bool blob_fits(const layout::BlobHeader& h) {
-    constexpr float kBig = 0x1p40f;
-    return h.node_origin[0] <= kBig && h.node_origin[1] <= kBig && h.node_origin[2] <= kBig && h.node_scale <= kBig;
+    return h.node_origin[0] <= kFusedBig && h.node_origin[1] <= kFusedBig && h.node_origin[2] <= kFusedBig &&
+           h.node_scale <= kFusedBig;
   }
 };
 

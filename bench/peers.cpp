@@ -12,6 +12,7 @@
 #include "bench/peer.h"
 #include "builder/layout_names.h"
 #include "builder/ray_sets.h"
+#include "cpu/counters.h"
 #include "meshcast/blob.h"
 #include "meshcast/build.h"
 
@@ -40,8 +41,8 @@ struct Contender {
 
 std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& o) {
   const double triangles = double(mesh.triangles.size());
-  const RayKind kinds[] = {RayKind::Long, RayKind::Probe, RayKind::Radial};
-  const char* kind_names[] = {"long", "probe", "radial"};
+  std::vector<RayKind> kinds;
+  for (const std::string& k : o.kinds) kinds.push_back(parse_ray_kind(k));
   std::vector<std::vector<Ray>> rays;
   for (RayKind k : kinds) rays.push_back(make_rays(mesh, k, o.rays, 19));
 
@@ -88,21 +89,33 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   for (Contender& c : all) c.ns.resize(std::size(kinds));
   for (uint32_t round = 0; round < o.rounds + 1; ++round)
     for (Contender& c : all)
-      for (size_t k = 0; k < std::size(kinds); ++k) {
+      for (size_t k = 0; k < kinds.size(); ++k) {
         const auto t0 = std::chrono::steady_clock::now();
         c.trace(rays[k], hits);
         const double ns = ms_since(t0) * 1e6 / double(o.rays);
         if (round > 0) c.ns[k].push_back(ns);  // round 0 warms the caches
       }
 
+  // A counting build (MESHCAST_COUNT_TESTS) also reports each meshcast
+  // layout's box and triangle tests a ray, from one more pass (its times are
+  // not for comparison).
+  if constexpr (kCountTests)
+    for (Contender& c : all)
+      for (size_t k = 0; k < kinds.size() && !c.is_peer; ++k) {
+        test_counts = {};
+        c.trace(rays[k], hits);
+        std::fprintf(stderr, "  %s %s %s: %.1f box tests, %.1f triangle tests a ray\n", name.c_str(), o.kinds[k].c_str(),
+                     c.name.c_str(), double(test_counts.boxes) / double(o.rays), double(test_counts.triangles) / double(o.rays));
+      }
+
   std::vector<PeerRow> rows;
-  for (size_t k = 0; k < std::size(kinds); ++k) {
+  for (size_t k = 0; k < kinds.size(); ++k) {
     double embree_default = 0;
     std::vector<PeerRow> kind_rows;
     for (Contender& c : all) {
       std::vector<double>& v = c.ns[k];
       std::sort(v.begin(), v.end());
-      PeerRow r{name, kind_names[k], c.name, c.is_peer, v[v.size() / 2], 0, c.bytes, c.build_one, c.build_all};
+      PeerRow r{name, o.kinds[k], c.name, c.is_peer, v[v.size() / 2], 0, c.bytes, c.build_one, c.build_all};
       if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;  // the first peer is the default build
       kind_rows.push_back(r);
     }

@@ -22,7 +22,8 @@ struct PeerRow {
 
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
-  size_t rays = 10000;               // a set, for each of long, probe and radial
+  std::vector<std::string> kinds = {"long", "probe", "radial"};  // ray kinds measured
+  size_t rays = 10000;               // a set, for each kind
   uint32_t rounds = 7;
 };
 

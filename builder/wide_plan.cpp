@@ -1,32 +1,100 @@
 #include "builder/wide_plan.h"
 
+#include <array>
+#include <cmath>
 #include <functional>
+#include <stdexcept>
 
 namespace meshcast {
+
+namespace {
+
+// The collapse's table (Ylitie, Karras and Laine 2017, with the leaves the
+// binary tree made): for a binary node n and i = 1..width, the least cost of
+// standing for n's subtree by at most i roots of a forest, each a leaf or a
+// wide node, where a wide node costs its surface area (how often a ray
+// tests its children). Leaves cost the same whatever the collapse, so they
+// count 0. A small constant a node, far below any area difference that
+// matters, makes the table prefer fewer nodes where areas tie (flat boxes).
+struct Collapse {
+  static constexpr uint32_t kMaxWidth = 8;
+  uint32_t width;
+  std::vector<double> cost;   // [n * width + i - 1]
+  std::vector<uint8_t> left;  // roots taken from the left child when n is opened into i roots (0: n stays one root)
+  double node_cost(const BuildTree& t, uint32_t n, double tie) const { return t.nodes[n].box.half_area() + tie; }
+
+  Collapse(const BuildTree& t, uint32_t w) : width(w), cost(t.nodes.size() * w, 0.0), left(t.nodes.size() * w, 0) {
+    const double tie = 1e-9 * t.nodes[0].box.half_area();
+    // Children before their parent (a post-order walk; recursion as deep as
+    // the binary tree, which the builders bound).
+    std::function<void(uint32_t)> fill = [&](uint32_t n) {
+      const BuildNode& b = t.nodes[n];
+      if (b.leaf()) return;  // cost 0 at every i
+      fill(b.left), fill(b.right);
+      // Opened into at most i roots: the best split of i between the children.
+      std::array<double, kMaxWidth + 1> opened;
+      std::array<uint8_t, kMaxWidth + 1> split{};
+      opened.fill(INFINITY);
+      for (uint32_t i = 2; i <= w; ++i)
+        for (uint32_t k = 1; k < i; ++k) {
+          const double c = at(b.left, k) + at(b.right, i - k);
+          if (c < opened[i]) opened[i] = c, split[i] = uint8_t(k);
+        }
+      const size_t row = size_t(n) * w;
+      const double as_node = node_cost(t, n, tie) + opened[w];
+      cost[row] = as_node;
+      for (uint32_t i = 2; i <= w; ++i) {
+        const bool open = opened[i] <= as_node;
+        cost[row + i - 1] = open ? opened[i] : as_node;
+        left[row + i - 1] = open ? split[i] : 0;
+      }
+    };
+    fill(0);
+  }
+  double at(uint32_t n, uint32_t i) const { return cost[size_t(n) * width + i - 1]; }
+
+  // The roots standing for n's subtree in at most i of them.
+  void roots(const BuildTree& t, uint32_t n, uint32_t i, std::vector<uint32_t>& out) const {
+    const uint32_t k = t.nodes[n].leaf() ? 0 : left[size_t(n) * width + i - 1];
+    if (k == 0) {
+      out.push_back(n);
+      return;
+    }
+    roots(t, t.nodes[n].left, k, out);
+    roots(t, t.nodes[n].right, i - k, out);
+  }
+  // A wide node's children: n opened into at most `width` roots.
+  std::vector<uint32_t> children(const BuildTree& t, uint32_t n) const {
+    uint32_t best = 1;
+    double c = INFINITY;
+    for (uint32_t k = 1; k < width; ++k) {
+      const double v = at(t.nodes[n].left, k) + at(t.nodes[n].right, width - k);
+      if (v < c) c = v, best = k;
+    }
+    std::vector<uint32_t> out;
+    roots(t, t.nodes[n].left, best, out);
+    roots(t, t.nodes[n].right, width - best, out);
+    return out;
+  }
+};
+
+}  // namespace
 
 WidePlan plan_wide(const BuildTree& t, uint32_t width) {
   WidePlan p;
   p.width = width;
   p.leaf_offset.assign(t.nodes.size(), 0);
   p.wide_index.assign(t.nodes.size(), 0);
+  if (t.nodes[0].leaf()) return p;
+  if (width < 2 || width > Collapse::kMaxWidth) throw std::invalid_argument("plan_wide: a width from 2 to 8");
+  const Collapse collapse(t, width);
   std::function<void(uint32_t, uint32_t)> visit = [&](uint32_t n, uint32_t depth) {
     if (t.nodes[n].leaf()) return;
     p.depth = std::max(p.depth, depth);
-    std::vector<uint32_t> list{t.nodes[n].left, t.nodes[n].right};
-    while (list.size() < width) {
-      int open = -1;
-      for (size_t i = 0; i < list.size(); ++i)
-        if (!t.nodes[list[i]].leaf() &&
-            (open < 0 || t.nodes[list[i]].box.half_area() > t.nodes[list[size_t(open)]].box.half_area()))
-          open = int(i);
-      if (open < 0) break;
-      uint32_t m = list[size_t(open)];
-      list.erase(list.begin() + open);
-      list.insert(list.begin() + open, {t.nodes[m].left, t.nodes[m].right});
-    }
     p.wide_index[n] = uint32_t(p.binary_of.size());
     p.binary_of.push_back(n);
-    p.children.push_back(list);
+    p.children.push_back(collapse.children(t, n));
+    const std::vector<uint32_t> list = p.children.back();
     for (uint32_t m : list) visit(m, depth + 1);
   };
   visit(0, 0);

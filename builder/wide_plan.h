@@ -23,9 +23,11 @@ struct WidePlan {
   uint32_t depth = 0;                           // deepest wide node, root 0
 };
 
-// Every binary node that stays a node takes up to `width` children, found
-// by opening its largest (surface area) interior descendant until `width`
-// are reached.
+// Which binary nodes stay nodes, and their up to `width` children: the
+// collapse that least sums the nodes' surface areas (the expected node tests
+// a ray) over the binary tree's own leaves, found exactly by a table over
+// the binary tree (Ylitie, Karras and Laine 2017), so nodes are full where
+// the tree allows it instead of a half-empty level above the leaves.
 WidePlan plan_wide(const BuildTree& t, uint32_t width);
 
 // Places the wide nodes (node_bytes each) and the leaf blocks (w.leaf_bytes)

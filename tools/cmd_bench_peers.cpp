@@ -47,7 +47,7 @@ void add_bench_peers(CLI::App* bench) {
   struct Args {
     std::string meshes = "data/bunny00.off,data/armadillo.off,data/refined_elephant.off,data/ChineseDragon-10kv.off,"
                          "terrain_2M,city_1M";
-    std::string layouts, out_dir = "out";
+    std::string layouts, kinds = "long,probe,radial", out_dir = "out";
     size_t rays = 10000;
     uint32_t rounds = 7;
   };
@@ -55,12 +55,14 @@ void add_bench_peers(CLI::App* bench) {
   CLI::App* cmd = bench->add_subcommand("peers", "issue 19: meshcast's layouts beside Embree default, robust and compact");
   cmd->add_option("--meshes", args->meshes, "comma-separated mesh files, terrain_2M or city_1M (default: all six)");
   cmd->add_option("--layouts", args->layouts, "comma-separated meshcast layouts (default: the OctTree and QuadTree ones)");
+  cmd->add_option("--kinds", args->kinds, "comma-separated ray kinds: long, probe, radial (default: all three)");
   cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(CLI::Range(size_t(100), size_t(1000000)));
   cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(CLI::Range(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where peers.csv and peers.png go");
   cmd->callback([args] {
     bench::PeersOptions o;
     o.layouts = args->layouts.empty() ? bench::default_peer_layouts() : split(args->layouts);
+    o.kinds = split(args->kinds);
     o.rays = args->rays, o.rounds = args->rounds;
     std::filesystem::create_directories(args->out_dir);
     std::vector<bench::PeerRow> rows;

@@ -184,6 +184,50 @@ inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at 
   const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
   return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(w, _mm256_setzero_si256()))) ^ 0xFF;
 }
+// An 8-wide node's hit children in the order a walk takes them, from its
+// entry distances (>= 0 in the hit lanes) and `bits`: entries and child
+// properties (8 uint32 at `properties`) written farthest first, all 8 lanes
+// (the lanes past the hits hold nothing of use); returns the properties of
+// the nearest hit child, the last of the popcount(bits) written. The order
+// is by a key of the entry's bits with its 3 low bits replaced by the lane,
+// so the written entries are rounded down by up to 7 ulps (a stack entry
+// is only ever compared to cull: rounded down, it culls no more; -0 reads
+// as +0), sorted in
+// registers by Batcher's network of 19 comparators in 6 layers; the nearest
+// comes from a separate 3-step reduction, off the sort's longer chain.
+inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i hit = _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(bits), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+                                         _mm256_setzero_si256());
+  const __m256i key = _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(entry.v), _mm256_set1_epi32(0x7FFFFFF8)), lane);
+  const __m256i props = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(properties));
+  // The nearest: the least key over the hit lanes (others INT_MAX).
+  __m256i m = _mm256_blendv_epi8(_mm256_set1_epi32(0x7FFFFFFF), key, hit);
+  m = _mm256_min_epi32(m, _mm256_shuffle_epi32(m, 0x4E));
+  m = _mm256_min_epi32(m, _mm256_shuffle_epi32(m, 0xB1));
+  m = _mm256_min_epi32(m, _mm256_permute2x128_si256(m, m, 1));
+  const uint32_t nearest = uint32_t(_mm256_cvtsi256_si32(m)) & 7;
+  // All of them, farthest first (misses as -1, last).
+  __m256i v = _mm256_blendv_epi8(_mm256_set1_epi32(-1), key, hit);
+  auto layer = [&v](__m256i partner, int take_max) {
+    const __m256i p = _mm256_permutevar8x32_epi32(v, partner);
+    const __m256i lo = _mm256_min_epi32(v, p), hi = _mm256_max_epi32(v, p);
+    v = _mm256_blendv_epi8(lo, hi, _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(take_max), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+                                                      _mm256_setzero_si256()));
+  };
+  layer(_mm256_setr_epi32(1, 0, 3, 2, 5, 4, 7, 6), 0x55);
+  layer(_mm256_setr_epi32(2, 3, 0, 1, 6, 7, 4, 5), 0x33);
+  layer(_mm256_setr_epi32(0, 2, 1, 3, 4, 6, 5, 7), 0x22);
+  layer(_mm256_setr_epi32(4, 5, 6, 7, 0, 1, 2, 3), 0x0F);
+  layer(_mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7), 0x0C);
+  layer(_mm256_setr_epi32(0, 2, 1, 4, 3, 6, 5, 7), 0x2A);
+  _mm256_storeu_ps(entries, _mm256_castsi256_ps(_mm256_and_si256(v, _mm256_set1_epi32(~7))));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(children),
+                      _mm256_permutevar8x32_epi32(props, _mm256_and_si256(v, _mm256_set1_epi32(7))));
+  uint32_t first;
+  std::memcpy(&first, properties + 4 * nearest, 4);
+  return first;
+}
 
 #else  // scalar
 
@@ -258,6 +302,22 @@ inline int nonzero_bits8(const uint8_t* p) {
     b |= int(w != 0) << i;
   }
   return b;
+}
+inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
+  uint32_t keys[8];
+  int n = 0;
+  for (int k = 0; k < 8; ++k) {  // insertion, largest key (farthest) first
+    if (!(bits >> k & 1)) continue;
+    const uint32_t key = (std::bit_cast<uint32_t>(entry.v[k]) & 0x7FFFFFF8u) | uint32_t(k);
+    int j = n++;
+    for (; j > 0 && keys[j - 1] < key; --j) keys[j] = keys[j - 1];
+    keys[j] = key;
+  }
+  for (int j = 0; j < n; ++j) {
+    entries[j] = std::bit_cast<float>(keys[j] & ~7u);
+    std::memcpy(&children[j], properties + 4 * (keys[j] & 7), 4);
+  }
+  return children[n - 1];
 }
 struct V16 { float v[16]; };
 inline V16 cluster_decode(const uint8_t* row, uint32_t count, bool wide, uint32_t origin, float scale, float offset) {

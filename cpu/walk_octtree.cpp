@@ -169,25 +169,15 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
         prefetch_child(tree + layout::oct_offset(properties));
         hit &= hit - 1;
         if (hit == 0) continue;  // one child: walk it next, no stack traffic
-        // Several: each pushed with its entry distance (and its lines asked
-        // for now, to be there when it is popped), kept farthest first by
-        // insertion into the stack's top (at most 8); the nearest is walked
-        // next.
-        alignas(32) float e[8];
-        test.entry.store(e);
-        entry_stack[top] = e[k], node_stack[top] = properties, ++top;
-        const int base = top - 1;
+        // Several: pushed farthest first with their entry distances (sorted
+        // in registers), each one's lines asked for now, to be there when it
+        // is popped; the nearest is walked next.
         do {
-          k = __builtin_ctz(unsigned(hit));
-          const float d = e[k];
-          const uint32_t p = layout::oct_child_properties(node, k);
-          prefetch_child(tree + layout::oct_offset(p));
-          int j = top++;
-          while (j > base && entry_stack[j - 1] < d) entry_stack[j] = entry_stack[j - 1], node_stack[j] = node_stack[j - 1], --j;
-          entry_stack[j] = d, node_stack[j] = p;
+          prefetch_child(tree + layout::oct_offset(layout::oct_child_properties(node, __builtin_ctz(unsigned(hit)))));
           hit &= hit - 1;
         } while (hit);
-        properties = node_stack[--top];
+        properties = simd::order_hits(test.entry, test.bits, node + MC_OCT_PROPERTIES_AT, entry_stack + top, node_stack + top);
+        top += std::popcount(unsigned(test.bits)) - 1;
         continue;
       }
     } else {

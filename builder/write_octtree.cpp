@@ -83,10 +83,8 @@ class OctWriter : public TreeWriter {
     const BuildTree& t = w.tree;
     for (uint32_t leaf : plan_.leaves) w.write_leaf(leaf, plan_.leaf_offset[leaf]);
     w.refit();
-    // The header's reach of the nodes' frames (layout/octtree.h): refit
-    // left the half-float frame there, which this tree does not use.
-    std::fill(std::begin(w.h.node_origin), std::end(w.h.node_origin), 0.0f);
-    w.h.node_scale = 0;
+    // The header's reach of the nodes' frames (layout/octtree.h), the
+    // largest over the nodes (0 where the root is a leaf).
     for (uint32_t q = 0; q < plan_.binary_of.size(); ++q) {
       uint8_t* node = w.bytes.data() + w.h.tree_offset + plan_.node_offset[q];
       write_oct_node(t, plan_, q, node);

@@ -111,13 +111,16 @@ struct Writer {
     frame(tree.nodes[0].box);
   }
 
-  // Header bounds, and the frame of half-float bounds: relative to the root
-  // centre, scaled by a power of two that puts the root's half extent near
-  // 2^14, far from both the half range limit (65504) and the subnormals.
+  // Header bounds, and for QuadTreeHalfFloat the frame of its half-float
+  // bounds: relative to the root centre, scaled by a power of two that puts
+  // the root's half extent near 2^14, far from both the half range limit
+  // (65504) and the subnormals. The other trees leave node_origin and
+  // node_scale as they are (OctTreeCompressed writes its node reach there).
   void frame(const Box3& root) {
+    for (int a = 0; a < 3; ++a) h.bounds_min[a] = root.min[a], h.bounds_max[a] = root.max[a];
+    if (h.tree_format != MC_TREE_QUADTREEHALFFLOAT) return;
     float half_extent = 0;
     for (int a = 0; a < 3; ++a) {
-      h.bounds_min[a] = root.min[a], h.bounds_max[a] = root.max[a];
       h.node_origin[a] = root.centre()[a];
       half_extent = std::max({half_extent, std::fabs(root.max[a] - h.node_origin[a]),
                               std::fabs(h.node_origin[a] - root.min[a])});

@@ -195,7 +195,7 @@ inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at 
 // as +0), sorted in
 // registers by Batcher's network of 19 comparators in 6 layers; the nearest
 // comes from a separate 3-step reduction, off the sort's longer chain.
-inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
+[[gnu::always_inline]] inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i hit = _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(bits), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
                                          _mm256_setzero_si256());
@@ -303,7 +303,7 @@ inline int nonzero_bits8(const uint8_t* p) {
   }
   return b;
 }
-inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
+[[gnu::always_inline]] inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
   uint32_t keys[8];
   int n = 0;
   for (int k = 0; k < 8; ++k) {  // insertion, largest key (farthest) first

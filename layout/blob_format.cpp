@@ -133,10 +133,6 @@ std::string validate(std::span<const uint8_t> blob) {
       !(std::isfinite(h.node_scale) && h.node_scale > 0 && std::isfinite(h.node_origin[0]) &&
         std::isfinite(h.node_origin[1]) && std::isfinite(h.node_origin[2])))
     return "half-float node origin or scale is not finite";
-  if (h.tree_format == MC_TREE_OCTTREECOMPRESSED &&
-      !(h.node_scale >= 0 && h.node_scale <= FLT_MAX && h.node_origin[0] >= 0 && h.node_origin[0] <= FLT_MAX &&
-        h.node_origin[1] >= 0 && h.node_origin[1] <= FLT_MAX && h.node_origin[2] >= 0 && h.node_origin[2] <= FLT_MAX))
-    return "OctTreeCompressed node reach (node_origin, node_scale) must be finite and not negative";
 
   if (tree_format_info(h.tree_format).triangles == TreeTriangles::Indexed24) return validate_zerobyte(blob, h);
   if (h.triangle_format == MC_TRI_INDEXED24) return "Indexed24 triangles belong to the zero-byte trees alone";

@@ -78,6 +78,13 @@ void descend_octtree(Descent& d, uint32_t properties) {
 // passes check_leaf.
 template <class Codec>
 std::string validate_tree(tree::OctTreeCompressed, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  // The header's node reach (what the walker pads its planes by): finite
+  // and not negative, and below each node checks against it.
+  for (int a = 0; a < 3; ++a)
+    if (!(h.node_origin[a] >= 0 && h.node_origin[a] <= FLT_MAX))
+      return "OctTreeCompressed node reach node_origin[" + num(uint32_t(a)) + "] must be finite and not negative";
+  if (!(h.node_scale >= 0 && h.node_scale <= FLT_MAX))
+    return "OctTreeCompressed node reach node_scale must be finite and not negative";
   struct Item { uint32_t properties, parent, depth; };
   std::vector<Item> stack{{h.root, 0, 0}};
   uint64_t visited = 0;

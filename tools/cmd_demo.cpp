@@ -2,7 +2,10 @@
 // foundation, casts 10,000 rays of each kind on the CPU and on the Vulkan
 // device (the recommended layout's very bytes), compares every answer with
 // the double-precision oracle, prints a table and renders a picture.
+#include <array>
 #include <cstdio>
+#include <functional>
+#include <memory>
 
 #include "bench/peer.h"
 #include "check/agreement.h"
@@ -31,7 +34,7 @@ void add_demo(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("demo", "the main job: three layouts, three ray kinds, oracle, picture");
   cmd->add_option("input", args->input, "mesh file")->required();
   cmd->add_option("--count", args->count, "rays of each kind")->check(CLI::Range(size_t(1), size_t(10000000)));
-  cmd->add_option("--repeat", args->repeat, "timed passes; the median is reported")->check(CLI::Range(1, 100));
+  cmd->add_option("--repeat", args->repeat, "timed rounds (each casts every CPU row and ray kind once); the median is reported")->check(CLI::Range(1, 100));
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf (default: each layout's own)")->check(CLI::Range(1, 31));
   cmd->add_option("--png", args->png, "picture to write");
   cmd->add_option("--gpu-count", args->gpu_count, "rays of each kind for the Vulkan row (0: no GPU row)");
@@ -60,45 +63,72 @@ void add_demo(CLI::App& app) {
       double build_ms, walked, remap, ns[3];
       uint64_t disagreements;
     };
-    std::vector<Row> rows;
-    // Median time per ray of --repeat passes over each ray set.
-    auto time_kinds = [&](auto&& cast, Row& row, auto&& answers_for) {
-      for (int k = 0; k < 3; ++k) {
-        std::vector<Hit> hits(rays[k].size());
-        std::vector<double> pass_ms;
-        for (uint32_t r = 0; r < args->repeat; ++r) {
-          auto t1 = std::chrono::steady_clock::now();
-          cast(rays[k], hits);
-          pass_ms.push_back(ms_since(t1));
-        }
-        row.ns[k] = median(pass_ms) * 1e6 / double(rays[k].size());
-        Agreement a = answers_for(k, hits);
-        row.disagreements += a.wrong + a.t_errors;
-      }
+    // The CPU contenders (the three layouts, then Embree when meshcast was
+    // built with it), timed in rounds that interleave every contender and
+    // ray kind, so a slow spell of the machine falls on all of them alike
+    // (as `bench peers`); the median of --repeat rounds is reported.
+    struct Contender {
+      Row row;
+      std::function<void(const std::vector<Ray>&, std::vector<Hit>&)> cast;
+      std::function<Agreement(int, const std::vector<Hit>&)> judge;
     };
-    std::vector<uint8_t> picture_blob;
+    std::vector<Contender> cpu;
+    std::vector<std::unique_ptr<std::vector<uint8_t>>> blobs;  // what the views read
+    std::vector<std::unique_ptr<BlobView>> views;
+    std::vector<std::unique_ptr<Mesh>> stored_meshes;
+    std::vector<std::unique_ptr<OracleTree>> stored_trees;
     for (const char* name : {"AABBTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4", "OctTreeCompressed/ClusterBitPackSOA8"}) {
       BuildOptions o = layout_options(name, args->leaf);
       BuildReport report;
-      std::vector<uint8_t> blob = build_blob(mesh, o, args->input, &report);
-      BlobView view(blob, name);
-      // The bit-packed layout is judged on the mesh it stores (its vertices
+      blobs.push_back(std::make_unique<std::vector<uint8_t>>(build_blob(mesh, o, args->input, &report)));
+      views.push_back(std::make_unique<BlobView>(*blobs.back(), name));
+      // The bit-packed layouts are judged on the mesh they store (vertices
       // moved by at most the quantization bound), the others on the input.
-      bool quantized = moves_vertices(uint32_t(o.layout.triangles));
-      Mesh stored = quantized ? stored_mesh(blob) : Mesh{};
-      std::unique_ptr<OracleTree> stored_tree = quantized ? std::make_unique<OracleTree>(stored) : nullptr;
-      SectionBytes s = section_bytes(blob);
-      Row row{name, report.build_ms, s.walked() / n, s.remap / n, {}, 0};
-      time_kinds([&](const std::vector<Ray>& r, std::vector<Hit>& h) { view.trace(r, h); }, row,
-                 [&](int k, const std::vector<Hit>& hits) {
-                   if (!quantized) return compare(mesh, rays[k], hits, oracle[k], tolerance);
-                   std::vector<OracleHit> answers(rays[k].size());
-                   for (size_t i = 0; i < rays[k].size(); ++i) answers[i] = stored_tree->closest(rays[k][i]);
-                   return compare(stored, rays[k], hits, answers, tolerance);
-                 });
-      rows.push_back(row);
-      picture_blob = std::move(blob);
+      const Mesh* judged_mesh = &mesh;
+      const OracleTree* judged_tree = nullptr;
+      if (moves_vertices(uint32_t(o.layout.triangles))) {
+        stored_meshes.push_back(std::make_unique<Mesh>(stored_mesh(*blobs.back())));
+        stored_trees.push_back(std::make_unique<OracleTree>(*stored_meshes.back()));
+        judged_mesh = stored_meshes.back().get(), judged_tree = stored_trees.back().get();
+      }
+      SectionBytes s = section_bytes(*blobs.back());
+      const BlobView* view = views.back().get();
+      cpu.push_back({Row{name, report.build_ms, s.walked() / n, s.remap / n, {}, 0},
+                     [view](const std::vector<Ray>& r, std::vector<Hit>& h) { view->trace(r, h); },
+                     [&, judged_mesh, judged_tree](int k, const std::vector<Hit>& hits) {
+                       if (!judged_tree) return compare(*judged_mesh, rays[k], hits, oracle[k], tolerance);
+                       std::vector<OracleHit> answers(rays[k].size());
+                       for (size_t i = 0; i < rays[k].size(); ++i) answers[i] = judged_tree->closest(rays[k][i]);
+                       return compare(*judged_mesh, rays[k], hits, answers, tolerance);
+                     }});
     }
+    const std::vector<uint8_t>& picture_blob = *blobs.back();
+    // A peer measured in the same run, when meshcast was built with it.
+    std::unique_ptr<bench::Peer> peer = bench::make_embree(mesh);
+    if (peer) {
+      const bench::Peer* p = peer.get();
+      cpu.push_back({Row{peer->name() + " (peer)", peer->build_ms(), double(peer->bytes()) / n, 0, {}, 0},
+                     [p](const std::vector<Ray>& r, std::vector<Hit>& h) { p->trace(r, h); },
+                     [&](int k, const std::vector<Hit>& hits) { return compare(mesh, rays[k], hits, oracle[k], tolerance); }});
+    }
+    std::vector<std::array<std::vector<double>, 3>> pass_ms(cpu.size());
+    std::vector<Hit> hits(args->count);
+    for (uint32_t round = 0; round <= args->repeat; ++round)  // round 0 warms the caches
+      for (size_t c = 0; c < cpu.size(); ++c)
+        for (int k = 0; k < 3; ++k) {
+          auto t1 = std::chrono::steady_clock::now();
+          cpu[c].cast(rays[k], hits);
+          if (round > 0) pass_ms[c][k].push_back(ms_since(t1));
+        }
+    for (size_t c = 0; c < cpu.size(); ++c)
+      for (int k = 0; k < 3; ++k) {
+        cpu[c].row.ns[k] = median(pass_ms[c][k]) * 1e6 / double(rays[k].size());
+        cpu[c].cast(rays[k], hits);  // judged on one more pass
+        Agreement a = cpu[c].judge(k, hits);
+        cpu[c].row.disagreements += a.wrong + a.t_errors;
+      }
+    std::vector<Row> rows;
+    for (size_t c = 0; c < 3; ++c) rows.push_back(cpu[c].row);
     // The GPU: the octtree method on the very bytes of the CPU's
     // recommended layout (OctTreeCompressed/ClusterBitPackSOA8), the first
     // gpu_count rays of each kind, timed from submission to read-back (the
@@ -143,23 +173,16 @@ void add_demo(CLI::App& app) {
         gpu_note = std::string("no Vulkan row: ") + e.what();
       }
     }
+    Row peer_row{};
+    if (peer) rows.push_back(peer_row = cpu.back().row);
     uint64_t disagreements_total = 0;
     for (const Row& r : rows) disagreements_total += r.disagreements;
-    // A peer measured in the same run, when meshcast was built with it.
-    std::unique_ptr<bench::Peer> peer = bench::make_embree(mesh);
-    Row peer_row{};
-    if (peer) {
-      peer_row = Row{peer->name() + " (peer)", peer->build_ms(), double(peer->bytes()) / n, 0, {}, 0};
-      time_kinds([&](const std::vector<Ray>& r, std::vector<Hit>& h) { peer->trace(r, h); }, peer_row,
-                 [&](int k, const std::vector<Hit>& hits) { return compare(mesh, rays[k], hits, oracle[k], tolerance); });
-      rows.push_back(peer_row);
-    }
     std::printf("\n| layout | build ms | bytes/tri walked | remap B/tri | ns/ray long | ns/ray probe | ns/ray radial "
                 "| disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const Row& r : rows)
       std::printf("| %s | %.0f | %.2f | %.2f | %.0f | %.0f | %.0f | %llu |\n", r.name.c_str(), r.build_ms, r.walked,
                   r.remap, r.ns[0], r.ns[1], r.ns[2], (unsigned long long)r.disagreements);
-    std::printf("\n%zu rays of each kind, one thread, median of %u passes; disagreements = rays whose triangle or t "
+    std::printf("\n%zu rays of each kind, one thread, median of %u rounds interleaving the CPU rows; disagreements = rays whose triangle or t "
                 "differs from the double-precision oracle beyond exact ties (t tolerance %.3g)\n",
                 args->count, args->repeat, tolerance);
     if (!gpu_note.empty()) std::printf("%s\n", gpu_note.c_str());

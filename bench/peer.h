@@ -16,8 +16,11 @@ class Peer {
   virtual std::string name() const = 0;
   virtual double build_ms() const = 0;
   virtual uint64_t bytes() const = 0;  // memory the peer reports for its scene
-  // One thread, closest hit, t in [0, t_max], hits in the caller's indices.
-  virtual void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits) const = 0;
+  // One thread, t in [0, t_max], hits in the caller's indices: the closest
+  // hit, or with Query::Any the peer's occlusion query (Embree's
+  // rtcOccluded1, which names no triangle: an occluded ray's hit is t 0,
+  // triangle 0).
+  virtual void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query = Query::Closest) const = 0;
 };
 
 // Embree 3 (libembree-dev) builds: Default (its fast mode, the default scene

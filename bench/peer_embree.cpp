@@ -58,9 +58,21 @@ class Embree final : public Peer {
   }
   double build_ms() const override { return build_ms_; }
   uint64_t bytes() const override { return uint64_t(bytes_.load()) + mesh_bytes_; }
-  void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits) const override {
+  void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query) const override {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
+    if (query == Query::Any) {
+      for (size_t i = 0; i < rays.size(); ++i) {
+        const Ray& r = rays[i];
+        RTCRay ray{};
+        ray.org_x = r.org[0], ray.org_y = r.org[1], ray.org_z = r.org[2];
+        ray.dir_x = r.dir[0], ray.dir_y = r.dir[1], ray.dir_z = r.dir[2];
+        ray.tnear = 0.0f, ray.tfar = r.tmax, ray.mask = ~0u;
+        rtcOccluded1(scene_, &context, &ray);
+        hits[i] = ray.tfar < 0 ? Hit{0.0f, 0} : Hit{};  // occluded: tfar is set to -inf
+      }
+      return;
+    }
     for (size_t i = 0; i < rays.size(); ++i) {
       const Ray& r = rays[i];
       RTCRayHit rh{};

@@ -33,8 +33,8 @@ struct Contender {
   std::string name;
   bool is_peer;
   double bytes, build_one, build_all;
-  std::function<void(const std::vector<Ray>&, std::vector<Hit>&)> trace;
-  std::vector<std::vector<double>> ns;  // per ray kind, one a round
+  std::function<void(const std::vector<Ray>&, std::vector<Hit>&, Query)> trace;
+  std::vector<std::vector<double>> ns;  // per set (ray kind and query), one a round
 };
 
 }  // namespace
@@ -68,7 +68,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     views.push_back(std::make_unique<BlobView>(std::span<const uint8_t>(aligned.back().get(), blobs.back().size()), name));
     const BlobView* view = views.back().get();
     all.push_back({layout, false, double(blobs.back().size()) / triangles, build, build,
-                   [view](const std::vector<Ray>& r, std::vector<Hit>& h) { view->trace(r, h); }, {}});
+                   [view](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) { view->trace(r, h, HitOutputs::None, q); }, {}});
   }
   std::vector<std::unique_ptr<Peer>> peers;
   for (EmbreeMode mode : {EmbreeMode::Default, EmbreeMode::Robust, EmbreeMode::Compact}) {
@@ -79,21 +79,29 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     const double build_all = make_embree(mesh, mode, 0)->build_ms();
     const Peer* p = peer.get();
     all.push_back({peer->name(), true, double(peer->bytes()) / triangles, peer->build_ms(), build_all,
-                   [p](const std::vector<Ray>& r, std::vector<Hit>& h) { p->trace(r, h); }, {}});
+                   [p](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) { p->trace(r, h, q); }, {}});
     peers.push_back(std::move(peer));
   }
 
-  // Rounds: every contender on every ray kind once a round, so a slow spell
-  // of the machine falls on all of them alike.
+  // The sets timed: each ray kind under each query asked for.
+  std::vector<Query> queries;
+  for (const std::string& q : o.queries) queries.push_back(q == "any" ? Query::Any : Query::Closest);
+  struct Set { size_t kind; size_t query; };
+  std::vector<Set> sets;
+  for (size_t k = 0; k < kinds.size(); ++k)
+    for (size_t q = 0; q < queries.size(); ++q) sets.push_back({k, q});
+
+  // Rounds: every contender on every set once a round, so a slow spell of
+  // the machine falls on all of them alike.
   std::vector<Hit> hits(o.rays);
-  for (Contender& c : all) c.ns.resize(std::size(kinds));
+  for (Contender& c : all) c.ns.resize(sets.size());
   for (uint32_t round = 0; round < o.rounds + 1; ++round)
     for (Contender& c : all)
-      for (size_t k = 0; k < kinds.size(); ++k) {
+      for (size_t s = 0; s < sets.size(); ++s) {
         const auto t0 = std::chrono::steady_clock::now();
-        c.trace(rays[k], hits);
+        c.trace(rays[sets[s].kind], hits, queries[sets[s].query]);
         const double ns = ms_since(t0) * 1e6 / double(o.rays);
-        if (round > 0) c.ns[k].push_back(ns);  // round 0 warms the caches
+        if (round > 0) c.ns[s].push_back(ns);  // round 0 warms the caches
       }
 
   // A counting build (MESHCAST_COUNT_TESTS) also reports each meshcast
@@ -101,25 +109,33 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   // not for comparison).
   if constexpr (kCountTests)
     for (Contender& c : all)
-      for (size_t k = 0; k < kinds.size() && !c.is_peer; ++k) {
+      for (size_t s = 0; s < sets.size() && !c.is_peer; ++s) {
         test_counts = {};
-        c.trace(rays[k], hits);
-        std::fprintf(stderr, "  %s %s %s: %.1f box tests, %.1f triangle tests a ray\n", name.c_str(), o.kinds[k].c_str(),
-                     c.name.c_str(), double(test_counts.boxes) / double(o.rays), double(test_counts.triangles) / double(o.rays));
+        c.trace(rays[sets[s].kind], hits, queries[sets[s].query]);
+        std::fprintf(stderr, "  %s %s %s %s: %.1f box tests, %.1f triangle tests a ray\n", name.c_str(),
+                     o.kinds[sets[s].kind].c_str(), o.queries[sets[s].query].c_str(), c.name.c_str(),
+                     double(test_counts.boxes) / double(o.rays), double(test_counts.triangles) / double(o.rays));
       }
 
   std::vector<PeerRow> rows;
-  for (size_t k = 0; k < kinds.size(); ++k) {
+  auto median_of = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  for (size_t s = 0; s < sets.size(); ++s) {
     double embree_default = 0;
-    std::vector<PeerRow> kind_rows;
+    std::vector<PeerRow> set_rows;
     for (Contender& c : all) {
-      std::vector<double>& v = c.ns[k];
-      std::sort(v.begin(), v.end());
-      PeerRow r{name, o.kinds[k], c.name, c.is_peer, v[v.size() / 2], 0, c.bytes, c.build_one, c.build_all};
+      PeerRow r{name, o.kinds[sets[s].kind], c.name, c.is_peer, median_of(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
+      r.query = o.queries[sets[s].query];
+      // The same contender's closest hit on the same rays, when measured.
+      for (size_t t = 0; t < sets.size(); ++t)
+        if (sets[t].kind == sets[s].kind && queries[sets[t].query] == Query::Closest)
+          r.to_closest = r.ns_per_ray / median_of(c.ns[t]);
       if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;  // the first peer is the default build
-      kind_rows.push_back(r);
+      set_rows.push_back(r);
     }
-    for (PeerRow& r : kind_rows) {
+    for (PeerRow& r : set_rows) {
       r.ratio = embree_default > 0 ? r.ns_per_ray / embree_default : 0;
       rows.push_back(r);
     }

@@ -169,6 +169,21 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
   return a;
 }
 
+Agreement compare_any(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                      const std::vector<OracleHit>& closest, double tolerance) {
+  // The oracle's answer a ray is judged by: the walker's own triangle where
+  // the double test hits it, a miss where it does not (so only compare()'s
+  // boundary rules can excuse it), the closest hit where the walker missed.
+  std::vector<OracleHit> judge(closest);
+  for (size_t i = 0; i < rays.size() && i < hits.size(); ++i) {
+    const uint32_t tri = hits[i].triangle;
+    if (tri == MC_NO_HIT || tri >= mesh.triangles.size()) continue;
+    const double t = oracle_triangle(rays[i], mesh.corner(tri, 0), mesh.corner(tri, 1), mesh.corner(tri, 2));
+    judge[i] = std::isfinite(t) ? OracleHit{t, tri} : OracleHit{};
+  }
+  return compare(mesh, rays, hits, judge, tolerance);
+}
+
 Mesh stored_mesh(const std::vector<uint8_t>& blob) {
   const layout::BlobHeader& h = layout::header_of(blob.data());
   Mesh m;

@@ -37,6 +37,14 @@ double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3
 Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
                   const std::vector<OracleHit>& oracle, double tolerance);
 
+// Query::Any's rules: the walker's hit/miss is the oracle's, and a hit
+// names a triangle the ray hits in double at the walker's t (the rules of
+// compare() above, with that triangle as the oracle's answer); a triangle
+// the double test misses counts only where compare() would call it a tie
+// (its edge, the segment's ends, the ray in its plane).
+Agreement compare_any(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                      const std::vector<OracleHit>& closest, double tolerance);
+
 // The triangles as the blob stores them, decoded by its triangle format and
 // put back in input order: a triangle soup, three vertices a triangle. The
 // exact reference for formats that move vertices. A blob without a remap

@@ -12,10 +12,22 @@
 namespace meshcast {
 MC_ISA_BEGIN
 
+// A walk's answer so far and its cut. `t` is what every box test, stack
+// pop and triangle test compares against: the closest hit's t, so nothing
+// farther is walked. Query::Any (`any`) takes the first triangle a walk
+// accepts and sets the cut below 0, which no box entry or hit distance
+// reaches: every walker culls what is left and ends, through the culling
+// it already has (no walker of its own). `hit_t` is the taken hit's t.
 struct Closest {
   float t;
   uint32_t slot = MC_NO_HIT;
   float u = 0, v = 0;
+  float hit_t = INFINITY;
+  bool any = false;
+  void take(float hit, uint32_t s, float hu, float hv) {
+    hit_t = hit, slot = s, u = hu, v = hv;
+    t = any ? -1.0f : hit;
+  }
 };
 
 template <class Codec>
@@ -178,7 +190,7 @@ inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint3
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < 3; ++j) v[k][j] = simd::F4::load(&rows[k * 3 + r.axis[j]][first]);
     LaneHit h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
-    if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
+    if (h.lane >= 0 && h.t <= c.t) c.take(h.t, slot0 + first + uint32_t(h.lane), h.u, h.v);
   }
   return bytes;
 }
@@ -200,7 +212,7 @@ inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t bl
     if (h.lane >= 0 && h.t <= c.t) {
       uint32_t below = (1u << h.lane) - 1;
       uint32_t index = made + uint32_t(std::popcount(used & below) + std::popcount(paired & below)) + h.second;
-      c = {h.t, slot0 + index, h.u, h.v};
+      c.take(h.t, slot0 + index, h.u, h.v);
     }
     made += uint32_t(std::popcount(used) + std::popcount(paired));
     at += Codec::kBlockBytes;
@@ -236,7 +248,7 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
         for (int j = 0; j < 3; ++j) v[k][j] = simd::cluster_pick(corner_axis[j], nibbles);
       }
       LaneHit hit = triangle_test(r, v, simd::lanes_below8(triangles - first), c.t);
-      if (hit.lane >= 0 && hit.t <= c.t) c = {hit.t, slot0 + made + first + uint32_t(hit.lane), hit.u, hit.v};
+      if (hit.lane >= 0 && hit.t <= c.t) c.take(hit.t, slot0 + made + first + uint32_t(hit.lane), hit.u, hit.v);
     }
     made += triangles;
     at += Codec::bytes_of(blob, at);
@@ -266,7 +278,7 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
         Loader<Codec>::load(blob, block, first, count, r.axis, v);
         h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
       }
-      if (h.lane >= 0 && h.t <= c.t) c = {h.t, slot0 + first + uint32_t(h.lane), h.u, h.v};
+      if (h.lane >= 0 && h.t <= c.t) c.take(h.t, slot0 + first + uint32_t(h.lane), h.u, h.v);
     }
   }
 }

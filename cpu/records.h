@@ -11,7 +11,7 @@ MC_ISA_BEGIN
 template <class Codec>
 inline void test_records(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, uint32_t at,
                          uint32_t end, Closest& c) {
-  while (at < end) {
+  while (at < end && c.t >= 0) {  // below 0: an any-hit query has its hit
     uint32_t count = layout::load<uint32_t>(blob + h.tree_offset + at);
     uint32_t block = at + MC_BRUTE_RECORD_BYTES;
     if constexpr (requires { Codec::kSequential; }) {  // strips: the decode tells the length

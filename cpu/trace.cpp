@@ -152,12 +152,15 @@ BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : by
   if (!walk_) throw InputError(name + ": no walker for this layout");
 }
 
-uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs) const {
+uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs, Query query) const {
   if (hits.size() < rays.size())
     throw UsageError("BlobView::trace: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(hits.size()) + " hits; the hits span must hold one hit a ray");
   uint64_t skipped = 0;
-  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, uint32_t(outputs));
+  if (query != Query::Closest && query != Query::Any)
+    throw UsageError("BlobView::trace: query " + std::to_string(uint32_t(query)) + " is not Query::Closest or Query::Any");
+  const uint32_t word = uint32_t(outputs) | (query == Query::Any ? MC_QUERY_ANY : 0u);
+  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, word);
   return skipped;
 }
 

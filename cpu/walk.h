@@ -30,7 +30,7 @@ MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WALK)
 // slots into the caller's triangles afterwards.
 inline void keep_slot(Hit& hit, const Closest& c, uint32_t outputs) {
   if (c.slot == MC_NO_HIT) return;
-  hit.t = c.t;
+  hit.t = c.hit_t;
   hit.triangle = c.slot;
   if (outputs & MC_HIT_UV) hit.u = c.u, hit.v = c.v;
 }
@@ -67,6 +67,7 @@ inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t
       }
       const RayPre r(rays[i], outputs);
       Closest c{rays[i].tmax};
+      c.any = (outputs & MC_QUERY_ANY) != 0;
       walk_one(r, c);
       keep_slot(hits[i], c, outputs);
     }

@@ -15,6 +15,10 @@
 // them with each batch, the Vulkan methods as specialization constant 0.
 #define MC_HIT_UV 1u     // barycentrics u, v of the hit in its triangle
 #define MC_HIT_POINT 2u  // the hit point: org + t * dir, in float
+// The query a trace answers, in the same word as the outputs (issue 20):
+// without it the closest hit; with it any hit in [0, t_max], the walk
+// ending at the first triangle it takes.
+#define MC_QUERY_ANY 0x100u
 
 // Header fields as 32-bit word indices, for readers that see the blob as a
 // uint array (the shaders); layout/blob_format.h checks them against BlobHeader.

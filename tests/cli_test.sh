@@ -40,6 +40,9 @@ check info-blob 0 "QuadTree/Float3SOA4, leaf size 4" -- "$meshcast" info "$work/
 check info-json 0 '"bytes_per_triangle":\{"header"' -- "$meshcast" info "$mesh" --json
 check trace 0 "ns/ray" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out "$work/h.hits" --repeat 2
 check trace-json 0 '"ns_per_ray":' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/h2.hits" --json
+check trace-any 0 '"query":"any"' -- "$meshcast" trace "$mesh" --layout OctTreeCompressed/ClusterBitPackSOA8 --query any --rays "$work/r.rays" --out "$work/ha.hits" --json
+check trace-any-vulkan 2 "runs on the CPU backend" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --query any --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-query-unknown 2 "query" -- "$meshcast" trace "$mesh" --query all --rays "$work/r.rays" --out "$work/hx.hits"
 # The two hits files agree (same triangle per ray): compare the triangle columns.
 if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
             <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then

@@ -117,6 +117,12 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
   size_t leaks = 0;
   for (const Hit& h : hits) leaks += h.triangle == MC_NO_HIT;
   EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded");
+#ifndef MESHCAST_TEST_GPU
+  // Query::Any leaks no ray either (the CPU walkers; issue 20).
+  leaks = 0;
+  for (const Hit& h : trace_all(blob, rays, nullptr, 0, Query::Any)) leaks += h.triangle == MC_NO_HIT;
+  EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded") << ", Query::Any";
+#endif
   }
 }
 
@@ -149,6 +155,14 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
     EXPECT_GE(h.u, -1e-6f);
     EXPECT_GE(h.v, -1e-6f);
   }
+#ifndef MESHCAST_TEST_GPU
+  // Query::Any: every ray through an edge or vertex still hits, at t 2.
+  std::vector<Hit> any = trace_all(blob, rays, nullptr, 0, Query::Any);
+  for (size_t i = 0; i < any.size(); ++i) {
+    ASSERT_NE(any[i].triangle, MC_NO_HIT) << "ray " << i << " leaked, Query::Any";
+    EXPECT_EQ(any[i].t, 2.0f) << "ray " << i << ", Query::Any";
+  }
+#endif
   expect_answers(g, rays, "grid");
 }
 

@@ -135,10 +135,10 @@ Mesh unwelded(const Mesh& m) {
 }
 
 std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped,
-                           uint32_t outputs) {
+                           uint32_t outputs, Query query) {
   BlobView view(blob, "test blob");
   std::vector<Hit> hits(rays.size());
-  uint64_t s = view.trace(rays, hits, HitOutputs(outputs));
+  uint64_t s = view.trace(rays, hits, HitOutputs(outputs), query);
   if (skipped) *skipped = s;
   return hits;
 }

@@ -55,7 +55,7 @@ const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count
 
 // `outputs`: the per-hit outputs asked for (MC_HIT_*).
 std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr,
-                           uint32_t outputs = 0);
+                           uint32_t outputs = 0, Query query = Query::Closest);
 
 // The same surface with every triangle owning its three vertices (as STL
 // gives it): a triangle soup, no vertex shared.

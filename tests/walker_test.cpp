@@ -46,6 +46,15 @@ void check_layout(const std::string& layout_name_, bool large) {
       // A ray set that never hits proves nothing: every kind must hit often.
       EXPECT_GT(hit_count, rays.size() / 20) << m.name << " kind " << int(kind);
       EXPECT_EQ(a.rays, count);
+      // Query::Any on the same rays: the oracle's hit/miss, and each hit a
+      // triangle the ray hits in double at that t.
+      std::vector<Hit> any = trace_all(blob, rays, nullptr, 0, Query::Any);
+      Agreement b = compare_any(*reference.mesh, rays, any, oracle, tolerance);
+      EXPECT_EQ(b.wrong + b.t_errors, 0u) << layout_name_ << " on " << m.name << " kind " << int(kind)
+                                          << ", Query::Any: " << b.first_problem;
+      size_t any_count = 0;
+      for (const Hit& h : any) any_count += h.triangle != MC_NO_HIT;
+      EXPECT_EQ(any_count, hit_count) << layout_name_ << " on " << m.name << " kind " << int(kind) << ", Query::Any";
     }
   }
 }

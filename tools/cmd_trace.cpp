@@ -18,7 +18,7 @@ void add_trace(CLI::App& app) {
     LayoutArgs layout;
     uint32_t repeat = 5;
     bool json = false;
-    std::string backend = "cpu", method = "bruteforce", device;
+    std::string backend = "cpu", method = "bruteforce", device, query = "closest";
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh or blob, write a hits file");
@@ -28,6 +28,8 @@ void add_trace(CLI::App& app) {
   add_layout_options(cmd, args->layout);
   cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
+  cmd->add_option("--query", args->query, "closest (the nearest hit) or any (a hit, the walk ending at the first; CPU backend)")
+      ->check(CLI::IsMember({"closest", "any"}));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
                                             "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
@@ -45,6 +47,9 @@ void add_trace(CLI::App& app) {
     std::vector<double> pass_ms, device_ms;
     uint64_t skipped = 0;
     std::string device = "CPU, one thread";
+    const Query query = args->query == "any" ? Query::Any : Query::Closest;
+    if (args->backend == "vulkan" && query != Query::Closest)
+      throw InputError("--query " + args->query + " runs on the CPU backend; the Vulkan methods answer the closest hit");
     if (args->backend == "vulkan") {
       gpu::Context ctx(gpu::DeviceChoice{args->device, false});
       device = ctx.device_name();
@@ -58,7 +63,7 @@ void add_trace(CLI::App& app) {
       BlobView view(in.blob, args->input);
       for (uint32_t r = 0; r < args->repeat; ++r) {
         auto t0 = std::chrono::steady_clock::now();
-        skipped = view.trace(rays, hits);
+        skipped = view.trace(rays, hits, HitOutputs::None, query);
         pass_ms.push_back(ms_since(t0));
       }
     }
@@ -70,7 +75,7 @@ void add_trace(CLI::App& app) {
     std::string layout = layout_name(h.tree_format, h.triangle_format);
     double device_ns = rays.empty() || device_ms.empty() ? 0 : median(device_ms) * 1e6 / double(rays.size());
     if (args->json) {
-      print_json({{"input", args->input}, {"layout", layout}, {"device", device}, {"load_ms", in.load_ms},
+      print_json({{"input", args->input}, {"layout", layout}, {"device", device}, {"query", args->query}, {"load_ms", in.load_ms},
                   {"build_ms", in.build_ms}, {"rays", rays.size()}, {"hits", hit_count}, {"invalid_rays", skipped},
                   {"repeat", args->repeat}, {"ns_per_ray", ns}, {"device_ns_per_ray", device_ns}});
     } else {

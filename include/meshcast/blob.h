@@ -27,10 +27,12 @@ class BlobView {
   // what is wrong.
   BlobView(std::span<const uint8_t> bytes, const std::string& name);
 
-  // The closest hit of each ray, written to hits[i]; returns how many rays
-  // were not walkable (ray_is_walkable: answered as misses). `outputs`: what
-  // else each hit carries. UsageError when hits is shorter than rays.
-  uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs = HitOutputs::None) const;
+  // The closest hit of each ray (or with Query::Any, any hit), written to
+  // hits[i]; returns how many rays were not walkable (ray_is_walkable:
+  // answered as misses). `outputs`: what else each hit carries. UsageError
+  // when hits is shorter than rays.
+  uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs = HitOutputs::None,
+                 Query query = Query::Closest) const;
 
   std::span<const uint8_t> bytes() const { return bytes_; }
   Layout layout() const;

@@ -37,6 +37,12 @@ enum class HitOutputs : uint32_t { None = 0, Uv = 1, Point = 2 };
 constexpr HitOutputs operator|(HitOutputs a, HitOutputs b) { return HitOutputs(uint32_t(a) | uint32_t(b)); }
 constexpr bool has(HitOutputs set, HitOutputs flag) { return (uint32_t(set) & uint32_t(flag)) != 0; }
 
+// The question a trace answers: the closest hit along [0, tmax] (the
+// default), or any hit there ("is anything in the way?": line of sight,
+// shadow and audio probes), where the walk ends at the first triangle it
+// takes and the hit names that triangle and its t, not the nearest.
+enum class Query : uint32_t { Closest = 0, Any = 1 };
+
 // The largest direction component a ray may have.
 constexpr float kMaxDirection = 0x1p126f;
 

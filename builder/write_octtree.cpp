@@ -1,6 +1,6 @@
 // OctTreeCompressed (issue 19): the binary SAH tree with the caller's leaves;
-// the wide plan gives every node up to 8 children (the largest interior
-// descendants opened first), which sit in the slots that order them for the
+// the wide plan gives every node up to 8 children (the collapse by table
+// of builder/wide_plan.h), which sit in the slots that order them for the
 // rays of each octant. An SAH collapse that chose the leaves again, counting
 // a leaf in whole triangle blocks (from a tree of 2-triangle leaves), was
 // measured and left out: no faster, and 20-22 bytes a triangle against 16

@@ -159,7 +159,8 @@ uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutp
   uint64_t skipped = 0;
   if (query != Query::Closest && query != Query::Any)
     throw UsageError("BlobView::trace: query " + std::to_string(uint32_t(query)) + " is not Query::Closest or Query::Any");
-  const uint32_t word = uint32_t(outputs) | (query == Query::Any ? MC_QUERY_ANY : 0u);
+  // Only the outputs' own bits: the query's flag shares their word.
+  const uint32_t word = (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | (query == Query::Any ? MC_QUERY_ANY : 0u);
   walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, word);
   return skipped;
 }

@@ -37,6 +37,9 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {
+    const Query query = args->query == "any" ? Query::Any : Query::Closest;
+    if (args->backend == "vulkan" && query != Query::Closest)
+      throw InputError("--query " + args->query + " runs on the CPU backend; the Vulkan methods answer the closest hit");
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
@@ -47,9 +50,6 @@ void add_trace(CLI::App& app) {
     std::vector<double> pass_ms, device_ms;
     uint64_t skipped = 0;
     std::string device = "CPU, one thread";
-    const Query query = args->query == "any" ? Query::Any : Query::Closest;
-    if (args->backend == "vulkan" && query != Query::Closest)
-      throw InputError("--query " + args->query + " runs on the CPU backend; the Vulkan methods answer the closest hit");
     if (args->backend == "vulkan") {
       gpu::Context ctx(gpu::DeviceChoice{args->device, false});
       device = ctx.device_name();

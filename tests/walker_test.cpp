@@ -260,6 +260,28 @@ TEST(Counters, CountEveryBoxAndTriangleTest) {
   EXPECT_GT(test_counts.triangles, 0u);
   EXPECT_LT(test_counts.triangles, rays.size() * m.triangles.size() / 4);
 }
+
+// Query::Any stops at its first hit on every walker: never more box or
+// triangle tests than the closest hit on the same rays, and fewer in all.
+// Rays from the centre of a sphere start inside every box around it, which
+// the closest hit must all enter and an any-query leaves after one hit.
+TEST(Counters, AnyStopsAtItsFirstHit) {
+  if constexpr (!kCountTests) GTEST_SKIP() << "built without MESHCAST_COUNT_TESTS";
+  Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  NamedMesh named{"counted_sphere", std::make_shared<const Mesh>(m)};
+  const std::vector<Ray>& rays = test_rays(named, RayKind::Radial, 200);
+  for (const std::string& name : quick() ? covering_layouts(layout_names()) : layout_names()) {
+    std::vector<uint8_t> blob = build_blob(m, parse_layout(name), "sphere");
+    test_counts = {};
+    trace_all(blob, rays);
+    const TestCounts closest = test_counts;
+    test_counts = {};
+    trace_all(blob, rays, nullptr, 0, Query::Any);
+    EXPECT_LE(test_counts.boxes, closest.boxes) << name;
+    EXPECT_LE(test_counts.triangles, closest.triangles) << name;
+    EXPECT_LT(test_counts.boxes + test_counts.triangles, closest.boxes + closest.triangles) << name;
+  }
+}
 }  // namespace
 }  // namespace meshcast::testing
 

@@ -197,8 +197,12 @@ inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at 
 // comes from a separate 3-step reduction, off the sort's longer chain.
 [[gnu::always_inline]] inline uint32_t order_hits(F8 entry, int bits, const uint8_t* properties, float* entries, uint32_t* children) {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i hit = _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(bits), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-                                         _mm256_setzero_si256());
+  // Lane i of the result set where bit i of `b` is.
+  auto lanes_of8 = [](int b) {
+    const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(b), bit), bit);
+  };
+  const __m256i hit = lanes_of8(bits);
   const __m256i key = _mm256_or_si256(_mm256_and_si256(_mm256_castps_si256(entry.v), _mm256_set1_epi32(0x7FFFFFF8)), lane);
   const __m256i props = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(properties));
   // The nearest: the least key over the hit lanes (others INT_MAX).
@@ -209,11 +213,10 @@ inline int nonzero_bits8(const uint8_t* p) {  // bit i: the i-th of 8 uint32 at 
   const uint32_t nearest = uint32_t(_mm256_cvtsi256_si32(m)) & 7;
   // All of them, farthest first (misses as -1, last).
   __m256i v = _mm256_blendv_epi8(_mm256_set1_epi32(-1), key, hit);
-  auto layer = [&v](__m256i partner, int take_max) {
+  auto layer = [&v, &lanes_of8](__m256i partner, int take_max) {
     const __m256i p = _mm256_permutevar8x32_epi32(v, partner);
     const __m256i lo = _mm256_min_epi32(v, p), hi = _mm256_max_epi32(v, p);
-    v = _mm256_blendv_epi8(lo, hi, _mm256_cmpgt_epi32(_mm256_and_si256(_mm256_set1_epi32(take_max), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-                                                      _mm256_setzero_si256()));
+    v = _mm256_blendv_epi8(lo, hi, lanes_of8(take_max));
   };
   layer(_mm256_setr_epi32(1, 0, 3, 2, 5, 4, 7, 6), 0x55);
   layer(_mm256_setr_epi32(2, 3, 0, 1, 6, 7, 4, 5), 0x33);

@@ -170,7 +170,7 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
 }
 
 Agreement compare_any(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
-                      const std::vector<OracleHit>& closest, double tolerance) {
+                      const std::vector<OracleHit>& closest, double tolerance, Cull cull) {
   // The oracle's answer a ray is judged by: the walker's own triangle where
   // the double test hits it, a miss where it does not (so only compare()'s
   // boundary rules can excuse it), the closest hit where the walker missed.
@@ -178,10 +178,66 @@ Agreement compare_any(const Mesh& mesh, const std::vector<Ray>& rays, const std:
   for (size_t i = 0; i < rays.size() && i < hits.size(); ++i) {
     const uint32_t tri = hits[i].triangle;
     if (tri == MC_NO_HIT || tri >= mesh.triangles.size()) continue;
-    const double t = oracle_triangle(rays[i], mesh.corner(tri, 0), mesh.corner(tri, 1), mesh.corner(tri, 2));
+    const double t = oracle_triangle(rays[i], mesh.corner(tri, 0), mesh.corner(tri, 1), mesh.corner(tri, 2), cull);
     judge[i] = std::isfinite(t) ? OracleHit{t, tri} : OracleHit{};
   }
   return compare(mesh, rays, hits, judge, tolerance);
+}
+
+Agreement compare_all(const Mesh& mesh, const std::vector<Ray>& rays, const HitLists& lists,
+                      const std::vector<std::vector<OracleHit>>& oracle, double tolerance) {
+  Agreement a;
+  auto wrong = [&](size_t i, const std::string& what) {
+    ++a.wrong;
+    if (a.first_problem.empty()) a.first_problem = "ray " + std::to_string(i) + ": " + what;
+  };
+  // Every (ray, triangle) of either set as one compare() case: the walker's
+  // hit or a miss against the oracle's hit or a miss.
+  std::vector<Ray> pair_rays;
+  std::vector<Hit> pair_hits;
+  std::vector<OracleHit> pair_oracle;
+  std::vector<size_t> pair_ray;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const std::span<const Hit> row = lists.row(i);
+    if (lists.found[i] > lists.max_hits) {
+      wrong(i, std::to_string(lists.found[i]) + " hits found, more than the row's " + std::to_string(lists.max_hits));
+      continue;
+    }
+    for (size_t k = row.size(); k < lists.max_hits; ++k) {
+      const Hit& unused = lists.hits[i * lists.max_hits + k];
+      if (unused.t != INFINITY || unused.triangle != MC_NO_HIT) wrong(i, "an unused record is not a miss");
+    }
+    for (size_t k = 1; k < row.size(); ++k)
+      if (row[k].t < row[k - 1].t || (row[k].t == row[k - 1].t && row[k].triangle <= row[k - 1].triangle))
+        wrong(i, "the row is not in order of t, then triangle, or names a triangle twice");
+    size_t w = 0, o = 0;
+    const std::vector<OracleHit>& expected = oracle[i];
+    // Both sets by triangle.
+    std::vector<Hit> mine(row.begin(), row.end());
+    std::vector<OracleHit> theirs(expected);
+    std::sort(mine.begin(), mine.end(), [](const Hit& x, const Hit& y) { return x.triangle < y.triangle; });
+    std::sort(theirs.begin(), theirs.end(), [](const OracleHit& x, const OracleHit& y) { return x.triangle < y.triangle; });
+    while (w < mine.size() || o < theirs.size()) {
+      Hit h;
+      OracleHit ref;
+      if (o == theirs.size() || (w < mine.size() && mine[w].triangle < theirs[o].triangle)) {
+        h = mine[w++];
+      } else if (w == mine.size() || theirs[o].triangle < mine[w].triangle) {
+        ref = theirs[o++];
+      } else {
+        h = mine[w++], ref = theirs[o++];
+      }
+      pair_rays.push_back(rays[i]), pair_hits.push_back(h), pair_oracle.push_back(ref), pair_ray.push_back(i);
+    }
+  }
+  Agreement b = compare(mesh, pair_rays, pair_hits, pair_oracle, tolerance);
+  a.rays = b.rays, a.ties = b.ties, a.wrong += b.wrong, a.t_errors = b.t_errors, a.max_t_error = b.max_t_error;
+  if (a.first_problem.empty() && !b.first_problem.empty()) {
+    // compare() names its own index: the pair's; name the ray too.
+    const size_t at = std::stoul(b.first_problem.substr(4));
+    a.first_problem = "ray " + std::to_string(pair_ray[at]) + ", " + b.first_problem.substr(b.first_problem.find(':') + 2);
+  }
+  return a;
 }
 
 Mesh stored_mesh(const std::vector<uint8_t>& blob) {

@@ -42,8 +42,19 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
 // compare() above, with that triangle as the oracle's answer); a triangle
 // the double test misses counts only where compare() would call it a tie
 // (its edge, the segment's ends, the ray in its plane).
+// `closest`: the oracle's closest hits under the same culling, `cull`.
 Agreement compare_any(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
-                      const std::vector<OracleHit>& closest, double tolerance);
+                      const std::vector<OracleHit>& closest, double tolerance, Cull cull = Cull::None);
+
+// Query::All's rules: ray i's row names the oracle's set of triangles
+// (oracle[i], OracleTree::all), each once, in order of t, with found[i] its
+// size (every row must hold all its hits: max_hits above the largest set).
+// Each triangle of one set and not the other is judged as compare() judges
+// a hit against a miss (its edge, the segment's ends, the ray in its plane
+// are ties); each triangle of both by its t. `rays` counts pairs of a ray
+// and a triangle.
+Agreement compare_all(const Mesh& mesh, const std::vector<Ray>& rays, const HitLists& lists,
+                      const std::vector<std::vector<OracleHit>>& oracle, double tolerance);
 
 // The triangles as the blob stores them, decoded by its triangle format and
 // put back in input order: a triangle soup, three vertices a triangle. The

@@ -6,7 +6,7 @@
 
 namespace meshcast {
 
-double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c) {
+double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, Cull cull) {
   if (!ray_is_walkable(ray)) return INFINITY;
   double d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
   int kz = std::fabs(d[0]) > std::fabs(d[1]) ? (std::fabs(d[0]) > std::fabs(d[2]) ? 0 : 2)
@@ -23,6 +23,7 @@ double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3&
   if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return INFINITY;
   double det = U + V + W;
   if (det == 0) return INFINITY;
+  if ((cull == Cull::Back && det < 0) || (cull == Cull::Front && det > 0)) return INFINITY;
   double T = (U * az + V * bz + W * cz) * sz;
   double t = T / det;
   // A t past the largest float is no hit: no walker could report it.
@@ -30,10 +31,10 @@ double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3&
   return t;
 }
 
-OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray) {
+OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray, Cull cull) {
   OracleHit best;
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-    double t = oracle_triangle(ray, mesh.corner(i, 0), mesh.corner(i, 1), mesh.corner(i, 2));
+    double t = oracle_triangle(ray, mesh.corner(i, 0), mesh.corner(i, 1), mesh.corner(i, 2), cull);
     if (t < best.t) best = {t, uint32_t(i)};  // strict: the lowest index wins a tie
   }
   return best;
@@ -74,9 +75,9 @@ uint32_t OracleTree::build(uint32_t first, uint32_t count) {
   return index;
 }
 
-OracleHit OracleTree::closest(const Ray& ray) const {
-  OracleHit best;
-  if (!ray_is_walkable(ray)) return best;
+template <class Take>
+void OracleTree::visit(const Ray& ray, Cull cull, const double* cut, Take&& take) const {
+  if (!ray_is_walkable(ray)) return;
   // Box test in double: exact enough that the small widening below covers
   // every rounding (the boxes hold float vertices, the ray float values).
   auto touches = [&](const Node& n) {
@@ -92,7 +93,7 @@ OracleHit OracleTree::closest(const Ray& ray) const {
       tn = std::max(tn, t0 - 1e-9 * std::fabs(t0));
       tf = std::min(tf, t1 + 1e-9 * std::fabs(t1));
     }
-    return tn <= tf && tn <= best.t;
+    return tn <= tf && tn <= *cut;
   };
   uint32_t stack[128];
   int top = 0;
@@ -103,15 +104,32 @@ OracleHit OracleTree::closest(const Ray& ray) const {
     if (n.count) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
         uint32_t t = order_[i];
-        double d = oracle_triangle(ray, mesh_.corner(t, 0), mesh_.corner(t, 1), mesh_.corner(t, 2));
-        if (d < best.t || (d == best.t && d != INFINITY && t < best.triangle)) best = {d, t};
+        double d = oracle_triangle(ray, mesh_.corner(t, 0), mesh_.corner(t, 1), mesh_.corner(t, 2), cull);
+        if (d != INFINITY) take(d, t);
       }
     } else {
       stack[++top] = n.right;
       stack[++top] = uint32_t(&n - nodes_.data()) + 1;
     }
   }
+}
+
+OracleHit OracleTree::closest(const Ray& ray, Cull cull) const {
+  OracleHit best;
+  visit(ray, cull, &best.t, [&](double d, uint32_t t) {
+    if (d < best.t || (d == best.t && t < best.triangle)) best = {d, t};
+  });
   return best;
+}
+
+std::vector<OracleHit> OracleTree::all(const Ray& ray, Cull cull) const {
+  std::vector<OracleHit> hits;
+  const double cut = INFINITY;  // tmax bounds every box already
+  visit(ray, cull, &cut, [&](double d, uint32_t t) { hits.push_back({d, t}); });
+  std::sort(hits.begin(), hits.end(), [](const OracleHit& a, const OracleHit& b) {
+    return a.t < b.t || (a.t == b.t && a.triangle < b.triangle);
+  });
+  return hits;
 }
 
 }  // namespace meshcast

@@ -16,11 +16,13 @@ struct OracleHit {
   uint32_t triangle = MC_NO_HIT;
 };
 
-// Hit distance of one triangle, or +inf when the ray misses it.
-double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c);
+// Hit distance of one triangle, or +inf when the ray misses it or `cull`
+// drops the face it meets (the sign of the same double determinant: the
+// front face's corners run counter-clockwise seen from the origin).
+double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, Cull cull = Cull::None);
 
 // Every triangle, in input order.
-OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray);
+OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray, Cull cull = Cull::None);
 
 // A simple median-split tree with double-precision boxes over the same
 // triangles, for meshes too large to brute-force; it visits every box the
@@ -29,7 +31,10 @@ OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray);
 class OracleTree {
  public:
   explicit OracleTree(const Mesh& mesh);
-  OracleHit closest(const Ray& ray) const;
+  OracleHit closest(const Ray& ray, Cull cull = Cull::None) const;
+  // Query::All's answer: every triangle the ray hits in [0, t_max], in
+  // order of t, then triangle.
+  std::vector<OracleHit> all(const Ray& ray, Cull cull = Cull::None) const;
 
  private:
   struct Node {
@@ -40,6 +45,10 @@ class OracleTree {
   std::vector<Node> nodes_;
   std::vector<uint32_t> order_;
   uint32_t build(uint32_t first, uint32_t count);
+  // Tests every triangle in a box the ray touches before *cut (read again
+  // after each leaf), giving each hit to take(t, triangle).
+  template <class Take>
+  void visit(const Ray& ray, Cull cull, const double* cut, Take&& take) const;
 };
 
 }  // namespace meshcast

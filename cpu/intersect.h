@@ -38,12 +38,28 @@ struct LaneHit {
   float t = 0, u = 0, v = 0;
 };
 
+// Every accepted lane of one test (Query::All), with its t and, when asked
+// for, u and v.
+struct LaneSet {
+  int mask = 0;
+  float t[8], u[8], v[8];
+  void add(int lane, const LaneHit& h) { mask |= 1 << lane, t[lane] = h.t, u[lane] = h.u, v[lane] = h.v; }
+};
+
+// The determinant's sign a culling query keeps, times the determinant, is
+// never negative: +1 keeps det > 0 (the front faces: corners counter-
+// clockwise seen from the origin), -1 det < 0, 0 both (no culling).
+inline float cull_sign(uint32_t flags) {
+  return (flags & MC_CULL_BACK) ? 1.0f : (flags & MC_CULL_FRONT) ? -1.0f : 0.0f;
+}
+
 // Double-precision redo of one lane float could not settle. Corners in ray
 // space (sheared x, y; z not yet scaled by sz): every product of two floats
 // is exact in double, so an edge function's sign is exact.
+// `cull`: cull_sign() of the query.
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
-                            float closest, LaneHit* out);
+                            float cull, float closest, LaneHit* out);
 
 // Which test the walkers run: the watertight one unless a benchmark asks
 // for the plain one (process-wide; set it before tracing, not during).
@@ -68,8 +84,9 @@ struct RayPre {
   int axis[3];  // {kx, ky, kz}: loaders fetch corners in this order
   float sx, sy, sz;
   uint32_t outputs;  // MC_HIT_* asked for: the triangle tests skip u, v unless asked
+  float cull;        // cull_sign() of the query's MC_CULL_* bits
 
-  explicit RayPre(const Ray& r, uint32_t hit_outputs = 0) : outputs(hit_outputs) {
+  explicit RayPre(const Ray& r, uint32_t hit_outputs = 0) : outputs(hit_outputs), cull(cull_sign(hit_outputs)) {
     for (int a = 0; a < 3; ++a) {
       org[a] = r.org[a];
       dir[a] = r.dir[a];
@@ -161,14 +178,15 @@ inline auto float_settles(const F4& det, const F4& T) {
 // three corners, then their unscaled z) stored, each lane redone by
 // watertight_lane_double against limit(); take(lane, hit) for each hit.
 template <class F4, class Limit, class Take>
-[[gnu::noinline, gnu::cold]] void settle_in_double(int redo, const F4 (&p)[9], float sz, Limit&& limit, Take&& take) {
+[[gnu::noinline, gnu::cold]] void settle_in_double(int redo, const F4 (&p)[9], float sz, float cull, Limit&& limit,
+                                                   Take&& take) {
   float l[9][F4::kLanes];
   for (int k = 0; k < 9; ++k) p[k].store(l[k]);
   for (int m = redo; m; m &= m - 1) {
     int i = __builtin_ctz(m);
     LaneHit h;
     if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i], sz,
-                               limit(), &h))
+                               cull, limit(), &h))
       take(i, h);
   }
 }
@@ -181,7 +199,7 @@ template <class F4, class Limit, class Take>
 // the permutation flips both crosses' signs together, so u, v, t do not
 // change. Off unless set_triangle_test() picks it.
 template <class F4, class M4>
-inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
+inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest, LaneSet* every) {
   constexpr int kW = F4::kLanes;
   F4 d[3], o[3], e1[3], e2[3], s[3], p[3], q[3];
   for (int j = 0; j < 3; ++j) {
@@ -198,12 +216,17 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
   F4 det = dot(e1, p);
   F4 inv = one / det;
   F4 u = dot(s, p) * inv, w = dot(d, q) * inv, t = dot(e2, q) * inv;
-  M4 accept = valid & (det != zero) & (u >= zero) & (w >= zero) & (u + w <= one) & (t >= zero) & (t <= F4::splat(closest));
+  // Culling: this det is the triple product in the ray's axis order, whose
+  // sign an odd permutation (kx, ky swapped: dir[kz] < 0) flips.
+  const float cull = r.dir[r.axis[2]] < 0 ? -r.cull : r.cull;
+  M4 accept = valid & (det != zero) & (det * F4::splat(cull) >= zero) & (u >= zero) & (w >= zero) & (u + w <= one) &
+              (t >= zero) & (t <= F4::splat(closest));
   LaneHit best;
   float tl[kW], ul[kW], wl[kW];
   t.store(tl), u.store(ul), w.store(wl);
   for (int m = simd::bits(accept); m; m &= m - 1) {
     int i = __builtin_ctz(m);
+    if (every) every->add(i, {i, tl[i], ul[i], wl[i]});
     if (best.lane < 0 || tl[i] < best.t) best = {i, tl[i], ul[i], wl[i]};
   }
   return best;
@@ -213,12 +236,17 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
 // Corners come in the ray's axis order, v[corner][j] = axis r.axis[j], so the
 // test indexes registers with constants. One source for every width: F4 (SSE,
 // 4 triangles) and F8 (AVX2, 8 triangles).
+//
+// Returns the closest accepted lane; with `every` (Query::All), every
+// accepted lane goes there too, and the double redo is limited by `closest`
+// alone.
 template <class F4, class M4>
-[[gnu::always_inline]] inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest) {
+[[gnu::always_inline]] inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest,
+                                                    LaneSet* every = nullptr) {
   constexpr int kW = F4::kLanes;
   if constexpr (kCountTests) count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(valid)))));
   if (triangle_test_choice.load(std::memory_order_relaxed) == TriangleTest::MollerTrumbore) [[unlikely]]
-    return moller_trumbore_test(r, v, valid, closest);
+    return moller_trumbore_test(r, v, valid, closest, every);
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
   F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;
@@ -242,7 +270,10 @@ template <class F4, class M4>
   // Lanes float cannot settle go to double below; t past the largest float
   // is no hit (it cannot be reported).
   M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
-  M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (t <= F4::splat(std::min(closest, FLT_MAX))));
+  // A culled face fails here; det is finite and not 0 on every lane that
+  // float settles, so cull 0 keeps them all.
+  M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (det * F4::splat(r.cull) >= zero) &
+                                     (t <= F4::splat(std::min(closest, FLT_MAX))));
 
   LaneHit best;
   int acc = simd::bits(accept);
@@ -252,7 +283,19 @@ template <class F4, class M4>
     int i = __builtin_ctz(m);
     if (best.lane < 0 || tl[i] < best.t) best.lane = i, best.t = tl[i];
   }
-  if (best.lane >= 0 && (r.outputs & MC_HIT_UV)) {
+  if (every) [[unlikely]] {
+    every->mask = acc;
+    t.store(every->t);
+    if (r.outputs & MC_HIT_UV) {
+      float Ul[kW], Vl[kW], Wl[kW];
+      U.store(Ul), V.store(Vl), W.store(Wl);
+      for (int m = acc; m; m &= m - 1) {
+        int i = __builtin_ctz(m);
+        float d = Ul[i] + Vl[i] + Wl[i];
+        every->u[i] = Vl[i] / d, every->v[i] = Wl[i] / d;
+      }
+    }
+  } else if (best.lane >= 0 && (r.outputs & MC_HIT_UV)) {
     float Ul[kW], Vl[kW], Wl[kW];
     U.store(Ul), V.store(Vl), W.store(Wl);
     float d = Ul[best.lane] + Vl[best.lane] + Wl[best.lane];
@@ -260,8 +303,10 @@ template <class F4, class M4>
   }
   // Rare: an edge function of 0, or det or T out of float's reach.
   if (int lanes = simd::bits(redo))
-    settle_in_double(lanes, {ax, ay, bx, by, cx, cy, az, bz, cz}, r.sz, [&] { return best.lane >= 0 ? best.t : closest; },
+    settle_in_double(lanes, {ax, ay, bx, by, cx, cy, az, bz, cz}, r.sz, r.cull,
+                     [&] { return best.lane >= 0 && !every ? best.t : closest; },
                      [&](int i, const LaneHit& h) {
+                       if (every) every->add(i, h);
                        if (best.lane < 0 || h.t < best.t) best = h, best.lane = i;
                      });
   return best;
@@ -280,8 +325,11 @@ struct PairHit {
   float t = 0, u = 0, v = 0;
 };
 
+// With `every` (Query::All): every accepted lane of the first triangles in
+// every[0], of the second in every[1].
 template <class F4, class M4>
-inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, float closest) {
+inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, float closest,
+                         LaneSet* every = nullptr) {
   constexpr int kW = F4::kLanes;
   if constexpr (kCountTests)
     count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(used))) + __builtin_popcount(unsigned(simd::bits(second)))));
@@ -311,25 +359,27 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
     F4 t = Ts / dets;
     M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
-    M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (t <= F4::splat(std::min(closest, FLT_MAX))));
+    M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (det * F4::splat(r.cull) >= zero) &
+                                       (t <= F4::splat(std::min(closest, FLT_MAX))));
     float tl[kW], Ul[kW], Vl[kW], Wl[kW];
     t.store(tl), U.store(Ul), V.store(Vl), W.store(Wl);
     for (int m = simd::bits(accept); m; m &= m - 1) {
       int i = __builtin_ctz(m);
-      if (best.lane < 0 || tl[i] < best.t) {
-        best = {i, tri == 1, tl[i], 0, 0};
-        if (r.outputs & MC_HIT_UV) {
-          const float d = Ul[i] + Vl[i] + Wl[i];
-          best.u = Vl[i] / d, best.v = Wl[i] / d;
-        }
+      LaneHit lane{i, tl[i], 0, 0};
+      if (r.outputs & MC_HIT_UV) {
+        const float d = Ul[i] + Vl[i] + Wl[i];
+        lane.u = Vl[i] / d, lane.v = Wl[i] / d;
       }
+      if (every) every[tri].add(i, lane);
+      if (best.lane < 0 || tl[i] < best.t) best = {i, tri == 1, lane.t, lane.u, lane.v};
     }
     // Rare: an edge function of 0, or det or T out of float's reach.
     const int* k = corner[tri];
     if (int lanes = simd::bits(redo))
       settle_in_double(lanes, {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]], z[k[0]], z[k[1]], z[k[2]]}, r.sz,
-                       [&] { return best.lane >= 0 ? best.t : closest; },
+                       r.cull, [&] { return best.lane >= 0 && !every ? best.t : closest; },
                        [&](int i, const LaneHit& h) {
+                         if (every) every[tri].add(i, h);
                          if (best.lane < 0 || h.t < best.t) best = {i, tri == 1, h.t, h.u, h.v};
                        });
   }

@@ -12,21 +12,58 @@
 namespace meshcast {
 MC_ISA_BEGIN
 
+// Query::All's hits of one ray so far, triangles still slots: the nearest
+// `cap` (at least 1) in hits[0, min(found, cap)) sorted by t, `found`
+// counting every hit taken.
+struct HitList {
+  Hit* hits;
+  uint32_t cap;
+  uint32_t found = 0;
+  void add(float t, uint32_t slot, float u, float v) {
+    uint32_t i = std::min(found, cap);
+    ++found;
+    if (i == cap) {
+      if (!(t < hits[cap - 1].t)) return;  // farther than the nearest cap: only counted
+      --i;
+    }
+    for (; i > 0 && hits[i - 1].t > t; --i) hits[i] = hits[i - 1];
+    hits[i] = Hit{t, slot, u, v};
+  }
+};
+
 // A walk's answer so far and its cut. `t` is what every box test, stack
 // pop and triangle test compares against: the closest hit's t, so nothing
 // farther is walked. Query::Any (`any`) takes the first triangle a walk
 // accepts and sets the cut below 0, which no box entry or hit distance
 // reaches: every walker culls what is left and ends, through the culling
-// it already has (no walker of its own). `hit_t` is the taken hit's t.
+// it already has (no walker of its own). Query::All (`list`) keeps the cut
+// at t_max and gives every accepted triangle to the list. `hit_t` is the
+// taken hit's t.
 struct Closest {
   float t;
   uint32_t slot = MC_NO_HIT;
   float u = 0, v = 0;
   float hit_t = INFINITY;
   bool any = false;
+  HitList* list = nullptr;
   void take(float hit, uint32_t s, float hu, float hv) {
     hit_t = hit, slot = s, u = hu, v = hv;
     t = any ? -1.0f : hit;
+  }
+  // Where a triangle test puts every accepted lane: only for Query::All.
+  LaneSet* every(LaneSet& scratch) const { return list ? &scratch : nullptr; }
+  // One test's answer: its closest lane `h`, or with a list every lane of
+  // `lanes`; slot_of(lane) names a lane's slot.
+  template <class SlotOf>
+  [[gnu::always_inline]] void offer(const LaneHit& h, const LaneSet& lanes, SlotOf&& slot_of) {
+    if (list) [[unlikely]] {
+      for (int m = lanes.mask; m; m &= m - 1) {
+        const int i = __builtin_ctz(m);
+        list->add(lanes.t[i], slot_of(uint32_t(i)), lanes.u[i], lanes.v[i]);
+      }
+    } else if (h.lane >= 0 && h.t <= t) {
+      take(h.t, slot_of(uint32_t(h.lane)), h.u, h.v);
+    }
   }
 };
 
@@ -189,8 +226,9 @@ inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint3
     simd::F4 v[3][3];
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < 3; ++j) v[k][j] = simd::F4::load(&rows[k * 3 + r.axis[j]][first]);
-    LaneHit h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
-    if (h.lane >= 0 && h.t <= c.t) c.take(h.t, slot0 + first + uint32_t(h.lane), h.u, h.v);
+    LaneSet lanes;
+    LaneHit h = triangle_test(r, v, simd::lanes_below(count - first), c.t, c.every(lanes));
+    c.offer(h, lanes, [&](uint32_t lane) { return slot0 + first + lane; });
   }
   return bytes;
 }
@@ -208,12 +246,16 @@ inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t bl
     simd::F4 v[4][3];
     for (int k = 0; k < 4; ++k)
       for (int j = 0; j < 3; ++j) v[k][j] = simd::F4::load(p + Codec::row(k, r.axis[j]));
-    PairHit h = pair_test(r, v, simd::lanes_of(used), simd::lanes_of(paired), c.t);
-    if (h.lane >= 0 && h.t <= c.t) {
-      uint32_t below = (1u << h.lane) - 1;
-      uint32_t index = made + uint32_t(std::popcount(used & below) + std::popcount(paired & below)) + h.second;
-      c.take(h.t, slot0 + index, h.u, h.v);
-    }
+    LaneSet lanes[2];  // Query::All: the first triangles' lanes, the second's
+    PairHit h = pair_test(r, v, simd::lanes_of(used), simd::lanes_of(paired), c.t, c.every(lanes[0]));
+    // A lane's triangles are numbered after those of the lanes below it.
+    auto slot_of = [&](uint32_t lane, bool second) {
+      uint32_t below = (1u << lane) - 1;
+      return slot0 + made + uint32_t(std::popcount(used & below) + std::popcount(paired & below)) + second;
+    };
+    for (int tri = 0; tri < (c.list ? 2 : 1); ++tri)
+      c.offer(LaneHit{h.lane, h.t, h.u, h.v}, lanes[tri],
+              [&](uint32_t lane) { return slot_of(lane, c.list ? tri == 1 : h.second); });
     made += uint32_t(std::popcount(used) + std::popcount(paired));
     at += Codec::kBlockBytes;
   }
@@ -247,8 +289,9 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
         const uint32_t nibbles = layout::load<uint32_t>(index + 4 * k);
         for (int j = 0; j < 3; ++j) v[k][j] = simd::cluster_pick(corner_axis[j], nibbles);
       }
-      LaneHit hit = triangle_test(r, v, simd::lanes_below8(triangles - first), c.t);
-      if (hit.lane >= 0 && hit.t <= c.t) c.take(hit.t, slot0 + made + first + uint32_t(hit.lane), hit.u, hit.v);
+      LaneSet lanes;
+      LaneHit hit = triangle_test(r, v, simd::lanes_below8(triangles - first), c.t, c.every(lanes));
+      c.offer(hit, lanes, [&](uint32_t lane) { return slot0 + made + first + lane; });
     }
     made += triangles;
     at += Codec::bytes_of(blob, at);
@@ -269,16 +312,17 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
     constexpr int kWidth = width_of<Loader<Codec>>();
     for (uint32_t first = 0; first < count; first += kWidth) {
       LaneHit h;
+      LaneSet lanes;
       if constexpr (kWidth == 8) {
         simd::F8 v[3][3];
         Loader<Codec>::load(blob, block, first, count, r.axis, v);
-        h = triangle_test(r, v, simd::lanes_below8(count - first), c.t);
+        h = triangle_test(r, v, simd::lanes_below8(count - first), c.t, c.every(lanes));
       } else {
         simd::F4 v[3][3];
         Loader<Codec>::load(blob, block, first, count, r.axis, v);
-        h = triangle_test(r, v, simd::lanes_below(count - first), c.t);
+        h = triangle_test(r, v, simd::lanes_below(count - first), c.t, c.every(lanes));
       }
-      if (h.lane >= 0 && h.t <= c.t) c.take(h.t, slot0 + first + uint32_t(h.lane), h.u, h.v);
+      c.offer(h, lanes, [&](uint32_t lane) { return slot0 + first + lane; });
     }
   }
 }

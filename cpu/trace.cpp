@@ -126,13 +126,13 @@ void set_triangle_test(TriangleTest t) { triangle_test_choice.store(t, std::memo
 
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
-                            float closest, LaneHit* out) {
+                            float cull, float closest, LaneHit* out) {
   double U = double(cx) * by - double(cy) * bx;
   double V = double(ax) * cy - double(ay) * cx;
   double W = double(bx) * ay - double(by) * ax;
   if ((U < 0 || V < 0 || W < 0) && (U > 0 || V > 0 || W > 0)) return false;
   double det = U + V + W;
-  if (det == 0) return false;
+  if (det == 0 || det * cull < 0) return false;  // cull: the face the query drops
   double T = (U * az + V * bz + W * cz) * double(sz);
   if (det < 0) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0) return false;
@@ -152,16 +152,47 @@ BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : by
   if (!walk_) throw InputError(name + ": no walker for this layout");
 }
 
-uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs, Query query) const {
+namespace {
+
+// The walkers' flags word: only the outputs' own bits (the query's and the
+// culling's share the word), checked names for the rest.
+uint32_t flags_of(const char* who, HitOutputs outputs, Query query, Cull cull) {
+  if (query != Query::Closest && query != Query::Any && query != Query::All)
+    throw UsageError(std::string(who) + ": query " + std::to_string(uint32_t(query)) +
+                     " is not Query::Closest, Query::Any or Query::All");
+  if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
+    throw UsageError(std::string(who) + ": cull " + std::to_string(uint32_t(cull)) +
+                     " is not Cull::None, Cull::Back or Cull::Front");
+  return (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | (query == Query::Any ? MC_QUERY_ANY : 0u) |
+         (query == Query::All ? MC_QUERY_ALL : 0u) | (cull == Cull::Back ? MC_CULL_BACK : 0u) |
+         (cull == Cull::Front ? MC_CULL_FRONT : 0u);
+}
+
+}  // namespace
+
+uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs, Query query,
+                         Cull cull) const {
   if (hits.size() < rays.size())
     throw UsageError("BlobView::trace: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(hits.size()) + " hits; the hits span must hold one hit a ray");
+  if (query == Query::All)
+    throw UsageError("BlobView::trace: Query::All has a list of hits a ray: BlobView::trace_all_hits answers it");
+  WalkRequest request{flags_of("BlobView::trace", outputs, query, cull)};
   uint64_t skipped = 0;
-  if (query != Query::Closest && query != Query::Any)
-    throw UsageError("BlobView::trace: query " + std::to_string(uint32_t(query)) + " is not Query::Closest or Query::Any");
-  // Only the outputs' own bits: the query's flag shares their word.
-  const uint32_t word = (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | (query == Query::Any ? MC_QUERY_ANY : 0u);
-  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, word);
+  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, request);
+  return skipped;
+}
+
+uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs, Cull cull) const {
+  if (lists.max_hits < 1 || lists.max_hits > kMaxHitsLimit)
+    throw UsageError("BlobView::trace_all_hits: max_hits " + std::to_string(lists.max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
+  lists.found.assign(rays.size(), 0);
+  lists.hits.assign(rays.size() * lists.max_hits, Hit{});
+  WalkRequest request{flags_of("BlobView::trace_all_hits", outputs, Query::All, cull), lists.max_hits,
+                      lists.found.data(), lists.hits.data()};
+  uint64_t skipped = 0;
+  walk_(bytes_.data(), rays.data(), nullptr, rays.size(), &skipped, request);
   return skipped;
 }
 

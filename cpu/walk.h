@@ -9,12 +9,24 @@
 #include "layout/catalog.h"
 
 namespace meshcast {
+
+// What a batch asks of a walker: `flags`, the MC_HIT_* outputs, the
+// MC_QUERY_* query and the MC_CULL_* culling; for Query::All (MC_QUERY_ALL)
+// where the hits go: found[i], and row i of `lists`, max_hits records (the
+// walker's `hits` are then not written).
+struct WalkRequest {
+  uint32_t flags = 0;
+  uint32_t max_hits = 0;
+  uint32_t* found = nullptr;
+  Hit* lists = nullptr;
+};
+
 MC_ISA_BEGIN
 
 // Walks `n` rays through a validated blob. Unwalkable rays (ray_is_walkable)
-// are answered as misses and counted in *skipped. `outputs`: the MC_HIT_*
-// asked for.
-using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs);
+// are answered as misses and counted in *skipped.
+using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
+                        const WalkRequest& request);
 
 // One walker a tree format, chosen by the catalog's tag (layout/catalog.h):
 // each family's walk_*.cpp defines its formats' overloads and instantiates
@@ -22,7 +34,7 @@ using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
 #define MC_DECLARE_WALK(Name, ...)                                                                          \
   template <class Codec>                                                                                     \
   void walk(layout::tree::Name, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, \
-            uint32_t outputs);
+            const WalkRequest& request);
 MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WALK)
 #undef MC_DECLARE_WALK
 
@@ -50,12 +62,45 @@ inline void finish_hits(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
   }
 }
 
+// Query::All's row of one ray, after its walk: slots to the caller's
+// triangles, the point if asked for, and the row in order of t, then
+// triangle (a tie's order no longer depends on where the walk met it).
+inline void finish_list(const uint8_t* blob, const Ray& ray, Hit* row, uint32_t used, uint32_t outputs) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  for (uint32_t k = 0; k < used; ++k) {
+    row[k].triangle = layout::remap_entry(blob, h, row[k].triangle);
+    if (outputs & MC_HIT_POINT)
+      for (int a = 0; a < 3; ++a) row[k].point[a] = ray.org[a] + row[k].t * ray.dir[a];
+  }
+  std::sort(row, row + used, [](const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.triangle < b.triangle); });
+}
+
 // The batch loop every walker shares: an unwalkable ray becomes a counted
 // miss; walk_one(r, c) walks one ray, shortening c on every hit. Rays go in
 // chunks, walked first, then finished (finish_hits).
 template <class WalkOne>
 inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
-                         uint32_t outputs, WalkOne&& walk_one) {
+                         const WalkRequest& request, WalkOne&& walk_one) {
+  const uint32_t outputs = request.flags;
+  if (outputs & MC_QUERY_ALL) {
+    for (size_t i = 0; i < n; ++i) {
+      Hit* row = request.lists + i * request.max_hits;
+      std::fill(row, row + request.max_hits, Hit{});
+      request.found[i] = 0;
+      if (!ray_is_walkable(rays[i])) {
+        ++*skipped;
+        continue;
+      }
+      const RayPre r(rays[i], outputs);
+      HitList list{row, request.max_hits};
+      Closest c{rays[i].tmax};
+      c.list = &list;
+      walk_one(r, c);
+      request.found[i] = list.found;
+      finish_list(blob, rays[i], row, std::min(list.found, list.cap), outputs);
+    }
+    return;
+  }
   constexpr size_t kChunk = 32;
   for (size_t begin = 0; begin < n; begin += kChunk) {
     const size_t end = std::min(n, begin + kChunk);

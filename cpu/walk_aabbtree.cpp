@@ -10,10 +10,10 @@ namespace meshcast {
 MC_ISA_BEGIN
 
 template <class Codec>
-void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     walk_aabb_nodes(tree, r, c, [&](const layout::AABBNode& node, uint32_t at) {
       uint32_t block = at + MC_AABB_NODE_BYTES;
       test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
@@ -26,10 +26,10 @@ void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hit
 // side of the split axis (the first child is the lower one) and pushes the
 // other.
 template <class Codec>
-void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     uint32_t stack[MC_MAX_DEPTH + 2];
     int top = -1;
     uint32_t at = 0;
@@ -55,10 +55,10 @@ void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays,
 // AABBTreePNS walker (seed 000 §5.3, seed 002): as AABBTreeSplitAxis, but
 // the near child is one AND away: bit octant(dir) of the node's 8 bits.
 template <class Codec>
-void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
     uint32_t stack[MC_MAX_DEPTH + 2];
     int top = -1;
@@ -83,9 +83,9 @@ void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* 
 }
 
 #define MC_INSTANTIATE(Codec, name)                                                                 \
-  template void walk<layout::Codec>(layout::tree::AABBTreePNS, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
-  template void walk<layout::Codec>(layout::tree::AABBTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t); \
-  template void walk<layout::Codec>(layout::tree::AABBTreeSplitAxis, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::AABBTreePNS, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&); \
+  template void walk<layout::Codec>(layout::tree::AABBTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&); \
+  template void walk<layout::Codec>(layout::tree::AABBTreeSplitAxis, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

@@ -6,14 +6,14 @@ namespace meshcast {
 MC_ISA_BEGIN
 
 template <class Codec>
-void walk(layout::tree::BruteForce, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::BruteForce, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
-  for_each_ray(blob, rays, hits, n, skipped, outputs,
+  for_each_ray(blob, rays, hits, n, skipped, request,
                [&](const RayPre& r, Closest& c) { test_records<Codec>(blob, h, r, 0, h.tree_size, c); });
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::BruteForce, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::BruteForce, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

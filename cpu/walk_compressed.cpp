@@ -9,12 +9,12 @@ namespace meshcast {
 MC_ISA_BEGIN
 
 template <class Codec>
-void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   const layout::CompressedBox root = layout::compressed_root_box(tree);
   const uint32_t root_count = layout::compressed_root_count(tree);
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     struct Entry {
       layout::CompressedBox box;
       uint32_t at, count;
@@ -52,7 +52,7 @@ void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::AABBTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::AABBTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

@@ -18,10 +18,10 @@ namespace meshcast {
 MC_ISA_BEGIN
 
 template <class Codec>
-void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
     uint32_t v = 1, o = 0, node_index = 1;
     for (;;) {
@@ -45,7 +45,7 @@ void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::StacklessLBVH, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::StacklessLBVH, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

@@ -195,10 +195,10 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
 
 template <class Codec>
 void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
-          uint32_t outputs) {
+          const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const bool blob_fits = OctFused::blob_fits(h);
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     const OctFused fused(r, h, blob_fits);
     if (fused.applies)
       walk_ray<Codec, true>(blob, h, r, fused, c);
@@ -208,7 +208,7 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::OctTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::OctTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 #undef MC_INSTANTIATE
 

@@ -48,10 +48,10 @@ constexpr int kStackSize = 3 * MC_MAX_DEPTH + 8;
 }  // namespace
 
 template <class Bounds, class Codec>
-void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     uint32_t node_stack[kStackSize];
     float fraction_stack[kStackSize];
     node_stack[0] = h.root;
@@ -94,18 +94,18 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
 }
 
 template <class Codec>
-void walk(layout::tree::QuadTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  walk_quadtree<layout::QuadBoundsFloat, Codec>(blob, rays, hits, n, skipped, outputs);
+void walk(layout::tree::QuadTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
+  walk_quadtree<layout::QuadBoundsFloat, Codec>(blob, rays, hits, n, skipped, request);
 }
 
 template <class Codec>
-void walk(layout::tree::QuadTreeHalfFloat, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  walk_quadtree<layout::QuadBoundsHalf, Codec>(blob, rays, hits, n, skipped, outputs);
+void walk(layout::tree::QuadTreeHalfFloat, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
+  walk_quadtree<layout::QuadBoundsHalf, Codec>(blob, rays, hits, n, skipped, request);
 }
 
 #define MC_INSTANTIATE(Codec, name)                                                                              \
-  template void walk<layout::Codec>(layout::tree::QuadTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);                                                 \
-  template void walk<layout::Codec>(layout::tree::QuadTreeHalfFloat, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::QuadTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);                                                 \
+  template void walk<layout::Codec>(layout::tree::QuadTreeHalfFloat, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

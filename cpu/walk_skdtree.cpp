@@ -14,10 +14,10 @@ namespace meshcast {
 MC_ISA_BEGIN
 
 template <class Codec>
-void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     struct Entry { uint32_t at; float tnear, tfar; };
     Entry stack[MC_MAX_DEPTH + 2];
     int top = -1;
@@ -58,7 +58,7 @@ void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::SKDTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+  template void walk<layout::Codec>(layout::tree::SKDTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

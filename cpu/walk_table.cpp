@@ -11,8 +11,8 @@ MC_ISA_BEGIN
 namespace {
 
 template <class Tree, class Codec>
-void walk_as(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
-  walk<Codec>(Tree{}, blob, rays, hits, n, skipped, outputs);
+void walk_as(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
+  walk<Codec>(Tree{}, blob, rays, hits, n, skipped, request);
 }
 
 // Every (tree, triangle format) pair the catalog allows: every codec under

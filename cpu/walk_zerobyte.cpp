@@ -54,19 +54,19 @@ void walk_zbt(const uint8_t* blob, const layout::BlobHeader& h, uint32_t root, u
 }
 
 template <bool kCache>
-void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     walk_zbt<kCache>(blob, h, h.tree_offset + h.triangle_base, 0, layout::pns_octant(r.dir), r, c, cache);
   });
 }
 
 template <bool kCache>
-void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
-  for_each_ray(blob, rays, hits, n, skipped, outputs, [&](const RayPre& r, Closest& c) {
+  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     const uint32_t octant = layout::pns_octant(r.dir);
     walk_aabb_nodes(blob + h.tree_offset, r, c, [&](const layout::AABBNode& node, uint32_t) {
       uint32_t root = h.tree_offset + h.triangle_base + node.value() * layout::Indexed24::kSlotDivisor;
@@ -77,33 +77,33 @@ void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_
 
 // Both zero-byte formats: the header's box-cache flag picks the instantiation.
 template <class Tree>
-void walk_zero_byte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk_zero_byte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
   if constexpr (std::is_same_v<Tree, layout::tree::ZeroByteHybrid>)
-    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, outputs)
-                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, outputs);
+    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, request)
+                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, request);
   else
-    return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, outputs)
-                 : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, outputs);
+    return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, request)
+                 : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, request);
 }
 
 }  // namespace
 
 // The zero-byte trees hold the mesh's own indices: Indexed24 is their one codec.
 template <class Codec>
-void walk(layout::tree::ZeroByteTree tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::ZeroByteTree tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   static_assert(std::is_same_v<Codec, layout::Indexed24>);
-  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, outputs);
+  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, request);
 }
 
 template <class Codec>
-void walk(layout::tree::ZeroByteHybrid tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, uint32_t outputs) {
+void walk(layout::tree::ZeroByteHybrid tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   static_assert(std::is_same_v<Codec, layout::Indexed24>);
-  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, outputs);
+  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, request);
 }
 
-template void walk<layout::Indexed24>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
-template void walk<layout::Indexed24>(layout::tree::ZeroByteHybrid, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t);
+template void walk<layout::Indexed24>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+template void walk<layout::Indexed24>(layout::tree::ZeroByteHybrid, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 
 MC_ISA_END
 }  // namespace meshcast

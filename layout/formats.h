@@ -16,9 +16,15 @@
 #define MC_HIT_UV 1u     // barycentrics u, v of the hit in its triangle
 #define MC_HIT_POINT 2u  // the hit point: org + t * dir, in float
 // The query a trace answers, in the same word as the outputs (issue 20):
-// without it the closest hit; with it any hit in [0, t_max], the walk
-// ending at the first triangle it takes.
+// without a query bit the closest hit; MC_QUERY_ANY any hit in [0, t_max],
+// the walk ending at the first triangle it takes; MC_QUERY_ALL every hit
+// along the segment. Face culling rides there too: MC_CULL_BACK keeps the
+// triangles whose corners run counter-clockwise seen from the ray's origin
+// (det > 0 in the watertight test's sheared space), MC_CULL_FRONT the others.
 #define MC_QUERY_ANY 0x100u
+#define MC_QUERY_ALL 0x200u
+#define MC_CULL_BACK 0x400u
+#define MC_CULL_FRONT 0x800u
 
 // Header fields as 32-bit word indices, for readers that see the blob as a
 // uint array (the shaders); layout/blob_format.h checks them against BlobHeader.

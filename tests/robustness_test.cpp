@@ -122,6 +122,27 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
   leaks = 0;
   for (const Hit& h : trace_all(blob, rays, nullptr, 0, Query::Any)) leaks += h.triangle == MC_NO_HIT;
   EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded") << ", Query::Any";
+  // Query::All: every ray from inside finds at least one hit.
+  const BlobView view(blob, "sphere");
+  const HitLists lists = trace_lists(view, rays, 8);
+  EXPECT_EQ(std::count(lists.found.begin(), lists.found.end(), 0u), 0) << (soup ? "unwelded" : "welded") << ", Query::All";
+  // From outside, through the sphere: a ray crosses a face of each side,
+  // so culling either side leaks no ray (the entry through an edge or a
+  // vertex included: culling keeps the test watertight).
+  std::vector<Ray> outside;
+  for (const Ray& r : rays) {
+    const float scale = 3 / std::sqrt(r.dir[0] * r.dir[0] + r.dir[1] * r.dir[1] + r.dir[2] * r.dir[2]);
+    const float away[3] = {0.1f - scale * r.dir[0], 0.2f - scale * r.dir[1], 0.3f - scale * r.dir[2]};
+    outside.push_back({{away[0], away[1], away[2]}, {r.org[0] - away[0], r.org[1] - away[1], r.org[2] - away[2]}, INFINITY});
+  }
+  for (Cull cull : {Cull::Back, Cull::Front}) {
+    leaks = 0;
+    for (const Hit& h : trace_all(view, outside, Query::Closest, cull)) leaks += h.triangle == MC_NO_HIT;
+    EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded") << ", from outside, cull " << int(cull);
+    leaks = 0;
+    for (const Hit& h : trace_all(view, outside, Query::Any, cull)) leaks += h.triangle == MC_NO_HIT;
+    EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded") << ", from outside, Query::Any, cull " << int(cull);
+  }
 #endif
   }
 }
@@ -162,6 +183,42 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
     ASSERT_NE(any[i].triangle, MC_NO_HIT) << "ray " << i << " leaked, Query::Any";
     EXPECT_EQ(any[i].t, 2.0f) << "ray " << i << ", Query::Any";
   }
+  // Culling: the grid's triangles all face one way (+z or -z); a ray sees
+  // their front faces when it runs against that normal. Through an edge or
+  // a vertex, the face kept is hit at t 2, the other culled.
+  const BlobView view(blob, "grid");
+  float facing = 0;  // the sign of the normals' z
+  for (size_t t = 0; t < g.triangles.size(); ++t) {
+    const Vec3 a = g.corner(t, 0), b = g.corner(t, 1), c = g.corner(t, 2);
+    const float nz = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    if (t == 0) facing = nz > 0 ? 1.0f : -1.0f;
+    ASSERT_GT(nz * facing, 0) << "grid triangle " << t << " faces the other way";
+  }
+  for (Cull cull : {Cull::Back, Cull::Front}) {
+    for (Query query : {Query::Closest, Query::Any}) {
+      std::vector<Hit> culled = trace_all(view, rays, query, cull);
+      for (size_t i = 0; i < culled.size(); ++i) {
+        const bool front = rays[i].dir[2] * facing < 0;
+        if (front == (cull == Cull::Back)) {
+          ASSERT_NE(culled[i].triangle, MC_NO_HIT) << "ray " << i << " leaked, cull " << int(cull);
+          EXPECT_EQ(culled[i].t, 2.0f) << "ray " << i << ", cull " << int(cull);
+        } else {
+          ASSERT_EQ(culled[i].triangle, MC_NO_HIT) << "ray " << i << " hit a culled face, cull " << int(cull);
+        }
+      }
+    }
+  }
+  // Query::All: through a vertex every triangle around it, through an edge
+  // both of its triangles, each once: the oracle's set on the stored grid.
+  const Mesh stored_grid = stored_mesh(blob);
+  const OracleTree tree(stored_grid);
+  std::vector<std::vector<OracleHit>> expected(rays.size());
+  size_t shared = 0;
+  for (size_t i = 0; i < rays.size(); ++i) expected[i] = tree.all(rays[i]), shared += expected[i].size() > 1;
+  // (Quantized corners sit a rounding away from the rays' exact lines.)
+  if (!quantized(blob)) EXPECT_GT(shared, rays.size() / 2) << "most of these rays meet an edge or a vertex";
+  Agreement all = compare_all(stored_grid, rays, trace_lists(view, rays, 16), expected, 1e-6);
+  EXPECT_EQ(all.wrong + all.t_errors + all.ties, 0u) << all.first_problem;
 #endif
   expect_answers(g, rays, "grid");
 }

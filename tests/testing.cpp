@@ -111,14 +111,33 @@ const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count
   return cache[key];
 }
 
-const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays) {
-  static std::map<std::tuple<std::string, int, size_t>, std::vector<OracleHit>> cache;
+namespace {
+const OracleTree& oracle_tree(const NamedMesh& m) {
   static std::map<std::string, std::unique_ptr<OracleTree>> trees;
-  auto key = std::make_tuple(m.name, int(kind), rays.size());
+  if (!trees.count(m.name)) trees[m.name] = std::make_unique<OracleTree>(*m.mesh);
+  return *trees[m.name];
+}
+}  // namespace
+
+const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays,
+                                             Cull cull) {
+  static std::map<std::tuple<std::string, int, size_t, int>, std::vector<OracleHit>> cache;
+  auto key = std::make_tuple(m.name, int(kind), rays.size(), int(cull));
   if (!cache.count(key)) {
-    if (!trees.count(m.name)) trees[m.name] = std::make_unique<OracleTree>(*m.mesh);
     std::vector<OracleHit> answers(rays.size());
-    for (size_t i = 0; i < rays.size(); ++i) answers[i] = trees[m.name]->closest(rays[i]);
+    for (size_t i = 0; i < rays.size(); ++i) answers[i] = oracle_tree(m).closest(rays[i], cull);
+    cache[key] = std::move(answers);
+  }
+  return cache[key];
+}
+
+const std::vector<std::vector<OracleHit>>& oracle_all_answers(const NamedMesh& m, RayKind kind,
+                                                              const std::vector<Ray>& rays, Cull cull) {
+  static std::map<std::tuple<std::string, int, size_t, int>, std::vector<std::vector<OracleHit>>> cache;
+  auto key = std::make_tuple(m.name, int(kind), rays.size(), int(cull));
+  if (!cache.count(key)) {
+    std::vector<std::vector<OracleHit>> answers(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) answers[i] = oracle_tree(m).all(rays[i], cull);
     cache[key] = std::move(answers);
   }
   return cache[key];
@@ -135,12 +154,25 @@ Mesh unwelded(const Mesh& m) {
 }
 
 std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped,
-                           uint32_t outputs, Query query) {
+                           uint32_t outputs, Query query, Cull cull) {
   BlobView view(blob, "test blob");
   std::vector<Hit> hits(rays.size());
-  uint64_t s = view.trace(rays, hits, HitOutputs(outputs), query);
+  uint64_t s = view.trace(rays, hits, HitOutputs(outputs), query, cull);
   if (skipped) *skipped = s;
   return hits;
+}
+
+std::vector<Hit> trace_all(const BlobView& view, const std::vector<Ray>& rays, Query query, Cull cull) {
+  std::vector<Hit> hits(rays.size());
+  view.trace(rays, hits, HitOutputs::None, query, cull);
+  return hits;
+}
+
+HitLists trace_lists(const BlobView& view, const std::vector<Ray>& rays, uint32_t max_hits, Cull cull) {
+  HitLists lists;
+  lists.max_hits = max_hits;
+  view.trace_all_hits(rays, lists, HitOutputs::None, cull);
+  return lists;
 }
 
 size_t expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,

@@ -49,13 +49,23 @@ bool quick();
 // walker's node code and each codec's leaf code run, not every pairing.
 std::vector<std::string> covering_layouts(const std::vector<std::string>& names);
 
-// Oracle answers (tree oracle) for a ray set, cached per (mesh, kind).
-const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays);
+// Oracle answers (tree oracle) for a ray set, cached per (mesh, kind, set
+// size, culling): the closest hits, and Query::All's sets.
+const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays,
+                                             Cull cull = Cull::None);
+const std::vector<std::vector<OracleHit>>& oracle_all_answers(const NamedMesh& m, RayKind kind,
+                                                              const std::vector<Ray>& rays, Cull cull = Cull::None);
 const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count = 10000);
 
 // `outputs`: the per-hit outputs asked for (MC_HIT_*).
 std::vector<Hit> trace_all(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, uint64_t* skipped = nullptr,
-                           uint32_t outputs = 0, Query query = Query::Closest);
+                           uint32_t outputs = 0, Query query = Query::Closest, Cull cull = Cull::None);
+// The same through a view validated once (validation reads the whole
+// blob: several queries on one blob pay it once).
+std::vector<Hit> trace_all(const BlobView& view, const std::vector<Ray>& rays, Query query = Query::Closest,
+                           Cull cull = Cull::None);
+// Query::All on every ray, rows of `max_hits`.
+HitLists trace_lists(const BlobView& view, const std::vector<Ray>& rays, uint32_t max_hits, Cull cull = Cull::None);
 
 // The same surface with every triangle owning its three vertices (as STL
 // gives it): a triangle soup, no vertex shared.

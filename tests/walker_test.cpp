@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdlib>
+#include <random>
 
 #include "check/generate.h"
 #include "layout/blob_format.h"
@@ -17,12 +18,42 @@ namespace {
 
 class WalkerVsOracle : public ::testing::TestWithParam<std::string> {};
 
+// The queries besides the closest hit (issue 20) on the first tenth of
+// a ray set: closest and any hit with a face culled (the back faces on
+// long rays, the front faces on probe and radial rays, which start inside
+// closed meshes and see back faces there), and every hit, culled on long
+// rays. Each against the oracle over `reference` with the same culling.
+void check_queries(const BlobView& blob, const NamedMesh& reference, RayKind kind,
+                   const std::vector<Ray>& rays, double tolerance, const std::string& what) {
+  const std::vector<Ray> part(rays.begin(), rays.begin() + std::ptrdiff_t(rays.size() / 10));
+  const Cull cull = kind == RayKind::Long ? Cull::Back : Cull::Front;
+  const std::vector<OracleHit>& culled_oracle = oracle_answers(reference, kind, part, cull);
+  std::vector<Hit> culled = trace_all(blob, part, Query::Closest, cull);
+  Agreement a = compare(*reference.mesh, part, culled, culled_oracle, tolerance);
+  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ", culled: " << a.first_problem;
+  size_t culled_hits = 0;
+  for (const Hit& h : culled) culled_hits += h.triangle != MC_NO_HIT;
+  EXPECT_GT(culled_hits, part.size() / 50) << what << ", culled: too few hits to show anything";
+  std::vector<Hit> any = trace_all(blob, part, Query::Any, cull);
+  Agreement b = compare_any(*reference.mesh, part, any, culled_oracle, tolerance, cull);
+  EXPECT_EQ(b.wrong + b.t_errors, 0u) << what << ", Query::Any culled: " << b.first_problem;
+
+  const Cull all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
+  HitLists lists = trace_lists(blob, part, 256, all_cull);
+  Agreement c = compare_all(*reference.mesh, part, lists, oracle_all_answers(reference, kind, part, all_cull), tolerance);
+  EXPECT_EQ(c.wrong + c.t_errors, 0u) << what << ", Query::All: " << c.first_problem;
+  EXPECT_GT(c.rays, part.size() / 20) << what << ", Query::All: too few hits to show anything";
+}
+
 void check_layout(const std::string& layout_name_, bool large) {
   BuildOptions options = parse_layout(layout_name_);
+  static const std::vector<std::string> covering_names = covering_layouts(layout_names());
+  const bool covering = std::find(covering_names.begin(), covering_names.end(), layout_name_) != covering_names.end();
   for (const NamedMesh& m : test_meshes(large)) {
     if (large && m.name != "terrain_1M") continue;
     std::vector<uint8_t> blob = build_blob(*m.mesh, options, m.name);
     ASSERT_EQ(layout::validate(blob), "") << m.name;
+    const BlobView view(blob, m.name);
     double diag = m.mesh->bounds().diagonal();
     double tolerance = 1e-5 * diag;
     // Bit-packed formats walk the quantized mesh: the oracle over that mesh
@@ -36,7 +67,7 @@ void check_layout(const std::string& layout_name_, bool large) {
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
       const std::vector<Ray>& rays = test_rays(m, kind, count);
       const std::vector<OracleHit>& oracle = oracle_answers(reference, kind, rays);
-      std::vector<Hit> hits = trace_all(blob, rays);
+      std::vector<Hit> hits = trace_all(view, rays);
       Agreement a = compare(*reference.mesh, rays, hits, oracle, tolerance);
       EXPECT_EQ(a.wrong, 0u) << layout_name_ << " on " << m.name << " kind " << int(kind) << ": " << a.first_problem;
       EXPECT_EQ(a.t_errors, 0u) << layout_name_ << " on " << m.name << " kind " << int(kind) << ": "
@@ -46,9 +77,13 @@ void check_layout(const std::string& layout_name_, bool large) {
       // A ray set that never hits proves nothing: every kind must hit often.
       EXPECT_GT(hit_count, rays.size() / 20) << m.name << " kind " << int(kind);
       EXPECT_EQ(a.rays, count);
+      // The other queries: in the quick runs on the covering layouts only.
+      if (quick() && !covering) continue;
+      check_queries(view, reference, kind, rays, tolerance,
+                    layout_name_ + " on " + m.name + " kind " + std::to_string(int(kind)));
       // Query::Any on the same rays: the oracle's hit/miss, and each hit a
       // triangle the ray hits in double at that t.
-      std::vector<Hit> any = trace_all(blob, rays, nullptr, 0, Query::Any);
+      std::vector<Hit> any = trace_all(view, rays, Query::Any);
       Agreement b = compare_any(*reference.mesh, rays, any, oracle, tolerance);
       EXPECT_EQ(b.wrong + b.t_errors, 0u) << layout_name_ << " on " << m.name << " kind " << int(kind)
                                           << ", Query::Any: " << b.first_problem;
@@ -305,6 +340,70 @@ TEST(TriangleTests, MollerTrumboreIsAnOptionOffByDefault) {
       size_t hits = size_t(std::count_if(plain.begin(), plain.end(), [](const Hit& h) { return h.triangle != MC_NO_HIT; }));
       EXPECT_GT(hits, rays.size() / 10) << layout << " on " << m.name;
     }
+  }
+}
+}  // namespace
+}  // namespace meshcast::testing
+
+// Culling's definition, judged apart from the walkers' determinant: in a
+// soup of random triangles, a query culling back faces finds exactly the
+// two-sided hits whose triangle's corners run counter-clockwise seen from
+// the ray's origin (dot((b - a) x (c - a), o - a) > 0, in double), culling
+// front faces exactly the others, on every layout (covering ones in quick
+// runs); the closest culled hit is the first of its set.
+namespace meshcast::testing {
+namespace {
+TEST(Culling, KeepsTheFaceSeenCounterClockwiseFromTheOrigin) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1, 1);
+  Mesh soup;
+  for (uint32_t t = 0; t < 300; ++t) {
+    const Vec3 centre{u(rng), u(rng), u(rng)};
+    for (int c = 0; c < 3; ++c)
+      soup.vertices.push_back({centre.x + 0.3f * u(rng), centre.y + 0.3f * u(rng), centre.z + 0.3f * u(rng)});
+    soup.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+  }
+  std::vector<Ray> rays;
+  for (int i = 0; i < 1000; ++i)
+    rays.push_back({{2 * u(rng), 2 * u(rng), 2 * u(rng)}, {u(rng), u(rng), u(rng)}, INFINITY});
+  // +1 front, -1 back; 0 for a ray within 1e-3 of the triangle's plane
+  // (by angle), where the quantized formats' rounding may turn the face.
+  auto facing = [&](const Ray& r, uint32_t t) {
+    const Vec3 a = soup.corner(t, 0), b = soup.corner(t, 1), c = soup.corner(t, 2);
+    double e1[3], e2[3], o[3];
+    for (int k = 0; k < 3; ++k) e1[k] = double(b[k]) - a[k], e2[k] = double(c[k]) - a[k], o[k] = double(r.org[k]) - a[k];
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const double dot = n[0] * o[0] + n[1] * o[1] + n[2] * o[2];
+    const double norms = std::sqrt((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]));
+    return std::fabs(dot) < 1e-3 * norms ? 0 : dot > 0 ? 1 : -1;
+  };
+  for (const std::string& name : quick() ? covering_layouts(layout_names()) : layout_names()) {
+    const BuildOptions options = parse_layout(name);
+    std::vector<uint8_t> blob = build_blob(soup, options, "soup");
+    if (!layout::has_remap(layout::header_of(blob.data()))) continue;  // hits would name slots
+    const BlobView view(blob, name);
+    const HitLists both = trace_lists(view, rays, 64);
+    size_t kept[2] = {0, 0};
+    for (Cull cull : {Cull::Back, Cull::Front}) {
+      const HitLists culled = trace_lists(view, rays, 64, cull);
+      const std::vector<Hit> closest = trace_all(view, rays, Query::Closest, cull);
+      for (size_t i = 0; i < rays.size(); ++i) {
+        std::vector<uint32_t> expected, got;
+        bool unsure = false;
+        for (const Hit& h : both.row(i)) {
+          const int f = facing(rays[i], h.triangle);
+          unsure = unsure || f == 0;
+          if (f == (cull == Cull::Back ? 1 : -1)) expected.push_back(h.triangle);
+        }
+        if (unsure) continue;
+        for (const Hit& h : culled.row(i)) got.push_back(h.triangle);
+        ASSERT_EQ(got, expected) << name << ", ray " << i << ", cull " << int(cull);
+        kept[cull == Cull::Front] += got.size();
+        ASSERT_EQ(closest[i].triangle, got.empty() ? MC_NO_HIT : got[0]) << name << ", ray " << i;
+      }
+    }
+    EXPECT_GT(kept[0], 100u) << name;
+    EXPECT_GT(kept[1], 100u) << name;
   }
 }
 }  // namespace

@@ -20,6 +20,8 @@
 
 namespace meshcast {
 
+struct WalkRequest;  // what a batch asks of a walker (internal: cpu/walk.h)
+
 class BlobView {
  public:
   // Proves every offset and index of the blob in range (the header, its
@@ -29,10 +31,17 @@ class BlobView {
 
   // The closest hit of each ray (or with Query::Any, any hit), written to
   // hits[i]; returns how many rays were not walkable (ray_is_walkable:
-  // answered as misses). `outputs`: what else each hit carries. UsageError
-  // when hits is shorter than rays.
+  // answered as misses). `outputs`: what else each hit carries; `cull`:
+  // which faces the rays see. UsageError when hits is shorter than rays, or
+  // for Query::All (trace_all_hits answers it).
   uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs = HitOutputs::None,
-                 Query query = Query::Closest) const;
+                 Query query = Query::Closest, Cull cull = Cull::None) const;
+
+  // Query::All: every hit of each ray along its segment into `lists`
+  // (resized to the rays; lists.max_hits, 1 to kMaxHitsLimit, says how many
+  // each row keeps). Returns the rays not walkable, as trace() does.
+  uint64_t trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs = HitOutputs::None,
+                          Cull cull = Cull::None) const;
 
   std::span<const uint8_t> bytes() const { return bytes_; }
   Layout layout() const;
@@ -40,7 +49,8 @@ class BlobView {
 
  private:
   std::span<const uint8_t> bytes_;
-  void (*walk_)(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, uint32_t) = nullptr;
+  using Walk = void (*)(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  Walk walk_ = nullptr;
 };
 
 // A blob file read whole into memory (not validated: give it to a BlobView

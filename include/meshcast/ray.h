@@ -1,11 +1,14 @@
 // Rays and the hits they get: the records every walker, shader and file
-// (RAYS, HITS) shares. A ray is o + t d for t in [0, tmax]; d need not be
-// normalized and t is in units of d. Triangles are two-sided and the test is
-// watertight: a ray through a shared edge or vertex hits one of its triangles.
+// (RAYS, HITS, HITN) shares. A ray is o + t d for t in [0, tmax]; d need not
+// be normalized and t is in units of d. Triangles are two-sided (unless a
+// query culls, see Cull) and the test is watertight: a ray through a shared
+// edge or vertex hits one of its triangles.
 #pragma once
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "meshcast/mesh.h"
 
@@ -41,7 +44,34 @@ constexpr bool has(HitOutputs set, HitOutputs flag) { return (uint32_t(set) & ui
 // default), or any hit there ("is anything in the way?": line of sight,
 // shadow and audio probes), where the walk ends at the first triangle it
 // takes and the hit names that triangle and its t, not the nearest.
-enum class Query : uint32_t { Closest = 0, Any = 1 };
+// Query::All answers every hit along the segment (BlobView::trace_all_hits,
+// what a bullet or a sound passes through).
+enum class Query : uint32_t { Closest = 0, Any = 1, All = 2 };
+
+// Query::All's answers for a batch of rays. Ray i found found[i] hits along
+// its segment; the nearest min(found[i], max_hits) of them are row i of
+// `hits` (max_hits records from i * max_hits), in order of t, then triangle;
+// the rest of the row reads as misses (t = inf, kNoHit). A found[i] above
+// max_hits says how many were dropped. A triangle the ray meets exactly on
+// an edge or vertex shared with others is one hit each of them.
+struct HitLists {
+  uint32_t max_hits = 16;
+  std::vector<uint32_t> found;
+  std::vector<Hit> hits;
+  std::span<const Hit> row(size_t ray) const {
+    return {hits.data() + ray * max_hits, std::min<size_t>(found[ray], max_hits)};
+  }
+};
+// The most hits a ray's row may hold.
+constexpr uint32_t kMaxHitsLimit = 4096;
+
+// Which faces a query sees. A triangle's front face is the one whose
+// corners, in the caller's order, run counter-clockwise seen from the ray's
+// origin (its normal (b - a) x (c - a) points back at the origin); formats
+// that rotate or quantize corners keep that winding. Culling keeps the
+// watertight test's promise: a ray through an edge shared by a front and a
+// back face hits the one it keeps.
+enum class Cull : uint32_t { None = 0, Back = 1, Front = 2 };
 
 // The largest direction component a ray may have.
 constexpr float kMaxDirection = 0x1p126f;

@@ -58,4 +58,49 @@ void write_hits(const std::string& path, const std::vector<Hit>& hits) {
   write_file(path, b.data(), b.size());
 }
 
+HitLists read_hit_lists(const std::string& path) {
+  std::vector<uint8_t> b = read_file(path);
+  if (b.size() < 12 || std::memcmp(b.data(), "HITN", 4) != 0)
+    throw InputError(path + ": not a HITN file (bad magic or shorter than 12 bytes)");
+  uint32_t n, width;
+  std::memcpy(&n, b.data() + 4, 4), std::memcpy(&width, b.data() + 8, 4);
+  if (width < 1 || width > kMaxHitsLimit)
+    throw InputError(path + ": " + std::to_string(width) + " records a ray, not in 1.." + std::to_string(kMaxHitsLimit));
+  const uint64_t row = 4 + 8 * uint64_t(width);
+  if (b.size() != 12 + n * row)
+    throw InputError(path + ": header says " + std::to_string(n) + " rays of " + std::to_string(width) + " records (" +
+                     std::to_string(12 + n * row) + " bytes) but the file has " + std::to_string(b.size()) + " bytes");
+  HitLists lists;
+  lists.max_hits = width;
+  lists.found.resize(n);
+  lists.hits.resize(size_t(n) * width);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* p = b.data() + 12 + i * row;
+    std::memcpy(&lists.found[i], p, 4);
+    for (size_t k = 0; k < width; ++k) {
+      HitRecord r;
+      std::memcpy(&r, p + 4 + 8 * k, 8);
+      lists.hits[i * width + k] = {r.t, r.triangle};
+    }
+  }
+  return lists;
+}
+
+void write_hit_lists(const std::string& path, const HitLists& lists) {
+  const size_t n = lists.found.size(), width = lists.max_hits, row = 4 + 8 * width;
+  std::vector<uint8_t> b(12 + n * row);
+  const uint32_t header[2] = {uint32_t(n), uint32_t(width)};
+  std::memcpy(b.data(), "HITN", 4), std::memcpy(b.data() + 4, header, 8);
+  for (size_t i = 0; i < n; ++i) {
+    uint8_t* p = b.data() + 12 + i * row;
+    std::memcpy(p, &lists.found[i], 4);
+    for (size_t k = 0; k < width; ++k) {
+      const Hit& h = lists.hits[i * width + k];
+      HitRecord r{h.t, h.triangle};
+      std::memcpy(p + 4 + 8 * k, &r, 8);
+    }
+  }
+  write_file(path, b.data(), b.size());
+}
+
 }  // namespace meshcast

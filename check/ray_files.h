@@ -1,6 +1,9 @@
 // The two files exchanged with the outside (ARCHITECTURE.md):
 //   rays: "RAYS", uint32 count, per ray 7 float32 (origin, direction, t_max)
 //   hits: "HITS", uint32 count, per ray float32 t (inf: miss), uint32 triangle
+//   every hit (Query::All): "HITN", uint32 count, uint32 N, per ray uint32
+//         hits found, then N records of float32 t, uint32 triangle, in
+//         order of t; unused records t = inf, triangle 0xFFFFFFFF
 // All little-endian.
 #pragma once
 #include <string>
@@ -17,6 +20,10 @@ std::vector<Ray> read_rays(const std::string& path);
 void write_rays(const std::string& path, const std::vector<Ray>& rays);
 std::vector<Hit> read_hits(const std::string& path);
 void write_hits(const std::string& path, const std::vector<Hit>& hits);
+// HITN files: InputError naming the file for a bad magic, an N outside
+// 1..kMaxHitsLimit or a size that is not the header's.
+HitLists read_hit_lists(const std::string& path);
+void write_hit_lists(const std::string& path, const HitLists& lists);
 
 // Most rays a rays file may hold, and `meshcast rays --count` make: 2^27
 // (3.5 GiB of records).

@@ -42,7 +42,14 @@ check trace 0 "ns/ray" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays"
 check trace-json 0 '"ns_per_ray":' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/h2.hits" --json
 check trace-any 0 '"query":"any"' -- "$meshcast" trace "$mesh" --layout OctTreeCompressed/ClusterBitPackSOA8 --query any --rays "$work/r.rays" --out "$work/ha.hits" --json
 check trace-any-vulkan 2 "runs on the CPU backend" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --query any --rays "$work/r.rays" --out "$work/hx.hits"
-check trace-query-unknown 2 "query" -- "$meshcast" trace "$mesh" --query all --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-query-unknown 2 "query" -- "$meshcast" trace "$mesh" --query nearest --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-all 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hn.hitn" --json
+# HITN: magic, 500 rays, rows of 4: 12 + 500 * (4 + 4 * 8) bytes.
+if [[ $(head -c 4 "$work/hn.hitn") != HITN || $(stat -c %s "$work/hn.hitn") -ne 18012 ]]; then
+  echo "FAIL trace-all: the HITN file's magic or size"; failures=$((failures + 1))
+fi
+check trace-max-hits-range 2 "max-hits" -- "$meshcast" trace "$mesh" --query all --max-hits 0 --rays "$work/r.rays" --out "$work/hx.hitn"
+check trace-cull-vulkan 2 "runs on the CPU backend" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --cull back --rays "$work/r.rays" --out "$work/hx.hits"
 # The two hits files agree (same triangle per ray): compare the triangle columns.
 if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
             <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then

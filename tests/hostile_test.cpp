@@ -202,3 +202,41 @@ TEST(Hostile, TruncatedBinaryStlSaysSo) {
 
 }  // namespace
 }  // namespace meshcast::testing
+
+// HITN files (Query::All's answers): written and read back record for
+// record; a bad magic, a row width outside 1..kMaxHitsLimit and a size
+// that is not the header's are refused with the file's name.
+namespace meshcast::testing {
+namespace {
+TEST(Hostile, HitListFilesRoundTripAndRefuseBadHeaders) {
+  HitLists lists;
+  lists.max_hits = 3;
+  lists.found = {0, 2, 5};
+  lists.hits.assign(9, Hit{});
+  lists.hits[3] = {1.5f, 7}, lists.hits[4] = {2.5f, 3};
+  lists.hits[6] = {0.5f, 1}, lists.hits[7] = {0.75f, 2}, lists.hits[8] = {1.0f, 9};
+  const std::string path = (scratch_dir() / "lists.hitn").string();
+  write_hit_lists(path, lists);
+  const HitLists back = read_hit_lists(path);
+  ASSERT_EQ(back.max_hits, 3u);
+  EXPECT_EQ(back.found, lists.found);
+  ASSERT_EQ(back.hits.size(), 9u);
+  for (size_t i = 0; i < 9; ++i) {
+    EXPECT_EQ(back.hits[i].t, lists.hits[i].t) << i;
+    EXPECT_EQ(back.hits[i].triangle, lists.hits[i].triangle) << i;
+  }
+  const std::vector<uint8_t> raw = read_file(path);
+  std::string bytes(raw.begin(), raw.end());
+  EXPECT_EQ(bytes.size(), 12u + 3 * (4 + 3 * 8));
+  const std::string truncated = make_file("short.hitn", bytes.substr(0, bytes.size() - 1));
+  expect_throws<InputError>([&] { read_hit_lists(truncated); }, {"short.hitn", "header says 3 rays"});
+  std::string wide = bytes;
+  const uint32_t width = kMaxHitsLimit + 1;
+  std::memcpy(wide.data() + 8, &width, 4);
+  const std::string too_wide = make_file("wide.hitn", wide);
+  expect_throws<InputError>([&] { read_hit_lists(too_wide); }, {"wide.hitn", "records a ray"});
+  const std::string hits_file = make_file("plain.hitn", "HITS" + bytes.substr(4));
+  expect_throws<InputError>([&] { read_hit_lists(hits_file); }, {"plain.hitn", "not a HITN file"});
+}
+}  // namespace
+}  // namespace meshcast::testing

@@ -1,5 +1,6 @@
-// meshcast trace MESH|BLOB --rays R.rays --out H.hits: one thread, the whole
-// batch cast --repeat times, the median pass reported per ray.
+// meshcast trace MESH|BLOB --rays R.rays --out H.hits [--query closest|any|all]
+// [--max-hits N] [--cull none|back|front]: one thread, the whole batch cast
+// --repeat times, the median pass reported per ray. --query all writes HITN.
 #include <cstdio>
 
 #include "check/ray_files.h"
@@ -18,7 +19,8 @@ void add_trace(CLI::App& app) {
     LayoutArgs layout;
     uint32_t repeat = 5;
     bool json = false;
-    std::string backend = "cpu", method = "bruteforce", device, query = "closest";
+    std::string backend = "cpu", method = "bruteforce", device, query = "closest", cull = "none";
+    uint32_t max_hits = 16;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh or blob, write a hits file");
@@ -28,8 +30,16 @@ void add_trace(CLI::App& app) {
   add_layout_options(cmd, args->layout);
   cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
-  cmd->add_option("--query", args->query, "closest (the nearest hit) or any (a hit, the walk ending at the first; CPU backend)")
-      ->check(CLI::IsMember({"closest", "any"}));
+  cmd->add_option("--query", args->query,
+                  "closest (the nearest hit), any (a hit, the walk ending at the first) or all (every hit along the "
+                  "ray, nearest first, written as a HITN file); any and all on the CPU backend")
+      ->check(CLI::IsMember({"closest", "any", "all"}));
+  cmd->add_option("--max-hits", args->max_hits, "--query all: the hits a ray's row keeps (more are counted, not kept)")
+      ->check(CLI::Range(1u, kMaxHitsLimit));
+  cmd->add_option("--cull", args->cull,
+                  "none (two-sided), back or front: the face culled; the front face's corners run counter-clockwise "
+                  "seen from the ray's origin (CPU backend)")
+      ->check(CLI::IsMember({"none", "back", "front"}));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
                                             "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
@@ -37,9 +47,12 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {
-    const Query query = args->query == "any" ? Query::Any : Query::Closest;
+    const Query query = args->query == "any" ? Query::Any : args->query == "all" ? Query::All : Query::Closest;
+    const Cull cull = args->cull == "back" ? Cull::Back : args->cull == "front" ? Cull::Front : Cull::None;
     if (args->backend == "vulkan" && query != Query::Closest)
       throw InputError("--query " + args->query + " runs on the CPU backend; the Vulkan methods answer the closest hit");
+    if (args->backend == "vulkan" && cull != Cull::None)
+      throw InputError("--cull " + args->cull + " runs on the CPU backend; the Vulkan methods answer two-sided");
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
@@ -47,6 +60,8 @@ void add_trace(CLI::App& app) {
     if (vulkan_auto) args->method = gpu::method_reading(in.blob);
     std::vector<Ray> rays = read_rays(args->rays);
     std::vector<Hit> hits(rays.size());
+    HitLists lists;
+    lists.max_hits = args->max_hits;
     std::vector<double> pass_ms, device_ms;
     uint64_t skipped = 0;
     std::string device = "CPU, one thread";
@@ -63,19 +78,27 @@ void add_trace(CLI::App& app) {
       BlobView view(in.blob, args->input);
       for (uint32_t r = 0; r < args->repeat; ++r) {
         auto t0 = std::chrono::steady_clock::now();
-        skipped = view.trace(rays, hits, HitOutputs::None, query);
+        skipped = query == Query::All ? view.trace_all_hits(rays, lists, HitOutputs::None, cull)
+                                      : view.trace(rays, hits, HitOutputs::None, query, cull);
         pass_ms.push_back(ms_since(t0));
       }
     }
-    write_hits(args->out, hits);
-    size_t hit_count = 0;
-    for (const Hit& h : hits) hit_count += h.triangle != MC_NO_HIT;
+    // hit_count: rays that hit; Query::All also counts every hit found.
+    size_t hit_count = 0, every_hit = 0;
+    if (query == Query::All) {
+      write_hit_lists(args->out, lists);
+      for (uint32_t found : lists.found) hit_count += found != 0, every_hit += found;
+    } else {
+      write_hits(args->out, hits);
+      for (const Hit& h : hits) hit_count += h.triangle != MC_NO_HIT;
+    }
     const layout::BlobHeader& h = layout::header_of(in.blob.data());
     double ns = rays.empty() ? 0 : median(pass_ms) * 1e6 / double(rays.size());
     std::string layout = layout_name(h.tree_format, h.triangle_format);
     double device_ns = rays.empty() || device_ms.empty() ? 0 : median(device_ms) * 1e6 / double(rays.size());
     if (args->json) {
-      print_json({{"input", args->input}, {"layout", layout}, {"device", device}, {"query", args->query}, {"load_ms", in.load_ms},
+      print_json({{"input", args->input}, {"layout", layout}, {"device", device}, {"query", args->query},
+                  {"cull", args->cull}, {"every_hit", every_hit}, {"load_ms", in.load_ms},
                   {"build_ms", in.build_ms}, {"rays", rays.size()}, {"hits", hit_count}, {"invalid_rays", skipped},
                   {"repeat", args->repeat}, {"ns_per_ray", ns}, {"device_ns_per_ray", device_ns}});
     } else {
@@ -83,6 +106,9 @@ void add_trace(CLI::App& app) {
                   in.build_ms);
       std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", rays.size(), hit_count,
                   (unsigned long long)skipped);
+      std::printf("query %s, cull %s", args->query.c_str(), args->cull.c_str());
+      if (query == Query::All) std::printf(": %zu hits in all, rows of %u", every_hit, args->max_hits);
+      std::printf("\n");
       std::printf("device: %s\n", device.c_str());
       std::printf("cast: %.1f ns/ray (median of %u passes%s)\n", ns, args->repeat,
                   device_ms.empty() ? ", one thread" : ", submission to read-back");

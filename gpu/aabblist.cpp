@@ -25,15 +25,16 @@ namespace {
 class AABBListMethod : public BatchMethod {
  public:
   AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint64_t pairs,
-                 uint32_t slots, uint32_t outputs)
+                 uint32_t slots, uint32_t flags, uint32_t max_hits)
       : BatchMethod(ctx, blob, name, "aabblist", MC_TREE_AABBLIST, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
-                    slots),
-        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push), slots, outputs),
-        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push), slots, outputs),
+                    slots, flags, max_hits),
+        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push), slots, flags, max_hits),
+        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push), slots, flags, max_hits),
         test_(ctx, bitpack ? aabblist_bitpack_spv : aabblist_float3_spv,
-              bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push), slots, outputs),
+              bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push), slots, flags, max_hits),
         resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push), slots, outputs) {
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 5, sizeof(Push), slots, flags,
+                 max_hits) {
     const uint64_t capacity = std::max<uint64_t>(pairs, records_);
     for (uint32_t k = 0; k < this->slots(); ++k) {  // every slot in flight has its own pairs and counter
       pairs_.push_back(std::make_unique<Buffer>(ctx, capacity * 8, "AABBList pair buffer"));
@@ -44,7 +45,10 @@ class AABBListMethod : public BatchMethod {
 
  protected:
   void bind_all(uint32_t slot) override {
+    // The passes before the resolve: (blob, rays, keys, hits, pairs,
+    // control); the resolve's fifth binding is the rows.
     std::vector<const Buffer*> all = buffers(slot);
+    all.resize(4);
     all.push_back(pairs_[slot].get()), all.push_back(control_[slot].get());
     for (Pipeline* p : {&boxes_, &args_, &test_}) p->bind(all, slot);
     resolve_.bind(buffers(slot), slot);
@@ -79,10 +83,10 @@ class AABBListMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                      uint64_t pairs, uint32_t slots, uint32_t outputs) {
+                                      uint64_t pairs, uint32_t slots, uint32_t flags, uint32_t max_hits) {
   ctx.require_int64_atomics("aabblist");
   const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack, pairs, slots, outputs);
+  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack, pairs, slots, flags, max_hits);
 }
 
 }  // namespace meshcast::gpu

@@ -16,8 +16,16 @@ uint32_t blob_triangle_format(std::span<const uint8_t> blob) {
 }
 
 BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
-                         uint32_t tree, uint32_t triangles, uint32_t slots)
-    : ctx_(ctx), slots_(std::max(slots, 1u)) {
+                         uint32_t tree, uint32_t triangles, uint32_t slots, uint32_t flags, uint32_t max_hits)
+    : ctx_(ctx), flags_(flags), max_hits_(max_hits), slots_(std::max(slots, 1u)) {
+  const uint32_t known = MC_HIT_UV | MC_HIT_POINT | MC_QUERY_ANY | MC_QUERY_ALL | MC_CULL_BACK | MC_CULL_FRONT;
+  if ((flags & ~known) || ((flags & MC_QUERY_ANY) && (flags & MC_QUERY_ALL)) ||
+      ((flags & MC_CULL_BACK) && (flags & MC_CULL_FRONT)))
+    throw UsageError("GPU method " + method + ": flags " + std::to_string(flags) +
+                     " are not MC_HIT_* with at most one MC_QUERY_* and one MC_CULL_*");
+  if (max_hits < 1 || max_hits > kMaxHitsLimit)
+    throw UsageError("GPU method " + method + ": max_hits " + std::to_string(max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
   BlobView view(blob, name);  // validates: the shaders trust what validation proved
   const layout::BlobHeader& h = layout::header_of(blob.data());
   if (h.tree_format != tree || h.triangle_format != triangles)
@@ -58,7 +66,7 @@ void BatchMethod::release_slots() {
 
 std::vector<const Buffer*> BatchMethod::buffers(uint32_t slot) const {
   const Slot& s = slots_[slot];
-  return {&*blob_, s.rays.get(), s.keys.get(), s.hits.get()};
+  return {&*blob_, s.rays.get(), s.keys.get(), s.hits.get(), s.rows.get()};
 }
 
 void BatchMethod::reserve(uint32_t slot, uint32_t n) {
@@ -68,9 +76,10 @@ void BatchMethod::reserve(uint32_t slot, uint32_t n) {
   // leaves the slot as it was.
   const uint32_t capacity = std::max<uint32_t>(n, 1024);
   auto rays = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * kRayWords * 4, "ray buffer");
-  auto keys = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * 8, "key buffer");
+  auto keys = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * keys_a_ray() * 8, "key buffer");
   auto hits = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * sizeof(Hit), "hit buffer");
-  s.rays = std::move(rays), s.keys = std::move(keys), s.hits = std::move(hits);
+  auto rows = std::make_unique<Buffer>(ctx_, all() ? uint64_t(capacity) * (1 + 2 * max_hits_) * 4 : 16, "hit row buffer");
+  s.rays = std::move(rays), s.keys = std::move(keys), s.hits = std::move(hits), s.rows = std::move(rows);
   s.capacity = capacity;
   s.recorded = 0;  // the command buffer names the old buffers
   bind_all(slot);
@@ -88,7 +97,7 @@ uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
   if (s.n == 0) return 0;
   reserve(slot, s.n);
   uint64_t skipped = pack_rays(rays, static_cast<uint32_t*>(s.rays->data()));
-  std::memset(s.keys->data(), 0xFF, uint64_t(s.n) * 8);
+  std::memset(s.keys->data(), 0xFF, uint64_t(s.n) * keys_a_ray() * 8);
   prepare(slot, s.n);
   if (s.recorded != s.n) {  // recorded once a batch size, resubmitted after
     check(ctx_.vk().ResetCommandBuffer(s.cb, 0), "vkResetCommandBuffer");
@@ -129,12 +138,36 @@ void BatchMethod::wait(uint32_t slot) {
 }
 
 void BatchMethod::finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) {
+  if (all()) throw UsageError("GPU method made for Query::All: finish_lists() reads its rows");
   Slot& s = slots_.at(slot);
+  finish_batch(s, timing);
+  if (s.n) std::memcpy(hits.data(), s.hits->data(), uint64_t(std::min<size_t>(s.n, hits.size())) * sizeof(Hit));
+}
+
+void BatchMethod::finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing) {
+  if (!all()) throw UsageError("GPU method made for one hit a ray: finish() reads its hits");
+  Slot& s = slots_.at(slot);
+  finish_batch(s, timing);
+  // A row is a HITN row: found, then max_hits (t, triangle) records.
+  lists.max_hits = max_hits_;
+  lists.found.assign(s.n, 0);
+  lists.hits.assign(size_t(s.n) * max_hits_, Hit{});
+  const uint32_t* row = static_cast<const uint32_t*>(s.rows->data());
+  for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_) {
+    lists.found[i] = row[0];
+    for (uint32_t k = 0; k < max_hits_; ++k) {
+      Hit& h = lists.hits[size_t(i) * max_hits_ + k];
+      std::memcpy(&h.t, &row[1 + 2 * k], 4);
+      h.triangle = row[2 + 2 * k];
+    }
+  }
+}
+
+void BatchMethod::finish_batch(Slot& s, GpuTiming* timing) {
   if (s.in_flight) {
     check(ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
     s.in_flight = false;  // only once done: a failed wait leaves the destructor to wait again
   }
-  if (s.n) std::memcpy(hits.data(), s.hits->data(), uint64_t(std::min<size_t>(s.n, hits.size())) * sizeof(Hit));
   if (timing) {
     timing->wall_ms = now_ms() - s.begin_ms;
     timing->device_ms = 0;

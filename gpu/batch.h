@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gpu/method.h"
+#include "layout/formats.h"
 #include "gpu/vulkan.h"
 
 namespace meshcast::gpu {
@@ -26,18 +27,22 @@ class BatchMethod : public Method {
  public:
   // Validates the blob and requires its layout to be `tree`/`triangles`
   // (InputError naming the method and both layouts otherwise).
+  // `flags`, `max_hits`: the batches' query (make_method); UsageError for
+  // flags other than MC_HIT_*, MC_QUERY_*, MC_CULL_* or a row length out
+  // of range.
   BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
-              uint32_t tree, uint32_t triangles, uint32_t slots);
+              uint32_t tree, uint32_t triangles, uint32_t slots, uint32_t flags, uint32_t max_hits);
   ~BatchMethod() override;
   uint32_t slots() const override { return uint32_t(slots_.size()); }
   uint64_t begin(uint32_t slot, std::span<const Ray> rays) override;
   bool ready(uint32_t slot) override;
   void wait(uint32_t slot) override;
   void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) override;
+  void finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing) override;
 
  protected:
-  // Points every pipeline's set `slot` at (blob, rays, keys, hits, ...)
-  // after the slot's buffers change.
+  // Points every pipeline's set `slot` at (blob, rays, keys, hits, rows,
+  // ...) after the slot's buffers change.
   virtual void bind_all(uint32_t slot) = 0;
   // Host-side work before every submission of the slot (the command buffer
   // is recorded once and resubmitted while the batch size stays the same).
@@ -48,11 +53,13 @@ class BatchMethod : public Method {
 
   Context& ctx_;
   uint32_t records_ = 0;  // the header's node_count (BruteForce: its records)
+  const uint32_t flags_, max_hits_;
+  bool all() const { return (flags_ & MC_QUERY_ALL) != 0; }
 
  private:
   void release_slots();
   struct Slot {
-    std::unique_ptr<Buffer> rays, keys, hits;
+    std::unique_ptr<Buffer> rays, keys, hits, rows;  // rows: Query::All's (a token buffer otherwise)
     uint32_t capacity = 0, recorded = 0, n = 0;  // recorded: the batch size its command buffer holds
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
@@ -61,6 +68,8 @@ class BatchMethod : public Method {
     double begin_ms = 0;  // steady clock at begin()
   };
   void reserve(uint32_t slot, uint32_t n);
+  void finish_batch(Slot& s, GpuTiming* timing);
+  uint32_t keys_a_ray() const { return all() ? max_hits_ + 1 : 1; }  // shaders/keys.glsl
   std::optional<Buffer> blob_;
   std::vector<Slot> slots_;
 };

@@ -21,17 +21,20 @@ namespace {
 class BruteForceMethod : public BatchMethod {
  public:
   BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint32_t slots,
-                   uint32_t outputs)
+                   uint32_t flags, uint32_t max_hits)
       : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
-                    slots),
+                    slots, flags, max_hits),
         test_(ctx, bitpack ? bruteforce_bitpack_spv : bruteforce_float3_spv,
-              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push), slots, outputs),
+              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push), slots, flags,
+              max_hits),
         resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 4, sizeof(Push), slots, outputs) {}
+                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 5, sizeof(Push), slots, flags,
+                 max_hits) {}
 
  protected:
   void bind_all(uint32_t slot) override {
-    test_.bind(buffers(slot), slot);
+    const std::vector<const Buffer*> all = buffers(slot);
+    test_.bind({all.begin(), all.begin() + 4}, slot);  // no rows: the resolve pass writes them
     resolve_.bind(buffers(slot), slot);
   }
   void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
@@ -52,11 +55,11 @@ class BruteForceMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                        uint32_t slots, uint32_t outputs) {
+                                        uint32_t slots, uint32_t flags, uint32_t max_hits) {
   // The codec the blob holds picks the shaders (BatchMethod refuses others).
   ctx.require_int64_atomics("bruteforce");
   const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack, slots, outputs);
+  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack, slots, flags, max_hits);
 }
 
 }  // namespace meshcast::gpu

@@ -42,6 +42,9 @@ class Method {
   virtual void wait(uint32_t slot) = 0;
   // Hits of the slot's batch into `hits` (at least the batch's size).
   virtual void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
+  // A Query::All method's rows of the slot's batch into `lists` (resized;
+  // max_hits the method's). UsageError for a method made for another query.
+  virtual void finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing = nullptr) = 0;
 
   // One batch in slot 0, waited for.
   uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing = nullptr) {
@@ -49,6 +52,12 @@ class Method {
     const size_t n = std::min(rays.size(), hits.size());
     uint64_t skipped = begin(0, rays.first(n));
     finish(0, hits.first(n), timing);
+    return skipped;
+  }
+  // One Query::All batch in slot 0, waited for.
+  uint64_t trace_all_hits(std::span<const Ray> rays, HitLists& lists, GpuTiming* timing = nullptr) {
+    uint64_t skipped = begin(0, rays);
+    finish_lists(0, lists, timing);
     return skipped;
   }
 };
@@ -62,10 +71,13 @@ class Method {
 //   octtree     OctTreeCompressed/ClusterBitPackSOA8
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout
 // the method does not read, naming both).
-// `outputs`: the per-hit outputs (MC_HIT_UV, MC_HIT_POINT) its shaders
-// compute; the others read 0.
+// `flags`: the per-hit outputs (MC_HIT_UV, MC_HIT_POINT) its shaders
+// compute (the others read 0), the query (MC_QUERY_ANY, MC_QUERY_ALL with
+// rows of `max_hits`, 1..kMaxHitsLimit) and the culling (MC_CULL_BACK,
+// MC_CULL_FRONT) of every batch: the shaders' specialization constants.
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
-                                    const std::string& name, uint32_t slots = 1, uint32_t outputs = 0);
+                                    const std::string& name, uint32_t slots = 1, uint32_t flags = 0,
+                                    uint32_t max_hits = 16);
 std::vector<std::string> method_names();
 
 // Every (method, layout) pair the GPU reads, in the order of seed 000 §7's
@@ -84,6 +96,6 @@ std::string method_reading(std::span<const uint8_t> blob);
 // uses 2^21 (16 MiB); a test passes a small one to split batches into many
 // chunks.
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                      uint64_t pairs, uint32_t slots = 1, uint32_t outputs = 0);
+                                      uint64_t pairs, uint32_t slots = 1, uint32_t flags = 0, uint32_t max_hits = 16);
 
 }  // namespace meshcast::gpu

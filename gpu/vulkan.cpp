@@ -370,7 +370,7 @@ void Buffer::release() {  // null handles are ignored by Vulkan's destroy calls
 }
 
 Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
-                   uint32_t sets, uint32_t hit_outputs)
+                   uint32_t sets, uint32_t flags, uint32_t max_hits)
     : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes) {
   try {
     VkDevice d = ctx.device();
@@ -390,10 +390,11 @@ Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint
     VkShaderModule module;
     check(ctx_.vk().CreateShaderModule(d, &sm, nullptr, &module), "vkCreateShaderModule");
     VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    // A shader that does not declare constant 0 ignores it (Vulkan spec,
+    // A shader that does not declare a constant ignores it (Vulkan spec,
     // VkSpecializationMapEntry).
-    const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-    const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &hit_outputs};
+    const uint32_t constants[2] = {flags, max_hits};
+    const VkSpecializationMapEntry entries[2] = {{0, 0, sizeof(uint32_t)}, {1, 4, sizeof(uint32_t)}};
+    const VkSpecializationInfo spec{2, entries, sizeof constants, constants};
     cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", &spec};
     cp.layout = layout_;
     VkResult r = ctx_.vk().CreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);

@@ -166,8 +166,10 @@ class Buffer {
 // shaders/hits.glsl reads: the per-hit outputs are fixed with the pipeline.
 class Pipeline {
  public:
+  // `flags` and `max_hits`: specialization constants 0 and 1 (the batch's
+  // MC_HIT_*, MC_QUERY_* and MC_CULL_* word; Query::All's row length).
   Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
-           uint32_t sets = 1, uint32_t hit_outputs = 0);
+           uint32_t sets = 1, uint32_t flags = 0, uint32_t max_hits = 1);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;

@@ -38,9 +38,9 @@ const Walker kWalkers[] = {
 class WalkMethod : public BatchMethod {
  public:
   WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const Walker& w, uint32_t slots,
-             uint32_t outputs)
-      : BatchMethod(ctx, blob, name, w.method, w.tree, w.triangles, slots),
-        walk_(ctx, w.spirv, w.spirv_bytes, 4, sizeof(Push), slots, outputs) {}
+             uint32_t flags, uint32_t max_hits)
+      : BatchMethod(ctx, blob, name, w.method, w.tree, w.triangles, slots, flags, max_hits),
+        walk_(ctx, w.spirv, w.spirv_bytes, 5, sizeof(Push), slots, flags, max_hits) {}
 
  protected:
   void bind_all(uint32_t slot) override { walk_.bind(buffers(slot), slot); }
@@ -56,7 +56,7 @@ class WalkMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                        uint32_t slots, uint32_t outputs);
+                                        uint32_t slots, uint32_t flags, uint32_t max_hits);
 
 std::vector<std::string> method_names() {
   std::vector<std::string> names{"bruteforce", "aabblist"};
@@ -89,11 +89,11 @@ std::string method_reading(std::span<const uint8_t> blob) {
 }
 
 std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std::span<const uint8_t> blob,
-                                    const std::string& name, uint32_t slots, uint32_t outputs) {
-  if (method == "bruteforce") return make_bruteforce(ctx, blob, name, slots, outputs);
+                                    const std::string& name, uint32_t slots, uint32_t flags, uint32_t max_hits) {
+  if (method == "bruteforce") return make_bruteforce(ctx, blob, name, slots, flags, max_hits);
   // 2^21 pairs (16 MiB a slot): far below every device's
   // maxStorageBufferRange, and still thousands of rays a chunk on large meshes.
-  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 21, slots, outputs);
+  if (method == "aabblist") return make_aabblist(ctx, blob, name, uint64_t(1) << 21, slots, flags, max_hits);
   // A method that reads several triangle formats takes the blob's; the
   // first listed is the one named when the blob fits none.
   const Walker* pick = nullptr;
@@ -106,7 +106,7 @@ std::unique_ptr<Method> make_method(Context& ctx, const std::string& method, std
       break;
     }
   }
-  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick, slots, outputs);
+  if (pick) return std::make_unique<WalkMethod>(ctx, blob, name, *pick, slots, flags, max_hits);
   std::string valid;
   for (const std::string& n : method_names()) valid += " " + n;
   throw InputError("unknown GPU method '" + method + "'; implemented:" + valid);

@@ -10,6 +10,7 @@
 #include "shaders/aabblist.glsl"
 #include "shaders/watertight.glsl"
 #include "shaders/hits.glsl"
+#define MESHCAST_WALK_BOXES_ONLY  // the box test alone: binding 4 is the pairs here
 #include "shaders/walk.glsl"
 
 layout(local_size_x = 64) in;

@@ -14,7 +14,7 @@ void main() {
   const uint ray = gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
-  Closest c = Closest(r.tmax, MC_NO_HIT, 0.0, 0.0);
+  Closest c = closest_start(ray, r);
   const uint tree = header(MC_HDR_TREE_OFFSET);
   if (r.walkable && box_test(r, node_min(tree), node_max(tree), c.t) != kInfinity) {
     uint stack_node[MC_MAX_DEPTH + 2u];

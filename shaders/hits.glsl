@@ -1,14 +1,12 @@
 // Hits as the CPU's Hit (cpu/intersect.h): t, triangle (MC_NO_HIT for a miss), u,
 // v, the hit point; 7 words. u, v and the point are written only when the
-// pipeline was made for them (specialization constant 0, MC_HIT_*), else 0,
+// pipeline was made for them (kFlags, MC_HIT_*), else 0,
 // so a method asked for neither leaves their arithmetic to dead-code
 // elimination.
 #ifndef MESHCAST_HITS_GLSL
 #define MESHCAST_HITS_GLSL
 
 #include "shaders/ray.glsl"
-
-layout(constant_id = 0) const uint kHitOutputs = 0u;
 
 struct GpuHit {
   float t;
@@ -23,11 +21,11 @@ void write_miss(uint ray) { hits[ray] = GpuHit(uintBitsToFloat(0x7F800000u), MC_
 
 void write_hit(uint ray, float t, uint triangle, float u, float v) {
   GpuHit h = GpuHit(t, triangle, 0.0, 0.0, 0.0, 0.0, 0.0);
-  if ((kHitOutputs & MC_HIT_UV) != 0u) {
+  if ((kFlags & MC_HIT_UV) != 0u) {
     h.u = u;
     h.v = v;
   }
-  if ((kHitOutputs & MC_HIT_POINT) != 0u) {
+  if ((kFlags & MC_HIT_POINT) != 0u) {
     const GpuRay r = load_ray(ray);
     h.px = r.org.x + t * r.dir.x;
     h.py = r.org.y + t * r.dir.y;

@@ -19,7 +19,7 @@ void main() {
   const uint ray = gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
-  Closest c = Closest(r.tmax, MC_NO_HIT, 0.0, 0.0);
+  Closest c = closest_start(ray, r);
   if (r.walkable) {
     const uint tree = header(MC_HDR_TREE_OFFSET);
     const uint octant = (sign_bit(r.dir.z) ? 1u : 0u) | (sign_bit(r.dir.y) ? 2u : 0u) | (sign_bit(r.dir.x) ? 4u : 0u);

@@ -60,7 +60,7 @@ void main() {
   const uint ray = gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
-  Closest c = Closest(r.tmax, MC_NO_HIT, 0.0, 0.0);
+  Closest c = closest_start(ray, r);
   if (r.walkable) {
     const uint tree = header(MC_HDR_TREE_OFFSET);
     uint node_stack[STACK_SIZE];

@@ -11,6 +11,12 @@
 #define kInfinity uintBitsToFloat(0x7F800000u)
 #define kFloatMax uintBitsToFloat(0x7F7FFFFFu)
 
+// The batch's flags word, specialization constant 0: the MC_HIT_* outputs,
+// the MC_QUERY_* query and the MC_CULL_* culling (layout/formats.h), the
+// word the CPU walkers get; Query::All's row length, constant 1.
+layout(constant_id = 0) const uint kFlags = 0u;
+layout(constant_id = 1) const uint kMaxHits = 1u;
+
 struct GpuRay {
   vec3 org, dir, inv;
   float tmax, sx, sy, sz;

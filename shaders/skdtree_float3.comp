@@ -19,7 +19,7 @@ void main() {
   const uint ray = gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
-  Closest c = Closest(r.tmax, MC_NO_HIT, 0.0, 0.0);
+  Closest c = closest_start(ray, r);
   const uint tree = header(MC_HDR_TREE_OFFSET);
   float tn, tf;
   box_interval(r, vec3(uintBitsToFloat(header(MC_HDR_BOUNDS_MIN)), uintBitsToFloat(header(MC_HDR_BOUNDS_MIN + 1u)),

@@ -14,11 +14,26 @@ float min_keep(float a, float b) { return a < b ? a : b; }
 // 1 + 2 gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (cpu/intersect.h).
 const float kFarScale = 1.0 + 2.0 * (3.0 * 5.9604644775390625e-8) / (1.0 - 3.0 * 5.9604644775390625e-8);
 
+// The walk's answer so far: `t` is the cut every box and triangle test and
+// stack pop compares against (the closest hit's t; below 0 once a
+// Query::Any has its hit; t_max throughout a Query::All, whose hits go to
+// the ray's row), `hit_t` the taken hit's t. As `Closest` in cpu/leaf.h.
 struct Closest {
   float t;
   uint slot;
   float u, v;
+  float hit_t;
+  uint ray;
 };
+
+#ifndef MESHCAST_WALK_BOXES_ONLY
+#include "shaders/hit_rows.glsl"
+
+Closest closest_start(uint ray, GpuRay r) {
+  if ((kFlags & MC_QUERY_ALL) != 0u) row_start(ray);
+  return Closest(r.tmax, MC_NO_HIT, 0.0, 0.0, kInfinity, ray);
+}
+#endif
 
 // The ray's interval [tn, tf] inside the box, each end one rounding of
 // (plane - origin) * 1/d (the slabs of box_interval in cpu/intersect.h).
@@ -46,10 +61,19 @@ float box_test(GpuRay r, vec3 mn, vec3 mx, float closest) {
   return interval_open(tn, tf, closest) ? tn : kInfinity;
 }
 
-// The triangle (a, b, d) of slot `slot` becomes the closest hit if it is one.
+#ifndef MESHCAST_WALK_BOXES_ONLY
+// The triangle (a, b, d) of slot `slot`, if the ray hits it before the cut:
+// the closest hit so far, any query's hit (the cut then below 0), or one
+// more of all hits.
 void consider(GpuRay r, vec3 a, vec3 b, vec3 d, uint slot, inout Closest c) {
   float t, u, v;
-  if (watertight(r, a, b, d, c.t, t, u, v) && t <= c.t) c = Closest(t, slot, u, v);
+  if (!watertight(r, a, b, d, c.t, t, u, v) || !(t <= c.t)) return;
+  if ((kFlags & MC_QUERY_ALL) != 0u) {
+    row_add(c.ray, t, slot);
+    return;
+  }
+  c.slot = slot, c.u = u, c.v = v, c.hit_t = t;
+  c.t = (kFlags & MC_QUERY_ANY) != 0u ? -1.0 : t;
 }
 
 // `count` Float3 triangles (9 floats each) at blob offset `block`, slots
@@ -64,9 +88,13 @@ void test_float3_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closes
 
 uint slot_of(uint tree_block) { return (tree_block - header(MC_HDR_TRIANGLE_BASE)) / header(MC_HDR_SLOT_DIVISOR); }
 
+// The ray's answer: its hit record, or for Query::All its finished row
+// (and a miss record).
 void write_closest(uint ray, Closest c) {
+  if ((kFlags & MC_QUERY_ALL) != 0u) row_finish(ray);
   if (c.slot == MC_NO_HIT) write_miss(ray);
-  else write_hit(ray, c.t, remap_entry(c.slot), c.u, c.v);
+  else write_hit(ray, c.hit_t, remap_entry(c.slot), c.u, c.v);
 }
+#endif
 
 #endif

@@ -4,10 +4,18 @@
 // the same roundings; a lane float cannot settle (an edge function of 0, a
 // det or T that overflowed or fell below kSettleTiny, a det of 2^126 or more,
 // beyond the divisors Vulkan bounds a division's error for) is redone in double,
-// as on the CPU. Two-sided; accepts t in [0, closest]; a t past the largest
-// float is no hit.
+// as on the CPU. Two-sided unless the batch culls (kFlags' MC_CULL_*: det > 0
+// is the front face, as cpu/intersect.h's cull_sign); accepts t in
+// [0, closest]; a t past the largest float is no hit.
 #ifndef MESHCAST_WATERTIGHT_GLSL
 #define MESHCAST_WATERTIGHT_GLSL
+
+#include "shaders/ray.glsl"
+
+// Whether the batch's culling drops the face a determinant of this sign
+// shows (positive: the front face, corners counter-clockwise seen from the
+// origin).
+bool culled(bool positive) { return (kFlags & (positive ? MC_CULL_FRONT : MC_CULL_BACK)) != 0u; }
 
 #define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/intersect.h kSettleTiny
 #define kSettleHuge uintBitsToFloat(0x7E800000u)  // 2^126, cpu/intersect.h kSettleHuge
@@ -20,7 +28,7 @@ bool watertight_double(float ax, float ay, float bx, float by, float cx, float c
   precise double W = double(bx) * double(ay) - double(by) * double(ax);
   if ((U < 0.0lf || V < 0.0lf || W < 0.0lf) && (U > 0.0lf || V > 0.0lf || W > 0.0lf)) return false;
   precise double det = U + V + W;
-  if (det == 0.0lf) return false;
+  if (det == 0.0lf || culled(det > 0.0lf)) return false;
   precise double T = (U * double(az) + V * double(bz) + W * double(cz)) * double(sz);
   if (det < 0.0lf) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0.0lf) return false;
@@ -49,6 +57,7 @@ bool watertight(GpuRay r, vec3 a, vec3 b, vec3 c, float closest, out float t, ou
   const float dets = abs(det), Tabs = abs(T);
   if (!(dets >= kSettleTiny && dets < kSettleHuge && Tabs >= kSettleTiny && Tabs < kInfinity))
     return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
+  if (culled(det > 0.0)) return false;
   const float Ts = det < 0.0 ? -T : T;
   if (!(Ts >= 0.0)) return false;
   t = Ts / dets;

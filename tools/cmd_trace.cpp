@@ -32,13 +32,13 @@ void add_trace(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   cmd->add_option("--query", args->query,
                   "closest (the nearest hit), any (a hit, the walk ending at the first) or all (every hit along the "
-                  "ray, nearest first, written as a HITN file); any and all on the CPU backend")
+                  "ray, nearest first, written as a HITN file)")
       ->check(CLI::IsMember({"closest", "any", "all"}));
   cmd->add_option("--max-hits", args->max_hits, "--query all: the hits a ray's row keeps (more are counted, not kept)")
       ->check(CLI::Range(1u, kMaxHitsLimit));
   cmd->add_option("--cull", args->cull,
                   "none (two-sided), back or front: the face culled; the front face's corners run counter-clockwise "
-                  "seen from the ray's origin (CPU backend)")
+                  "seen from the ray's origin")
       ->check(CLI::IsMember({"none", "back", "front"}));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
@@ -49,10 +49,6 @@ void add_trace(CLI::App& app) {
   cmd->callback([args] {
     const Query query = args->query == "any" ? Query::Any : args->query == "all" ? Query::All : Query::Closest;
     const Cull cull = args->cull == "back" ? Cull::Back : args->cull == "front" ? Cull::Front : Cull::None;
-    if (args->backend == "vulkan" && query != Query::Closest)
-      throw InputError("--query " + args->query + " runs on the CPU backend; the Vulkan methods answer the closest hit");
-    if (args->backend == "vulkan" && cull != Cull::None)
-      throw InputError("--cull " + args->cull + " runs on the CPU backend; the Vulkan methods answer two-sided");
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
@@ -68,10 +64,13 @@ void add_trace(CLI::App& app) {
     if (args->backend == "vulkan") {
       gpu::Context ctx(gpu::DeviceChoice{args->device, false});
       device = ctx.device_name();
-      std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input);
+      // The query and culling are the method's specialization constants.
+      const uint32_t flags = (query == Query::Any ? MC_QUERY_ANY : query == Query::All ? MC_QUERY_ALL : 0u) |
+                             (cull == Cull::Back ? MC_CULL_BACK : cull == Cull::Front ? MC_CULL_FRONT : 0u);
+      std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input, 1, flags, args->max_hits);
       for (uint32_t r = 0; r < args->repeat; ++r) {
         gpu::GpuTiming timing;
-        skipped = method->trace(rays, hits, &timing);
+        skipped = query == Query::All ? method->trace_all_hits(rays, lists, &timing) : method->trace(rays, hits, &timing);
         pass_ms.push_back(timing.wall_ms), device_ms.push_back(timing.device_ms);
       }
     } else {

@@ -189,8 +189,20 @@ uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, HitLists& lists, Hi
                      std::to_string(kMaxHitsLimit));
   lists.found.assign(rays.size(), 0);
   lists.hits.assign(rays.size() * lists.max_hits, Hit{});
-  WalkRequest request{flags_of("BlobView::trace_all_hits", outputs, Query::All, cull), lists.max_hits,
-                      lists.found.data(), lists.hits.data()};
+  return trace_all_hits(rays, lists.max_hits, lists.found, lists.hits, outputs, cull);
+}
+
+uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, uint32_t max_hits, std::span<uint32_t> found,
+                                  std::span<Hit> rows, HitOutputs outputs, Cull cull) const {
+  if (max_hits < 1 || max_hits > kMaxHitsLimit)
+    throw UsageError("BlobView::trace_all_hits: max_hits " + std::to_string(max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
+  if (found.size() < rays.size() || rows.size() / max_hits < rays.size())
+    throw UsageError("BlobView::trace_all_hits: " + std::to_string(rays.size()) + " rays but room for " +
+                     std::to_string(found.size()) + " counts and " + std::to_string(rows.size()) + " hits (" +
+                     std::to_string(max_hits) + " a ray)");
+  WalkRequest request{flags_of("BlobView::trace_all_hits", outputs, Query::All, cull), max_hits, found.data(),
+                      rows.data()};
   uint64_t skipped = 0;
   walk_(bytes_.data(), rays.data(), nullptr, rays.size(), &skipped, request);
   return skipped;

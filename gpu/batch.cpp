@@ -34,8 +34,7 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
                      std::string(layout::tree_format_name(h.tree_format)) + "/" +
                      std::string(layout::triangle_format_name(h.triangle_format)));
   records_ = h.node_count;
-  blob_.emplace(ctx, blob.size(), "blob of " + name, 0, Memory::DeviceLocal);
-  blob_->upload(blob);
+  blob_ = ctx.blob_buffer(blob, name);
   try {
     for (Slot& s : slots_) {
       VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
@@ -66,7 +65,7 @@ void BatchMethod::release_slots() {
 
 std::vector<const Buffer*> BatchMethod::buffers(uint32_t slot) const {
   const Slot& s = slots_[slot];
-  return {&*blob_, s.rays.get(), s.keys.get(), s.hits.get(), s.rows.get()};
+  return {blob_.get(), s.rays.get(), s.keys.get(), s.hits.get(), s.rows.get()};
 }
 
 void BatchMethod::reserve(uint32_t slot, uint32_t n) {

@@ -70,7 +70,7 @@ class BatchMethod : public Method {
   void reserve(uint32_t slot, uint32_t n);
   void finish_batch(Slot& s, GpuTiming* timing);
   uint32_t keys_a_ray() const { return all() ? max_hits_ + 1 : 1; }  // shaders/keys.glsl
-  std::optional<Buffer> blob_;
+  std::shared_ptr<Buffer> blob_;  // shared by the methods made on the same blob (Context::blob_buffer)
   std::vector<Slot> slots_;
 };
 

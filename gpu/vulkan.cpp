@@ -1,5 +1,7 @@
 #include "gpu/vulkan.h"
 
+#include "layout/blob_format.h"
+
 #include <algorithm>
 #include <charconv>
 #include <bit>
@@ -451,6 +453,17 @@ void Pipeline::dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* p
                                  uint64_t offset) const {
   bind_for(cb, set, push);
   ctx_.vk().CmdDispatchIndirect(cb, args.handle(), offset);
+}
+
+std::shared_ptr<Buffer> Context::blob_buffer(std::span<const uint8_t> blob, const std::string& name) {
+  std::lock_guard<std::mutex> lock(blobs_mutex_);
+  // The header's checksum: the blob was validated before any method reads it.
+  const auto key = std::make_tuple(static_cast<const void*>(blob.data()), blob.size(), layout::header_of(blob.data()).checksum);
+  if (std::shared_ptr<Buffer> kept = blobs_[key].lock()) return kept;
+  auto buffer = std::make_shared<Buffer>(*this, blob.size(), "blob of " + name, 0, Memory::DeviceLocal);
+  buffer->upload(blob);
+  blobs_[key] = buffer;
+  return buffer;
 }
 
 void Context::barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access) const {

@@ -5,11 +5,13 @@
 #pragma once
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "gpu/vk_functions.h"
@@ -47,6 +49,8 @@ struct ExternalDevice {
   PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;  // null: the loader's
 };
 
+class Buffer;
+
 class Context {
  public:
   explicit Context(const DeviceChoice& choice = {});
@@ -68,6 +72,12 @@ class Context {
   bool has_timestamps() const { return timestamps_; }
   // GpuError naming `method` when the device lacks 64-bit buffer atomics.
   void require_int64_atomics(const std::string& method) const;
+
+  // The blob's device-local copy, uploaded once and shared by every method
+  // made on the same bytes (a caster's methods for its queries): kept while
+  // a method holds it. The bytes are the caller's, unchanged while in use
+  // (BlobView's rule); the key is their address, size and checksum.
+  std::shared_ptr<Buffer> blob_buffer(std::span<const uint8_t> blob, const std::string& name);
 
   // Command buffers kept for resubmission, and their submission without
   // waiting (the caller's fence signals completion). Not thread-safe.
@@ -105,6 +115,8 @@ class Context {
                                                    VkDebugUtilsMessageTypeFlagsEXT,
                                                    const VkDebugUtilsMessengerCallbackDataEXT*, void*);
 
+  std::mutex blobs_mutex_;
+  std::map<std::tuple<const void*, size_t, uint32_t>, std::weak_ptr<Buffer>> blobs_;
   VulkanFunctions vk_;
   bool owns_device_ = true;  // false: the engine's instance and device
   uint32_t family_ = 0;

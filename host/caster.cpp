@@ -46,7 +46,10 @@ struct Caster::Slot {
   uint64_t id = 0;
   uint32_t n = 0;
   std::vector<Ray> rays;
-  std::vector<Hit> hits;
+  BatchQuery query;
+  std::vector<Hit> hits;       // a hit a ray, or Query::All's rows of query.max_hits
+  std::vector<uint32_t> found;  // Query::All: hits found a ray
+  gpu::Method* method = nullptr;  // the GPU batch's
   Backend ran_on = Backend::Cpu;
   double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
   // CPU batches: jobs of `chunk` rays; the last to finish completes.
@@ -76,8 +79,14 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
       calls_in_work_.fetch_add(1, std::memory_order_acquire);
       const auto t0 = std::chrono::steady_clock::now();
       const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
-      view_.trace(std::span<const Ray>(sp->rays).subspan(first, count), std::span<Hit>(sp->hits).subspan(first, count),
-                  options_.hit_outputs);
+      const std::span<const Ray> rays = std::span<const Ray>(sp->rays).subspan(first, count);
+      const BatchQuery& q = sp->query;
+      if (q.query == Query::All)
+        view_.trace_all_hits(rays, q.max_hits, std::span<uint32_t>(sp->found).subspan(first, count),
+                             std::span<Hit>(sp->hits).subspan(size_t(first) * q.max_hits, size_t(count) * q.max_hits),
+                             options_.hit_outputs, q.cull);
+      else
+        view_.trace(rays, std::span<Hit>(sp->hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
       sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
       if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu);
       calls_in_work_.fetch_sub(1, std::memory_order_release);  // the last touch of the caster
@@ -109,6 +118,7 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
       for (const std::string& m : names) {
         try {
           method_ = gpu::make_method(*gpu_, m, blob, name, uint32_t(slots_.size()), uint32_t(options_.hit_outputs));
+          method_name_ = m;
           break;
         } catch (const InputError&) {
           if (!options_.gpu_method.empty()) throw;
@@ -175,6 +185,7 @@ Caster::~Caster() {
   while (calls_in_work_.load(std::memory_order_acquire) != 0) std::this_thread::yield();
   pool_.reset();
   jobs_ = nullptr;
+  query_methods_.clear();  // before the context they were made on
   method_.reset();
   gpu_.reset();
 }
@@ -210,7 +221,14 @@ std::string Caster::why(uint32_t rays) const {
          " the crossover of " + std::to_string(crossover) + " rays (" + note + ")";
 }
 
-Ticket Caster::submit(std::span<const Ray> rays) {
+Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
+  if (query.query != Query::Closest && query.query != Query::Any && query.query != Query::All)
+    throw UsageError("Caster::submit: query " + std::to_string(uint32_t(query.query)) + " is not a Query");
+  if (query.cull != Cull::None && query.cull != Cull::Back && query.cull != Cull::Front)
+    throw UsageError("Caster::submit: cull " + std::to_string(uint32_t(query.cull)) + " is not a Cull");
+  if (query.query == Query::All && (query.max_hits < 1 || query.max_hits > kMaxHitsLimit))
+    throw UsageError("Caster::submit: max_hits " + std::to_string(query.max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
   Slot* s = nullptr;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -221,6 +239,7 @@ Ticket Caster::submit(std::span<const Ray> rays) {
                        " frames hold batches not yet collected; wait() for one before submitting more");
     s->state = Slot::Running;
     s->id = next_id_++;
+    s->query = query;
   }
   start(*s, rays, choose(uint32_t(rays.size())));
   return {s->id, s->index};
@@ -231,7 +250,9 @@ void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
     s.submit_ms = now_ms();
     s.n = uint32_t(rays.size());
     s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-    s.hits.resize(s.n);
+    const bool all = s.query.query == Query::All;
+    s.hits.resize(all ? size_t(s.n) * s.query.max_hits : s.n);
+    s.found.resize(all ? s.n : 0);
     if (backend == Backend::Vulkan && gpu_available() && s.n > 0) {
       try {
         start_gpu(s);
@@ -271,7 +292,8 @@ void Caster::start_gpu(Slot& s) {
   {
     std::lock_guard<std::mutex> lock(gpu_mutex_);
     if (options_.before_gpu_submit) options_.before_gpu_submit();
-    method_->begin(s.index, s.rays);
+    s.method = method_for(s.query);
+    s.method->begin(s.index, s.rays);
   }
   s.ran_on = Backend::Vulkan;
   s.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -298,7 +320,7 @@ void Caster::gpu_completions() {
     }
     try {
       if (gpu_failed_) throw GpuError(gpu_error());
-      method_->wait(s->index);
+      s->method->wait(s->index);
       complete(*s, Backend::Vulkan);
     } catch (const GpuError& e) {  // waiting failed: the device is lost
       gpu_failed(e.what());
@@ -338,15 +360,32 @@ bool Caster::poll(const Ticket& t) {
   return s.state == Slot::Ready;
 }
 
-BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return collect(slot_of(t), t, hits, true); }
+gpu::Method* Caster::method_for(const BatchQuery& q) {
+  const uint32_t flags = uint32_t(options_.hit_outputs) |
+                         (q.query == Query::Any ? MC_QUERY_ANY : q.query == Query::All ? MC_QUERY_ALL : 0u) |
+                         (q.cull == Cull::Back ? MC_CULL_BACK : q.cull == Cull::Front ? MC_CULL_FRONT : 0u);
+  if (flags == uint32_t(options_.hit_outputs)) return method_.get();
+  const uint32_t max_hits = q.query == Query::All ? q.max_hits : 1;
+  std::unique_ptr<gpu::Method>& m = query_methods_[{flags, max_hits}];
+  if (!m) m = gpu::make_method(*gpu_, method_name_, view_.bytes(), "the caster's blob", uint32_t(slots_.size()), flags, max_hits);
+  return m.get();
+}
 
-BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, bool record) {
+BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return collect(slot_of(t), t, hits, nullptr, true); }
+
+BatchRecord Caster::wait(const Ticket& t, HitLists& lists) { return collect(slot_of(t), t, {}, &lists, true); }
+
+BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record) {
   BatchRecord r;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
     if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
-    if (hits.size() < s.n)
+    const bool all = s.query.query == Query::All;
+    if (all != (lists != nullptr))
+      throw UsageError(all ? "ticket " + std::to_string(t.id) + " asked for every hit: wait(ticket, HitLists&) collects it"
+                           : "ticket " + std::to_string(t.id) + " asked for one hit a ray: wait(ticket, hits) collects it");
+    if (!all && hits.size() < s.n)
       throw UsageError("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
     // Another thread may collect the same ticket first: then this one throws.
     changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
@@ -359,17 +398,23 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, bool 
     try {
       std::lock_guard<std::mutex> lock(gpu_mutex_);
       gpu::GpuTiming timing;
-      method_->finish(s.index, hits.first(s.n), &timing);  // straight from the mapped buffer
+      if (lists) s.method->finish_lists(s.index, *lists, &timing);
+      else s.method->finish(s.index, hits.first(s.n), &timing);  // straight from the mapped buffer
       r.device_ms = timing.device_ms;
       copied = true;
     } catch (const GpuError& e) {  // the device went while reading back: the CPU answers
       gpu_failed(e.what());
-      view_.trace(s.rays, hits.first(s.n), options_.hit_outputs);
+      if (lists) trace_now(s.rays, *lists, s.query.cull);
+      else trace_now(s.rays, hits.first(s.n), s.query);
       r.ran_on = Backend::Cpu;
       copied = true;
     }
   }
-  if (!copied && s.n) {
+  if (!copied && lists) {
+    lists->max_hits = s.query.max_hits;
+    lists->found.assign(s.found.begin(), s.found.end());
+    lists->hits.assign(s.hits.begin(), s.hits.end());
+  } else if (!copied && s.n) {
     std::memcpy(hits.data(), s.hits.data(), s.n * sizeof(Hit));
   }
   {
@@ -385,7 +430,13 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, bool 
   return r;
 }
 
-void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits) const { view_.trace(rays, hits, options_.hit_outputs); }
+void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {
+  view_.trace(rays, hits, options_.hit_outputs, query.query, query.cull);
+}
+
+void Caster::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const {
+  view_.trace_all_hits(rays, lists, options_.hit_outputs, cull);
+}
 
 std::vector<BatchRecord> Caster::records() const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -484,10 +535,11 @@ void Caster::measure_crossover() {
           std::lock_guard<std::mutex> lock(mutex_);
           slot.state = Slot::Running;
           slot.id = next_id_++;
+          slot.query = {};  // the crossover is the closest hit's
           t = {slot.id, slot.index};
         }
         start(slot, std::span<const Ray>(rays).first(n), b);
-        ms.push_back(collect(slot, t, hits, false).latency_ms);
+        ms.push_back(collect(slot, t, hits, nullptr, false).latency_ms);
       }
       std::sort(ms.begin(), ms.end());
       (b == Backend::Cpu ? cpu : gpu).push_back(ms[1]);

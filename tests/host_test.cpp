@@ -163,6 +163,53 @@ TEST(Host, HitOutputsOnBothBackends) {
   }
 }
 
+// The query is per batch (issue 20): any hit, culled closest hits and
+// every hit, in flight at once beside closest-hit batches, on both
+// backends: each batch the BlobView's own answer to its query. Asking for
+// the other kind of answer than the batch's is a UsageError.
+TEST(Host, EveryQueryPerBatchOnBothBackends) {
+  Mesh m = make_sphere(16, 32, 1.0f, {0, 0, 0});
+  NamedMesh named{"sphere_host", std::make_shared<const Mesh>(m)};
+  const std::vector<Ray>& rays = test_rays(named, RayKind::Long, 700);
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  const BlobView view(blob, "sphere");
+  for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+    if (b == Backend::Vulkan && cpu_only()) continue;
+    Caster caster(blob, "sphere", options(b));
+    ASSERT_TRUE(b == Backend::Cpu || caster.gpu_available()) << caster.gpu_error();
+    const host::BatchQuery any{Query::Any}, culled{Query::Closest, Cull::Back}, all{Query::All, Cull::Front, 4};
+    const host::Ticket t_closest = caster.submit(rays), t_any = caster.submit(rays, any);
+    const host::Ticket t_culled = caster.submit(rays, culled), t_all = caster.submit(rays, all);
+    std::vector<Hit> hits(rays.size()), expected(rays.size());
+    HitLists lists;
+    EXPECT_THROW(caster.wait(t_all, hits), UsageError);
+    EXPECT_THROW(caster.wait(t_any, lists), UsageError);
+    EXPECT_EQ(caster.wait(t_all, lists).ran_on, b);
+    const HitLists expected_lists = trace_lists(view, rays, 4, Cull::Front);
+    EXPECT_EQ(lists.max_hits, 4u);
+    EXPECT_EQ(lists.found, expected_lists.found) << host::backend_name(b);
+    for (size_t i = 0; i < rays.size(); ++i)
+      for (size_t k = 0; k < lists.row(i).size(); ++k)
+        EXPECT_EQ(lists.row(i)[k].triangle, expected_lists.row(i)[k].triangle) << host::backend_name(b) << " ray " << i;
+    for (auto [ticket, query] : {std::pair{t_culled, culled}, std::pair{t_any, any}, std::pair{t_closest, host::BatchQuery{}}}) {
+      EXPECT_EQ(caster.wait(ticket, hits).ran_on, b);
+      view.trace(rays, expected, HitOutputs::None, query.query, query.cull);
+      if (query.query == Query::Any) {  // any hit will do, but a hit for a hit
+        for (size_t i = 0; i < rays.size(); ++i)
+          EXPECT_EQ(hits[i].triangle == MC_NO_HIT, expected[i].triangle == MC_NO_HIT) << host::backend_name(b) << " ray " << i;
+      } else {
+        expect_same(hits, expected, std::string(host::backend_name(b)) + ", query " + std::to_string(int(query.cull)));
+      }
+    }
+    HitLists now;
+    now.max_hits = 4;
+    caster.trace_now(rays, now, Cull::Front);
+    EXPECT_EQ(now.found, expected_lists.found);
+    EXPECT_THROW(caster.submit(rays, {Query::All, Cull::None, 0}), UsageError);
+    EXPECT_EQ(caster.validation_messages(), 0u);
+  }
+}
+
 // Eight frames of different sizes and rays, collected in reverse order.
 TEST(Host, FramesInFlightNeverMix) {
   Mesh m = make_sphere(24, 48, 1, {0, 0, 0});

@@ -42,6 +42,11 @@ class BlobView {
   // each row keeps). Returns the rays not walkable, as trace() does.
   uint64_t trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs = HitOutputs::None,
                           Cull cull = Cull::None) const;
+  // The same into the caller's storage: ray i's count in found[i], its row
+  // in rows[i * max_hits, (i + 1) * max_hits). UsageError when either is
+  // shorter or max_hits is out of range.
+  uint64_t trace_all_hits(std::span<const Ray> rays, uint32_t max_hits, std::span<uint32_t> found, std::span<Hit> rows,
+                          HitOutputs outputs = HitOutputs::None, Cull cull = Cull::None) const;
 
   std::span<const uint8_t> bytes() const { return bytes_; }
   Layout layout() const;

@@ -8,6 +8,9 @@
 //   ... a frame later ...
 //   caster.wait(t, hits);                       // or poll(t) first
 //   caster.trace_now(one_ray, one_hit);         // synchronous, this thread
+//   Ticket s = caster.submit(rays, {Query::Any});     // per batch: any hit,
+//   Ticket a = caster.submit(rays, {Query::All, Cull::Back, 8});  // every hit
+//   caster.wait(a, lists);                      // HitLists for Query::All
 //
 // A caster owns a ring of `frames` slots; each submitted batch holds one
 // until it is collected with wait(). Slot buffers (rays, hits, the GPU's
@@ -20,6 +23,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -46,6 +50,16 @@ const char* backend_name(Backend b);
 struct Ticket {
   uint64_t id = 0;
   uint32_t slot = 0;
+};
+
+// The question a batch asks (ray.h): the query, the faces culled, and for
+// Query::All the hits a ray's row keeps (1..kMaxHitsLimit). The CPU walks
+// any of them; the GPU makes a method for each combination on its first
+// batch (the blob's device copy shared), an extra moment on that batch.
+struct BatchQuery {
+  Query query = Query::Closest;
+  Cull cull = Cull::None;
+  uint32_t max_hits = 16;
 };
 
 // What one batch cost. latency: submit() to the moment the hits were ready
@@ -110,16 +124,23 @@ class Caster {
   Caster& operator=(const Caster&) = delete;
 
   // Copies the rays and starts the batch; returns at once. Throws
-  // UsageError when all `frames` slots hold uncollected batches.
-  Ticket submit(std::span<const Ray> rays);
+  // UsageError when all `frames` slots hold uncollected batches, or for a
+  // query out of range.
+  Ticket submit(std::span<const Ray> rays, BatchQuery query = {});
   // Whether the batch is ready. UsageError for a ticket this caster did not
   // issue or that was already collected.
   bool poll(const Ticket& t);
   // Blocks until ready, copies the hits into `hits` (at least the batch's
   // size, else UsageError) and frees the slot; returns that batch's record.
+  // UsageError for a Query::All batch (its rows: the overload below).
   BatchRecord wait(const Ticket& t, std::span<Hit> hits);
-  // The calling thread walks the rays now (the CPU walker, no pool).
-  void trace_now(std::span<const Ray> rays, std::span<Hit> hits) const;
+  // A Query::All batch's rows into `lists` (resized); UsageError for a
+  // batch of another query.
+  BatchRecord wait(const Ticket& t, HitLists& lists);
+  // The calling thread walks the rays now (the CPU walker, no pool):
+  // closest or any hit, or with `lists` every hit (rows of lists.max_hits).
+  void trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query = {}) const;
+  void trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull = Cull::None) const;
 
   // Where a batch of `rays` would go now, and why in a sentence.
   Backend choose(uint32_t rays) const;
@@ -153,7 +174,10 @@ class Caster {
   // CPU too when the GPU refuses it); collect() waits for it, copies its
   // hits and frees the slot, keeping its record if `record`.
   void start(Slot& s, std::span<const Ray> rays, Backend backend);
-  BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, bool record);
+  // `lists`: where a Query::All batch's rows go (null for the others).
+  BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record);
+  // The GPU method for a batch's query, made on first use (under gpu_mutex_).
+  gpu::Method* method_for(const BatchQuery& q);
   void start_cpu(Slot& s);
   void start_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
@@ -167,7 +191,9 @@ class Caster {
   std::unique_ptr<WorkerPool> pool_;
   JobSystem* jobs_ = nullptr;
   std::shared_ptr<gpu::Context> gpu_;  // shared_ptr: deleted where Vulkan is known (none without it)
-  std::unique_ptr<gpu::Method> method_;
+  std::unique_ptr<gpu::Method> method_;  // the closest hit's, two-sided (and the crossover's)
+  std::string method_name_;
+  std::map<std::pair<uint32_t, uint32_t>, std::unique_ptr<gpu::Method>> query_methods_;  // (flags, max_hits)
   std::string gpu_error_;
   std::atomic<bool> gpu_failed_{false};
   std::atomic<uint32_t> crossover_{~0u};

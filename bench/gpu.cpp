@@ -13,6 +13,7 @@
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
 #include "layout/blob_format.h"
+#include "layout/formats.h"
 
 namespace meshcast::bench {
 
@@ -53,13 +54,32 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
       method->trace(rays, hits, &t);
       device_ms.push_back(t.device_ms), wall_ms.push_back(t.wall_ms);
     }
+    // The other queries, each a method of its own, the passes interleaved
+    // with a closest-hit pass so both see the same state of the device.
+    std::unique_ptr<gpu::Method> any = gpu::make_method(ctx, c.method, blob, name, 1, MC_QUERY_ANY);
+    std::unique_ptr<gpu::Method> every = gpu::make_method(ctx, c.method, blob, name, 1, MC_QUERY_ALL, 16);
+    std::vector<double> closest_ms, any_ms, all_ms;
+    HitLists lists;
+    auto ms_of = [](const gpu::GpuTiming& t) { return t.device_ms > 0 ? t.device_ms : t.wall_ms; };
+    for (uint32_t r = 0; r < repeat; ++r) {
+      gpu::GpuTiming t;
+      method->trace(rays, hits, &t);
+      closest_ms.push_back(ms_of(t));
+      any->trace(rays, hits, &t);
+      any_ms.push_back(ms_of(t));
+      every->trace_all_hits(rays, lists, &t);
+      all_ms.push_back(ms_of(t));
+    }
     const layout::BlobHeader& h = layout::header_of(blob.data());
     auto figure = seed.find(c.layout);
     GpuRow row{c.method, c.layout, figure == seed.end() ? "" : figure->second};
     row.device_us = median_of(device_ms) * 1000.0 / double(rays.size());
     row.wall_us = median_of(wall_ms) * 1000.0 / double(rays.size());
     row.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
+    method->trace(rays, hits);  // the closest hits, judged
     row.disagreements = oracle_mistakes(mesh, blob, rays, hits, oracle);
+    row.any_to_closest = median_of(any_ms) / median_of(closest_ms);
+    row.all_to_closest = median_of(all_ms) / median_of(closest_ms);
     rows.push_back(row);
   }
   // The CPU's recommended layout, one thread, as the source's yellow row.

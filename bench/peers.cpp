@@ -29,11 +29,27 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// A query as `--queries` names it: closest, any, all (every hit, rows of
+// 16), closest-back (the closest hit, back faces culled).
+struct QuerySpec {
+  Query query = Query::Closest;
+  Cull cull = Cull::None;
+};
+
+QuerySpec parse_query(const std::string& q) {
+  if (q == "any") return {Query::Any};
+  if (q == "all") return {Query::All};
+  if (q == "closest-back") return {Query::Closest, Cull::Back};
+  return {};
+}
+
 struct Contender {
   std::string name;
   bool is_peer;
   double bytes, build_one, build_all;
-  std::function<void(const std::vector<Ray>&, std::vector<Hit>&, Query)> trace;
+  // False for a query the contender has no answer to (Embree: all hits,
+  // culling, which its build takes only at compile time).
+  std::function<bool(const std::vector<Ray>&, std::vector<Hit>&, QuerySpec)> trace;
   std::vector<std::vector<double>> ns;  // per set (ray kind and query), one a round
 };
 
@@ -67,8 +83,15 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     std::memcpy(aligned.back().get(), blobs.back().data(), blobs.back().size());
     views.push_back(std::make_unique<BlobView>(std::span<const uint8_t>(aligned.back().get(), blobs.back().size()), name));
     const BlobView* view = views.back().get();
+    auto lists = std::make_shared<HitLists>();  // Query::All's rows, kept from pass to pass as a game would
     all.push_back({layout, false, double(blobs.back().size()) / triangles, build, build,
-                   [view](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) { view->trace(r, h, HitOutputs::None, q); }, {}});
+                   [view, lists](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
+                     if (q.query == Query::All) view->trace_all_hits(r, lists->max_hits, lists->found, lists->hits, HitOutputs::None, q.cull);
+                     else view->trace(r, h, HitOutputs::None, q.query, q.cull);
+                     return true;
+                   },
+                   {}});
+    lists->found.resize(o.rays), lists->hits.resize(o.rays * lists->max_hits);
   }
   std::vector<std::unique_ptr<Peer>> peers;
   for (EmbreeMode mode : {EmbreeMode::Default, EmbreeMode::Robust, EmbreeMode::Compact}) {
@@ -79,13 +102,18 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     const double build_all = make_embree(mesh, mode, 0)->build_ms();
     const Peer* p = peer.get();
     all.push_back({peer->name(), true, double(peer->bytes()) / triangles, peer->build_ms(), build_all,
-                   [p](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) { p->trace(r, h, q); }, {}});
+                   [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
+                     if (q.query == Query::All || q.cull != Cull::None) return false;
+                     p->trace(r, h, q.query);
+                     return true;
+                   },
+                   {}});
     peers.push_back(std::move(peer));
   }
 
   // The sets timed: each ray kind under each query asked for.
-  std::vector<Query> queries;
-  for (const std::string& q : o.queries) queries.push_back(q == "any" ? Query::Any : Query::Closest);
+  std::vector<QuerySpec> queries;
+  for (const std::string& q : o.queries) queries.push_back(parse_query(q));
   struct Set { size_t kind; size_t query; };
   std::vector<Set> sets;
   for (size_t k = 0; k < kinds.size(); ++k)
@@ -99,7 +127,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     for (Contender& c : all)
       for (size_t s = 0; s < sets.size(); ++s) {
         const auto t0 = std::chrono::steady_clock::now();
-        c.trace(rays[sets[s].kind], hits, queries[sets[s].query]);
+        if (!c.trace(rays[sets[s].kind], hits, queries[sets[s].query])) continue;  // no such query: no row
         const double ns = ms_since(t0) * 1e6 / double(o.rays);
         if (round > 0) c.ns[s].push_back(ns);  // round 0 warms the caches
       }
@@ -126,11 +154,12 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     double embree_default = 0;
     std::vector<PeerRow> set_rows;
     for (Contender& c : all) {
+      if (c.ns[s].empty()) continue;  // a query the contender does not answer
       PeerRow r{name, o.kinds[sets[s].kind], c.name, c.is_peer, median_of(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
       r.query = o.queries[sets[s].query];
       // The same contender's closest hit on the same rays, when measured.
       for (size_t t = 0; t < sets.size(); ++t)
-        if (sets[t].kind == sets[s].kind && queries[sets[t].query] == Query::Closest)
+        if (sets[t].kind == sets[s].kind && o.queries[sets[t].query] == "closest")
           r.to_closest = r.ns_per_ray / median_of(c.ns[t]);
       if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;  // the first peer is the default build
       set_rows.push_back(r);

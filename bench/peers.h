@@ -18,14 +18,17 @@ struct PeerRow {
   double bytes_per_triangle;  // all included: the blob with its remap; Embree's scene and the mesh it keeps
   double build_ms_one = 0;    // one thread
   double build_ms_all = 0;    // all cores (meshcast's builder is serial: the same build)
-  std::string query = "closest";  // closest, or any (Embree: rtcOccluded1)
+  // closest, any (Embree: rtcOccluded1), all (every hit, rows of 16) or
+  // closest-back (back faces culled): Embree rows for the first two only
+  // (its culling is a compile-time option), so `ratio` is 0 for the others.
+  std::string query = "closest";
   double to_closest = 0;          // time / the same contender's closest-hit time on the same rays (0: not measured)
 };
 
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
   std::vector<std::string> kinds = {"long", "probe", "radial"};  // ray kinds measured
-  std::vector<std::string> queries = {"closest", "any"};          // each kind under each query
+  std::vector<std::string> queries = {"closest", "any"};          // each kind under each query (see PeerRow)
   size_t rays = 10000;               // a set, for each kind
   uint32_t rounds = 7;
 };

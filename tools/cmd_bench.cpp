@@ -180,14 +180,17 @@ void add_bench_gpu(CLI::App* bench) {
     std::string device;
     std::vector<bench::GpuRow> rows = bench::bench_gpu(mesh, gargs->input, gargs->rays, gargs->repeat, *gdevice, &device);
     std::printf("\n%s, %zu triangles, %zu long rays, device: %s; us per ray, median of %u passes (device: GPU "
-                "timestamps; wall: packing, submission and read-back); leaf 4 as the source's GPU table\n\n"
-                "| method | layout | us/ray device | us/ray wall | walked B/tri | seed (GTX 1050, DX11) | disagreements |\n"
-                "|---|---|---:|---:|---:|---|---:|\n",
+                "timestamps; wall: packing, submission and read-back); leaf 4 as the source's GPU table; any / closest, "
+                "all / closest: each query's time (device, else wall) on the same rays, all hits in rows of 16\n\n"
+                "| method | layout | us/ray device | us/ray wall | walked B/tri | seed (GTX 1050, DX11) | disagreements "
+                "| any / closest | all / closest |\n"
+                "|---|---|---:|---:|---:|---|---:|---:|---:|\n",
                 gargs->input.c_str(), mesh.triangles.size(), gargs->rays, device.c_str(), gargs->repeat);
     for (const bench::GpuRow& r : rows)
-      std::printf("| %s | %s | %s | %.3f | %.2f | %s | %llu |\n", r.method.c_str(), r.layout.c_str(),
+      std::printf("| %s | %s | %s | %.3f | %.2f | %s | %llu | %.2f | %.2f |\n", r.method.c_str(), r.layout.c_str(),
                   r.device_us > 0 ? std::to_string(r.device_us).substr(0, std::to_string(r.device_us).find('.') + 4).c_str() : "-",
-                  r.wall_us, r.bytes, r.seed.empty() ? "-" : r.seed.c_str(), (unsigned long long)r.disagreements);
+                  r.wall_us, r.bytes, r.seed.empty() ? "-" : r.seed.c_str(), (unsigned long long)r.disagreements,
+                  r.any_to_closest, r.all_to_closest);
   });
 }
 

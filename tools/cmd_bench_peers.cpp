@@ -57,7 +57,8 @@ void add_bench_peers(CLI::App* bench) {
   cmd->add_option("--layouts", args->layouts, "comma-separated meshcast layouts (default: the OctTree and QuadTree ones)");
   cmd->add_option("--kinds", args->kinds, "comma-separated ray kinds: long, probe, radial (default: all three)");
   cmd->add_option("--queries", args->queries,
-                  "comma-separated queries: closest, any (Embree: rtcOccluded1) (default: both)");
+                  "comma-separated queries: closest, any (Embree: rtcOccluded1), all (every hit, rows of 16), "
+                  "closest-back (back faces culled); Embree answers the first two (default: closest,any)");
   cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(CLI::Range(size_t(100), size_t(1000000)));
   cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(CLI::Range(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where peers.csv and peers.png go");
@@ -67,7 +68,8 @@ void add_bench_peers(CLI::App* bench) {
     o.kinds = split(args->kinds);
     o.queries = split(args->queries);
     for (const std::string& q : o.queries)
-      if (q != "closest" && q != "any") throw UsageError("--queries: '" + q + "' is not closest or any");
+      if (q != "closest" && q != "any" && q != "all" && q != "closest-back")
+        throw UsageError("--queries: '" + q + "' is not closest, any, all or closest-back");
     o.rays = args->rays, o.rounds = args->rounds;
     std::filesystem::create_directories(args->out_dir);
     std::vector<bench::PeerRow> rows;

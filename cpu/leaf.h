@@ -283,7 +283,8 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
                                             h.quant_scale[a], h.quant_offset[a]);
     }
     const uint8_t* index = blob + Codec::index_at(at);
-    for (uint32_t first = 0; first < triangles; first += 8, index += MC_CLUSTER_INDEX_BLOCK_BYTES) {
+    // c.t below 0: an any-hit query has its hit, the rest of the leaf is moot.
+    for (uint32_t first = 0; first < triangles && c.t >= 0; first += 8, index += MC_CLUSTER_INDEX_BLOCK_BYTES) {
       simd::F8 v[3][3];
       for (int k = 0; k < 3; ++k) {
         const uint32_t nibbles = layout::load<uint32_t>(index + 4 * k);
@@ -310,7 +311,7 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
     test_pair_leaf<Codec>(blob, r, block, count, slot0, c);
   } else {
     constexpr int kWidth = width_of<Loader<Codec>>();
-    for (uint32_t first = 0; first < count; first += kWidth) {
+    for (uint32_t first = 0; first < count && c.t >= 0; first += kWidth) {  // below 0: any's hit taken
       LaneHit h;
       LaneSet lanes;
       if constexpr (kWidth == 8) {

@@ -147,8 +147,12 @@ inline void prefetch_child(const uint8_t* child) {
   __builtin_prefetch(child + 192);
 }
 
-// One ray's walk with the node test's exact or fused form.
-template <class Codec, bool Fused>
+// One ray's walk with the node test's exact or fused form. `Any`
+// (Query::Any, the query as a template parameter): hit children are pushed
+// as they come, unsorted and without their entries (nothing is culled on
+// popping before the first hit, and the walk ends at that hit), as
+// Embree's any-hit traversal does.
+template <class Codec, bool Fused, bool Any>
 inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, const OctFused& fused,
                      Closest& c) {
   const uint8_t* tree = blob + h.tree_offset;
@@ -169,6 +173,21 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
         prefetch_child(tree + layout::oct_offset(properties));
         hit &= hit - 1;
         if (hit == 0) continue;  // one child: walk it next, no stack traffic
+        if constexpr (Any) {
+          // The nearest walked next (a hit is likeliest there), the others
+          // pushed as they come.
+          float entry[8];
+          test.entry.store(entry);
+          int nearest = k;
+          for (int m = hit; m; m &= m - 1) nearest = entry[__builtin_ctz(unsigned(m))] < entry[nearest] ? __builtin_ctz(unsigned(m)) : nearest;
+          for (int m = test.bits & ~(1 << nearest); m; m &= m - 1) {
+            const uint32_t child = layout::oct_child_properties(node, __builtin_ctz(unsigned(m)));
+            prefetch_child(tree + layout::oct_offset(child));
+            node_stack[top++] = child;
+          }
+          properties = layout::oct_child_properties(node, nearest);
+          continue;
+        }
         // Several: pushed farthest first with their entry distances (sorted
         // in registers), each one's lines asked for now, to be there when it
         // is popped; the nearest is walked next.
@@ -182,6 +201,12 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
       }
     } else {
       test_leaf<Codec>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
+      if (Any && c.slot != MC_NO_HIT) return;
+    }
+    if constexpr (Any) {
+      if (top == 0) return;
+      properties = node_stack[--top];
+      continue;
     }
     do {
       if (top == 0) return;
@@ -200,10 +225,13 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
   const bool blob_fits = OctFused::blob_fits(h);
   for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     const OctFused fused(r, h, blob_fits);
-    if (fused.applies)
-      walk_ray<Codec, true>(blob, h, r, fused, c);
-    else
-      walk_ray<Codec, false>(blob, h, r, fused, c);
+    if (c.any) {
+      if (fused.applies) walk_ray<Codec, true, true>(blob, h, r, fused, c);
+      else walk_ray<Codec, false, true>(blob, h, r, fused, c);
+    } else {
+      if (fused.applies) walk_ray<Codec, true, false>(blob, h, r, fused, c);
+      else walk_ray<Codec, false, false>(blob, h, r, fused, c);
+    }
   });
 }
 

@@ -44,6 +44,7 @@ struct LaneSet {
   int mask = 0;
   float t[8], u[8], v[8];
   void add(int lane, const LaneHit& h) { mask |= 1 << lane, t[lane] = h.t, u[lane] = h.u, v[lane] = h.v; }
+  // Only the lanes of `mask` are ever read: the arrays are left unset.
 };
 
 // The determinant's sign a culling query keeps, times the determinant, is
@@ -226,7 +227,7 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
   t.store(tl), u.store(ul), w.store(wl);
   for (int m = simd::bits(accept); m; m &= m - 1) {
     int i = __builtin_ctz(m);
-    if (every) every->add(i, {i, tl[i], ul[i], wl[i]});
+    if (every) every->add(i, {i, tl[i], (r.outputs & MC_HIT_UV) ? ul[i] : 0.0f, (r.outputs & MC_HIT_UV) ? wl[i] : 0.0f});
     if (best.lane < 0 || tl[i] < best.t) best = {i, tl[i], ul[i], wl[i]};
   }
   return best;
@@ -286,14 +287,13 @@ template <class F4, class M4>
   if (every) [[unlikely]] {
     every->mask = acc;
     t.store(every->t);
-    if (r.outputs & MC_HIT_UV) {
-      float Ul[kW], Vl[kW], Wl[kW];
-      U.store(Ul), V.store(Vl), W.store(Wl);
-      for (int m = acc; m; m &= m - 1) {
-        int i = __builtin_ctz(m);
-        float d = Ul[i] + Vl[i] + Wl[i];
-        every->u[i] = Vl[i] / d, every->v[i] = Wl[i] / d;
-      }
+    float Ul[kW], Vl[kW], Wl[kW];
+    const bool uv = (r.outputs & MC_HIT_UV) != 0;
+    if (uv) U.store(Ul), V.store(Vl), W.store(Wl);
+    for (int m = acc; m; m &= m - 1) {  // u, v read 0 unless asked for, as in a closest hit
+      int i = __builtin_ctz(m);
+      float d = uv ? Ul[i] + Vl[i] + Wl[i] : 1.0f;
+      every->u[i] = uv ? Vl[i] / d : 0.0f, every->v[i] = uv ? Wl[i] / d : 0.0f;
     }
   } else if (best.lane >= 0 && (r.outputs & MC_HIT_UV)) {
     float Ul[kW], Vl[kW], Wl[kW];

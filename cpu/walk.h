@@ -69,6 +69,7 @@ inline void finish_list(const uint8_t* blob, const Ray& ray, Hit* row, uint32_t 
   const layout::BlobHeader& h = layout::header_of(blob);
   for (uint32_t k = 0; k < used; ++k) {
     row[k].triangle = layout::remap_entry(blob, h, row[k].triangle);
+    if (!(outputs & MC_HIT_UV)) row[k].u = row[k].v = 0;  // the double redo sets them unasked
     if (outputs & MC_HIT_POINT)
       for (int a = 0; a < 3; ++a) row[k].point[a] = ray.org[a] + row[k].t * ray.dir[a];
   }

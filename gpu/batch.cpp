@@ -23,6 +23,9 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
       ((flags & MC_CULL_BACK) && (flags & MC_CULL_FRONT)))
     throw UsageError("GPU method " + method + ": flags " + std::to_string(flags) +
                      " are not MC_HIT_* with at most one MC_QUERY_* and one MC_CULL_*");
+  if ((flags & MC_QUERY_ALL) && (flags & MC_HIT_UV))
+    throw UsageError("GPU method " + method + ": every hit's rows carry t and the triangle (and the point, " +
+                     "filled on the host), not u and v: ask the CPU for those");
   if (max_hits < 1 || max_hits > kMaxHitsLimit)
     throw UsageError("GPU method " + method + ": max_hits " + std::to_string(max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
@@ -152,12 +155,15 @@ void BatchMethod::finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing
   lists.found.assign(s.n, 0);
   lists.hits.assign(size_t(s.n) * max_hits_, Hit{});
   const uint32_t* row = static_cast<const uint32_t*>(s.rows->data());
-  for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_) {
+  const float* ray = static_cast<const float*>(s.rays->data());  // packed: origin, direction first (gpu/rays.h)
+  for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_, ray += kRayWords) {
     lists.found[i] = row[0];
     for (uint32_t k = 0; k < max_hits_; ++k) {
       Hit& h = lists.hits[size_t(i) * max_hits_ + k];
       std::memcpy(&h.t, &row[1 + 2 * k], 4);
       h.triangle = row[2 + 2 * k];
+      if ((flags_ & MC_HIT_POINT) && h.triangle != MC_NO_HIT)
+        for (int a = 0; a < 3; ++a) h.point[a] = ray[a] + h.t * ray[3 + a];
     }
   }
 }

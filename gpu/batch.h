@@ -49,6 +49,9 @@ class BatchMethod : public Method {
   virtual void prepare(uint32_t, uint32_t) {}
   // Records the dispatches for `n` packed rays in `slot`.
   virtual void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) = 0;
+  // Whether the shaders fold hits into keys (the brute force, AABBList),
+  // not into the rows directly (the tree walkers).
+  virtual bool reads_keys() const { return true; }
   std::vector<const Buffer*> buffers(uint32_t slot) const;
 
   Context& ctx_;
@@ -69,7 +72,8 @@ class BatchMethod : public Method {
   };
   void reserve(uint32_t slot, uint32_t n);
   void finish_batch(Slot& s, GpuTiming* timing);
-  uint32_t keys_a_ray() const { return all() ? max_hits_ + 1 : 1; }  // shaders/keys.glsl
+  // shaders/keys.glsl: a row of keys a ray for Query::All, where the method reads keys at all.
+  uint32_t keys_a_ray() const { return all() && reads_keys() ? max_hits_ + 1 : 1; }
   std::shared_ptr<Buffer> blob_;  // shared by the methods made on the same blob (Context::blob_buffer)
   std::vector<Slot> slots_;
 };

@@ -459,6 +459,7 @@ std::shared_ptr<Buffer> Context::blob_buffer(std::span<const uint8_t> blob, cons
   std::lock_guard<std::mutex> lock(blobs_mutex_);
   // The header's checksum: the blob was validated before any method reads it.
   const auto key = std::make_tuple(static_cast<const void*>(blob.data()), blob.size(), layout::header_of(blob.data()).checksum);
+  std::erase_if(blobs_, [](const auto& entry) { return entry.second.expired(); });
   if (std::shared_ptr<Buffer> kept = blobs_[key].lock()) return kept;
   auto buffer = std::make_shared<Buffer>(*this, blob.size(), "blob of " + name, 0, Memory::DeviceLocal);
   buffer->upload(blob);

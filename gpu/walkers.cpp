@@ -44,6 +44,7 @@ class WalkMethod : public BatchMethod {
 
  protected:
   void bind_all(uint32_t slot) override { walk_.bind(buffers(slot), slot); }
+  bool reads_keys() const override { return false; }
   void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
     Push push{0, n, records_};
     walk_.dispatch(cb, slot, &push, (n + 63) / 64, 1, 1);

@@ -253,7 +253,9 @@ void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
     const bool all = s.query.query == Query::All;
     s.hits.resize(all ? size_t(s.n) * s.query.max_hits : s.n);
     s.found.resize(all ? s.n : 0);
-    if (backend == Backend::Vulkan && gpu_available() && s.n > 0) {
+    // The GPU's rows of every hit carry no u, v (gpu::BatchMethod): such a batch is the CPU's.
+    const bool gpu_answers = !(all && has(options_.hit_outputs, HitOutputs::Uv));
+    if (backend == Backend::Vulkan && gpu_available() && s.n > 0 && gpu_answers) {
       try {
         start_gpu(s);
         return;
@@ -404,7 +406,10 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLi
       copied = true;
     } catch (const GpuError& e) {  // the device went while reading back: the CPU answers
       gpu_failed(e.what());
-      if (lists) trace_now(s.rays, *lists, s.query.cull);
+      if (lists) {
+        lists->max_hits = s.query.max_hits;  // the batch's rows, not what the caller's lists held
+        trace_now(s.rays, *lists, s.query.cull);
+      }
       else trace_now(s.rays, hits.first(s.n), s.query);
       r.ran_on = Backend::Cpu;
       copied = true;

@@ -29,7 +29,10 @@ struct CompressedNode {
   uint32_t right_count() const { return bounds_max >> MC_COMPRESSED_COUNT_SHIFT; }
 
   // The two child boxes of a node whose decoded box is `parent`.
-  void unpack(const CompressedBox& parent, CompressedBox& left, CompressedBox& right) const {
+  // Always inlined: the walkers of every instruction set call it, and an
+  // out-of-line copy compiled for a wide set could stand in for the
+  // baseline one (tests/isa_symbols_test.sh).
+  [[gnu::always_inline]] void unpack(const CompressedBox& parent, CompressedBox& left, CompressedBox& right) const {
     left = parent, right = parent;
     for (int a = 0; a < 3; ++a) {
       float lo = compressed_value(parent.min[a], parent.max[a], bounds_min >> (7 * a) & 127);

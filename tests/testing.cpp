@@ -1,5 +1,8 @@
 #include "tests/testing.h"
 
+#include <cmath>
+#include <random>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -141,6 +144,45 @@ const std::vector<std::vector<OracleHit>>& oracle_all_answers(const NamedMesh& m
     cache[key] = std::move(answers);
   }
   return cache[key];
+}
+
+Mesh stacked_planes(int planes) {
+  Mesh m;
+  for (int k = 0; k < planes; ++k) {
+    const uint32_t base = uint32_t(m.vertices.size());
+    const float z = float(k);
+    for (Vec3 p : {Vec3{0, 0, z}, Vec3{1, 0, z}, Vec3{1, 1, z}, Vec3{0, 1, z}}) m.vertices.push_back(p);
+    m.triangles.push_back({base, base + 1, base + 2});
+    m.triangles.push_back({base, base + 2, base + 3});
+  }
+  return m;
+}
+
+std::vector<Ray> rays_down_through(int planes, size_t count) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.05f, 0.95f);
+  std::vector<Ray> rays;
+  while (rays.size() < count) {
+    const float x = u(rng), y = u(rng);
+    if (std::fabs(x - y) < 0.05f) continue;  // clear of the diagonal: one triangle a plane
+    rays.push_back({{x, y, float(planes) + 1}, {0, 0, -1}, INFINITY});
+  }
+  return rays;
+}
+
+void expect_nearest_rows(const Mesh& mesh, const std::vector<Ray>& rays, const HitLists& lists, const std::string& what) {
+  const OracleTree tree(mesh);
+  ASSERT_EQ(lists.found.size(), rays.size()) << what;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const std::vector<OracleHit> all = tree.all(rays[i]);
+    ASSERT_EQ(lists.found[i], all.size()) << what << ", ray " << i;
+    const std::span<const Hit> row = lists.row(i);
+    ASSERT_EQ(row.size(), std::min<size_t>(all.size(), lists.max_hits)) << what << ", ray " << i;
+    for (size_t k = 0; k < row.size(); ++k) {
+      EXPECT_EQ(row[k].triangle, all[k].triangle) << what << ", ray " << i << ", record " << k;
+      EXPECT_NEAR(row[k].t, all[k].t, 1e-5 * (1 + all[k].t)) << what << ", ray " << i << ", record " << k;
+    }
+  }
 }
 
 Mesh unwelded(const Mesh& m) {

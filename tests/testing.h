@@ -67,6 +67,17 @@ std::vector<Hit> trace_all(const BlobView& view, const std::vector<Ray>& rays, Q
 // Query::All on every ray, rows of `max_hits`.
 HitLists trace_lists(const BlobView& view, const std::vector<Ray>& rays, uint32_t max_hits, Cull cull = Cull::None);
 
+// `planes` unit squares (two triangles each) stacked at z = 0, 1, ...,
+// and `count` rays straight down from above them, each through every plane
+// and clear of the squares' diagonals: a ray's hits are one a plane, at t =
+// top - z. What truncated rows of every hit are checked on.
+Mesh stacked_planes(int planes);
+std::vector<Ray> rays_down_through(int planes, size_t count);
+// Query::All rows of `max_hits` against the oracle's sets over `mesh` (the
+// mesh as the blob stores it): each row the nearest max_hits of its set,
+// found[i] the set's size. A failure names `what`.
+void expect_nearest_rows(const Mesh& mesh, const std::vector<Ray>& rays, const HitLists& lists, const std::string& what);
+
 // The same surface with every triangle owning its three vertices (as STL
 // gives it): a triangle soup, no vertex shared.
 Mesh unwelded(const Mesh& m);

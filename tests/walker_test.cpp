@@ -408,3 +408,24 @@ TEST(Culling, KeepsTheFaceSeenCounterClockwiseFromTheOrigin) {
 }
 }  // namespace
 }  // namespace meshcast::testing
+
+// Rows shorter than the hits (issue 20): 12 stacked planes, rows of 1, 3
+// and 12, on every layout (covering ones in quick runs): each row the
+// nearest of the oracle's set, the count all of them.
+namespace meshcast::testing {
+namespace {
+TEST(EveryHit, RowsKeepTheNearestAndCountAll) {
+  const Mesh planes = stacked_planes(12);
+  const std::vector<Ray> rays = rays_down_through(12, 300);
+  for (const std::string& name : quick() ? covering_layouts(layout_names()) : layout_names()) {
+    const BuildOptions options = parse_layout(name);
+    const std::vector<uint8_t> blob = build_blob(planes, options, "planes");
+    const layout::BlobHeader& h = layout::header_of(blob.data());
+    const Mesh stored = moves_vertices(h.triangle_format) || !layout::has_remap(h) ? stored_mesh(blob) : planes;
+    const BlobView view(blob, name);
+    for (uint32_t max_hits : {1u, 3u, 12u})
+      expect_nearest_rows(stored, rays, trace_lists(view, rays, max_hits), name + ", rows of " + std::to_string(max_hits));
+  }
+}
+}  // namespace
+}  // namespace meshcast::testing

@@ -55,7 +55,9 @@ struct Ticket {
 // The question a batch asks (ray.h): the query, the faces culled, and for
 // Query::All the hits a ray's row keeps (1..kMaxHitsLimit). The CPU walks
 // any of them; the GPU makes a method for each combination on its first
-// batch (the blob's device copy shared), an extra moment on that batch.
+// batch (the blob's device copy shared), an extra moment on that batch. A
+// Query::All batch with HitOutputs::Uv is the CPU's (the GPU's rows carry
+// no u, v).
 struct BatchQuery {
   Query query = Query::Closest;
   Cull cull = Cull::None;

@@ -52,8 +52,11 @@ enum class Query : uint32_t { Closest = 0, Any = 1, All = 2 };
 // its segment; the nearest min(found[i], max_hits) of them are row i of
 // `hits` (max_hits records from i * max_hits), in order of t, then triangle;
 // the rest of the row reads as misses (t = inf, kNoHit). A found[i] above
-// max_hits says how many were dropped. A triangle the ray meets exactly on
-// an edge or vertex shared with others is one hit each of them.
+// max_hits means found[i] - max_hits of the farthest were dropped (among
+// hits of one t at the cut, which are kept depends on the walk). A
+// triangle the ray meets exactly on an edge or vertex shared with others
+// is one hit each of them. u and v only when asked for (on the CPU; the
+// Vulkan rows carry t, the triangle and the point).
 struct HitLists {
   uint32_t max_hits = 16;
   std::vector<uint32_t> found;

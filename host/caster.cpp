@@ -363,6 +363,10 @@ bool Caster::poll(const Ticket& t) {
 }
 
 gpu::Method* Caster::method_for(const BatchQuery& q) {
+#if !MESHCAST_VULKAN
+  (void)q;
+  return method_.get();  // not reached: without the Vulkan backend no batch goes to a GPU
+#else
   const uint32_t flags = uint32_t(options_.hit_outputs) |
                          (q.query == Query::Any ? MC_QUERY_ANY : q.query == Query::All ? MC_QUERY_ALL : 0u) |
                          (q.cull == Cull::Back ? MC_CULL_BACK : q.cull == Cull::Front ? MC_CULL_FRONT : 0u);
@@ -371,6 +375,7 @@ gpu::Method* Caster::method_for(const BatchQuery& q) {
   std::unique_ptr<gpu::Method>& m = query_methods_[{flags, max_hits}];
   if (!m) m = gpu::make_method(*gpu_, method_name_, view_.bytes(), "the caster's blob", uint32_t(slots_.size()), flags, max_hits);
   return m.get();
+#endif
 }
 
 BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return collect(slot_of(t), t, hits, nullptr, true); }

@@ -13,6 +13,7 @@
 #include "builder/layout_names.h"
 #include "builder/ray_sets.h"
 #include "cpu/counters.h"
+#include "layout/queries.h"
 #include "meshcast/blob.h"
 #include "meshcast/build.h"
 
@@ -29,19 +30,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// A query as `--queries` names it: closest, any, all (every hit, rows of
-// 16), closest-back (the closest hit, back faces culled).
-struct QuerySpec {
-  Query query = Query::Closest;
-  Cull cull = Cull::None;
-};
-
-QuerySpec parse_query(const std::string& q) {
-  if (q == "any") return {Query::Any};
-  if (q == "all") return {Query::All};
-  if (q == "closest-back") return {Query::Closest, Cull::Back};
-  return {};
-}
+using layout::QuerySpec;
 
 struct Contender {
   std::string name;
@@ -113,7 +102,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
 
   // The sets timed: each ray kind under each query asked for.
   std::vector<QuerySpec> queries;
-  for (const std::string& q : o.queries) queries.push_back(parse_query(q));
+  for (const std::string& q : o.queries) queries.push_back(layout::query_spec_named(q, "--queries"));
   struct Set { size_t kind; size_t query; };
   std::vector<Set> sets;
   for (size_t k = 0; k < kinds.size(); ++k)

@@ -13,6 +13,7 @@
 #endif
 
 #include "cpu/walk.h"
+#include "layout/queries.h"
 #include "cpu/walk_table.h"
 #include "layout/blob_format.h"
 #include "layout/codecs.h"
@@ -163,9 +164,7 @@ uint32_t flags_of(const char* who, HitOutputs outputs, Query query, Cull cull) {
   if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
     throw UsageError(std::string(who) + ": cull " + std::to_string(uint32_t(cull)) +
                      " is not Cull::None, Cull::Back or Cull::Front");
-  return (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | (query == Query::Any ? MC_QUERY_ANY : 0u) |
-         (query == Query::All ? MC_QUERY_ALL : 0u) | (cull == Cull::Back ? MC_CULL_BACK : 0u) |
-         (cull == Cull::Front ? MC_CULL_FRONT : 0u);
+  return (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | layout::query_bits(query, cull);
 }
 
 }  // namespace

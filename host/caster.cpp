@@ -16,6 +16,7 @@
 #endif
 #include "host/jobs.h"
 #include "layout/blob_format.h"
+#include "layout/queries.h"
 
 namespace meshcast::host {
 
@@ -367,9 +368,7 @@ gpu::Method* Caster::method_for(const BatchQuery& q) {
   (void)q;
   return method_.get();  // not reached: without the Vulkan backend no batch goes to a GPU
 #else
-  const uint32_t flags = uint32_t(options_.hit_outputs) |
-                         (q.query == Query::Any ? MC_QUERY_ANY : q.query == Query::All ? MC_QUERY_ALL : 0u) |
-                         (q.cull == Cull::Back ? MC_CULL_BACK : q.cull == Cull::Front ? MC_CULL_FRONT : 0u);
+  const uint32_t flags = uint32_t(options_.hit_outputs) | layout::query_bits(q.query, q.cull);
   if (flags == uint32_t(options_.hit_outputs)) return method_.get();
   const uint32_t max_hits = q.query == Query::All ? q.max_hits : 1;
   std::unique_ptr<gpu::Method>& m = query_methods_[{flags, max_hits}];

@@ -8,6 +8,7 @@
 
 #include "gpu/method.h"
 #include "layout/formats.h"
+#include "layout/queries.h"
 #include "gpu/vulkan.h"
 #include "check/generate.h"
 #include "tests/testing.h"
@@ -149,25 +150,23 @@ TEST_P(GpuMethods, QueriesMatchTheOracle) {
       const size_t count = std::string_view(mc.method) == "bruteforce" ? 150 : 500;
       const std::vector<Ray>& rays = test_rays(m, kind, count);
       const std::string what = std::string(mc.method) + " on " + m.name + " kind " + std::to_string(int(kind));
-      const Cull cull = kind == RayKind::Long ? Cull::Back : Cull::Front;
-      const uint32_t cull_flag = cull == Cull::Back ? MC_CULL_BACK : MC_CULL_FRONT;
-      const std::vector<OracleHit>& culled_oracle = oracle_answers(reference, kind, rays, cull);
-      std::vector<Hit> culled(rays.size()), any(rays.size());
-      gpu::make_method(context(), mc.method, blob, m.name, 1, cull_flag)->trace(rays, culled);
-      Agreement a = compare(*reference.mesh, rays, culled, culled_oracle, tolerance);
-      EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ", culled: " << a.first_problem;
-      expect_same_as_cpu(culled, trace_all(view, rays, Query::Closest, cull), what + ", culled");
-      gpu::make_method(context(), mc.method, blob, m.name, 1, cull_flag | MC_QUERY_ANY)->trace(rays, any);
-      Agreement b = compare_any(*reference.mesh, rays, any, culled_oracle, tolerance, cull);
-      EXPECT_EQ(b.wrong + b.t_errors, 0u) << what << ", Query::Any culled: " << b.first_problem;
-      const Cull all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
-      const uint32_t all_flags = MC_QUERY_ALL | (all_cull == Cull::Front ? MC_CULL_FRONT : 0u);
-      HitLists lists;
-      gpu::make_method(context(), mc.method, blob, m.name, 1, all_flags, 64)->trace_all_hits(rays, lists);
-      Agreement c = compare_all(*reference.mesh, rays, lists, oracle_all_answers(reference, kind, rays, all_cull), tolerance);
-      EXPECT_EQ(c.wrong + c.t_errors, 0u) << what << ", Query::All: " << c.first_problem;
-      EXPECT_GT(c.rays, rays.size() / 20) << what << ", Query::All: too few hits to show anything";
-      const HitLists cpu = trace_lists(view, rays, 64, all_cull);
+      // The query and culling are the method's specialization constants.
+      const QueryTracer vulkan{
+          [&](const std::vector<Ray>& r, Query q, Cull c) {
+            std::vector<Hit> hits(r.size());
+            gpu::make_method(context(), mc.method, blob, m.name, 1, layout::query_bits(q, c))->trace(r, hits);
+            return hits;
+          },
+          [&](const std::vector<Ray>& r, uint32_t max_hits, Cull c) {
+            HitLists rows;
+            gpu::make_method(context(), mc.method, blob, m.name, 1, layout::query_bits(Query::All, c), max_hits)
+                ->trace_all_hits(r, rows);
+            return rows;
+          }};
+      const QueryAnswers answers = check_queries(vulkan, reference, kind, rays, tolerance, 64, what);
+      expect_same_as_cpu(answers.culled, trace_all(view, rays, Query::Closest, answers.cull), what + ", culled");
+      const HitLists& lists = answers.all;
+      const HitLists cpu = trace_lists(view, rays, 64, answers.all_cull);
       for (size_t i = 0; i < rays.size(); ++i) {
         ASSERT_EQ(lists.found[i], cpu.found[i]) << what << ", Query::All, ray " << i;
         for (size_t k = 0; k < lists.row(i).size(); ++k)

@@ -17,6 +17,7 @@
 
 #include "check/generate.h"
 #include "layout/blob_format.h"
+#include "layout/queries.h"
 #include "tests/testing.h"
 #ifdef MESHCAST_TEST_GPU
 #include "gpu/method.h"
@@ -80,7 +81,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
   std::vector<Hit> trace_query(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, Query query, Cull cull) {
 #ifdef MESHCAST_TEST_GPU
     std::vector<Hit> hits(rays.size());
-    method_for(blob, query_flags(query, cull), 1)->trace(rays, hits);
+    method_for(blob, layout::query_bits(query, cull), 1)->trace(rays, hits);
     return hits;
 #else
     return trace_all(BlobView(blob, GetParam()), rays, query, cull);
@@ -90,17 +91,13 @@ class Robustness : public ::testing::TestWithParam<std::string> {
                       Cull cull = Cull::None) {
 #ifdef MESHCAST_TEST_GPU
     HitLists lists;
-    method_for(blob, query_flags(Query::All, cull), max_hits)->trace_all_hits(rays, lists);
+    method_for(blob, layout::query_bits(Query::All, cull), max_hits)->trace_all_hits(rays, lists);
     return lists;
 #else
     return trace_lists(BlobView(blob, GetParam()), rays, max_hits, cull);
 #endif
   }
 #ifdef MESHCAST_TEST_GPU
-  static uint32_t query_flags(Query query, Cull cull) {
-    return (query == Query::Any ? MC_QUERY_ANY : query == Query::All ? MC_QUERY_ALL : 0u) |
-           (cull == Cull::Back ? MC_CULL_BACK : cull == Cull::Front ? MC_CULL_FRONT : 0u);
-  }
   std::unique_ptr<gpu::Method> method_for(const std::vector<uint8_t>& blob, uint32_t flags, uint32_t max_hits) {
     return gpu::make_method(context(), automatic() ? gpu::method_reading(blob) : method(), blob, GetParam(), 1, flags,
                             max_hits);
@@ -248,7 +245,9 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
   size_t shared = 0;
   for (size_t i = 0; i < rays.size(); ++i) expected[i] = tree.all(rays[i]), shared += expected[i].size() > 1;
   // (Quantized corners sit a rounding away from the rays' exact lines.)
-  if (!quantized(blob)) EXPECT_GT(shared, rays.size() / 2) << "most of these rays meet an edge or a vertex";
+  if (!quantized(blob)) {
+    EXPECT_GT(shared, rays.size() / 2) << "most of these rays meet an edge or a vertex";
+  }
   Agreement all = compare_all(stored_grid, rays, trace_rows(blob, rays, 16), expected, 1e-6);
   EXPECT_EQ(all.wrong + all.t_errors + all.ties, 0u) << all.first_problem;
   expect_answers(g, rays, "grid");

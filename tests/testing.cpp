@@ -185,6 +185,30 @@ void expect_nearest_rows(const Mesh& mesh, const std::vector<Ray>& rays, const H
   }
 }
 
+QueryAnswers check_queries(const QueryTracer& trace, const NamedMesh& reference, RayKind kind,
+                           const std::vector<Ray>& rays, double tolerance, uint32_t max_hits, const std::string& what) {
+  QueryAnswers out;
+  const Cull cull = out.cull = kind == RayKind::Long ? Cull::Back : Cull::Front;
+  const std::vector<OracleHit>& culled_oracle = oracle_answers(reference, kind, rays, cull);
+  out.culled = trace.hits(rays, Query::Closest, cull);
+  const Agreement a = compare(*reference.mesh, rays, out.culled, culled_oracle, tolerance);
+  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ", culled: " << a.first_problem;
+  size_t culled_hits = 0;
+  for (const Hit& h : out.culled) culled_hits += h.triangle != MC_NO_HIT;
+  EXPECT_GT(culled_hits, rays.size() / 50) << what << ", culled: too few hits to show anything";
+  out.any = trace.hits(rays, Query::Any, cull);
+  const Agreement b = compare_any(*reference.mesh, rays, out.any, culled_oracle, tolerance, cull);
+  EXPECT_EQ(b.wrong + b.t_errors, 0u) << what << ", Query::Any culled: " << b.first_problem;
+
+  const Cull all_cull = out.all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
+  out.all = trace.rows(rays, max_hits, all_cull);
+  const Agreement c = compare_all(*reference.mesh, rays, out.all, oracle_all_answers(reference, kind, rays, all_cull),
+                                  tolerance);
+  EXPECT_EQ(c.wrong + c.t_errors, 0u) << what << ", Query::All: " << c.first_problem;
+  EXPECT_GT(c.rays, rays.size() / 20) << what << ", Query::All: too few hits to show anything";
+  return out;
+}
+
 Mesh unwelded(const Mesh& m) {
   Mesh soup;
   for (size_t t = 0; t < m.triangles.size(); ++t) {

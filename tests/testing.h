@@ -2,6 +2,7 @@
 // mesh and ray set, and the agreement rules of the foundation issue.
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <tuple>
 #include <memory>
@@ -66,6 +67,27 @@ std::vector<Hit> trace_all(const BlobView& view, const std::vector<Ray>& rays, Q
                            Cull cull = Cull::None);
 // Query::All on every ray, rows of `max_hits`.
 HitLists trace_lists(const BlobView& view, const std::vector<Ray>& rays, uint32_t max_hits, Cull cull = Cull::None);
+
+// What check_queries traces: hits for a query and culling, or rows of
+// `max_hits` for Query::All (a CPU blob view, a Vulkan method).
+struct QueryTracer {
+  std::function<std::vector<Hit>(const std::vector<Ray>&, Query, Cull)> hits;
+  std::function<HitLists(const std::vector<Ray>&, uint32_t max_hits, Cull)> rows;
+};
+// What check_queries traced, for a caller's own comparisons.
+struct QueryAnswers {
+  Cull cull, all_cull;  // the culling of `culled` and `any`, of `all`
+  std::vector<Hit> culled, any;
+  HitLists all;
+};
+// The queries against the oracle over `reference` (the mesh as the blob
+// stores it) on `rays` of `kind`: the closest hit culled (back faces on
+// long rays, front faces on the others) and any hit culled alike, each
+// with the oracle's answer under the same culling; every hit in rows of
+// `max_hits` (front faces culled on long rays) against the oracle's sets.
+// A failure names `what`.
+QueryAnswers check_queries(const QueryTracer& trace, const NamedMesh& reference, RayKind kind,
+                           const std::vector<Ray>& rays, double tolerance, uint32_t max_hits, const std::string& what);
 
 // `planes` unit squares (two triangles each) stacked at z = 0, 1, ...,
 // and `count` rays straight down from above them, each through every plane

@@ -23,26 +23,13 @@ class WalkerVsOracle : public ::testing::TestWithParam<std::string> {};
 // long rays, the front faces on probe and radial rays, which start inside
 // closed meshes and see back faces there), and every hit, culled on long
 // rays. Each against the oracle over `reference` with the same culling.
+// The queries (testing's check_queries) on a tenth of the rays.
 void check_queries(const BlobView& blob, const NamedMesh& reference, RayKind kind,
                    const std::vector<Ray>& rays, double tolerance, const std::string& what) {
   const std::vector<Ray> part(rays.begin(), rays.begin() + std::ptrdiff_t(rays.size() / 10));
-  const Cull cull = kind == RayKind::Long ? Cull::Back : Cull::Front;
-  const std::vector<OracleHit>& culled_oracle = oracle_answers(reference, kind, part, cull);
-  std::vector<Hit> culled = trace_all(blob, part, Query::Closest, cull);
-  Agreement a = compare(*reference.mesh, part, culled, culled_oracle, tolerance);
-  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ", culled: " << a.first_problem;
-  size_t culled_hits = 0;
-  for (const Hit& h : culled) culled_hits += h.triangle != MC_NO_HIT;
-  EXPECT_GT(culled_hits, part.size() / 50) << what << ", culled: too few hits to show anything";
-  std::vector<Hit> any = trace_all(blob, part, Query::Any, cull);
-  Agreement b = compare_any(*reference.mesh, part, any, culled_oracle, tolerance, cull);
-  EXPECT_EQ(b.wrong + b.t_errors, 0u) << what << ", Query::Any culled: " << b.first_problem;
-
-  const Cull all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
-  HitLists lists = trace_lists(blob, part, 256, all_cull);
-  Agreement c = compare_all(*reference.mesh, part, lists, oracle_all_answers(reference, kind, part, all_cull), tolerance);
-  EXPECT_EQ(c.wrong + c.t_errors, 0u) << what << ", Query::All: " << c.first_problem;
-  EXPECT_GT(c.rays, part.size() / 20) << what << ", Query::All: too few hits to show anything";
+  const QueryTracer cpu{[&](const std::vector<Ray>& r, Query q, Cull c) { return trace_all(blob, r, q, c); },
+                        [&](const std::vector<Ray>& r, uint32_t max_hits, Cull c) { return trace_lists(blob, r, max_hits, c); }};
+  testing::check_queries(cpu, reference, kind, part, tolerance, 256, what);
 }
 
 void check_layout(const std::string& layout_name_, bool large) {

@@ -7,6 +7,7 @@
 #include "meshcast/blob.h"
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
+#include "layout/queries.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 #include "tools/render.h"
@@ -47,8 +48,8 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args] {
-    const Query query = args->query == "any" ? Query::Any : args->query == "all" ? Query::All : Query::Closest;
-    const Cull cull = args->cull == "back" ? Cull::Back : args->cull == "front" ? Cull::Front : Cull::None;
+    const Query query = layout::query_named(args->query, "--query");
+    const Cull cull = layout::cull_named(args->cull, "--cull");
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
@@ -65,8 +66,7 @@ void add_trace(CLI::App& app) {
       gpu::Context ctx(gpu::DeviceChoice{args->device, false});
       device = ctx.device_name();
       // The query and culling are the method's specialization constants.
-      const uint32_t flags = (query == Query::Any ? MC_QUERY_ANY : query == Query::All ? MC_QUERY_ALL : 0u) |
-                             (cull == Cull::Back ? MC_CULL_BACK : cull == Cull::Front ? MC_CULL_FRONT : 0u);
+      const uint32_t flags = layout::query_bits(query, cull);
       std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input, 1, flags, args->max_hits);
       for (uint32_t r = 0; r < args->repeat; ++r) {
         gpu::GpuTiming timing;

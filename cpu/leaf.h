@@ -271,7 +271,9 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
                               Closest& c) {
   const layout::BlobHeader& h = layout::header_of(blob);
   uint32_t at = block, made = 0;
-  while (made < count) {
+  // c.t below 0: an any-hit query has its hit, the rest of the leaf is moot
+  // (not even decoded).
+  while (made < count && c.t >= 0) {
     const uint64_t origin = layout::load<uint64_t>(blob + at);
     const uint32_t vertices = Codec::vertex_count(blob, at), triangles = Codec::triangle_count(blob, at);
     const bool wide = Codec::wide(blob, at);
@@ -283,7 +285,6 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
                                             h.quant_scale[a], h.quant_offset[a]);
     }
     const uint8_t* index = blob + Codec::index_at(at);
-    // c.t below 0: an any-hit query has its hit, the rest of the leaf is moot.
     for (uint32_t first = 0; first < triangles && c.t >= 0; first += 8, index += MC_CLUSTER_INDEX_BLOCK_BYTES) {
       simd::F8 v[3][3];
       for (int k = 0; k < 3; ++k) {

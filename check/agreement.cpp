@@ -15,9 +15,28 @@ double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b
 
 }  // namespace
 
-// Distance from p to the nearest edge of the triangle abc.
+namespace {
+struct Corners {
+  double a[3], b[3], c[3];
+  Corners(const Vec3& x, const Vec3& y, const Vec3& z) {
+    for (int k = 0; k < 3; ++k) a[k] = x[k], b[k] = y[k], c[k] = z[k];
+  }
+};
+}  // namespace
+
 double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c) {
-  auto segment = [&](const Vec3& s, const Vec3& e) {
+  const Corners k(a, b, c);
+  return edge_distance(p, k.a, k.b, k.c);
+}
+
+double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Corners k(a, b, c);
+  return point_triangle_distance(p, k.a, k.b, k.c);
+}
+
+// Distance from p to the nearest edge of the triangle abc.
+double edge_distance(const double p[3], const double a[3], const double b[3], const double c[3]) {
+  auto segment = [&](const double* s, const double* e) {
     double d[3], w[3];
     for (int k = 0; k < 3; ++k) d[k] = double(e[k]) - s[k], w[k] = p[k] - s[k];
     double dd = dot(d, d), u = dd > 0 ? std::clamp(dot(w, d) / dd, 0.0, 1.0) : 0.0;
@@ -29,7 +48,7 @@ double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3
 
 // Closest point on a triangle by its Voronoi regions (vertex, edge, face),
 // in double.
-double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c) {
+double point_triangle_distance(const double p[3], const double a[3], const double b[3], const double c[3]) {
   double ab[3], ac[3], ap[3];
   for (int k = 0; k < 3; ++k) ab[k] = double(b[k]) - a[k], ac[k] = double(c[k]) - a[k], ap[k] = p[k] - a[k];
   double q[3];

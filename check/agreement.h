@@ -19,6 +19,9 @@ struct Agreement {
 // Distances in double: to the triangle abc, and to its nearest edge.
 double point_triangle_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
 double edge_distance(const double p[3], const Vec3& a, const Vec3& b, const Vec3& c);
+// The same with corners in double (scenes far from the origin).
+double point_triangle_distance(const double p[3], const double a[3], const double b[3], const double c[3]);
+double edge_distance(const double p[3], const double a[3], const double b[3], const double c[3]);
 
 // The foundation rules: the walker returns the oracle's hit/miss and
 // triangle, with t within `tolerance`, a distance along the ray (1e-5 of the

@@ -8,13 +8,20 @@ namespace meshcast {
 
 double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, Cull cull) {
   if (!ray_is_walkable(ray)) return INFINITY;
-  double d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
+  const double o[3] = {ray.org[0], ray.org[1], ray.org[2]}, d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
+  const double da[3] = {a[0], a[1], a[2]}, db[3] = {b[0], b[1], b[2]}, dc[3] = {c[0], c[1], c[2]};
+  return oracle_triangle(o, d, ray.tmax, da, db, dc, cull);
+}
+
+double oracle_triangle(const double org[3], const double dir[3], double tmax, const double a[3], const double b[3],
+                       const double c[3], Cull cull) {
+  const double* d = dir;
   int kz = std::fabs(d[0]) > std::fabs(d[1]) ? (std::fabs(d[0]) > std::fabs(d[2]) ? 0 : 2)
                                              : (std::fabs(d[1]) > std::fabs(d[2]) ? 1 : 2);
   int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
   if (d[kz] < 0) std::swap(kx, ky);
   double sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
-  auto rel = [&](const Vec3& p, int k) { return double(p[k]) - double(ray.org[k]); };
+  auto rel = [&](const double* p, int k) { return p[k] - org[k]; };
   double az = rel(a, kz), bz = rel(b, kz), cz = rel(c, kz);
   double ax = rel(a, kx) - sx * az, ay = rel(a, ky) - sy * az;
   double bx = rel(b, kx) - sx * bz, by = rel(b, ky) - sy * bz;
@@ -27,7 +34,7 @@ double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3&
   double T = (U * az + V * bz + W * cz) * sz;
   double t = T / det;
   // A t past the largest float is no hit: no walker could report it.
-  if (!(t >= 0) || t > double(ray.tmax) || t > double(FLT_MAX)) return INFINITY;
+  if (!(t >= 0) || t > tmax || t > double(FLT_MAX)) return INFINITY;
   return t;
 }
 

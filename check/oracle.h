@@ -20,6 +20,10 @@ struct OracleHit {
 // drops the face it meets (the sign of the same double determinant: the
 // front face's corners run counter-clockwise seen from the origin).
 double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, Cull cull = Cull::None);
+// The same test on double coordinates (a ray's origin and corners far from
+// the origin, scenes): the ray's walkability is the caller's to check.
+double oracle_triangle(const double org[3], const double dir[3], double tmax, const double a[3], const double b[3],
+                       const double c[3], Cull cull = Cull::None);
 
 // Every triangle, in input order.
 OracleHit oracle_brute_force(const Mesh& mesh, const Ray& ray, Cull cull = Cull::None);

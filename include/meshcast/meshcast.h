@@ -9,3 +9,4 @@
 #include "meshcast/jobs.h"
 #include "meshcast/mesh.h"
 #include "meshcast/ray.h"
+#include "meshcast/scene.h"

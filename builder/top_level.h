@@ -1,0 +1,17 @@
+// Builds a scene's top level (layout/top_level.h) over placed instances whose
+// world boxes are set: what Scene::commit() does once a frame.
+#pragma once
+#include <vector>
+
+#include "layout/top_level.h"
+
+namespace meshcast {
+
+// A binary tree by median splits: each node's instances split in half at the
+// median of their box centres along the widest axis of those centres
+// (std::nth_element: O(n log n), no sort), down to leaves of at most
+// kTopLeafSize. Every box is the union of its instances' boxes, in double,
+// so nothing is rounded inward.
+layout::TopLevel build_top_level(std::vector<layout::PlacedInstance> placed);
+
+}  // namespace meshcast

@@ -1,0 +1,80 @@
+#include "check/scene_oracle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "check/agreement.h"
+
+namespace meshcast {
+
+SceneOracle::SceneOracle(const std::vector<const Mesh*>& meshes, const std::vector<OracleInstance>& instances) {
+  for (const OracleInstance& i : instances) {
+    Placed p{i, {}, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    const Mesh& mesh = *meshes.at(i.mesh);
+    const float* m = i.transform.rotation_scale;
+    p.corners.reserve(mesh.triangles.size() * 9);
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 v = mesh.corner(t, k);
+        for (int r = 0; r < 3; ++r) {
+          // Products of two floats are exact in double; two roundings at most.
+          const double w = i.transform.translation[r] +
+                           (double(m[3 * r]) * v[0] + double(m[3 * r + 1]) * v[1] + double(m[3 * r + 2]) * v[2]);
+          p.corners.push_back(w);
+          p.min[r] = std::min(p.min[r], w), p.max[r] = std::max(p.max[r], w);
+        }
+      }
+    placed_.push_back(std::move(p));
+  }
+}
+
+SceneOracleHit SceneOracle::closest(const RayD& ray, Cull cull, uint8_t mask) const {
+  SceneOracleHit best;
+  const double d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
+  for (const Placed& p : placed_) {
+    if ((p.instance.mask & mask) == 0) continue;
+    // The instance's box in double, inclusive: only a miss of every
+    // triangle is skipped.
+    double tn = 0, tf = std::min(double(ray.tmax), best.t);
+    for (int a = 0; a < 3 && tn <= tf; ++a) {
+      if (d[a] == 0) {
+        if (ray.org[a] < p.min[a] || ray.org[a] > p.max[a]) tn = INFINITY;
+        continue;
+      }
+      double t0 = (p.min[a] - ray.org[a]) / d[a], t1 = (p.max[a] - ray.org[a]) / d[a];
+      if (t0 > t1) std::swap(t0, t1);
+      // One rounding each way: widened by a relative 2^-50.
+      tn = std::max(tn, t0 * (1 - 0x1p-50)), tf = std::min(tf, t1 * (1 + 0x1p-50));
+    }
+    if (!(tn <= tf)) continue;
+    for (size_t t = 0; t < p.corners.size() / 9; ++t) {
+      const double* c = p.corners.data() + 9 * t;
+      const double hit = oracle_triangle(ray.org, d, ray.tmax, c, c + 3, c + 6, cull);
+      // Ties: the lower instance id, then the lower triangle.
+      if (hit < best.t || (hit == best.t && hit != INFINITY && p.instance.id < best.instance))
+        best = {hit, p.instance.id, uint32_t(t)};
+    }
+  }
+  return best;
+}
+
+size_t SceneOracle::index_of(uint32_t id) const {
+  for (size_t i = 0; i < placed_.size(); ++i)
+    if (placed_[i].instance.id == id) return i;
+  throw std::out_of_range("SceneOracle: no instance " + std::to_string(id));
+}
+
+double SceneOracle::distance_to(size_t instance, uint32_t triangle, const RayD& ray, double t) const {
+  const double* c = placed_.at(instance).corners.data() + 9 * size_t(triangle);
+  const double p[3] = {ray.org[0] + t * ray.dir[0], ray.org[1] + t * ray.dir[1], ray.org[2] + t * ray.dir[2]};
+  return point_triangle_distance(p, c, c + 3, c + 6);
+}
+
+double SceneOracle::distance_to_edge(size_t instance, uint32_t triangle, const RayD& ray, double t) const {
+  const double* c = placed_.at(instance).corners.data() + 9 * size_t(triangle);
+  const double p[3] = {ray.org[0] + t * ray.dir[0], ray.org[1] + t * ray.dir[1], ray.org[2] + t * ray.dir[2]};
+  return edge_distance(p, c, c + 3, c + 6);
+}
+
+}  // namespace meshcast

@@ -1,0 +1,147 @@
+// Scene: the caller's edits, and commit() turning them into a snapshot.
+#include "meshcast/scene.h"
+
+#include <cmath>
+
+#include "builder/top_level.h"
+#include "cpu/scene.h"
+#include "layout/blob_format.h"
+#include "meshcast/errors.h"
+
+namespace meshcast {
+
+struct Scene::Edits {
+  std::vector<std::shared_ptr<const SceneMesh>> meshes;
+  struct Instance {
+    layout::PlacedInstance placed;  // inverse and world box kept up to date
+    bool enabled = true, removed = false;
+  };
+  std::vector<Instance> instances;  // by InstanceId
+  size_t live = 0;
+
+  Instance& at(InstanceId id, const char* who) {
+    if (id >= instances.size() || instances[id].removed)
+      throw UsageError(std::string(who) + ": instance " + std::to_string(id) + " is unknown or removed");
+    return instances[id];
+  }
+};
+
+namespace {
+
+// The inverse of the 3x3 (in double, then rounded to float), its mirroring,
+// and the world box of the mesh's bounds under the transform: centre
+// M c + T and half extents |M| e, in double, padded by 2^-20 of their size
+// (the rounding of the float inverse; what a ray's own rounding adds is the
+// walk's slack, see scene_trace.cpp).
+void place(layout::PlacedInstance& p, const Transform& t, const SceneMesh& mesh, const char* who) {
+  const float* m = t.rotation_scale;
+  for (int i = 0; i < 9; ++i)
+    if (!std::isfinite(m[i])) throw UsageError(std::string(who) + ": rotation_scale[" + std::to_string(i) + "] is not finite");
+  for (int a = 0; a < 3; ++a)
+    if (!(std::fabs(t.translation[a]) <= double(kMaxCoordinate)))
+      throw UsageError(std::string(who) + ": translation[" + std::to_string(a) + "] " + std::to_string(t.translation[a]) +
+                       " is not finite or beyond 2^100");
+  auto e = [&](int r, int c) { return double(m[3 * r + c]); };
+  const double cof[9] = {e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1), e(0, 2) * e(2, 1) - e(0, 1) * e(2, 2),
+                         e(0, 1) * e(1, 2) - e(0, 2) * e(1, 1), e(1, 2) * e(2, 0) - e(1, 0) * e(2, 2),
+                         e(0, 0) * e(2, 2) - e(0, 2) * e(2, 0), e(0, 2) * e(1, 0) - e(0, 0) * e(1, 2),
+                         e(1, 0) * e(2, 1) - e(1, 1) * e(2, 0), e(0, 1) * e(2, 0) - e(0, 0) * e(2, 1),
+                         e(0, 0) * e(1, 1) - e(0, 1) * e(1, 0)};
+  const double det = e(0, 0) * cof[0] + e(0, 1) * cof[3] + e(0, 2) * cof[6];
+  bool usable = det != 0 && std::isfinite(det);
+  for (int i = 0; i < 9 && usable; ++i) {
+    p.to_local[i] = float(cof[i] / det);
+    usable = std::isfinite(p.to_local[i]) && std::fabs(p.to_local[i]) <= 0x1p40f;
+  }
+  if (!usable)
+    throw UsageError(std::string(who) + ": rotation_scale is not invertible (determinant " + std::to_string(det) +
+                     ") or its inverse has an entry beyond 2^40");
+  p.mirrored = det < 0;
+  for (int a = 0; a < 3; ++a) p.translation[a] = t.translation[a];
+  const layout::BlobHeader& h = layout::header_of(mesh.bytes.data());
+  double c[3], half[3];
+  for (int a = 0; a < 3; ++a)
+    c[a] = 0.5 * (double(h.bounds_min[a]) + h.bounds_max[a]), half[a] = 0.5 * (double(h.bounds_max[a]) - h.bounds_min[a]);
+  for (int r = 0; r < 3; ++r) {
+    double centre = t.translation[r], extent = 0;
+    for (int k = 0; k < 3; ++k) centre += e(r, k) * c[k], extent += std::fabs(e(r, k)) * half[k];
+    extent += (extent + std::fabs(centre - t.translation[r])) * 0x1p-20;
+    p.box_min[r] = centre - extent, p.box_max[r] = centre + extent;
+  }
+}
+
+}  // namespace
+
+Scene::Scene() : edits_(std::make_unique<Edits>()), committed_(std::make_shared<SceneSnapshot>()) {}
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
+  edits_->meshes.push_back(std::make_shared<const SceneMesh>(std::move(blob), name));
+  return MeshId(edits_->meshes.size() - 1);
+}
+
+InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask) {
+  if (mesh >= edits_->meshes.size())
+    throw UsageError("Scene::add_instance: mesh " + std::to_string(mesh) + " is unknown (" +
+                     std::to_string(edits_->meshes.size()) + " added)");
+  Edits::Instance i;
+  i.placed.id = uint32_t(edits_->instances.size());
+  i.placed.mesh = mesh;
+  i.placed.mask = mask;
+  place(i.placed, transform, *edits_->meshes[mesh], "Scene::add_instance");
+  edits_->instances.push_back(i);
+  ++edits_->live;
+  return i.placed.id;
+}
+
+void Scene::set_transform(InstanceId instance, const Transform& transform) {
+  Edits::Instance& i = edits_->at(instance, "Scene::set_transform");
+  layout::PlacedInstance moved = i.placed;  // unchanged should the transform be refused
+  place(moved, transform, *edits_->meshes[moved.mesh], "Scene::set_transform");
+  i.placed = moved;
+}
+
+void Scene::set_mask(InstanceId instance, uint8_t mask) { edits_->at(instance, "Scene::set_mask").placed.mask = mask; }
+
+void Scene::set_enabled(InstanceId instance, bool enabled) {
+  edits_->at(instance, "Scene::set_enabled").enabled = enabled;
+}
+
+void Scene::remove_instance(InstanceId instance) {
+  edits_->at(instance, "Scene::remove_instance").removed = true;
+  --edits_->live;
+}
+
+void Scene::commit() {
+  std::vector<layout::PlacedInstance> placed;
+  placed.reserve(edits_->live);
+  for (const Edits::Instance& i : edits_->instances)
+    if (i.enabled && !i.removed) placed.push_back(i.placed);
+  auto next = std::make_shared<SceneSnapshot>();
+  next->meshes = edits_->meshes;
+  next->top = build_top_level(std::move(placed));
+  committed_ = std::move(next);
+}
+
+std::shared_ptr<const SceneSnapshot> Scene::snapshot() const { return committed_; }
+
+size_t Scene::instance_count() const { return edits_->live; }
+
+uint64_t Scene::trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
+                      uint8_t mask) const {
+  return trace_snapshot(*committed_, rays, hits, outputs, query, cull, mask);
+}
+
+uint64_t Scene::trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
+                      uint8_t mask) const {
+  std::vector<RayD> wide(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    for (int a = 0; a < 3; ++a) wide[i].org[a] = rays[i].org[a], wide[i].dir[a] = rays[i].dir[a];
+    wide[i].tmax = rays[i].tmax;
+  }
+  return trace_snapshot(*committed_, wide, hits, outputs, query, cull, mask);
+}
+
+}  // namespace meshcast

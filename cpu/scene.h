@@ -1,0 +1,31 @@
+// What one Scene::commit() makes (include/meshcast/scene.h): the meshes'
+// blobs, shared by every snapshot that places them, and the top level.
+// Immutable once made: a trace reads it while the next frame is edited.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "layout/top_level.h"
+#include "meshcast/blob.h"
+
+namespace meshcast {
+
+// A scene's mesh: its blob's bytes and the view over them (validated once).
+struct SceneMesh {
+  SceneMesh(std::vector<uint8_t> blob, std::string mesh_name)
+      : bytes(std::move(blob)), name(std::move(mesh_name)), view(bytes, name) {}
+  SceneMesh(const SceneMesh&) = delete;
+  SceneMesh& operator=(const SceneMesh&) = delete;
+  const std::vector<uint8_t> bytes;
+  const std::string name;
+  const BlobView view;  // reads `bytes`, declared before it
+};
+
+class SceneSnapshot {
+ public:
+  std::vector<std::shared_ptr<const SceneMesh>> meshes;
+  layout::TopLevel top;
+};
+
+}  // namespace meshcast

@@ -1,0 +1,123 @@
+// Scenes (issue 21): many placed copies of a few blobs, cast against as one
+// world, far larger than a float reaches.
+//
+//   meshcast::Scene scene;
+//   meshcast::MeshId rock = scene.add_mesh(load_blob("rock.mcb"), "rock.mcb");
+//   meshcast::InstanceId a = scene.add_instance(rock, transform);  // any number
+//   scene.commit();                                                // the frame's changes are done
+//   scene.trace(rays, hits);                                       // sees what was committed
+//   scene.set_transform(a, moved);  scene.commit();                // next frame
+//
+// A blob is built once and walked by every instance of it: an instance
+// brings a ray into the blob's own frame (the translation subtracted in
+// double, then the inverse rotation and scale applied in float) and walks
+// it with the walkers BlobView has. The ray's t is the same number in both
+// frames (the direction is carried over with the origin), so hits report t
+// in the world ray's units.
+//
+// Edits (add, remove, move, hide, mask) change nothing a trace sees until
+// commit(), which builds the top-level tree over the enabled instances'
+// world boxes into a new immutable snapshot. A trace holds the snapshot it
+// started with, so a commit on another thread never shows it a half-made
+// world; the Scene itself (its edits and commit) is for one thread at a time.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "meshcast/blob.h"
+#include "meshcast/ray.h"
+
+namespace meshcast {
+
+// A ray whose origin is in double precision: worlds kilometres across keep
+// their millimetres. The same record as a RAYD file's (40 bytes).
+struct RayD {
+  double org[3];
+  float dir[3];
+  float tmax;
+};
+static_assert(sizeof(RayD) == 40, "RayD is the record of a RAYD file");
+
+// A hit in a scene: the instance and the triangle of its mesh (the index in
+// the mesh the blob was built from), t in the world ray's units.
+struct SceneHit {
+  float t = INFINITY;  // INFINITY on a miss
+  uint32_t instance = kNoHit;
+  uint32_t triangle = kNoHit;
+  float u = 0, v = 0;  // only with HitOutputs::Uv, as Hit's
+};
+
+// Where an instance stands: world = rotation_scale * local + translation.
+// The 3x3 is row-major and may rotate, scale (non-uniformly too) and mirror
+// (a negative determinant; a mirrored instance's corners run the other way
+// in the world, so what is its front face flips with it); it must be
+// invertible. The translation is in double: placements far from the origin
+// keep their precision.
+struct Transform {
+  float rotation_scale[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  double translation[3] = {0, 0, 0};
+};
+
+using MeshId = uint32_t;
+using InstanceId = uint32_t;
+
+class SceneSnapshot;  // what one commit() made (internal: cpu/scene.h)
+
+class Scene {
+ public:
+  Scene();
+  ~Scene();
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+
+  // A blob every instance of it walks, validated once (InputError naming
+  // `name`); the scene keeps the bytes.
+  MeshId add_mesh(std::vector<uint8_t> blob, const std::string& name);
+
+  // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
+  // share a bit with it for the instance to be walked). UsageError for an
+  // unknown mesh, a transform that is not finite or not invertible, or a
+  // translation beyond 2^100 (kMaxCoordinate).
+  InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF);
+  void set_transform(InstanceId instance, const Transform& transform);
+  void set_mask(InstanceId instance, uint8_t mask);
+  void set_enabled(InstanceId instance, bool enabled);
+  // The id is not given again. UsageError for an unknown or removed id.
+  void remove_instance(InstanceId instance);
+
+  // The frame's changes are done: from now on traces see them.
+  void commit();
+
+  // The hit of each world ray under `query` (Closest or Any) against the
+  // committed scene, among the instances whose mask shares a bit with
+  // `mask`; `cull` as BlobView::trace, the front face as the instance shows
+  // it in the world. Returns the rays not walkable (a non-finite origin or
+  // one beyond 2^100, a direction or t_max BlobView would refuse), answered
+  // as misses. UsageError when hits is shorter than rays or for Query::All.
+  uint64_t trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitOutputs outputs = HitOutputs::None,
+                 Query query = Query::Closest, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
+  // Float rays, their origins taken as doubles.
+  uint64_t trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs = HitOutputs::None,
+                 Query query = Query::Closest, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
+
+  // What the last commit() made, for a caster that keeps a batch on the
+  // scene it was submitted to (traces through it see that frame).
+  std::shared_ptr<const SceneSnapshot> snapshot() const;
+
+  size_t instance_count() const;  // not removed, committed or not
+
+ private:
+  struct Edits;
+  std::unique_ptr<Edits> edits_;
+  std::shared_ptr<const SceneSnapshot> committed_;
+};
+
+// A snapshot's trace: the same as Scene::trace, on the frame it holds.
+uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,
+                        HitOutputs outputs = HitOutputs::None, Query query = Query::Closest, Cull cull = Cull::None,
+                        uint8_t mask = 0xFF);
+
+}  // namespace meshcast

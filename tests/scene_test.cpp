@@ -1,0 +1,378 @@
+// Scenes (issue 21): generated levels of placed, rotated, scaled and
+// mirrored instances, at the origin and 10^6 and 10^7 units from it,
+// against the double-precision scene oracle (check/scene_oracle.h); the
+// closed sphere and the grid far away; edits and commits; bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "builder/error_bounds.h"
+#include "check/generate.h"
+#include "check/scene_oracle.h"
+#include "meshcast/scene.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+// A level: its meshes (as their blobs store them), blobs and instances.
+struct Level {
+  std::vector<Mesh> meshes;  // as stored (the oracle's)
+  std::vector<std::vector<uint8_t>> blobs;
+  std::vector<OracleInstance> instances;
+  std::vector<bool> enabled;
+  double offset = 0;  // added to every translation and ray origin
+};
+
+// A random rotation (a unit quaternion from 4 normals) times a scale per
+// axis; `mirror` negates the first column.
+Transform random_transform(std::mt19937& rng, double spread, double offset, bool uniform, bool mirror) {
+  std::normal_distribution<double> n(0, 1);
+  double q[4] = {n(rng), n(rng), n(rng), n(rng)};
+  const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  for (double& x : q) x /= len;
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                       2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                       2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  std::uniform_real_distribution<double> s(0.5, 3.0), u(-spread, spread);
+  const double base = s(rng);
+  const double scale[3] = {base, uniform ? base : s(rng), uniform ? base : s(rng)};
+  Transform t;
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col)
+      t.rotation_scale[3 * row + col] = float(r[3 * row + col] * scale[col] * (mirror && col == 0 ? -1 : 1));
+  for (int a = 0; a < 3; ++a) t.translation[a] = offset + std::round(u(rng));
+  return t;
+}
+
+// `count` instances of a sphere, a terrain patch and an unwelded sphere
+// (every triangle its own corners), built with `layout`, spread over a cube
+// of 2 `spread` around `offset`: every 3rd mirrored, every 4th scaled
+// unevenly, masks 1, 2, 4 or all, every 7th disabled.
+Level make_level(const std::string& layout, size_t count, double spread, double offset, uint32_t seed) {
+  Level level;
+  level.offset = offset;
+  const BuildOptions options = parse_layout(layout);
+  for (const Mesh& m : {make_sphere(10, 14, 1.0f, {0, 0, 0}), make_terrain(8, 8, 5), unwelded(make_sphere(6, 9, 1.5f, {0.5f, 0, 0}))}) {
+    level.blobs.push_back(build_blob(m, options, "level mesh"));
+    level.meshes.push_back(moves_vertices(uint32_t(options.layout.triangles)) ? stored_mesh(level.blobs.back()) : m);
+  }
+  std::mt19937 rng(seed);
+  const uint8_t masks[4] = {1, 2, 4, 0xFF};
+  for (uint32_t i = 0; i < count; ++i) {
+    const Transform t = random_transform(rng, spread, offset, i % 4 != 0, i % 3 == 0);
+    level.instances.push_back({i, i % 3, t, masks[i % 4]});
+    level.enabled.push_back(i % 7 != 6);
+  }
+  return level;
+}
+
+Scene make_scene(const Level& level) {
+  Scene scene;
+  for (size_t m = 0; m < level.blobs.size(); ++m) scene.add_mesh(level.blobs[m], "level mesh " + std::to_string(m));
+  for (size_t i = 0; i < level.instances.size(); ++i) {
+    const OracleInstance& o = level.instances[i];
+    EXPECT_EQ(scene.add_instance(o.mesh, o.transform, o.mask), o.id);
+    if (!level.enabled[i]) scene.set_enabled(o.id, false);
+  }
+  scene.commit();
+  return scene;
+}
+
+SceneOracle oracle_of(const Level& level) {
+  std::vector<const Mesh*> meshes;
+  for (const Mesh& m : level.meshes) meshes.push_back(&m);
+  std::vector<OracleInstance> enabled;
+  for (size_t i = 0; i < level.instances.size(); ++i)
+    if (level.enabled[i]) enabled.push_back(level.instances[i]);
+  return SceneOracle(meshes, enabled);
+}
+
+// Rays from random points of the level's cube towards random instances'
+// places (a unit's jitter), a third of them with a finite t_max.
+std::vector<RayD> level_rays(const Level& level, size_t count, double spread, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-spread, spread), jitter(-1.5, 1.5), reach(5, 400);
+  std::vector<RayD> rays(count);
+  for (size_t i = 0; i < count; ++i) {
+    const Transform& target = level.instances[rng() % level.instances.size()].transform;
+    RayD& r = rays[i];
+    for (int a = 0; a < 3; ++a) {
+      r.org[a] = level.offset + u(rng);
+      r.dir[a] = float(target.translation[a] + jitter(rng) - r.org[a]);
+    }
+    r.tmax = i % 3 == 0 ? float(reach(rng) / 400) : INFINITY;
+  }
+  return rays;
+}
+
+// How far, in the world, a scene hit may stray from the oracle's where only
+// rounding decides: 1e-5 of the distance from the ray's origin to the hit
+// plus the instance's scale (the ray's place in an instance's frame is
+// rounded to float, about 2^-22 of that distance; a layout's own error is
+// in the stored mesh the oracle uses).
+double slack(const RayD& r, double t) {
+  const double len = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
+  return 1e-5 * (t * len + 4);
+}
+
+struct Judged {
+  size_t hits = 0, ties = 0, wrong = 0;
+  std::string first_problem;
+  void fail(const std::string& why) {
+    if (wrong++ == 0) first_problem = why;
+  }
+};
+
+// The rules of check/agreement.h's compare(), for scenes: the oracle's
+// instance, triangle and t; where only rounding decides (another triangle
+// at the same place, a graze of the hit triangle's edge, the segment's
+// ends) a tie. `any`: a hit names a triangle the ray meets at its t.
+Judged judge(const SceneOracle& oracle, const std::vector<RayD>& rays, const std::vector<SceneHit>& hits, Cull cull,
+             uint8_t mask, bool any) {
+  Judged j;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const RayD& r = rays[i];
+    const SceneHit& h = hits[i];
+    const SceneOracleHit o = oracle.closest(r, cull, mask);
+    const std::string where = "ray " + std::to_string(i);
+    const double tlen = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
+    auto near_end = [&](double t) { return t * tlen <= slack(r, t) || std::fabs(t - r.tmax) * tlen <= slack(r, t); };
+    if (h.instance == kNoHit && o.instance == kNoHit) continue;
+    if (h.instance != kNoHit) ++j.hits;
+    if (h.instance != kNoHit && o.instance != kNoHit) {
+      const size_t at = oracle.index_of(h.instance);
+      const bool meets = oracle.distance_to(at, h.triangle, r, h.t) <= slack(r, h.t);
+      if (any) {
+        if (!meets) j.fail(where + ": any-hit's triangle is not on the ray at its t");
+        continue;
+      }
+      const bool same = h.instance == o.instance && h.triangle == o.triangle;
+      if (std::fabs(h.t - o.t) * tlen > slack(r, o.t)) j.fail(where + ": t " + std::to_string(h.t) + " against " + std::to_string(o.t));
+      else if (!same && !meets) j.fail(where + ": instance " + std::to_string(h.instance) + " triangle " + std::to_string(h.triangle) + " against " + std::to_string(o.instance) + "/" + std::to_string(o.triangle));
+      else if (!same) ++j.ties;
+    } else if (h.instance == kNoHit) {
+      const size_t at = oracle.index_of(o.instance);
+      if (oracle.distance_to_edge(at, o.triangle, r, o.t) <= slack(r, o.t) || near_end(o.t)) ++j.ties;
+      else j.fail(where + ": a miss where the oracle hits instance " + std::to_string(o.instance) + " triangle " + std::to_string(o.triangle) + " at " + std::to_string(o.t));
+    } else {
+      const size_t at = oracle.index_of(h.instance);
+      if (oracle.distance_to(at, h.triangle, r, h.t) <= slack(r, h.t) &&
+          (oracle.distance_to_edge(at, h.triangle, r, h.t) <= slack(r, h.t) || near_end(h.t)))
+        ++j.ties;
+      else j.fail(where + ": a hit of instance " + std::to_string(h.instance) + " triangle " + std::to_string(h.triangle) + " where the oracle misses");
+    }
+  }
+  return j;
+}
+
+std::vector<SceneHit> trace(const Scene& scene, const std::vector<RayD>& rays, Query query = Query::Closest,
+                            Cull cull = Cull::None, uint8_t mask = 0xFF) {
+  std::vector<SceneHit> hits(rays.size());
+  EXPECT_EQ(scene.trace(rays, hits, HitOutputs::None, query, cull, mask), 0u);
+  return hits;
+}
+
+class SceneVsOracle : public ::testing::TestWithParam<std::tuple<std::string, double>> {};
+
+// Every query and culling, masks, on a level of 60 instances over a
+// cube of 200 units, against the oracle; the level 10^6 and 10^7 units away
+// answers as at the origin.
+TEST_P(SceneVsOracle, GeneratedLevel) {
+  const auto& [layout, offset] = GetParam();
+  constexpr double kSpread = 100;
+  const Level level = make_level(layout, 60, kSpread, offset, 7);
+  const Scene scene = make_scene(level);
+  const SceneOracle oracle = oracle_of(level);
+  const std::vector<RayD> rays = level_rays(level, quick() ? 400 : 1500, kSpread, 11);
+  struct Case {
+    Query query;
+    Cull cull;
+    uint8_t mask;
+  };
+  for (const Case c : {Case{Query::Closest, Cull::None, 0xFF}, Case{Query::Closest, Cull::Back, 0xFF},
+                       Case{Query::Closest, Cull::Front, 0x02}, Case{Query::Any, Cull::None, 0xFF},
+                       Case{Query::Any, Cull::Back, 0x05}}) {
+    const std::vector<SceneHit> hits = trace(scene, rays, c.query, c.cull, c.mask);
+    const Judged j = judge(oracle, rays, hits, c.cull, c.mask, c.query == Query::Any);
+    const std::string what = layout + " at " + std::to_string(offset) + ", query " + std::to_string(int(c.query)) +
+                             ", cull " + std::to_string(int(c.cull)) + ", mask " + std::to_string(c.mask);
+    EXPECT_EQ(j.wrong, 0u) << what << ": " << j.first_problem;
+    EXPECT_LE(j.ties, rays.size() / 100) << what;
+    EXPECT_GT(j.hits, rays.size() / (c.mask == 0xFF ? 5 : 10)) << what << ": too few hits to show anything";
+  }
+  if (offset != 0) {
+    // The same level at the origin: the same instance and triangle for every
+    // ray but a rounding's worth, the same t to float rounding.
+    Level home = make_level(layout, 60, kSpread, 0, 7);
+    const Scene at_home = make_scene(home);
+    std::vector<RayD> home_rays = rays;
+    for (RayD& r : home_rays)
+      for (double& o : r.org) o -= offset;
+    const std::vector<SceneHit> far = trace(scene, rays), near = trace(at_home, home_rays);
+    size_t differ = 0;
+    for (size_t i = 0; i < rays.size(); ++i)
+      differ += far[i].instance != near[i].instance || far[i].triangle != near[i].triangle ||
+                std::fabs(far[i].t - near[i].t) > 1e-5f * (1 + near[i].t);
+    EXPECT_LE(differ, rays.size() / 200) << layout << " at " << offset << " against the origin";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, SceneVsOracle,
+                         ::testing::Combine(::testing::Values("OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3",
+                                                              "QuadTreeHalfFloat/Indexed8BitPackSOA4"),
+                                            ::testing::Values(0.0, 1e6, 1e7)));
+
+// A closed sphere 10^7 units away, plain and mirrored, rays from all
+// around it through its inside: every ray hits, under every query and
+// culling of the back faces (the far side's inner face for the mirrored
+// one, whose outside the world sees turned).
+TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
+  const Mesh sphere = make_sphere(24, 32, 2.0f, {0, 0, 0});
+  for (const char* layout : {"OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3"}) {
+    Scene scene;
+    const MeshId m = scene.add_mesh(build_blob(sphere, parse_layout(layout), "sphere"), "sphere");
+    std::mt19937 rng(3);
+    Transform plain = random_transform(rng, 0, 1e7, true, false), mirrored = random_transform(rng, 0, 1e7, false, true);
+    mirrored.translation[0] += 20;
+    scene.add_instance(m, plain);
+    scene.add_instance(m, mirrored);
+    scene.commit();
+    std::normal_distribution<double> n(0, 1);
+    std::uniform_real_distribution<double> inside(-0.5, 0.5);
+    const size_t count = quick() ? 2000 : 10000;
+    std::vector<RayD> rays(count);
+    for (size_t i = 0; i < count; ++i) {
+      const Transform& at = i % 2 ? mirrored : plain;
+      double d[3] = {n(rng), n(rng), n(rng)};
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (int a = 0; a < 3; ++a) {
+        const double target = at.translation[a] + inside(rng);
+        rays[i].org[a] = target + 9 * d[a] / len;
+        rays[i].dir[a] = float(target - rays[i].org[a]);
+      }
+      rays[i].tmax = INFINITY;
+    }
+    for (Query q : {Query::Closest, Query::Any})
+      for (Cull c : {Cull::None, Cull::Back}) {
+        const std::vector<SceneHit> hits = trace(scene, rays, q, c);
+        size_t leaks = 0;
+        // Past its sphere a ray may go on to the other: any hit may be there.
+        for (size_t i = 0; i < count; ++i)
+          leaks += q == Query::Any ? hits[i].instance == kNoHit : hits[i].instance != (i % 2 ? 1u : 0u);
+        EXPECT_EQ(leaks, 0u) << layout << ", query " << int(q) << ", cull " << int(c);
+      }
+  }
+}
+
+// A grid of unit cells 10^7 units away, rays straight down through its
+// vertices and edge midpoints (the shared places): every one hits, the
+// same triangle as the grid at the origin.
+TEST(Scene, GridFarAwayLeaksNothingThroughSharedEdgesAndVertices) {
+  const Mesh grid = make_grid_plane(16, 16);
+  for (const char* layout : {"OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3"}) {
+    const std::vector<uint8_t> blob = build_blob(grid, parse_layout(layout), "grid");
+    std::vector<SceneHit> answers[2];
+    for (int far = 0; far < 2; ++far) {
+      const double offset = far ? 1e7 : 0;
+      Scene scene;
+      Transform t;
+      for (double& x : t.translation) x = offset;
+      scene.add_instance(scene.add_mesh(blob, "grid"), t);
+      scene.commit();
+      std::vector<RayD> rays;
+      for (int y = 1; y < 32; ++y)
+        for (int x = 1; x < 32; ++x)
+          rays.push_back({{offset + x * 0.5, offset + y * 0.5, offset + 3}, {0, 0, -1}, INFINITY});
+      answers[far] = trace(scene, rays);
+      size_t leaks = 0;
+      for (const SceneHit& h : answers[far]) leaks += h.instance != 0 || h.t != 3.0f;
+      EXPECT_EQ(leaks, 0u) << layout << " at " << offset;
+    }
+    for (size_t i = 0; i < answers[0].size(); ++i) EXPECT_EQ(answers[0][i].triangle, answers[1][i].triangle) << layout << ", ray " << i;
+  }
+}
+
+// Edits show only after commit(); a snapshot keeps the frame it was taken
+// at; each state against the oracle over the instances it has.
+TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
+  Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 30, 40, 0, 21);
+  Scene scene = make_scene(level);
+  const std::vector<RayD> rays = level_rays(level, quick() ? 300 : 1000, 40, 5);
+  const std::vector<SceneHit> before = trace(scene, rays);
+  const std::shared_ptr<const SceneSnapshot> frame0 = scene.snapshot();
+  std::mt19937 rng(9);
+  for (int frame = 0; frame < 4; ++frame) {
+    // Move a few, hide one, show one, remask one, remove one, add one.
+    for (int k = 0; k < 5; ++k) {
+      const uint32_t id = rng() % uint32_t(level.instances.size());
+      if (level.instances[id].mask == 0) continue;  // removed
+      level.instances[id].transform = random_transform(rng, 40, 0, k % 2 == 0, k == 3);
+      scene.set_transform(id, level.instances[id].transform);
+    }
+    const uint32_t hide = rng() % uint32_t(level.instances.size()), show = rng() % uint32_t(level.instances.size());
+    if (level.instances[hide].mask != 0) scene.set_enabled(hide, false), level.enabled[hide] = false;
+    if (level.instances[show].mask != 0) scene.set_enabled(show, true), level.enabled[show] = true;
+    const uint32_t gone = rng() % uint32_t(level.instances.size());
+    if (level.instances[gone].mask != 0) {
+      scene.remove_instance(gone);
+      level.instances[gone].mask = 0, level.enabled[gone] = false;  // an oracle instance no ray mask reaches
+      EXPECT_THROW(scene.set_mask(gone, 1), UsageError);
+    }
+    const OracleInstance added{uint32_t(level.instances.size()), uint32_t(frame % 3), random_transform(rng, 40, 0, true, false), 0xFF};
+    EXPECT_EQ(scene.add_instance(added.mesh, added.transform), added.id);
+    level.instances.push_back(added), level.enabled.push_back(true);
+    // Not committed yet: the last frame's answers.
+    const std::vector<SceneHit> uncommitted = trace(scene, rays);
+    size_t same = 0;
+    for (size_t i = 0; i < rays.size(); ++i) same += uncommitted[i].instance == before[i].instance || frame > 0;
+    EXPECT_EQ(same, rays.size());
+    scene.commit();
+    const Judged j = judge(oracle_of(level), rays, trace(scene, rays), Cull::None, 0xFF, false);
+    EXPECT_EQ(j.wrong, 0u) << "frame " << frame << ": " << j.first_problem;
+  }
+  // The first frame's snapshot still answers as it did.
+  std::vector<SceneHit> again(rays.size());
+  trace_snapshot(*frame0, rays, again);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_EQ(again[i].instance, before[i].instance) << "ray " << i;
+    EXPECT_EQ(again[i].triangle, before[i].triangle) << "ray " << i;
+  }
+}
+
+TEST(Scene, RefusesBadInput) {
+  Scene scene;
+  EXPECT_THROW(scene.add_mesh({1, 2, 3}, "three bytes"), InputError);
+  const MeshId m = scene.add_mesh(build_blob(make_sphere(4, 6, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "s"), "s");
+  Transform flat;
+  flat.rotation_scale[8] = 0;  // not invertible
+  EXPECT_THROW(scene.add_instance(m, flat), UsageError);
+  Transform nan;
+  nan.translation[1] = NAN;
+  EXPECT_THROW(scene.add_instance(m, nan), UsageError);
+  Transform far;
+  far.translation[2] = 1e31;
+  EXPECT_THROW(scene.add_instance(m, far), UsageError);
+  EXPECT_THROW(scene.add_instance(m + 1, Transform{}), UsageError);
+  const InstanceId id = scene.add_instance(m, Transform{});
+  EXPECT_THROW(scene.set_transform(id, flat), UsageError);
+  EXPECT_THROW(scene.set_enabled(id + 1, false), UsageError);
+  scene.commit();
+  // The refused transform left the instance where it was.
+  std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}, {{NAN, 0, 5}, {0, 0, -1}, INFINITY},
+                            {{0, 0, 1e31}, {0, 0, -1}, INFINITY}, {{0, 0, 5}, {0, 0, 0}, INFINITY}};
+  std::vector<SceneHit> hits(rays.size());
+  EXPECT_EQ(scene.trace(rays, hits), 3u);  // the NaN origin, the far origin, the zero direction
+  EXPECT_EQ(hits[0].instance, id);
+  EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
+  for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(hits[i].instance, kNoHit);
+  std::vector<SceneHit> short_hits(1);
+  EXPECT_THROW(scene.trace(rays, short_hits), UsageError);
+  EXPECT_THROW(scene.trace(rays, hits, HitOutputs::None, Query::All), UsageError);
+}
+
+}  // namespace
+}  // namespace meshcast::testing

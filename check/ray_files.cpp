@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cstring>
+#include <fstream>
 
 namespace meshcast {
 
@@ -26,6 +27,11 @@ std::vector<Record> read_records(const std::string& path, const char magic[4], s
 struct HitRecord {
   float t;
   uint32_t triangle;
+};
+
+struct SceneHitRecord {
+  float t;
+  uint32_t instance, triangle;
 };
 
 }  // namespace
@@ -101,6 +107,40 @@ void write_hit_lists(const std::string& path, const HitLists& lists) {
     }
   }
   write_file(path, b.data(), b.size());
+}
+
+std::vector<RayD> read_scene_rays(const std::string& path) { return read_records<RayD>(path, "RAYD", 40); }
+
+void write_scene_rays(const std::string& path, const std::vector<RayD>& rays) {
+  if (rays.size() > kMaxRayCount)
+    throw InputError(path + ": " + std::to_string(rays.size()) + " rays, more than a rays file may hold (" +
+                     std::to_string(kMaxRayCount) + ")");
+  const uint32_t n = uint32_t(rays.size());
+  static_assert(sizeof(RayD) == 40 && std::endian::native == std::endian::little, "a RayD is its record");
+  write_file(path, {{"RAYD", 4}, {&n, 4}, {rays.data(), rays.size() * sizeof(RayD)}});
+}
+
+std::vector<SceneHit> read_scene_hits(const std::string& path) {
+  std::vector<SceneHit> hits;
+  for (const SceneHitRecord& r : read_records<SceneHitRecord>(path, "HITI", 12)) hits.push_back({r.t, r.instance, r.triangle});
+  return hits;
+}
+
+void write_scene_hits(const std::string& path, const std::vector<SceneHit>& hits) {
+  std::vector<uint8_t> b(8 + hits.size() * 12);
+  const uint32_t n = uint32_t(hits.size());
+  std::memcpy(b.data(), "HITI", 4), std::memcpy(b.data() + 4, &n, 4);
+  for (size_t i = 0; i < hits.size(); ++i) {
+    const SceneHitRecord r{hits[i].t, hits[i].instance, hits[i].triangle};
+    std::memcpy(b.data() + 8 + i * 12, &r, 12);
+  }
+  write_file(path, b.data(), b.size());
+}
+
+bool is_scene_rays_file(const std::string& path) {
+  char magic[4] = {};
+  std::ifstream(path, std::ios::binary).read(magic, 4);  // unreadable: read_rays says why
+  return std::memcmp(magic, "RAYD", 4) == 0;
 }
 
 }  // namespace meshcast

@@ -4,6 +4,10 @@
 //   every hit (Query::All): "HITN", uint32 count, uint32 N, per ray uint32
 //         hits found, then N records of float32 t, uint32 triangle, in
 //         order of t; unused records t = inf, triangle 0xFFFFFFFF
+//   scene rays: "RAYD", uint32 count, per ray 3 float64 origin, 3 float32
+//         direction, float32 t_max (40 bytes)
+//   scene hits: "HITI", uint32 count, per ray float32 t (inf: miss),
+//         uint32 instance, uint32 triangle (a miss: 0xFFFFFFFF twice)
 // All little-endian.
 #pragma once
 #include <string>
@@ -12,6 +16,7 @@
 #include "builder/ray_sets.h"
 #include "layout/files.h"
 #include "meshcast/ray.h"
+#include "meshcast/scene.h"
 
 namespace meshcast {
 
@@ -24,6 +29,13 @@ void write_hits(const std::string& path, const std::vector<Hit>& hits);
 // 1..kMaxHitsLimit or a size that is not the header's.
 HitLists read_hit_lists(const std::string& path);
 void write_hit_lists(const std::string& path, const HitLists& lists);
+// Scenes' files (issue 21), with read_rays' refusals.
+std::vector<RayD> read_scene_rays(const std::string& path);
+void write_scene_rays(const std::string& path, const std::vector<RayD>& rays);
+std::vector<SceneHit> read_scene_hits(const std::string& path);
+void write_scene_hits(const std::string& path, const std::vector<SceneHit>& hits);
+// Whether the file starts with RAYD (else it is read as a RAYS file).
+bool is_scene_rays_file(const std::string& path);
 
 // Most rays a rays file may hold, and `meshcast rays --count` make: 2^27
 // (3.5 GiB of records).

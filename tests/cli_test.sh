@@ -47,6 +47,27 @@ check trace-all 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --l
 if [[ $(head -c 4 "$work/hn.hitn") != HITN || $(stat -c %s "$work/hn.hitn") -ne 18012 ]]; then
   echo "FAIL trace-all: the HITN file's magic or size"; failures=$((failures + 1))
 fi
+# Scenes: a scene file of the mesh and the blob, one instance mirrored and
+# far away, another hidden; RAYS rays in, a HITI file out (12 + 500 * 12 bytes).
+cat >"$work/level.json" <<JSON
+{"meshes": {"mesh": "$mesh", "blob": "m.blob"},
+ "instances": [{"mesh": "mesh"},
+               {"mesh": "blob", "rotation_scale": [-1, 0, 0, 0, 2, 0, 0, 0, 1], "translation": [1e7, 0, 0], "mask": 2},
+               {"mesh": "blob", "translation": [0.5, 0, 0], "enabled": false}]}
+JSON
+check trace-scene 0 '"instances":3.*"rays":500' -- "$meshcast" trace "$work/level.json" --rays "$work/r.rays" --out "$work/h.hiti" --query any --cull back --json
+if [[ $(head -c 4 "$work/h.hiti") != HITI || $(stat -c %s "$work/h.hiti") -ne 6008 ]]; then
+  echo "FAIL trace-scene: the HITI file's magic or size"; failures=$((failures + 1))
+fi
+check render-scene 0 "3 instances of 2 meshes.*scene.png" -- "$meshcast" render "$work/level.json" --png "$work/scene.png" --width 64 --height 48
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "translation": [1, 2]}]}' "$mesh" >"$work/short.json"
+check scene-short-translation 2 "short.json: instances\[0\].translation is not an array of 3 numbers" -- "$meshcast" trace "$work/short.json" --rays "$work/r.rays" --out "$work/x.hiti"
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "rotation_scale": [1,0,0, 0,0,0, 0,0,1]}]}' "$mesh" >"$work/flat.json"
+check scene-flat 2 "flat.json: instances\[0\]: .*not invertible" -- "$meshcast" trace "$work/flat.json" --rays "$work/r.rays" --out "$work/x.hiti"
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "rock"}]}' "$mesh" >"$work/rock.json"
+check scene-unknown-mesh 2 'rock.json: instances\[0\].mesh: "rock" is not in "meshes"' -- "$meshcast" trace "$work/rock.json" --rays "$work/r.rays" --out "$work/x.hiti"
+printf '{"meshes": {' >"$work/cut.json"
+check scene-not-json 2 "cut.json: not JSON" -- "$meshcast" trace "$work/cut.json" --rays "$work/r.rays" --out "$work/x.hiti"
 check trace-max-hits-range 2 "max-hits" -- "$meshcast" trace "$mesh" --query all --max-hits 0 --rays "$work/r.rays" --out "$work/hx.hitn"
 # The two hits files agree (same triangle per ray): compare the triangle columns.
 if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \

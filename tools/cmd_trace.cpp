@@ -11,8 +11,52 @@
 #include "tools/commands.h"
 #include "tools/common.h"
 #include "tools/render.h"
+#include "tools/scene_file.h"
 
 namespace meshcast::tools {
+
+namespace {
+
+// trace on a scene file: RAYD or RAYS rays in, a HITI file out.
+void trace_scene(const std::string& input, const std::string& rays_path, const std::string& out, const LayoutArgs& layout,
+                 Query query, Cull cull, uint32_t repeat, bool json) {
+  auto t0 = std::chrono::steady_clock::now();
+  SceneFile file = load_scene_file(input, layout, json ? stderr : stdout);
+  const double load_ms = ms_since(t0);
+  std::vector<RayD> rays;
+  if (is_scene_rays_file(rays_path)) {
+    rays = read_scene_rays(rays_path);
+  } else {
+    for (const Ray& r : read_rays(rays_path))
+      rays.push_back({{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax});
+  }
+  std::vector<SceneHit> hits(rays.size());
+  std::vector<double> pass_ms;
+  uint64_t skipped = 0;
+  for (uint32_t r = 0; r < repeat; ++r) {
+    auto t1 = std::chrono::steady_clock::now();
+    skipped = file.scene.trace(rays, hits, HitOutputs::None, query, cull);
+    pass_ms.push_back(ms_since(t1));
+  }
+  write_scene_hits(out, hits);
+  size_t hit_count = 0;
+  for (const SceneHit& h : hits) hit_count += h.instance != kNoHit;
+  const double ns = rays.empty() ? 0 : median(pass_ms) * 1e6 / double(rays.size());
+  if (json) {
+    print_json({{"input", input}, {"meshes", file.mesh_names.size()}, {"instances", file.instances},
+                {"blob_bytes", file.blob_bytes}, {"load_ms", load_ms}, {"query", int(query)}, {"cull", int(cull)},
+                {"rays", rays.size()}, {"hits", hit_count}, {"invalid_rays", skipped}, {"repeat", repeat},
+                {"ns_per_ray", ns}});
+    return;
+  }
+  std::printf("%s: %zu meshes (%llu blob bytes), %zu instances, loaded and built in %.1f ms\n", input.c_str(),
+              file.mesh_names.size(), (unsigned long long)file.blob_bytes, file.instances, load_ms);
+  std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", rays.size(), hit_count,
+              (unsigned long long)skipped);
+  std::printf("cast: %.1f ns/ray (median of %u passes, one thread) -> %s\n", ns, repeat, out.c_str());
+}
+
+}  // namespace
 
 void add_trace(CLI::App& app) {
   struct Args {
@@ -24,8 +68,8 @@ void add_trace(CLI::App& app) {
     uint32_t max_hits = 16;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh or blob, write a hits file");
-  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL) or blob")->required();
+  CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh, blob or scene (.json), write a hits file");
+  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), blob or scene file (.json: RAYD or RAYS rays in, HITI hits out)")->required();
   cmd->add_option("--rays", args->rays, "rays file")->required();
   cmd->add_option("--out", args->out, "hits file to write")->required();
   add_layout_options(cmd, args->layout);
@@ -50,6 +94,12 @@ void add_trace(CLI::App& app) {
   cmd->callback([args] {
     const Query query = layout::query_named(args->query, "--query");
     const Cull cull = layout::cull_named(args->cull, "--cull");
+    if (is_scene_file(args->input)) {
+      if (args->backend != "cpu") throw InputError("trace " + args->input + ": scenes are cast on the CPU (--backend cpu)");
+      if (query == Query::All) throw InputError("trace " + args->input + ": --query all is not answered on scenes yet");
+      trace_scene(args->input, args->rays, args->out, args->layout, query, cull, args->repeat, args->json);
+      return;
+    }
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
@@ -116,6 +166,7 @@ void add_trace(CLI::App& app) {
   });
 }
 
+
 void add_render(CLI::App& app) {
   struct Args {
     std::string input, png = "out/render.png", backend = "cpu", method, device;  // method "": the blob's
@@ -123,8 +174,8 @@ void add_render(CLI::App& app) {
     int width = 800, height = 600;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("render", "a depth-shaded picture of a mesh or blob, one primary ray a pixel");
-  cmd->add_option("input", args->input, "mesh file or blob")->required();
+  CLI::App* cmd = app.add_subcommand("render", "a depth-shaded picture of a mesh, blob or scene, one primary ray a pixel");
+  cmd->add_option("input", args->input, "mesh file, blob or scene file (.json)")->required();
   add_layout_options(cmd, args->layout);
   cmd->add_option("--png", args->png, "picture to write");
   cmd->add_option("--width", args->width)->check(CLI::Range(16, 8192));
@@ -133,6 +184,15 @@ void add_render(CLI::App& app) {
   cmd->add_option("--method", args->method, "GPU method (see trace --help; default: the one that reads the layout)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->callback([args] {
+    if (is_scene_file(args->input)) {
+      if (args->backend != "cpu") throw InputError("render " + args->input + ": scenes are cast on the CPU (--backend cpu)");
+      SceneFile file = load_scene_file(args->input, args->layout, stdout);
+      const Picture p = render_scene(file.scene, args->width, args->height);
+      write_png(args->png, p.width, p.height, p.rgb);
+      std::printf("%s: %zu instances of %zu meshes, CPU, one thread, %dx%d, %.0f ns/ray -> %s\n", args->input.c_str(),
+                  file.instances, file.mesh_names.size(), p.width, p.height, p.ns_per_ray, args->png.c_str());
+      return;
+    }
     const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
     if (vulkan_auto) args->layout.gpu = true;
     Loaded in = load_input(args->input, args->layout);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cpu/intersect.h"
+#include "meshcast/scene.h"
 
 namespace meshcast::tools {
 
@@ -24,5 +25,10 @@ using CastFn = std::function<void(std::span<const Ray>, std::span<Hit>)>;
 // `cast` null: the CPU walker on `blob`.
 Picture render(const std::vector<uint8_t>& blob, int width, int height, const std::vector<Ray>& markers,
                const std::vector<Hit>& marker_hits, const CastFn& cast = nullptr);
+
+// The same camera and shading over a scene: framed on the committed
+// instances' world box, the camera's rays in double (a scene far from the
+// origin keeps its detail).
+Picture render_scene(const Scene& scene, int width, int height);
 
 }  // namespace meshcast::tools

@@ -1,0 +1,93 @@
+#include "tools/scene_file.h"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "meshcast/errors.h"
+#include "tools/common.h"
+
+namespace meshcast::tools {
+
+namespace {
+
+using nlohmann::json;
+
+// The numbers of an array field of `count` entries, or InputError naming it.
+std::vector<double> numbers(const json& value, size_t count, const std::string& where) {
+  if (!value.is_array() || value.size() != count)
+    throw InputError(where + " is not an array of " + std::to_string(count) + " numbers");
+  std::vector<double> out;
+  for (const json& v : value) {
+    if (!v.is_number()) throw InputError(where + " holds " + v.dump() + ", not a number");
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
+}  // namespace
+
+bool is_scene_file(const std::string& path) { return std::filesystem::path(path).extension() == ".json"; }
+
+SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std::FILE* report) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot be opened");
+  json doc;
+  try {
+    doc = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(path + ": not JSON: " + e.what());
+  }
+  if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_object() || !doc.contains("instances") ||
+      !doc["instances"].is_array())
+    throw InputError(path + ": a scene file is an object with \"meshes\" (an object) and \"instances\" (an array)");
+  SceneFile out;
+  std::map<std::string, MeshId> ids;
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  for (const auto& [name, file] : doc["meshes"].items()) {
+    if (!file.is_string()) throw InputError(path + ": meshes." + name + " is not a file name");
+    const std::string mesh_path = (folder / file.get<std::string>()).string();
+    Loaded mesh = load_input(mesh_path, layout, report);
+    out.blob_bytes += mesh.blob.size();
+    ids[name] = out.scene.add_mesh(std::move(mesh.blob), mesh_path);
+    out.mesh_names.push_back(name);
+  }
+  size_t index = 0;
+  for (const json& i : doc["instances"]) {
+    const std::string where = path + ": instances[" + std::to_string(index++) + "]";
+    if (!i.is_object() || !i.contains("mesh") || !i["mesh"].is_string())
+      throw InputError(where + " is not an object with a \"mesh\" name");
+    const auto mesh = ids.find(i["mesh"].get<std::string>());
+    if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + i["mesh"].get<std::string>() + "\" is not in \"meshes\"");
+    Transform t;
+    if (i.contains("rotation_scale")) {
+      const std::vector<double> m = numbers(i["rotation_scale"], 9, where + ".rotation_scale");
+      for (int k = 0; k < 9; ++k) t.rotation_scale[k] = float(m[size_t(k)]);
+    }
+    if (i.contains("translation")) {
+      const std::vector<double> v = numbers(i["translation"], 3, where + ".translation");
+      for (int k = 0; k < 3; ++k) t.translation[k] = v[size_t(k)];
+    }
+    uint8_t mask = 0xFF;
+    if (i.contains("mask")) {
+      if (!i["mask"].is_number_integer() || i["mask"].get<int64_t>() < 0 || i["mask"].get<int64_t>() > 255)
+        throw InputError(where + ".mask is not an integer in 0..255");
+      mask = uint8_t(i["mask"].get<int64_t>());
+    }
+    if (i.contains("enabled") && !i["enabled"].is_boolean()) throw InputError(where + ".enabled is not true or false");
+    InstanceId id;
+    try {
+      id = out.scene.add_instance(mesh->second, t, mask);
+    } catch (const UsageError& e) {
+      throw InputError(where + ": " + e.what());
+    }
+    if (i.contains("enabled") && !i["enabled"].get<bool>()) out.scene.set_enabled(id, false);
+    ++out.instances;
+  }
+  out.scene.commit();
+  return out;
+}
+
+}  // namespace meshcast::tools

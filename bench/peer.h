@@ -7,6 +7,7 @@
 
 #include "meshcast/mesh.h"
 #include "cpu/intersect.h"
+#include "meshcast/scene.h"
 
 namespace meshcast::bench {
 
@@ -32,5 +33,28 @@ class Peer {
 // nullptr when meshcast was built without Embree.
 enum class EmbreeMode { Default, Robust, Compact };
 std::unique_ptr<Peer> make_embree(const Mesh& mesh, EmbreeMode mode = EmbreeMode::Default, uint32_t threads = 1);
+
+// A peer's instanced scene (issue 21): each mesh its own scene, built once;
+// the instances over them in a top scene rebuilt by commit().
+struct PeerInstance {
+  uint32_t mesh;
+  Transform transform;
+};
+class ScenePeer {
+ public:
+  virtual ~ScenePeer() = default;
+  virtual std::string name() const = 0;
+  virtual uint64_t bytes() const = 0;  // every scene, top included, plus the meshes kept
+  virtual void set_transform(uint32_t instance, const Transform& transform) = 0;
+  virtual void commit() = 0;
+  // One thread; the ray's origin rounded to float (Embree has no double
+  // rays), hits naming the instance and the triangle.
+  virtual void trace(const std::vector<RayD>& rays, std::vector<SceneHit>& hits) const = 0;
+};
+// Embree's instancing (RTC_GEOMETRY_TYPE_INSTANCE over one scene a mesh, its
+// default build; the top scene RTC_SCENE_FLAG_DYNAMIC, one thread); its
+// transforms are float. nullptr without Embree.
+std::unique_ptr<ScenePeer> make_embree_scene(const std::vector<const Mesh*>& meshes,
+                                             const std::vector<PeerInstance>& instances);
 
 }  // namespace meshcast::bench

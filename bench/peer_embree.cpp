@@ -96,7 +96,110 @@ class Embree final : public Peer {
   std::atomic<int64_t> bytes_{0};
 };
 
+// Embree's instancing: a scene a mesh (its geometry shares our arrays), a
+// top scene of instance geometries whose ids are the instances' indices.
+class EmbreeScene final : public ScenePeer {
+ public:
+  EmbreeScene(const std::vector<const Mesh*>& meshes, const std::vector<PeerInstance>& instances) {
+    device_ = rtcNewDevice("threads=1");
+    if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
+    rtcSetDeviceMemoryMonitorFunction(
+        device_,
+        [](void* user, ssize_t bytes, bool) {
+          static_cast<std::atomic<int64_t>*>(user)->fetch_add(bytes);
+          return true;
+        },
+        &bytes_);
+    shapes_.reserve(meshes.size());  // Embree keeps pointers into each shape's arrays
+    for (const Mesh* mesh : meshes) {
+      Shape& s = shapes_.emplace_back();
+      s.vertices.resize(3 * mesh->vertices.size() + 1, 0.0f);  // 16-byte loads: 4 bytes of padding
+      for (size_t i = 0; i < mesh->vertices.size(); ++i)
+        for (int a = 0; a < 3; ++a) s.vertices[3 * i + size_t(a)] = mesh->vertices[i][a];
+      s.indices.resize(3 * mesh->triangles.size());
+      for (size_t t = 0; t < mesh->triangles.size(); ++t)
+        for (int c = 0; c < 3; ++c) s.indices[3 * t + size_t(c)] = mesh->triangles[t][size_t(c)];
+      mesh_bytes_ += 12ull * mesh->vertices.size() + 12ull * mesh->triangles.size();
+      s.scene = rtcNewScene(device_);
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s.vertices.data(), 0, 12,
+                                 mesh->vertices.size());
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s.indices.data(), 0, 12,
+                                 mesh->triangles.size());
+      rtcCommitGeometry(g);
+      rtcAttachGeometry(s.scene, g);
+      rtcReleaseGeometry(g);
+      rtcCommitScene(s.scene);
+    }
+    top_ = rtcNewScene(device_);
+    rtcSetSceneFlags(top_, RTC_SCENE_FLAG_DYNAMIC);
+    for (size_t i = 0; i < instances.size(); ++i) {
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(g, shapes_[instances[i].mesh].scene);
+      rtcAttachGeometryByID(top_, g, unsigned(i));
+      instances_.push_back(g);
+      set_transform(uint32_t(i), instances[i].transform);
+    }
+    rtcCommitScene(top_);
+  }
+  ~EmbreeScene() override {
+    for (RTCGeometry g : instances_) rtcReleaseGeometry(g);
+    rtcReleaseScene(top_);
+    for (Shape& s : shapes_) rtcReleaseScene(s.scene);
+    rtcReleaseDevice(device_);
+  }
+  std::string name() const override {
+    return "Embree " + std::to_string(RTC_VERSION_MAJOR) + "." + std::to_string(RTC_VERSION_MINOR) + "." +
+           std::to_string(RTC_VERSION_PATCH) + " instances";
+  }
+  uint64_t bytes() const override { return uint64_t(bytes_.load()) + mesh_bytes_; }
+  void set_transform(uint32_t instance, const Transform& t) override {
+    float xfm[12];  // 3x4 row-major: rotation_scale, then the translation (rounded to float)
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) xfm[4 * r + c] = t.rotation_scale[3 * r + c];
+      xfm[4 * r + 3] = float(t.translation[r]);
+    }
+    rtcSetGeometryTransform(instances_[instance], 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, xfm);
+    rtcCommitGeometry(instances_[instance]);
+  }
+  void commit() override { rtcCommitScene(top_); }
+  void trace(const std::vector<RayD>& rays, std::vector<SceneHit>& hits) const override {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      const RayD& r = rays[i];
+      RTCRayHit rh{};
+      rh.ray.org_x = float(r.org[0]), rh.ray.org_y = float(r.org[1]), rh.ray.org_z = float(r.org[2]);
+      rh.ray.dir_x = r.dir[0], rh.ray.dir_y = r.dir[1], rh.ray.dir_z = r.dir[2];
+      rh.ray.tnear = 0.0f, rh.ray.tfar = r.tmax, rh.ray.mask = ~0u;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(top_, &context, &rh);
+      hits[i] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? SceneHit{}
+                                                         : SceneHit{rh.ray.tfar, rh.hit.instID[0], rh.hit.primID};
+    }
+  }
+
+ private:
+  struct Shape {
+    std::vector<float> vertices;
+    std::vector<unsigned> indices;
+    RTCScene scene = nullptr;
+  };
+  RTCDevice device_ = nullptr;
+  std::vector<Shape> shapes_;
+  std::vector<RTCGeometry> instances_;
+  RTCScene top_ = nullptr;
+  uint64_t mesh_bytes_ = 0;
+  std::atomic<int64_t> bytes_{0};
+};
+
 }  // namespace
+
+std::unique_ptr<ScenePeer> make_embree_scene(const std::vector<const Mesh*>& meshes,
+                                             const std::vector<PeerInstance>& instances) {
+  return std::make_unique<EmbreeScene>(meshes, instances);
+}
 
 std::unique_ptr<Peer> make_embree(const Mesh& mesh, EmbreeMode mode, uint32_t threads) {
   return std::make_unique<Embree>(mesh, mode, threads);

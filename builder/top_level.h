@@ -12,6 +12,13 @@ namespace meshcast {
 // (std::nth_element: O(n log n), no sort), down to leaves of at most
 // kTopLeafSize. Every box is the union of its instances' boxes, in double,
 // so nothing is rounded inward.
-layout::TopLevel build_top_level(std::vector<layout::PlacedInstance> placed);
+layout::TopLevel build_top_level(const std::vector<layout::PlacedInstance>& placed);
+
+// The same tree over instances that moved (top.placed updated in place,
+// none added or taken away): every box joined again from the leaves up, in
+// one pass over the nodes (children follow their parent in the array).
+// O(n), where a build is O(n log n); the tree's splits stay as they were, so
+// it fits less well the farther the instances have gone.
+void refit_top_level(layout::TopLevel& top);
 
 }  // namespace meshcast

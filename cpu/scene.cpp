@@ -18,6 +18,11 @@ struct Scene::Edits {
   };
   std::vector<Instance> instances;  // by InstanceId
   size_t live = 0;
+  // Since the last build of the top level: whether an instance was added,
+  // removed, shown or hidden (the tree must be built again), and how many
+  // commits refit it instead (moves and masks only).
+  bool rebuild = true;
+  uint32_t refits = 0;
 
   Instance& at(InstanceId id, const char* who) {
     if (id >= instances.size() || instances[id].removed)
@@ -93,6 +98,7 @@ InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t 
   place(i.placed, transform, *edits_->meshes[mesh], "Scene::add_instance");
   edits_->instances.push_back(i);
   ++edits_->live;
+  edits_->rebuild = true;
   return i.placed.id;
 }
 
@@ -106,22 +112,41 @@ void Scene::set_transform(InstanceId instance, const Transform& transform) {
 void Scene::set_mask(InstanceId instance, uint8_t mask) { edits_->at(instance, "Scene::set_mask").placed.mask = mask; }
 
 void Scene::set_enabled(InstanceId instance, bool enabled) {
-  edits_->at(instance, "Scene::set_enabled").enabled = enabled;
+  Edits::Instance& i = edits_->at(instance, "Scene::set_enabled");
+  edits_->rebuild |= i.enabled != enabled;
+  i.enabled = enabled;
 }
 
 void Scene::remove_instance(InstanceId instance) {
   edits_->at(instance, "Scene::remove_instance").removed = true;
   --edits_->live;
+  edits_->rebuild = true;
 }
 
+// A refit keeps the tree's splits while instances wander; after this many
+// in a row the tree is built again, so a level in motion never walks a tree
+// fitted to where it was long ago.
+constexpr uint32_t kRefitsBeforeRebuild = 16;
+
 void Scene::commit() {
-  std::vector<layout::PlacedInstance> placed;
-  placed.reserve(edits_->live);
-  for (const Edits::Instance& i : edits_->instances)
-    if (i.enabled && !i.removed) placed.push_back(i.placed);
+  Edits& e = *edits_;
   auto next = std::make_shared<SceneSnapshot>();
-  next->meshes = edits_->meshes;
-  next->top = build_top_level(std::move(placed));
+  next->meshes = e.meshes;
+  if (!e.rebuild && e.refits < kRefitsBeforeRebuild) {
+    // Moves and masks only: the same instances in the same places of the
+    // tree, their records and the boxes refreshed.
+    next->top = committed_->top;
+    for (layout::PlacedInstance& p : next->top.placed) p = e.instances[p.id].placed;
+    refit_top_level(next->top);
+    ++e.refits;
+  } else {
+    std::vector<layout::PlacedInstance> placed;
+    placed.reserve(e.live);
+    for (const Edits::Instance& i : e.instances)
+      if (i.enabled && !i.removed) placed.push_back(i.placed);
+    next->top = build_top_level(placed);
+    e.rebuild = false, e.refits = 0;
+  }
   committed_ = std::move(next);
 }
 

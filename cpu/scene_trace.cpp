@@ -12,13 +12,14 @@ namespace meshcast {
 
 namespace {
 
-// How much a node's box is widened for one ray: the ray reaches each
+// How much every box is widened for one ray: the ray reaches each
 // instance rounded (its origin relative to the instance in float, then the
-// float inverse), so where the walker meets a triangle can lie off the
-// world ray by about 2^-22 of the ray origin's distance to it (more for
-// strongly non-uniform scales): 2^-16 of the distance from the origin to
-// the box's centre plus its half extent covers that, and is still well
-// inside the box's size for any ray that starts near it.
+// float inverse), so where a walker meets a triangle can lie off the world
+// ray by about 2^-22 of the distance from the ray's origin (more for
+// strongly non-uniform scales). 2^-16 of the origin's distance to the far
+// corner of the whole scene's box covers every instance the ray can reach
+// (worked out once a ray: a few centimetres for a ray inside a level 10 km
+// across, far inside the smallest instance a game places).
 constexpr double kBoxSlack = 0x1p-16;
 
 struct WorldRay {
@@ -26,27 +27,20 @@ struct WorldRay {
   double inv[3];  // 1 / dir, +-inf for a zero component
   float dir[3];
   float tmax;
+  double pad;  // kBoxSlack of the farthest the ray's origin is from the scene's box
 };
 
-// The ray's [entry, exit] in a widened box, or false.
+// The ray's entry into a widened box before `cut`, or false.
 bool enters(const WorldRay& r, const layout::TopNode& n, double cut, double* entry) {
-  double reach = 0, half = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double centre = 0.5 * (n.min[a] + n.max[a]);
-    reach = std::max(reach, std::fabs(r.org[a] - centre));
-    half = std::max(half, 0.5 * (n.max[a] - n.min[a]));
-  }
-  const double pad = (reach + half) * kBoxSlack;
   double tn = 0, tf = cut * (1 + kBoxSlack);
   for (int a = 0; a < 3; ++a) {
-    const double lo = n.min[a] - pad - r.org[a], hi = n.max[a] + pad - r.org[a];
+    const double lo = n.min[a] - r.pad - r.org[a], hi = n.max[a] + r.pad - r.org[a];
     if (r.dir[a] == 0) {
       if (lo > 0 || hi < 0) return false;  // beside the slab, parallel to it
       continue;
     }
-    double t0 = lo * r.inv[a], t1 = hi * r.inv[a];
-    if (t0 > t1) std::swap(t0, t1);
-    tn = std::max(tn, t0), tf = std::min(tf, t1);
+    const double t0 = lo * r.inv[a], t1 = hi * r.inv[a];
+    tn = std::max(tn, std::min(t0, t1)), tf = std::min(tf, std::max(t0, t1));
   }
   *entry = tn;
   return tn <= tf;
@@ -85,6 +79,10 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
   WorldRay r;
   for (int a = 0; a < 3; ++a) r.org[a] = rd.org[a], r.dir[a] = rd.dir[a], r.inv[a] = 1.0 / double(rd.dir[a]);
   r.tmax = rd.tmax;
+  const layout::TopNode& root = s.top.nodes[0];
+  double far = 0;
+  for (int a = 0; a < 3; ++a) far = std::max({far, std::fabs(rd.org[a] - root.min[a]), std::fabs(rd.org[a] - root.max[a])});
+  r.pad = far * kBoxSlack;
   bool complete = true;
   float cut = rd.tmax;  // the closest hit's t so far
   constexpr int kStack = 128;
@@ -116,13 +114,12 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
         if ((p.mask & mask) == 0) continue;
         Ray local = to_local(r, p);
         local.tmax = cut;
-        if (!ray_is_walkable(local)) {
-          complete = false;
-          continue;
-        }
         Hit h;
-        s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
-                                     as_instance_sees(cull, p.mirrored != 0));
+        // A local ray the walkers refuse (its direction scaled past their
+        // range) is counted, not walked.
+        if (s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
+                                         as_instance_sees(cull, p.mirrored != 0)) != 0)
+          complete = false;
         // Equal t: the lower instance id, as the oracle breaks ties.
         if (h.triangle != kNoHit && (h.t < cut || best.instance == kNoHit || (h.t == cut && p.id < best.instance))) {
           best = {h.t, p.id, h.triangle, h.u, h.v};

@@ -29,7 +29,7 @@ struct TopNode {
 // The top level: placed instances reordered into tree order, the nodes
 // (root first; empty when no instance is placed). Leaves hold at most
 // kTopLeafSize instances.
-constexpr uint32_t kTopLeafSize = 2;
+constexpr uint32_t kTopLeafSize = 1;
 struct TopLevel {
   std::vector<PlacedInstance> placed;
   std::vector<TopNode> nodes;

@@ -343,6 +343,30 @@ TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
   }
 }
 
+// Frames that only move instances and change masks refit the top level
+// (16 in a row, then a build): every frame against the oracle, moves large
+// enough to carry instances across the level.
+TEST(Scene, FramesOfMovesAlone) {
+  Level level = make_level("AABBTree/Float3", 40, 60, 1e7, 33);
+  Scene scene = make_scene(level);
+  const std::vector<RayD> rays = level_rays(level, quick() ? 200 : 800, 60, 8);
+  std::mt19937 rng(4);
+  for (int frame = 0; frame < 20; ++frame) {
+    for (int k = 0; k < 8; ++k) {
+      const uint32_t id = rng() % uint32_t(level.instances.size());
+      level.instances[id].transform = random_transform(rng, 60, 1e7, k % 2 == 0, k % 3 == 0);
+      scene.set_transform(id, level.instances[id].transform);
+    }
+    const uint32_t remask = rng() % uint32_t(level.instances.size());
+    level.instances[remask].mask = uint8_t(1u << (frame % 3));
+    scene.set_mask(remask, level.instances[remask].mask);
+    scene.commit();
+    const Judged j = judge(oracle_of(level), rays, trace(scene, rays, Query::Closest, Cull::None, 0x03), Cull::None, 0x03, false);
+    EXPECT_EQ(j.wrong, 0u) << "frame " << frame << ": " << j.first_problem;
+    EXPECT_GT(j.hits, rays.size() / 25) << "frame " << frame;
+  }
+}
+
 TEST(Scene, RefusesBadInput) {
   Scene scene;
   EXPECT_THROW(scene.add_mesh({1, 2, 3}, "three bytes"), InputError);

@@ -429,6 +429,7 @@ void add_bench(CLI::App& app) {
   bench->require_subcommand(1);
   add_bench_auto(bench);
   add_bench_peers(bench);
+  add_bench_scenes(bench);
   add_bench_encodings(bench);
   add_bench_tables(bench);
   add_bench_gpu(bench);

@@ -18,31 +18,6 @@
 
 namespace meshcast::tools {
 
-namespace {
-
-// The processor, as /proc/cpuinfo names it (figures count only with it).
-std::string processor_name() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  std::string flags;
-  std::string name = "unknown processor";
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0 && name == "unknown processor") name = line.substr(line.find(':') + 2);
-    if (line.rfind("flags", 0) == 0 && flags.empty()) flags = line;
-  }
-  const bool avx512 = flags.find(" avx512f") != std::string::npos, avx2 = flags.find(" avx2") != std::string::npos;
-  return name + (avx512 ? " (AVX-512)" : avx2 ? " (AVX2, no AVX-512)" : " (no AVX2)");
-}
-
-std::vector<std::string> split(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  for (std::string part; std::getline(in, part, ',');)
-    if (!part.empty()) out.push_back(part);
-  return out;
-}
-
-}  // namespace
 
 void add_bench_peers(CLI::App* bench) {
   struct Args {

@@ -18,6 +18,7 @@ void add_bench(CLI::App& app);
 void add_render(CLI::App& app);
 void add_bench_auto(CLI::App* bench);   // `meshcast bench auto`, under `bench`
 void add_bench_peers(CLI::App* bench);  // `meshcast bench peers`
+void add_bench_scenes(CLI::App* bench);  // `meshcast bench scenes`
 
 // A mesh file, or a generated terrain: "terrain_2M" (2,097,152 triangles,
 // 1,050,625 vertices) or "terrain_66k" (131,072 triangles, 66,049 vertices:

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "builder/auto_layout.h"
 #include "check/ray_files.h"
@@ -167,6 +169,27 @@ SectionBytes section_bytes(const std::vector<uint8_t>& blob) {
   s.remap = h.remap_size;
   s.total = blob.size();
   return s;
+}
+
+std::string processor_name() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  std::string flags;
+  std::string name = "unknown processor";
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0 && name == "unknown processor") name = line.substr(line.find(':') + 2);
+    if (line.rfind("flags", 0) == 0 && flags.empty()) flags = line;
+  }
+  const bool avx512 = flags.find(" avx512f") != std::string::npos, avx2 = flags.find(" avx2") != std::string::npos;
+  return name + (avx512 ? " (AVX-512)" : avx2 ? " (AVX2, no AVX-512)" : " (no AVX2)");
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string part; std::getline(in, part, ',');)
+    if (!part.empty()) out.push_back(part);
+  return out;
 }
 
 }  // namespace meshcast::tools

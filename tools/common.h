@@ -43,6 +43,12 @@ struct SectionBytes {
 };
 SectionBytes section_bytes(const std::vector<uint8_t>& blob);
 
+// The processor, as /proc/cpuinfo names it, with its widest vector set
+// (a benchmark's figures count only with it).
+std::string processor_name();
+// The parts of a comma-separated list, empty parts dropped.
+std::vector<std::string> split(const std::string& text);
+
 void write_png(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 
 // One JSON object on a line of stdout, written by nlohmann::json: strings are

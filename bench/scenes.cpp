@@ -86,8 +86,8 @@ struct Contender {
   std::function<void(const std::vector<RayD>&, std::vector<SceneHit>&)> trace;
   std::function<void(uint32_t, const Transform&)> move;
   std::function<void()> commit;
-  std::vector<double> ns;
-  std::vector<SceneHit> hits, origin_hits;
+  std::vector<double> ns = {};
+  std::vector<SceneHit> hits = {};
 };
 
 }  // namespace

@@ -71,7 +71,88 @@ layout::TopLevel build_top_level(const std::vector<layout::PlacedInstance>& plac
   TopBuilder{placed, items, top.nodes}.build(0, uint32_t(placed.size()));
   top.placed.reserve(placed.size());
   for (const Item& item : items) top.placed.push_back(placed[item.index]);
+  collapse_top_level(top);
   return top;
+}
+
+namespace {
+
+double half_area(const layout::TopNode& n) {
+  const double e[3] = {n.max[0] - n.min[0], n.max[1] - n.min[1], n.max[2] - n.min[2]};
+  return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
+// d - anchor in float, rounded down (lo) or up (hi): the float box holds
+// the double one.
+float below(double d, double anchor) {
+  const double x = d - anchor;  // exact enough: one rounding, covered by the walk's pad
+  float f = float(x);
+  if (double(f) > x) f = std::nextafter(f, -INFINITY);
+  return f;
+}
+float above(double d, double anchor) {
+  const double x = d - anchor;
+  float f = float(x);
+  if (double(f) < x) f = std::nextafter(f, INFINITY);
+  return f;
+}
+
+struct Collapser {
+  layout::TopLevel& top;
+
+  // The wide node over binary node `root` (an inner node); returns its index.
+  uint32_t collapse(uint32_t root) {
+    uint32_t kids[4] = {root + 1, top.nodes[root].right, 0, 0};
+    int count = 2;
+    // Open the largest inner child until there are 4.
+    while (count < 4) {
+      int best = -1;
+      for (int k = 0; k < count; ++k)
+        if (top.nodes[kids[k]].count == 0 && (best < 0 || half_area(top.nodes[kids[k]]) > half_area(top.nodes[kids[best]])))
+          best = k;
+      if (best < 0) break;
+      const uint32_t opened = kids[best];
+      kids[best] = opened + 1;
+      kids[count++] = top.nodes[opened].right;
+    }
+    const uint32_t index = uint32_t(top.wide.size());
+    top.wide.emplace_back();
+    for (int k = 0; k < 4; ++k) {
+      uint32_t slot = layout::kTopEmpty;
+      float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      if (k < count) {
+        const layout::TopNode& n = top.nodes[kids[k]];
+        for (int a = 0; a < 3; ++a) lo[a] = below(n.min[a], top.anchor[a]), hi[a] = above(n.max[a], top.anchor[a]);
+        slot = n.count > 0 ? layout::kTopInstance | n.first : collapse(kids[k]);
+      }
+      layout::TopWideNode& w = top.wide[index];  // (collapse() may have moved it)
+      for (int a = 0; a < 3; ++a) w.lo[a][k] = lo[a], w.hi[a][k] = hi[a];
+      w.slot[k] = slot;
+    }
+    return index;
+  }
+};
+
+}  // namespace
+
+void collapse_top_level(layout::TopLevel& top) {
+  top.wide.clear();
+  if (top.nodes.empty()) return;
+  const layout::TopNode& root = top.nodes[0];
+  for (int a = 0; a < 3; ++a) top.anchor[a] = 0.5 * (root.min[a] + root.max[a]);
+  top.wide.reserve(top.nodes.size() / 2 + 1);
+  if (root.count > 0) {
+    // One instance: a wide root with it in slot 0.
+    layout::TopWideNode w;
+    for (int a = 0; a < 3; ++a)
+      for (int k = 0; k < 4; ++k) w.lo[a][k] = INFINITY, w.hi[a][k] = -INFINITY;
+    for (int k = 0; k < 4; ++k) w.slot[k] = layout::kTopEmpty;
+    for (int a = 0; a < 3; ++a) w.lo[a][0] = below(root.min[a], top.anchor[a]), w.hi[a][0] = above(root.max[a], top.anchor[a]);
+    w.slot[0] = layout::kTopInstance | root.first;
+    top.wide.push_back(w);
+    return;
+  }
+  Collapser{top}.collapse(0);
 }
 
 void refit_top_level(layout::TopLevel& top) {
@@ -91,6 +172,7 @@ void refit_top_level(layout::TopLevel& top) {
       node.max[a] = std::max(top.nodes[n + 1].max[a], top.nodes[node.right].max[a]);
     }
   }
+  collapse_top_level(top);
 }
 
 }  // namespace meshcast

@@ -14,6 +14,12 @@ namespace meshcast {
 // so nothing is rounded inward.
 layout::TopLevel build_top_level(const std::vector<layout::PlacedInstance>& placed);
 
+// The 4-wide nodes of top.wide and the anchor, made again from the binary
+// nodes (each wide node takes the largest of its binary descendants' boxes
+// apart until it has 4 children or only leaves): O(n), after every build
+// and refit.
+void collapse_top_level(layout::TopLevel& top);
+
 // The same tree over instances that moved (top.placed updated in place,
 // none added or taken away): every box joined again from the leaves up, in
 // one pass over the nodes (children follow their parent in the array).

@@ -1,8 +1,12 @@
-// A snapshot's walk: the top level in double, each instance it reaches
+// A snapshot's walk: the top level's float boxes near its anchor, each instance it reaches
 // walked by its blob's own walker on the ray brought into its frame.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "cpu/scene.h"
 #include "meshcast/errors.h"
@@ -24,26 +28,56 @@ constexpr double kBoxSlack = 0x1p-16;
 
 struct WorldRay {
   double org[3];
-  double inv[3];  // 1 / dir, +-inf for a zero component
   float dir[3];
   float tmax;
-  double pad;  // kBoxSlack of the farthest the ray's origin is from the scene's box
+  // For the top level's float boxes: the origin relative to the anchor
+  // (rounded), 1 / dir (+-inf for a zero component), and the pad every box
+  // is widened by, kBoxSlack of the farthest the origin is from the scene's
+  // box (which also covers the rounding of the origin and the boxes).
+  float rel[3], inv[3], pad;
+  bool negative[3];  // dir's sign bit: the box's hi plane is met first
 };
 
-// The ray's entry into a widened box before `cut`, or false.
-bool enters(const WorldRay& r, const layout::TopNode& n, double cut, double* entry) {
-  double tn = 0, tf = cut * (1 + kBoxSlack);
+// The entries into the 4 slots' widened boxes before `cut`: a bit a slot
+// entered, its entry distance in entry[slot]. Written as straight loops
+// over 4 lanes. Near and far planes go by the direction's sign, so a zero
+// component (an infinite inverse) gives -inf or +inf on the right sides,
+// and NaN (0 * inf) only for a ray in a slab's plane, which the min and max
+// below drop (they keep their second operand on NaN, as the walkers' box
+// tests do): the closed box holds that ray.
+int enter_slots(const WorldRay& r, const layout::TopWideNode& n, float cut, float entry[4]) {
+#if defined(__SSE2__)
+  // Every x86-64 processor has SSE2: the 4 slots in one register (the
+  // library's own code is built for the baseline; the walkers are the part
+  // built for each instruction set).
+  __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(cut * (1 + float(kBoxSlack)));
+  const __m128 pad = _mm_set1_ps(r.pad);
   for (int a = 0; a < 3; ++a) {
-    const double lo = n.min[a] - r.pad - r.org[a], hi = n.max[a] + r.pad - r.org[a];
-    if (r.dir[a] == 0) {
-      if (lo > 0 || hi < 0) return false;  // beside the slab, parallel to it
-      continue;
-    }
-    const double t0 = lo * r.inv[a], t1 = hi * r.inv[a];
-    tn = std::max(tn, std::min(t0, t1)), tf = std::min(tf, std::max(t0, t1));
+    const __m128 rel = _mm_set1_ps(r.rel[a]), inv = _mm_set1_ps(r.inv[a]);
+    const __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(n.lo[a]), pad), rel), inv);
+    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(_mm_loadu_ps(n.hi[a]), pad), rel), inv);
+    tn = _mm_max_ps(r.negative[a] ? t1 : t0, tn);  // NaN: the second operand kept
+    tf = _mm_min_ps(r.negative[a] ? t0 : t1, tf);
   }
-  *entry = tn;
-  return tn <= tf;
+  _mm_storeu_ps(entry, tn);
+  return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+#else
+  float tn[4], tf[4];
+  for (int k = 0; k < 4; ++k) tn[k] = 0, tf[k] = cut * (1 + float(kBoxSlack));
+  for (int a = 0; a < 3; ++a)
+    for (int k = 0; k < 4; ++k) {
+      const float t0 = (n.lo[a][k] - r.pad - r.rel[a]) * r.inv[a], t1 = (n.hi[a][k] + r.pad - r.rel[a]) * r.inv[a];
+      const float near = r.negative[a] ? t1 : t0, far = r.negative[a] ? t0 : t1;
+      tn[k] = near > tn[k] ? near : tn[k];
+      tf[k] = far < tf[k] ? far : tf[k];
+    }
+  int bits = 0;
+  for (int k = 0; k < 4; ++k) {
+    entry[k] = tn[k];
+    bits |= int(tn[k] <= tf[k]) << k;
+  }
+  return bits;
+#endif
 }
 
 // The world ray in the instance's frame: the translation subtracted in
@@ -76,65 +110,68 @@ bool world_ray_walkable(const RayD& r) {
 // local ray not walkable): that instance is not walked and the ray counted.
 bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
           uint8_t mask) {
+  const layout::TopLevel& top = s.top;
   WorldRay r;
-  for (int a = 0; a < 3; ++a) r.org[a] = rd.org[a], r.dir[a] = rd.dir[a], r.inv[a] = 1.0 / double(rd.dir[a]);
-  r.tmax = rd.tmax;
-  const layout::TopNode& root = s.top.nodes[0];
   double far = 0;
-  for (int a = 0; a < 3; ++a) far = std::max({far, std::fabs(rd.org[a] - root.min[a]), std::fabs(rd.org[a] - root.max[a])});
-  r.pad = far * kBoxSlack;
+  for (int a = 0; a < 3; ++a) {
+    r.org[a] = rd.org[a], r.dir[a] = rd.dir[a];
+    r.rel[a] = float(rd.org[a] - top.anchor[a]);
+    r.inv[a] = 1.0f / rd.dir[a];
+    r.negative[a] = std::signbit(rd.dir[a]);
+    far = std::max({far, std::fabs(rd.org[a] - top.nodes[0].min[a]), std::fabs(rd.org[a] - top.nodes[0].max[a])});
+  }
+  r.tmax = rd.tmax;
+  r.pad = float(far * kBoxSlack);
   bool complete = true;
   float cut = rd.tmax;  // the closest hit's t so far
-  constexpr int kStack = 128;
+  // A wide node leaves at most 3 entries behind a level; the binary tree
+  // under it is at most 64 deep (median splits of fewer than 2^32).
+  constexpr int kStack = 3 * 64 + 4;
   uint32_t stack[kStack];
-  int top = 0;
-  uint32_t node = 0;
-  double entry;
-  if (!enters(r, s.top.nodes[0], cut, &entry)) return true;
-  for (;;) {
-    const layout::TopNode& n = s.top.nodes[node];
-    if (n.count == 0) {
-      const uint32_t kids[2] = {node + 1, n.right};
-      double e[2];
-      const bool hit0 = enters(r, s.top.nodes[kids[0]], cut, &e[0]), hit1 = enters(r, s.top.nodes[kids[1]], cut, &e[1]);
-      if (hit0 && hit1) {
-        const int near = e[1] < e[0] ? 1 : 0;
-        if (top < kStack) stack[top++] = kids[near ^ 1];
-        else complete = false;  // deeper than a median split makes: not reached
-        node = kids[near];
-        continue;
+  float entries[kStack];
+  int top_of = 0;
+  stack[top_of] = 0, entries[top_of++] = 0;  // the root node
+  while (top_of > 0) {
+    --top_of;
+    if (entries[top_of] > cut * (1 + float(kBoxSlack))) continue;
+    const uint32_t item = stack[top_of];
+    if (item & layout::kTopInstance) {
+      const layout::PlacedInstance& p = top.placed[item & ~layout::kTopInstance];
+      if ((p.mask & mask) == 0) continue;
+      Ray local = to_local(r, p);
+      local.tmax = cut;
+      Hit h;
+      // A local ray the walkers refuse (its direction scaled past their
+      // range) is counted, not walked.
+      if (s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
+                                       as_instance_sees(cull, p.mirrored != 0)) != 0)
+        complete = false;
+      // Equal t: the lower instance id, as the oracle breaks ties.
+      if (h.triangle != kNoHit && (h.t < cut || best.instance == kNoHit || (h.t == cut && p.id < best.instance))) {
+        best = {h.t, p.id, h.triangle, h.u, h.v};
+        cut = h.t;
+        if (query == Query::Any) return complete;
       }
-      if (hit0 || hit1) {
-        node = kids[hit0 ? 0 : 1];
-        continue;
-      }
-    } else {
-      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-        const layout::PlacedInstance& p = s.top.placed[i];
-        if ((p.mask & mask) == 0) continue;
-        Ray local = to_local(r, p);
-        local.tmax = cut;
-        Hit h;
-        // A local ray the walkers refuse (its direction scaled past their
-        // range) is counted, not walked.
-        if (s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
-                                         as_instance_sees(cull, p.mirrored != 0)) != 0)
-          complete = false;
-        // Equal t: the lower instance id, as the oracle breaks ties.
-        if (h.triangle != kNoHit && (h.t < cut || best.instance == kNoHit || (h.t == cut && p.id < best.instance))) {
-          best = {h.t, p.id, h.triangle, h.u, h.v};
-          cut = h.t;
-          if (query == Query::Any) return complete;
-        }
-      }
+      continue;
     }
-    // Pop the next box still entered before the cut.
-    for (;;) {
-      if (top == 0) return complete;
-      node = stack[--top];
-      if (enters(r, s.top.nodes[node], cut, &entry)) break;
+    const layout::TopWideNode& n = top.wide[item];
+    float entry[4];
+    int bits = enter_slots(r, n, cut, entry);
+    // Pushed farthest first, so the nearest is walked next.
+    int order[4], count = 0;
+    for (; bits; bits &= bits - 1) {
+      const int k = __builtin_ctz(unsigned(bits));
+      int at = count++;
+      for (; at > 0 && entry[order[at - 1]] < entry[k]; --at) order[at] = order[at - 1];
+      order[at] = k;
     }
+    if (top_of + count > kStack) {  // deeper than a median split makes: not reached
+      complete = false;
+      count = kStack - top_of;
+    }
+    for (int i = 0; i < count; ++i) stack[top_of] = n.slot[order[i]], entries[top_of++] = entry[order[i]];
   }
+  return complete;
 }
 
 }  // namespace

@@ -26,13 +26,29 @@ struct TopNode {
   uint32_t first, count, right, pad = 0;
 };
 
-// The top level: placed instances reordered into tree order, the nodes
-// (root first; empty when no instance is placed). Leaves hold at most
-// kTopLeafSize instances.
+// What a walk reads: 4-wide nodes, each slot a child's box in float,
+// relative to the top level's anchor (double) and rounded outward, and what
+// the slot holds: a node's index, kTopInstance | an index into `placed`, or
+// kTopEmpty (its box empty: lo +inf, hi -inf, never entered). Float boxes
+// near the anchor keep a level 10 km across to half a millimetre at 10^7
+// from the origin: the anchor carries the distance.
+constexpr uint32_t kTopInstance = 0x80000000u, kTopEmpty = 0xFFFFFFFFu;
+struct TopWideNode {
+  float lo[3][4], hi[3][4];  // [axis][slot]
+  uint32_t slot[4];
+};
+
+// The top level: placed instances reordered into tree order, the binary
+// nodes (root first; empty when no instance is placed; what builds and
+// refits work on), and the 4-wide nodes collapsed from them (root first)
+// with their anchor, the root box's centre. Leaves hold at most
+// kTopLeafSize instances: each instance's own box is tested before its walk.
 constexpr uint32_t kTopLeafSize = 1;
 struct TopLevel {
   std::vector<PlacedInstance> placed;
   std::vector<TopNode> nodes;
+  std::vector<TopWideNode> wide;
+  double anchor[3] = {0, 0, 0};
 };
 
 }  // namespace meshcast::layout

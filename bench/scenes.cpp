@@ -112,9 +112,9 @@ std::vector<SceneRow> bench_scenes(const std::vector<Mesh>& meshes, const Scenes
       for (size_t m = 0; m < blobs.size(); ++m) scene.add_mesh(blobs[m], "mesh " + std::to_string(m));
       for (const PeerInstance& p : level) scene.add_instance(p.mesh, p.transform);
       scene.commit();
-      const std::shared_ptr<const SceneSnapshot> s = scene.snapshot();
-      const double top_bytes = double(s->top.placed.size() * sizeof(layout::PlacedInstance) +
-                                      s->top.nodes.size() * sizeof(layout::TopNode));
+      // Everything the scene holds besides the blobs: its records of the
+      // instances, the tree it refits, the two snapshots it keeps.
+      const double top_bytes = double(scene.top_level_bytes());
       std::vector<Contender> all;
       all.push_back({"meshcast " + o.layout, blob_bytes + top_bytes,
                      [&](const std::vector<RayD>& r, std::vector<SceneHit>& h) { scene.trace(r, h); },

@@ -26,7 +26,7 @@ struct SceneRow {
   double offset = 0;
   std::string contender;
   double ns_per_ray = 0;          // median of the rounds
-  double bytes = 0;               // all included
+  double bytes = 0;               // all included (meshcast: the blobs and Scene::top_level_bytes)
   double update_ms = 0;           // a tenth of the instances moved, then commit (median)
   double update_all_ms = 0;       // every instance moved, then commit (median)
   double hits = 0;                // fraction of rays that hit

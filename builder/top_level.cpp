@@ -1,6 +1,8 @@
 #include "builder/top_level.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 
 namespace meshcast {
@@ -82,19 +84,27 @@ double half_area(const layout::TopNode& n) {
   return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
 }
 
+// The float next to a finite f towards -inf (down) or +inf (up), by its
+// bits (std::nextafter is a library call, and a refit makes 24 of these a
+// node).
+float next_down(float f) {
+  if (f == 0) return -0x1p-149f;
+  const uint32_t bits = std::bit_cast<uint32_t>(f);
+  return std::bit_cast<float>(f > 0 ? bits - 1 : bits + 1);
+}
+float next_up(float f) { return -next_down(-f); }
+
 // d - anchor in float, rounded down (lo) or up (hi): the float box holds
 // the double one.
 float below(double d, double anchor) {
   const double x = d - anchor;  // exact enough: one rounding, covered by the walk's pad
-  float f = float(x);
-  if (double(f) > x) f = std::nextafter(f, -INFINITY);
-  return f;
+  const float f = float(x);
+  return double(f) > x && std::isfinite(f) ? next_down(f) : f;
 }
 float above(double d, double anchor) {
   const double x = d - anchor;
-  float f = float(x);
-  if (double(f) < x) f = std::nextafter(f, INFINITY);
-  return f;
+  const float f = float(x);
+  return double(f) < x && std::isfinite(f) ? next_up(f) : f;
 }
 
 struct Collapser {
@@ -117,17 +127,15 @@ struct Collapser {
     }
     const uint32_t index = uint32_t(top.wide.size());
     top.wide.emplace_back();
+    top.wide_from.insert(top.wide_from.end(), 4, layout::kTopEmpty);
     for (int k = 0; k < 4; ++k) {
       uint32_t slot = layout::kTopEmpty;
-      float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
       if (k < count) {
         const layout::TopNode& n = top.nodes[kids[k]];
-        for (int a = 0; a < 3; ++a) lo[a] = below(n.min[a], top.anchor[a]), hi[a] = above(n.max[a], top.anchor[a]);
         slot = n.count > 0 ? layout::kTopInstance | n.first : collapse(kids[k]);
+        top.wide_from[4 * size_t(index) + size_t(k)] = kids[k];
       }
-      layout::TopWideNode& w = top.wide[index];  // (collapse() may have moved it)
-      for (int a = 0; a < 3; ++a) w.lo[a][k] = lo[a], w.hi[a][k] = hi[a];
-      w.slot[k] = slot;
+      top.wide[index].slot[k] = slot;  // (collapse() may have moved the node)
     }
     return index;
   }
@@ -137,22 +145,37 @@ struct Collapser {
 
 void collapse_top_level(layout::TopLevel& top) {
   top.wide.clear();
+  top.wide_from.clear();
   if (top.nodes.empty()) return;
   const layout::TopNode& root = top.nodes[0];
   for (int a = 0; a < 3; ++a) top.anchor[a] = 0.5 * (root.min[a] + root.max[a]);
   top.wide.reserve(top.nodes.size() / 2 + 1);
-  if (root.count > 0) {
-    // One instance: a wide root with it in slot 0.
-    layout::TopWideNode w;
-    for (int a = 0; a < 3; ++a)
-      for (int k = 0; k < 4; ++k) w.lo[a][k] = INFINITY, w.hi[a][k] = -INFINITY;
-    for (int k = 0; k < 4; ++k) w.slot[k] = layout::kTopEmpty;
-    for (int a = 0; a < 3; ++a) w.lo[a][0] = below(root.min[a], top.anchor[a]), w.hi[a][0] = above(root.max[a], top.anchor[a]);
-    w.slot[0] = layout::kTopInstance | root.first;
-    top.wide.push_back(w);
-    return;
+  top.wide_from.reserve(2 * top.nodes.size() + 4);
+  if (root.count > 0) {  // one instance: a wide root with it in slot 0
+    top.wide.emplace_back();
+    top.wide_from = {0, layout::kTopEmpty, layout::kTopEmpty, layout::kTopEmpty};
+    for (int k = 0; k < 4; ++k) top.wide[0].slot[k] = k == 0 ? layout::kTopInstance | root.first : layout::kTopEmpty;
+  } else {
+    Collapser{top}.collapse(0);
   }
-  Collapser{top}.collapse(0);
+  fit_wide_boxes(top);
+}
+
+void fit_wide_boxes(layout::TopLevel& top) {
+  for (int a = 0; a < 3; ++a) top.min[a] = top.nodes[0].min[a], top.max[a] = top.nodes[0].max[a];
+  for (size_t w = 0; w < top.wide.size(); ++w)
+    for (int k = 0; k < 4; ++k) {
+      layout::TopWideNode& node = top.wide[w];
+      const uint32_t from = top.wide_from[4 * w + size_t(k)];
+      for (int a = 0; a < 3; ++a) {
+        if (from == layout::kTopEmpty) {
+          node.lo[a][k] = INFINITY, node.hi[a][k] = -INFINITY;  // never entered
+        } else {
+          node.lo[a][k] = below(top.nodes[from].min[a], top.anchor[a]);
+          node.hi[a][k] = above(top.nodes[from].max[a], top.anchor[a]);
+        }
+      }
+    }
 }
 
 void refit_top_level(layout::TopLevel& top) {
@@ -172,7 +195,7 @@ void refit_top_level(layout::TopLevel& top) {
       node.max[a] = std::max(top.nodes[n + 1].max[a], top.nodes[node.right].max[a]);
     }
   }
-  collapse_top_level(top);
+  fit_wide_boxes(top);  // the same wide nodes and anchor, their boxes again
 }
 
 }  // namespace meshcast

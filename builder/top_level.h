@@ -19,6 +19,10 @@ layout::TopLevel build_top_level(const std::vector<layout::PlacedInstance>& plac
 // apart until it has 4 children or only leaves): O(n), after every build
 // and refit.
 void collapse_top_level(layout::TopLevel& top);
+// The wide nodes' boxes read again from the binary nodes they were
+// collapsed from (top.wide_from), relative to the anchor: what a refit does
+// after joining the binary boxes.
+void fit_wide_boxes(layout::TopLevel& top);
 
 // The same tree over instances that moved (top.placed updated in place,
 // none added or taken away): every box joined again from the leaves up, in

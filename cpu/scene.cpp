@@ -1,6 +1,7 @@
 // Scene: the caller's edits, and commit() turning them into a snapshot.
 #include "meshcast/scene.h"
 
+#include <atomic>
 #include <cmath>
 
 #include "builder/top_level.h"
@@ -23,6 +24,11 @@ struct Scene::Edits {
   // commits refit it instead (moves and masks only).
   bool rebuild = true;
   uint32_t refits = 0;
+  layout::TopLevel built;  // the last build, refitted since: what snapshots copy
+  // The last two snapshots made. Once no batch holds the older one, the
+  // next commit writes into it: its arrays are reused, not allocated and
+  // faulted in again every frame.
+  std::shared_ptr<SceneSnapshot> current, previous;
 
   Instance& at(InstanceId id, const char* who) {
     if (id >= instances.size() || instances[id].removed)
@@ -130,29 +136,57 @@ constexpr uint32_t kRefitsBeforeRebuild = 16;
 
 void Scene::commit() {
   Edits& e = *edits_;
-  auto next = std::make_shared<SceneSnapshot>();
-  next->meshes = e.meshes;
   if (!e.rebuild && e.refits < kRefitsBeforeRebuild) {
     // Moves and masks only: the same instances in the same places of the
     // tree, their records and the boxes refreshed.
-    next->top = committed_->top;
-    for (layout::PlacedInstance& p : next->top.placed) p = e.instances[p.id].placed;
-    refit_top_level(next->top);
+    for (layout::PlacedInstance& p : e.built.placed) p = e.instances[p.id].placed;
+    refit_top_level(e.built);
     ++e.refits;
   } else {
     std::vector<layout::PlacedInstance> placed;
     placed.reserve(e.live);
     for (const Edits::Instance& i : e.instances)
       if (i.enabled && !i.removed) placed.push_back(i.placed);
-    next->top = build_top_level(placed);
+    e.built = build_top_level(placed);
     e.rebuild = false, e.refits = 0;
   }
+  // The snapshot: what a walk reads, copied (the last one may still be
+  // walked by a batch in flight).
+  std::shared_ptr<SceneSnapshot> next;
+  if (e.previous && e.previous.use_count() == 1) {
+    // Only this scene holds it: whoever walked it has let go (the fence
+    // orders their last reads, released with their reference, before the
+    // writes below).
+    std::atomic_thread_fence(std::memory_order_acquire);
+    next = std::move(e.previous);
+  } else {
+    next = std::make_shared<SceneSnapshot>();
+  }
+  next->meshes = e.meshes;
+  next->top.placed.assign(e.built.placed.begin(), e.built.placed.end());
+  next->top.wide.assign(e.built.wide.begin(), e.built.wide.end());
+  for (int a = 0; a < 3; ++a)
+    next->top.anchor[a] = e.built.anchor[a], next->top.min[a] = e.built.min[a], next->top.max[a] = e.built.max[a];
+  e.previous = std::move(e.current);
+  e.current = next;
   committed_ = std::move(next);
 }
 
 std::shared_ptr<const SceneSnapshot> Scene::snapshot() const { return committed_; }
 
 size_t Scene::instance_count() const { return edits_->live; }
+
+size_t Scene::top_level_bytes() const {
+  const Edits& e = *edits_;
+  auto walked = [](const layout::TopLevel& t) {
+    return t.placed.capacity() * sizeof(layout::PlacedInstance) + t.wide.capacity() * sizeof(layout::TopWideNode);
+  };
+  size_t bytes = e.instances.capacity() * sizeof(Edits::Instance) + walked(e.built) +
+                 e.built.nodes.capacity() * sizeof(layout::TopNode) + e.built.wide_from.capacity() * sizeof(uint32_t);
+  for (const auto& s : {e.current, e.previous})
+    if (s) bytes += walked(s->top);
+  return bytes;
+}
 
 uint64_t Scene::trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
                       uint8_t mask) const {

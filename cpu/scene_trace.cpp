@@ -118,7 +118,7 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
     r.rel[a] = float(rd.org[a] - top.anchor[a]);
     r.inv[a] = 1.0f / rd.dir[a];
     r.negative[a] = std::signbit(rd.dir[a]);
-    far = std::max({far, std::fabs(rd.org[a] - top.nodes[0].min[a]), std::fabs(rd.org[a] - top.nodes[0].max[a])});
+    far = std::max({far, std::fabs(rd.org[a] - top.min[a]), std::fabs(rd.org[a] - top.max[a])});
   }
   r.tmax = rd.tmax;
   r.pad = float(far * kBoxSlack);
@@ -186,7 +186,7 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     hits[i] = SceneHit{};
-    if (snapshot.top.nodes.empty()) continue;
+    if (snapshot.top.wide.empty()) continue;
     if (!world_ray_walkable(rays[i])) {
       ++skipped;
       continue;

@@ -39,16 +39,21 @@ struct TopWideNode {
 };
 
 // The top level: placed instances reordered into tree order, the binary
-// nodes (root first; empty when no instance is placed; what builds and
-// refits work on), and the 4-wide nodes collapsed from them (root first)
-// with their anchor, the root box's centre. Leaves hold at most
-// kTopLeafSize instances: each instance's own box is tested before its walk.
+// nodes (root first; empty when no instance is placed) and the 4-wide nodes
+// collapsed from them (root first), with their anchor (the root box's
+// centre at the last build) and the root box. Leaves hold at most
+// kTopLeafSize instances: each instance's own box is tested before its
+// walk. A walk reads `placed`, `wide`, the anchor and the box; builds and
+// refits work on the binary nodes and `wide_from`, which a scene's
+// snapshots leave out.
 constexpr uint32_t kTopLeafSize = 1;
 struct TopLevel {
   std::vector<PlacedInstance> placed;
-  std::vector<TopNode> nodes;
   std::vector<TopWideNode> wide;
   double anchor[3] = {0, 0, 0};
+  double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};
+  std::vector<TopNode> nodes;
+  std::vector<uint32_t> wide_from;  // 4 a wide node: the binary node each slot's box is, or kTopEmpty
 };
 
 }  // namespace meshcast::layout

@@ -54,10 +54,10 @@ std::vector<uint8_t> shade_depth(const std::vector<float>& t) {
 
 Picture render_scene(const Scene& scene, int width, int height) {
   const std::shared_ptr<const SceneSnapshot> s = scene.snapshot();
-  if (s->top.nodes.empty()) throw InputError("render: the scene places no enabled instance");
-  const layout::TopNode& root = s->top.nodes[0];
+  if (s->top.wide.empty()) throw InputError("render: the scene places no enabled instance");
+  const layout::TopLevel& top = s->top;
   double c[3], r2 = 0;
-  for (int a = 0; a < 3; ++a) c[a] = 0.5 * (root.min[a] + root.max[a]), r2 += 0.25 * (root.max[a] - root.min[a]) * (root.max[a] - root.min[a]);
+  for (int a = 0; a < 3; ++a) c[a] = 0.5 * (top.min[a] + top.max[a]), r2 += 0.25 * (top.max[a] - top.min[a]) * (top.max[a] - top.min[a]);
   const Camera cam(c, std::sqrt(r2), width, height);
   std::vector<RayD> rays(size_t(width) * height);
   for (int y = 0; y < height; ++y)

@@ -108,6 +108,10 @@ class Scene {
   std::shared_ptr<const SceneSnapshot> snapshot() const;
 
   size_t instance_count() const;  // not removed, committed or not
+  // What the scene holds besides its meshes' blobs: the instances' records,
+  // the top level it builds and refits, and the snapshots it keeps (the
+  // last two; a batch in flight may hold an older one too).
+  size_t top_level_bytes() const;
 
  private:
   struct Edits;

@@ -29,14 +29,14 @@ SceneOracle::SceneOracle(const std::vector<const Mesh*>& meshes, const std::vect
   }
 }
 
-SceneOracleHit SceneOracle::closest(const RayD& ray, Cull cull, uint8_t mask) const {
-  SceneOracleHit best;
+template <class Take>
+void SceneOracle::visit(const RayD& ray, Cull cull, uint8_t mask, const double* cut, Take&& take) const {
   const double d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
   for (const Placed& p : placed_) {
     if ((p.instance.mask & mask) == 0) continue;
     // The instance's box in double, inclusive: only a miss of every
     // triangle is skipped.
-    double tn = 0, tf = std::min(double(ray.tmax), best.t);
+    double tn = 0, tf = std::min(double(ray.tmax), *cut);
     for (int a = 0; a < 3 && tn <= tf; ++a) {
       if (d[a] == 0) {
         if (ray.org[a] < p.min[a] || ray.org[a] > p.max[a]) tn = INFINITY;
@@ -51,12 +51,29 @@ SceneOracleHit SceneOracle::closest(const RayD& ray, Cull cull, uint8_t mask) co
     for (size_t t = 0; t < p.corners.size() / 9; ++t) {
       const double* c = p.corners.data() + 9 * t;
       const double hit = oracle_triangle(ray.org, d, ray.tmax, c, c + 3, c + 6, cull);
-      // Ties: the lower instance id, then the lower triangle.
-      if (hit < best.t || (hit == best.t && hit != INFINITY && p.instance.id < best.instance))
-        best = {hit, p.instance.id, uint32_t(t)};
+      if (hit != INFINITY) take(hit, p.instance.id, uint32_t(t));
     }
   }
+}
+
+SceneOracleHit SceneOracle::closest(const RayD& ray, Cull cull, uint8_t mask) const {
+  SceneOracleHit best;
+  visit(ray, cull, mask, &best.t, [&](double t, uint32_t instance, uint32_t triangle) {
+    // Ties: the lower instance id, then the lower triangle.
+    if (t < best.t || (t == best.t && (instance < best.instance || (instance == best.instance && triangle < best.triangle))))
+      best = {t, instance, triangle};
+  });
   return best;
+}
+
+std::vector<SceneOracleHit> SceneOracle::all(const RayD& ray, Cull cull, uint8_t mask) const {
+  std::vector<SceneOracleHit> hits;
+  const double no_cut = INFINITY;
+  visit(ray, cull, mask, &no_cut, [&](double t, uint32_t instance, uint32_t triangle) { hits.push_back({t, instance, triangle}); });
+  std::sort(hits.begin(), hits.end(), [](const SceneOracleHit& a, const SceneOracleHit& b) {
+    return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
+  });
+  return hits;
 }
 
 size_t SceneOracle::index_of(uint32_t id) const {

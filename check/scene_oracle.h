@@ -32,6 +32,8 @@ class SceneOracle {
   // `mask`; the front face as the world sees it (the winding of the
   // triangle's world corners from the ray's origin).
   SceneOracleHit closest(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
+  // Every hit in [0, t_max], in order of t, then instance, then triangle.
+  std::vector<SceneOracleHit> all(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Whether the triangle of instance `instance` (an index into the
   // instances given) meets the ray in double at distance t, to within
   // `slack` in the world: the distance from o + t d to the triangle.
@@ -42,6 +44,10 @@ class SceneOracle {
   size_t index_of(uint32_t id) const;
 
  private:
+  // Every triangle of every instance whose box the ray enters before `cut`
+  // (read again after each instance) to take(t, instance id, triangle).
+  template <class Take>
+  void visit(const RayD& ray, Cull cull, uint8_t mask, const double* cut, Take&& take) const;
   struct Placed {
     OracleInstance instance;
     std::vector<double> corners;  // 9 a triangle, world coordinates

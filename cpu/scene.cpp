@@ -193,6 +193,11 @@ uint64_t Scene::trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitO
   return trace_snapshot(*committed_, rays, hits, outputs, query, cull, mask);
 }
 
+uint64_t Scene::trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists, HitOutputs outputs, Cull cull,
+                               uint8_t mask) const {
+  return trace_all_hits_snapshot(*committed_, rays, lists, outputs, cull, mask);
+}
+
 uint64_t Scene::trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
                       uint8_t mask) const {
   std::vector<RayD> wide(rays.size());

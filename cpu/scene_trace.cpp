@@ -106,11 +106,8 @@ bool world_ray_walkable(const RayD& r) {
   return ray_is_walkable(probe);
 }
 
-// One ray. Returns false when some instance's frame could not take it (its
-// local ray not walkable): that instance is not walked and the ray counted.
-bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
-          uint8_t mask) {
-  const layout::TopLevel& top = s.top;
+// The world ray as the top level reads it.
+WorldRay world_ray(const layout::TopLevel& top, const RayD& rd) {
   WorldRay r;
   double far = 0;
   for (int a = 0; a < 3; ++a) {
@@ -122,10 +119,20 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
   }
   r.tmax = rd.tmax;
   r.pad = float(far * kBoxSlack);
-  bool complete = true;
-  float cut = rd.tmax;  // the closest hit's t so far
-  // A wide node leaves at most 3 entries behind a level; the binary tree
-  // under it is at most 64 deep (median splits of fewer than 2^32).
+  return r;
+}
+
+// The top level's walk for one ray: every instance whose box the ray
+// enters before the cut, nearest entry first, whose mask shares a bit
+// with `mask`, goes to visit(instance, its local ray with t_max the cut),
+// which returns the cut from then on (a nearer hit's t, or the same), or
+// a negative number to end the walk.
+template <class Visit>
+void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Visit&& visit) {
+  float cut = r.tmax;
+  // A wide node leaves at most 3 entries behind a level, and the binary
+  // tree under it is at most 64 deep (median splits of fewer than 2^32):
+  // the stack cannot fill.
   constexpr int kStack = 3 * 64 + 4;
   uint32_t stack[kStack];
   float entries[kStack];
@@ -140,18 +147,8 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
       if ((p.mask & mask) == 0) continue;
       Ray local = to_local(r, p);
       local.tmax = cut;
-      Hit h;
-      // A local ray the walkers refuse (its direction scaled past their
-      // range) is counted, not walked.
-      if (s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
-                                       as_instance_sees(cull, p.mirrored != 0)) != 0)
-        complete = false;
-      // Equal t: the lower instance id, as the oracle breaks ties.
-      if (h.triangle != kNoHit && (h.t < cut || best.instance == kNoHit || (h.t == cut && p.id < best.instance))) {
-        best = {h.t, p.id, h.triangle, h.u, h.v};
-        cut = h.t;
-        if (query == Query::Any) return complete;
-      }
+      cut = visit(p, local);
+      if (cut < 0) return;
       continue;
     }
     const layout::TopWideNode& n = top.wide[item];
@@ -165,13 +162,66 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
       for (; at > 0 && entry[order[at - 1]] < entry[k]; --at) order[at] = order[at - 1];
       order[at] = k;
     }
-    if (top_of + count > kStack) {  // deeper than a median split makes: not reached
-      complete = false;
-      count = kStack - top_of;
-    }
     for (int i = 0; i < count; ++i) stack[top_of] = n.slot[order[i]], entries[top_of++] = entry[order[i]];
   }
+}
+
+// Closest or any hit of one ray. Returns false when some instance's frame
+// could not take it (its local ray not walkable): that instance is not
+// walked and the ray counted.
+bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
+          uint8_t mask) {
+  bool complete = true;
+  walk_top(s.top, world_ray(s.top, rd), mask, [&](const layout::PlacedInstance& p, const Ray& local) {
+    Hit h;
+    // A local ray the walkers refuse (its direction scaled past their
+    // range) is counted, not walked.
+    if (s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
+                                     as_instance_sees(cull, p.mirrored != 0)) != 0)
+      complete = false;
+    // Equal t: the lower instance id, as the oracle breaks ties.
+    if (h.triangle != kNoHit &&
+        (h.t < local.tmax || best.instance == kNoHit || (h.t == local.tmax && p.id < best.instance))) {
+      best = {h.t, p.id, h.triangle, h.u, h.v};
+      return query == Query::Any ? -1.0f : h.t;
+    }
+    return local.tmax;
+  });
   return complete;
+}
+
+// Every hit of one ray into its row (max_hits long, filled with misses):
+// each instance's own hits (its walker's rows, `scratch` max_hits long)
+// merged in, the nearest kept in order of t, instance, triangle. Returns
+// the hits found, or with `complete` false a ray some frame could not take.
+uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> row, std::vector<Hit>& scratch,
+                  HitOutputs outputs, Cull cull, uint8_t mask, bool& complete) {
+  const uint32_t cap = uint32_t(row.size());
+  uint32_t found = 0, kept = 0;
+  auto before = [](const SceneHit& a, const SceneHit& b) {
+    return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
+  };
+  walk_top(s.top, world_ray(s.top, rd), mask, [&](const layout::PlacedInstance& p, const Ray& local) {
+    uint32_t own = 0;
+    if (s.meshes[p.mesh]->view.trace_all_hits(std::span(&local, 1), cap, std::span(&own, 1), scratch, outputs,
+                                              as_instance_sees(cull, p.mirrored != 0)) != 0)
+      complete = false;
+    found += own;
+    for (uint32_t k = 0; k < std::min(own, cap); ++k) {
+      const SceneHit h{scratch[k].t, p.id, scratch[k].triangle, scratch[k].u, scratch[k].v};
+      uint32_t at = std::min(kept, cap);
+      if (at == cap) {
+        if (!before(h, row[cap - 1])) break;  // this instance's rest is farther still
+        --at;
+      } else {
+        ++kept;
+      }
+      for (; at > 0 && before(h, row[at - 1]); --at) row[at] = row[at - 1];
+      row[at] = h;
+    }
+    return local.tmax;  // every hit along the segment: the cut stays
+  });
+  return found;
 }
 
 }  // namespace
@@ -181,7 +231,8 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
   if (hits.size() < rays.size())
     throw UsageError("Scene::trace: " + std::to_string(rays.size()) + " rays but " + std::to_string(hits.size()) +
                      " hits; the hits span must hold one hit a ray");
-  if (query == Query::All) throw UsageError("Scene::trace: Query::All is not answered on scenes yet");
+  if (query == Query::All)
+    throw UsageError("Scene::trace: Query::All has a list of hits a ray: Scene::trace_all_hits answers it");
   if (has(outputs, HitOutputs::Point)) throw UsageError("Scene::trace: a scene hit carries no point (HitOutputs::Point)");
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
@@ -192,6 +243,31 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
       continue;
     }
     if (!walk(snapshot, rays[i], hits[i], outputs, query, cull, mask)) ++skipped;
+  }
+  return skipped;
+}
+
+uint64_t trace_all_hits_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, SceneHitLists& lists,
+                                 HitOutputs outputs, Cull cull, uint8_t mask) {
+  if (lists.max_hits < 1 || lists.max_hits > kMaxHitsLimit)
+    throw UsageError("Scene::trace_all_hits: max_hits " + std::to_string(lists.max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
+  if (has(outputs, HitOutputs::Point))
+    throw UsageError("Scene::trace_all_hits: a scene hit carries no point (HitOutputs::Point)");
+  lists.found.assign(rays.size(), 0);
+  lists.hits.assign(rays.size() * lists.max_hits, SceneHit{});
+  std::vector<Hit> scratch(lists.max_hits);
+  uint64_t skipped = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (snapshot.top.wide.empty()) continue;
+    if (!world_ray_walkable(rays[i])) {
+      ++skipped;
+      continue;
+    }
+    bool complete = true;
+    const std::span<SceneHit> row(lists.hits.data() + i * lists.max_hits, lists.max_hits);
+    lists.found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, complete);
+    skipped += !complete;
   }
   return skipped;
 }

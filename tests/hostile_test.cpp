@@ -240,3 +240,48 @@ TEST(Hostile, HitListFilesRoundTripAndRefuseBadHeaders) {
 }
 }  // namespace
 }  // namespace meshcast::testing
+
+// Scenes' files (RAYD rays with double origins, HITI hits naming the
+// instance): written and read back exactly, doubles whole; a truncated
+// file and a bad magic refused with the file's name.
+namespace meshcast::testing {
+namespace {
+TEST(Hostile, SceneRayAndHitFilesRoundTripAndRefuseBadHeaders) {
+  const std::vector<RayD> rays = {{{1e7 + 0.125, -3.5e6, 0.1}, {0, -1, 0.5f}, INFINITY},
+                                  {{-2.0, 1e15, 7.0}, {1, 2, 3}, 4.5f}};
+  const std::string rays_path = (scratch_dir() / "level.rayd").string();
+  write_scene_rays(rays_path, rays);
+  EXPECT_TRUE(is_scene_rays_file(rays_path));
+  const std::vector<RayD> rays_back = read_scene_rays(rays_path);
+  ASSERT_EQ(rays_back.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(rays_back[i].org[a], rays[i].org[a]) << i;  // every bit of the double
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(rays_back[i].dir[a], rays[i].dir[a]) << i;
+    EXPECT_EQ(rays_back[i].tmax, rays[i].tmax) << i;
+  }
+  const std::vector<uint8_t> raw = read_file(rays_path);
+  EXPECT_EQ(raw.size(), 8u + 2 * 40);
+  const std::string cut = make_file("cut.rayd", std::string(raw.begin(), raw.end() - 1));
+  expect_throws<InputError>([&] { read_scene_rays(cut); }, {"cut.rayd", "header says 2 records"});
+  const std::string plain = make_file("plain.rayd", "RAYS" + std::string(raw.begin() + 4, raw.end()));
+  expect_throws<InputError>([&] { read_scene_rays(plain); }, {"plain.rayd", "not a RAYD file"});
+  EXPECT_FALSE(is_scene_rays_file(plain));
+
+  const std::vector<SceneHit> hits = {{2.5f, 7, 11}, {}};
+  const std::string hits_path = (scratch_dir() / "level.hiti").string();
+  write_scene_hits(hits_path, hits);
+  const std::vector<SceneHit> hits_back = read_scene_hits(hits_path);
+  ASSERT_EQ(hits_back.size(), 2u);
+  EXPECT_EQ(hits_back[0].t, 2.5f);
+  EXPECT_EQ(hits_back[0].instance, 7u);
+  EXPECT_EQ(hits_back[0].triangle, 11u);
+  EXPECT_EQ(hits_back[1].t, INFINITY);
+  EXPECT_EQ(hits_back[1].instance, kNoHit);
+  EXPECT_EQ(hits_back[1].triangle, kNoHit);
+  const std::vector<uint8_t> hit_bytes = read_file(hits_path);
+  EXPECT_EQ(hit_bytes.size(), 8u + 2 * 12);
+  const std::string short_hits = make_file("short.hiti", std::string(hit_bytes.begin(), hit_bytes.end() - 4));
+  expect_throws<InputError>([&] { read_scene_hits(short_hits); }, {"short.hiti", "header says 2 records"});
+}
+}  // namespace
+}  // namespace meshcast::testing

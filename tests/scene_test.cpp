@@ -4,6 +4,7 @@
 // closed sphere and the grid far away; edits and commits; bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -169,6 +170,46 @@ Judged judge(const SceneOracle& oracle, const std::vector<RayD>& rays, const std
   return j;
 }
 
+// Query::All: each row against the oracle's set, under the same rules
+// pair by pair (a triangle of one set and not the other is a tie only where
+// rounding decides: a graze of its edge, the segment's ends); rows in order
+// of t, found[i] the row's length (rows long enough for every hit).
+Judged judge_all(const SceneOracle& oracle, const std::vector<RayD>& rays, const SceneHitLists& lists, Cull cull,
+                 uint8_t mask) {
+  Judged j;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const RayD& r = rays[i];
+    const std::vector<SceneOracleHit> want = oracle.all(r, cull, mask);
+    const std::span<const SceneHit> row = lists.row(i);
+    const std::string where = "ray " + std::to_string(i);
+    if (lists.found[i] != row.size()) j.fail(where + ": found " + std::to_string(lists.found[i]) + " hits for a row of " + std::to_string(row.size()));
+    for (size_t k = 1; k < row.size(); ++k)
+      if (row[k].t < row[k - 1].t) j.fail(where + ": the row is not in order of t");
+    const double tlen = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
+    auto near_end = [&](double t) { return t * tlen <= slack(r, t) || std::fabs(t - r.tmax) * tlen <= slack(r, t); };
+    j.hits += row.size();
+    for (const SceneOracleHit& o : want) {
+      const auto m = std::find_if(row.begin(), row.end(), [&](const SceneHit& h) { return h.instance == o.instance && h.triangle == o.triangle; });
+      if (m != row.end()) {
+        if (std::fabs(m->t - o.t) * tlen > slack(r, o.t)) j.fail(where + ": t " + std::to_string(m->t) + " against " + std::to_string(o.t));
+        continue;
+      }
+      if (oracle.distance_to_edge(oracle.index_of(o.instance), o.triangle, r, o.t) <= slack(r, o.t) || near_end(o.t)) ++j.ties;
+      else j.fail(where + ": instance " + std::to_string(o.instance) + " triangle " + std::to_string(o.triangle) + " missing");
+    }
+    for (const SceneHit& h : row) {
+      if (std::any_of(want.begin(), want.end(), [&](const SceneOracleHit& o) { return o.instance == h.instance && o.triangle == h.triangle; }))
+        continue;
+      const size_t at = oracle.index_of(h.instance);
+      if (oracle.distance_to(at, h.triangle, r, h.t) <= slack(r, h.t) &&
+          (oracle.distance_to_edge(at, h.triangle, r, h.t) <= slack(r, h.t) || near_end(h.t)))
+        ++j.ties;
+      else j.fail(where + ": instance " + std::to_string(h.instance) + " triangle " + std::to_string(h.triangle) + " is no hit");
+    }
+  }
+  return j;
+}
+
 std::vector<SceneHit> trace(const Scene& scene, const std::vector<RayD>& rays, Query query = Query::Closest,
                             Cull cull = Cull::None, uint8_t mask = 0xFF) {
   std::vector<SceneHit> hits(rays.size());
@@ -204,6 +245,14 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
     EXPECT_LE(j.ties, rays.size() / 100) << what;
     EXPECT_GT(j.hits, rays.size() / (c.mask == 0xFF ? 5 : 10)) << what << ": too few hits to show anything";
   }
+  // Every hit, front faces culled and mask 3, rows long enough for all.
+  SceneHitLists lists;
+  lists.max_hits = 256;
+  EXPECT_EQ(scene.trace_all_hits(rays, lists, HitOutputs::None, Cull::Front, 0x03), 0u);
+  const Judged all = judge_all(oracle, rays, lists, Cull::Front, 0x03);
+  EXPECT_EQ(all.wrong, 0u) << layout << " at " << offset << ", Query::All: " << all.first_problem;
+  EXPECT_LE(all.ties, all.hits / 100 + 2) << layout << " at " << offset << ", Query::All";
+  EXPECT_GT(all.hits, rays.size() / 5) << layout << " at " << offset << ", Query::All: too few hits to show anything";
   if (offset != 0) {
     // The same level at the origin: the same instance and triangle for every
     // ray but a rounding's worth, the same t to float rounding.
@@ -396,6 +445,14 @@ TEST(Scene, RefusesBadInput) {
   std::vector<SceneHit> short_hits(1);
   EXPECT_THROW(scene.trace(rays, short_hits), UsageError);
   EXPECT_THROW(scene.trace(rays, hits, HitOutputs::None, Query::All), UsageError);
+  SceneHitLists lists;
+  lists.max_hits = 0;
+  EXPECT_THROW(scene.trace_all_hits(rays, lists), UsageError);
+  lists.max_hits = 2;
+  EXPECT_EQ(scene.trace_all_hits(rays, lists), 3u);
+  EXPECT_GE(lists.found[0], 2u);  // through both poles: every triangle around each, once
+  EXPECT_EQ(lists.row(0)[0].instance, id);
+  EXPECT_FLOAT_EQ(lists.row(0)[0].t, 4.0f);
 }
 
 }  // namespace

@@ -96,7 +96,7 @@ void add_trace(CLI::App& app) {
     const Cull cull = layout::cull_named(args->cull, "--cull");
     if (is_scene_file(args->input)) {
       if (args->backend != "cpu") throw InputError("trace " + args->input + ": scenes are cast on the CPU (--backend cpu)");
-      if (query == Query::All) throw InputError("trace " + args->input + ": --query all is not answered on scenes yet");
+      if (query == Query::All) throw InputError("trace " + args->input + ": --query all on a scene has no hits file yet (the library answers it: Scene::trace_all_hits)");
       trace_scene(args->input, args->rays, args->out, args->layout, query, cull, args->repeat, args->json);
       return;
     }

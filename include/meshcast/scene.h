@@ -21,6 +21,8 @@
 // started with, so a commit on another thread never shows it a half-made
 // world; the Scene itself (its edits and commit) is for one thread at a time.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -48,6 +50,18 @@ struct SceneHit {
   uint32_t instance = kNoHit;
   uint32_t triangle = kNoHit;
   float u = 0, v = 0;  // only with HitOutputs::Uv, as Hit's
+};
+
+// Query::All's answers on a scene, as HitLists: ray i found found[i] hits
+// over every instance it reaches, the nearest min(found[i], max_hits) in row
+// i in order of t, then instance, then triangle.
+struct SceneHitLists {
+  uint32_t max_hits = 16;
+  std::vector<uint32_t> found;
+  std::vector<SceneHit> hits;
+  std::span<const SceneHit> row(size_t ray) const {
+    return {hits.data() + ray * max_hits, std::min<size_t>(found[ray], max_hits)};
+  }
 };
 
 // Where an instance stands: world = rotation_scale * local + translation.
@@ -91,8 +105,8 @@ class Scene {
   // The frame's changes are done: from now on traces see them.
   void commit();
 
-  // The hit of each world ray under `query` (Closest or Any) against the
-  // committed scene, among the instances whose mask shares a bit with
+  // The hit of each world ray under `query` (Closest or Any; All has
+  // trace_all_hits) against the committed scene, among the instances whose mask shares a bit with
   // `mask`; `cull` as BlobView::trace, the front face as the instance shows
   // it in the world. Returns the rays not walkable (a non-finite origin or
   // one beyond 2^100, a direction or t_max BlobView would refuse), answered
@@ -102,6 +116,11 @@ class Scene {
   // Float rays, their origins taken as doubles.
   uint64_t trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs = HitOutputs::None,
                  Query query = Query::Closest, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
+  // Query::All: every hit of each ray along its segment over the committed
+  // scene into `lists` (resized; lists.max_hits, 1 to kMaxHitsLimit, the
+  // row length). Returns the rays not walkable, as trace() does.
+  uint64_t trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists, HitOutputs outputs = HitOutputs::None,
+                          Cull cull = Cull::None, uint8_t mask = 0xFF) const;
 
   // What the last commit() made, for a caster that keeps a batch on the
   // scene it was submitted to (traces through it see that frame).
@@ -119,9 +138,11 @@ class Scene {
   std::shared_ptr<const SceneSnapshot> committed_;
 };
 
-// A snapshot's trace: the same as Scene::trace, on the frame it holds.
+// A snapshot's traces: the same as Scene's, on the frame it holds.
 uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,
                         HitOutputs outputs = HitOutputs::None, Query query = Query::Closest, Cull cull = Cull::None,
                         uint8_t mask = 0xFF);
+uint64_t trace_all_hits_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, SceneHitLists& lists,
+                                 HitOutputs outputs = HitOutputs::None, Cull cull = Cull::None, uint8_t mask = 0xFF);
 
 }  // namespace meshcast

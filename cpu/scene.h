@@ -8,6 +8,7 @@
 
 #include "layout/top_level.h"
 #include "meshcast/blob.h"
+#include "meshcast/scene.h"
 
 namespace meshcast {
 
@@ -27,5 +28,11 @@ class SceneSnapshot {
   std::vector<std::shared_ptr<const SceneMesh>> meshes;
   layout::TopLevel top;
 };
+
+// trace_all_hits_snapshot into the caller's storage (a batch's slice): ray
+// i's count in found[i], its row in rows[i * max_hits, (i + 1) * max_hits).
+uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint32_t max_hits,
+                          std::span<uint32_t> found, std::span<SceneHit> rows, HitOutputs outputs, Cull cull,
+                          uint8_t mask);
 
 }  // namespace meshcast

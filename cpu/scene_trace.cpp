@@ -252,21 +252,29 @@ uint64_t trace_all_hits_snapshot(const SceneSnapshot& snapshot, std::span<const 
   if (lists.max_hits < 1 || lists.max_hits > kMaxHitsLimit)
     throw UsageError("Scene::trace_all_hits: max_hits " + std::to_string(lists.max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
-  if (has(outputs, HitOutputs::Point))
-    throw UsageError("Scene::trace_all_hits: a scene hit carries no point (HitOutputs::Point)");
   lists.found.assign(rays.size(), 0);
   lists.hits.assign(rays.size() * lists.max_hits, SceneHit{});
-  std::vector<Hit> scratch(lists.max_hits);
+  return trace_scene_rows(snapshot, rays, lists.max_hits, lists.found, lists.hits, outputs, cull, mask);
+}
+
+uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint32_t max_hits,
+                          std::span<uint32_t> found, std::span<SceneHit> rows, HitOutputs outputs, Cull cull,
+                          uint8_t mask) {
+  if (has(outputs, HitOutputs::Point))
+    throw UsageError("Scene::trace_all_hits: a scene hit carries no point (HitOutputs::Point)");
+  std::vector<Hit> scratch(max_hits);
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
+    const std::span<SceneHit> row = rows.subspan(i * max_hits, max_hits);
+    std::fill(row.begin(), row.end(), SceneHit{});
+    found[i] = 0;
     if (snapshot.top.wide.empty()) continue;
     if (!world_ray_walkable(rays[i])) {
       ++skipped;
       continue;
     }
     bool complete = true;
-    const std::span<SceneHit> row(lists.hits.data() + i * lists.max_hits, lists.max_hits);
-    lists.found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, complete);
+    found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, complete);
     skipped += !complete;
   }
   return skipped;

@@ -17,6 +17,7 @@
 #include "host/jobs.h"
 #include "layout/blob_format.h"
 #include "layout/queries.h"
+#include "cpu/scene.h"
 
 namespace meshcast::host {
 
@@ -51,6 +52,12 @@ struct Caster::Slot {
   std::vector<Hit> hits;       // a hit a ray, or Query::All's rows of query.max_hits
   std::vector<uint32_t> found;  // Query::All: hits found a ray
   gpu::Method* method = nullptr;  // the GPU batch's
+  // A scene batch: the snapshot it walks (held until collected), its world
+  // rays, its hits or rows (`found` as above).
+  std::shared_ptr<const SceneSnapshot> scene;
+  std::vector<RayD> world;
+  std::vector<SceneHit> scene_hits;
+  SceneBatchQuery scene_query;
   Backend ran_on = Backend::Cpu;
   double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
   // CPU batches: jobs of `chunk` rays; the last to finish completes.
@@ -61,7 +68,21 @@ struct Caster::Slot {
 };
 
 Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options)
-    : view_(blob, name), options_(std::move(options)) {
+    : view_(std::in_place, blob, name), options_(std::move(options)) {
+  setup(blob, name);
+}
+
+Caster::Caster(CasterOptions options) : options_(std::move(options)) {
+  options_.backend = Backend::Cpu;  // nothing for a GPU to read
+  setup({}, "");
+}
+
+const BlobView& Caster::blob(const char* who) const {
+  if (!view_) throw UsageError(std::string(who) + ": this caster was made without a blob (scene batches alone)");
+  return *view_;
+}
+
+void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
   options_.frames = std::max(options_.frames, 1u);
   if (options_.jobs) {
     jobs_ = options_.jobs;
@@ -80,14 +101,26 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
       calls_in_work_.fetch_add(1, std::memory_order_acquire);
       const auto t0 = std::chrono::steady_clock::now();
       const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
-      const std::span<const Ray> rays = std::span<const Ray>(sp->rays).subspan(first, count);
+      const std::span<const Ray> rays = sp->scene ? std::span<const Ray>() : std::span<const Ray>(sp->rays).subspan(first, count);
       const BatchQuery& q = sp->query;
-      if (q.query == Query::All)
-        view_.trace_all_hits(rays, q.max_hits, std::span<uint32_t>(sp->found).subspan(first, count),
-                             std::span<Hit>(sp->hits).subspan(size_t(first) * q.max_hits, size_t(count) * q.max_hits),
-                             options_.hit_outputs, q.cull);
-      else
-        view_.trace(rays, std::span<Hit>(sp->hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
+      if (sp->scene) {  // scene hits carry u, v at most
+        const SceneBatchQuery& sq = sp->scene_query;
+        const HitOutputs outputs = HitOutputs(uint32_t(options_.hit_outputs) & uint32_t(HitOutputs::Uv));
+        const std::span<const RayD> world = std::span<const RayD>(sp->world).subspan(first, count);
+        if (sq.query == Query::All)
+          trace_scene_rows(*sp->scene, world, sq.max_hits, std::span<uint32_t>(sp->found).subspan(first, count),
+                           std::span<SceneHit>(sp->scene_hits).subspan(size_t(first) * sq.max_hits, size_t(count) * sq.max_hits),
+                           outputs, sq.cull, sq.mask);
+        else
+          trace_snapshot(*sp->scene, world, std::span<SceneHit>(sp->scene_hits).subspan(first, count), outputs, sq.query,
+                         sq.cull, sq.mask);
+      } else if (q.query == Query::All) {
+        view_->trace_all_hits(rays, q.max_hits, std::span<uint32_t>(sp->found).subspan(first, count),
+                              std::span<Hit>(sp->hits).subspan(size_t(first) * q.max_hits, size_t(count) * q.max_hits),
+                              options_.hit_outputs, q.cull);
+      } else {
+        view_->trace(rays, std::span<Hit>(sp->hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
+      }
       sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
       if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu);
       calls_in_work_.fetch_sub(1, std::memory_order_release);  // the last touch of the caster
@@ -98,6 +131,7 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
 
   if (options_.backend != Backend::Cpu) {
 #if !MESHCAST_VULKAN
+    (void)blob, (void)name;
     gpu_error_ = "meshcast was built without its Vulkan backend (MESHCAST_VULKAN=OFF): the CPU answers";
 #else
     try {
@@ -230,20 +264,54 @@ Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
   if (query.query == Query::All && (query.max_hits < 1 || query.max_hits > kMaxHitsLimit))
     throw UsageError("Caster::submit: max_hits " + std::to_string(query.max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
-  Slot* s = nullptr;
-  {
+  blob("Caster::submit");
+  Slot& s = take_slot();
+  s.query = query;
+  start(s, rays, choose(uint32_t(rays.size())));
+  return {s.id, s.index};
+}
+
+Caster::Slot& Caster::take_slot() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (uint32_t i = 0; i < game_slots_; ++i)
+    if (slots_[i]->state == Slot::Free) {
+      Slot& s = *slots_[i];
+      s.state = Slot::Running;
+      s.id = next_id_++;
+      return s;
+    }
+  throw UsageError("all " + std::to_string(game_slots_) +
+                   " frames hold batches not yet collected; wait() for one before submitting more");
+}
+
+Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
+  if (query.query != Query::Closest && query.query != Query::Any && query.query != Query::All)
+    throw UsageError("Caster::submit: query " + std::to_string(uint32_t(query.query)) + " is not a Query");
+  if (query.cull != Cull::None && query.cull != Cull::Back && query.cull != Cull::Front)
+    throw UsageError("Caster::submit: cull " + std::to_string(uint32_t(query.cull)) + " is not a Cull");
+  if (query.query == Query::All && (query.max_hits < 1 || query.max_hits > kMaxHitsLimit))
+    throw UsageError("Caster::submit: max_hits " + std::to_string(query.max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
+  Slot& s = take_slot();
+  try {
+    s.scene = scene.snapshot();
+    s.scene_query = query;
+    s.query = {query.query, query.cull, query.max_hits};
+    s.submit_ms = now_ms();
+    s.n = uint32_t(rays.size());
+    s.world.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+    const bool all = query.query == Query::All;
+    s.scene_hits.resize(all ? size_t(s.n) * query.max_hits : s.n);
+    s.found.resize(all ? s.n : 0);
+    start_cpu(s);
+  } catch (...) {  // nothing started: the slot is free again
     std::lock_guard<std::mutex> lock(mutex_);
-    for (uint32_t i = 0; i < game_slots_ && !s; ++i)
-      if (slots_[i]->state == Slot::Free) s = slots_[i].get();
-    if (!s)
-      throw UsageError("all " + std::to_string(game_slots_) +
-                       " frames hold batches not yet collected; wait() for one before submitting more");
-    s->state = Slot::Running;
-    s->id = next_id_++;
-    s->query = query;
+    s.scene.reset();
+    s.state = Slot::Free;
+    changed_.notify_all();
+    throw;
   }
-  start(*s, rays, choose(uint32_t(rays.size())));
-  return {s->id, s->index};
+  return {s.id, s.index};
 }
 
 void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
@@ -372,7 +440,7 @@ gpu::Method* Caster::method_for(const BatchQuery& q) {
   if (flags == uint32_t(options_.hit_outputs)) return method_.get();
   const uint32_t max_hits = q.query == Query::All ? q.max_hits : 1;
   std::unique_ptr<gpu::Method>& m = query_methods_[{flags, max_hits}];
-  if (!m) m = gpu::make_method(*gpu_, method_name_, view_.bytes(), "the caster's blob", uint32_t(slots_.size()), flags, max_hits);
+  if (!m) m = gpu::make_method(*gpu_, method_name_, view_->bytes(), "the caster's blob", uint32_t(slots_.size()), flags, max_hits);
   return m.get();
 #endif
 }
@@ -381,24 +449,61 @@ BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return collect(
 
 BatchRecord Caster::wait(const Ticket& t, HitLists& lists) { return collect(slot_of(t), t, {}, &lists, true); }
 
-BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record) {
-  BatchRecord r;
-  {
-    std::unique_lock<std::mutex> lock(mutex_);
-    auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
-    if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
-    const bool all = s.query.query == Query::All;
-    if (all != (lists != nullptr))
-      throw UsageError(all ? "ticket " + std::to_string(t.id) + " asked for every hit: wait(ticket, HitLists&) collects it"
-                           : "ticket " + std::to_string(t.id) + " asked for one hit a ray: wait(ticket, hits) collects it");
-    if (!all && hits.size() < s.n)
-      throw UsageError("wait() needs room for " + std::to_string(s.n) + " hits, got " + std::to_string(hits.size()));
-    // Another thread may collect the same ticket first: then this one throws.
-    changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
-    if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " was collected by another thread");
-    s.state = Slot::Collecting;
-    r = {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
+// What a ticket is collected into must be what its batch asked for.
+static void check_collected(uint64_t id, bool scene_batch, bool scene_wait, bool all, bool lists, size_t room, size_t n) {
+  if (scene_batch != scene_wait)
+    throw UsageError("ticket " + std::to_string(id) + (scene_batch ? " is a scene batch: wait(ticket, SceneHit hits or SceneHitLists&) collects it"
+                                                                   : " is a blob batch: wait(ticket, Hit hits or HitLists&) collects it"));
+  if (all != lists)
+    throw UsageError(all ? "ticket " + std::to_string(id) + " asked for every hit: wait(ticket, lists) collects it"
+                         : "ticket " + std::to_string(id) + " asked for one hit a ray: wait(ticket, hits) collects it");
+  if (!all && room < n) throw UsageError("wait() needs room for " + std::to_string(n) + " hits, got " + std::to_string(room));
+}
+
+BatchRecord Caster::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists, size_t room) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
+  if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
+  check_collected(t.id, s.scene != nullptr, scene_wait, s.query.query == Query::All, lists, room, s.n);
+  // Another thread may collect the same ticket first: then this one throws.
+  changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
+  if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " was collected by another thread");
+  s.state = Slot::Collecting;
+  return {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
+}
+
+void Caster::release(Slot& s, const BatchRecord& r, bool record) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (record) {
+    if (records_.size() < kRecords) records_.push_back(r);
+    else records_[recorded_ % kRecords] = r;
+    ++recorded_;
   }
+  s.scene.reset();  // a scene batch lets its frame go (its arrays may serve a later commit)
+  s.state = Slot::Free;
+  changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
+}
+
+BatchRecord Caster::wait(const Ticket& t, std::span<SceneHit> hits) {
+  Slot& s = slot_of(t);
+  const BatchRecord r = claim(s, t, true, false, hits.size());
+  std::copy(s.scene_hits.begin(), s.scene_hits.begin() + s.n, hits.begin());
+  release(s, r, true);
+  return r;
+}
+
+BatchRecord Caster::wait(const Ticket& t, SceneHitLists& lists) {
+  Slot& s = slot_of(t);
+  const BatchRecord r = claim(s, t, true, true, 0);
+  lists.max_hits = s.scene_query.max_hits;
+  lists.found.assign(s.found.begin(), s.found.end());
+  lists.hits.assign(s.scene_hits.begin(), s.scene_hits.end());
+  release(s, r, true);
+  return r;
+}
+
+BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record) {
+  BatchRecord r = claim(s, t, false, lists != nullptr, hits.size());
   bool copied = false;
   if (r.ran_on == Backend::Vulkan) {
     try {
@@ -426,25 +531,16 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLi
   } else if (!copied && s.n) {
     std::memcpy(hits.data(), s.hits.data(), s.n * sizeof(Hit));
   }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (record) {
-      if (records_.size() < kRecords) records_.push_back(r);
-      else records_[recorded_ % kRecords] = r;
-      ++recorded_;
-    }
-    s.state = Slot::Free;
-    changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
-  }
+  release(s, r, record);
   return r;
 }
 
 void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {
-  view_.trace(rays, hits, options_.hit_outputs, query.query, query.cull);
+  blob("Caster::trace_now").trace(rays, hits, options_.hit_outputs, query.query, query.cull);
 }
 
 void Caster::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const {
-  view_.trace_all_hits(rays, lists, options_.hit_outputs, cull);
+  blob("Caster::trace_now").trace_all_hits(rays, lists, options_.hit_outputs, cull);
 }
 
 std::vector<BatchRecord> Caster::records() const {
@@ -499,7 +595,7 @@ bool Caster::load_crossover() {
   std::string magic, saved_key, note;
   uint32_t crossover = 0;
   if (!(std::getline(in, magic) && magic == "meshcast-profile 1" && std::getline(in, saved_key) &&
-        saved_key == profile_key(device_name(), view_) && in >> crossover && std::getline(in >> std::ws, note)))
+        saved_key == profile_key(device_name(), *view_) && in >> crossover && std::getline(in >> std::ws, note)))
     return false;
   crossover_ = crossover;
   crossover_note_ = note + ", loaded from " + options_.profile;
@@ -512,7 +608,7 @@ bool Caster::load_crossover() {
 // after the game's (its batches are not the game's records), then saved to
 // options.profile when one is named.
 void Caster::measure_crossover() {
-  const layout::BlobHeader& h = layout::header_of(view_.bytes().data());
+  const layout::BlobHeader& h = layout::header_of(view_->bytes().data());
   std::vector<Ray> rays(16384);
   uint64_t state = 0x9E3779B97F4A7C15ull;
   auto uniform = [&] {
@@ -566,7 +662,7 @@ void Caster::measure_crossover() {
   if (!options_.profile.empty()) {
     try {
       OutputText out(options_.profile);
-      out << "meshcast-profile 1\n" << profile_key(device_name(), view_) << "\n" << crossover << "\n" << note.str() << "\n";
+      out << "meshcast-profile 1\n" << profile_key(device_name(), *view_) << "\n" << crossover << "\n" << note.str() << "\n";
       out.commit();
     } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
       saved = std::string("; not saved: ") + e.what();

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <deque>
+#include <random>
 #include <cmath>
 #include <cstdlib>
 #include <new>
@@ -14,6 +16,7 @@
 #include <thread>
 
 #include "meshcast/caster.h"
+#include "cpu/scene.h"
 #include "check/generate.h"
 #include "tests/testing.h"
 
@@ -455,5 +458,150 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
   std::filesystem::remove(profile);
 }
 
+}  // namespace
+}  // namespace meshcast::testing
+
+// Scene batches (issue 21): the game moves, hides, shows, adds and removes
+// instances and commits a frame while up to three batches are in flight;
+// every batch, collected frames later, is the scene as it was when it was
+// submitted (the same answers as walking that frame's snapshot), and the
+// world did change under them. The job system here starts each batch's
+// work only a while after it was handed over, so the batches really walk
+// while later frames are committed (and their snapshots' arrays would be
+// reused under them, were a held snapshot ever taken for a new frame).
+namespace meshcast::testing {
+namespace {
+class LateJobs : public host::JobSystem {
+ public:
+  LateJobs() : thread_([this] { loop(); }) {}
+  ~LateJobs() override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back({count, &work, std::chrono::steady_clock::now() + std::chrono::milliseconds(3)});
+    }
+    wake_.notify_all();
+  }
+  uint32_t threads() const override { return 1; }
+
+ private:
+  struct Run {
+    uint32_t count;
+    const std::function<void(uint32_t)>* work;
+    std::chrono::steady_clock::time_point at;
+  };
+  void loop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;
+      const Run r = queue_.front();
+      queue_.pop_front();
+      lock.unlock();
+      std::this_thread::sleep_until(r.at);
+      for (uint32_t i = 0; i < r.count; ++i) (*r.work)(i);
+      lock.lock();
+    }
+  }
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<Run> queue_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
+  Scene scene;
+  const MeshId sphere = scene.add_mesh(build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "sphere"), "sphere");
+  const MeshId ground = scene.add_mesh(build_blob(make_terrain(6, 6, 3), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "terrain"), "terrain");
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-30, 30);
+  auto somewhere = [&] {
+    Transform t;
+    for (double& x : t.translation) x = 1e6 + std::round(u(rng));
+    if (rng() % 3 == 0) t.rotation_scale[0] = -1;  // mirrored
+    return t;
+  };
+  std::vector<InstanceId> live;
+  for (int i = 0; i < 40; ++i) live.push_back(scene.add_instance(i % 2 ? sphere : ground, somewhere(), uint8_t(1u << (i % 3))));
+  scene.commit();
+  std::vector<RayD> rays(500);
+  for (RayD& r : rays) {
+    for (int a = 0; a < 3; ++a) r.org[a] = 1e6 + u(rng), r.dir[a] = float(1e6 + u(rng) - r.org[a]);
+    r.tmax = INFINITY;
+  }
+  LateJobs late;
+  CasterOptions o = options(Backend::Cpu, 3);
+  o.jobs = &late;
+  Caster caster(o);
+  EXPECT_THROW(caster.submit(std::vector<Ray>(1)), UsageError);  // no blob
+  struct InFlight {
+    host::Ticket ticket;
+    std::shared_ptr<const SceneSnapshot> frame;
+    host::SceneBatchQuery query;
+  };
+  std::deque<InFlight> flight;
+  size_t changed = 0;
+  auto collect = [&] {
+    const InFlight f = flight.front();
+    flight.pop_front();
+    if (f.query.query == Query::All) {
+      SceneHitLists got, want;
+      want.max_hits = f.query.max_hits;
+      caster.wait(f.ticket, got);
+      trace_all_hits_snapshot(*f.frame, rays, want, HitOutputs::None, f.query.cull, f.query.mask);
+      ASSERT_EQ(got.found, want.found);
+      for (size_t i = 0; i < want.hits.size(); ++i) {
+        EXPECT_EQ(got.hits[i].instance, want.hits[i].instance) << "record " << i;
+        EXPECT_EQ(got.hits[i].triangle, want.hits[i].triangle) << "record " << i;
+      }
+      return;
+    }
+    std::vector<SceneHit> got(rays.size()), want(rays.size()), now(rays.size());
+    caster.wait(f.ticket, got);
+    trace_snapshot(*f.frame, rays, want, HitOutputs::None, f.query.query, f.query.cull, f.query.mask);
+    scene.trace(rays, now, HitOutputs::None, f.query.query, f.query.cull, f.query.mask);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      EXPECT_EQ(got[i].instance, want[i].instance) << "ray " << i;
+      EXPECT_EQ(got[i].triangle, want[i].triangle) << "ray " << i;
+      EXPECT_EQ(got[i].t, want[i].t) << "ray " << i;
+      changed += got[i].instance != now[i].instance || got[i].t != now[i].t;
+    }
+  };
+  for (int frame = 0; frame < 24; ++frame) {
+    const host::SceneBatchQuery q = frame % 3 == 0   ? host::SceneBatchQuery{Query::All, Cull::None, 0xFF, 32}
+                                    : frame % 3 == 1 ? host::SceneBatchQuery{Query::Closest, Cull::None, 0xFF}
+                                                     : host::SceneBatchQuery{Query::Any, Cull::Back, 0x03};
+    flight.push_back({caster.submit(scene, rays, q), scene.snapshot(), q});
+    if (flight.size() == 3) collect();
+    // The next frame: moves, a hidden and a shown instance, one added, one
+    // removed every 4th frame.
+    for (int k = 0; k < 6; ++k) scene.set_transform(live[rng() % live.size()], somewhere());
+    scene.set_enabled(live[rng() % live.size()], false);
+    scene.set_enabled(live[rng() % live.size()], true);
+    live.push_back(scene.add_instance(frame % 2 ? sphere : ground, somewhere()));
+    if (frame % 4 == 3) {
+      const size_t gone = rng() % live.size();
+      scene.remove_instance(live[gone]);
+      live.erase(live.begin() + std::ptrdiff_t(gone));
+    }
+    scene.commit();
+  }
+  while (!flight.empty()) collect();
+  EXPECT_GT(changed, rays.size() / 10) << "the world hardly changed under the batches";
+  // A scene batch is collected as scene hits, and a wrong kind is refused.
+  const host::Ticket t = caster.submit(scene, rays);
+  std::vector<Hit> plain(rays.size());
+  EXPECT_THROW(caster.wait(t, plain), UsageError);
+  std::vector<SceneHit> hits(rays.size());
+  caster.wait(t, hits);
+}
 }  // namespace
 }  // namespace meshcast::testing

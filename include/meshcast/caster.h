@@ -12,6 +12,16 @@
 //   Ticket a = caster.submit(rays, {Query::All, Cull::Back, 8});  // every hit
 //   caster.wait(a, lists);                      // HitLists for Query::All
 //
+// Scenes (meshcast/scene.h): a batch of world rays against the scene as it
+// was committed when the batch was submitted (the batch holds that
+// snapshot), while the game moves, hides and adds instances and commits the
+// next frames; the CPU's workers walk it.
+//
+//   Caster scenes({});                          // no blob: scene batches alone
+//   Ticket f = scenes.submit(scene, world_rays, {Query::Closest, Cull::None, 0xFF});
+//   scene.set_transform(a, moved); scene.commit();  // the batch still sees the last frame
+//   scenes.wait(f, scene_hits);                 // or a SceneHitLists for Query::All
+//
 // A caster owns a ring of `frames` slots; each submitted batch holds one
 // until it is collected with wait(). Slot buffers (rays, hits, the GPU's
 // mapped buffers, the recorded command buffers) are reused, so after the
@@ -26,6 +36,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
@@ -34,6 +45,7 @@
 #include "meshcast/blob.h"
 #include "meshcast/jobs.h"
 #include "meshcast/ray.h"
+#include "meshcast/scene.h"
 
 namespace meshcast::gpu {
 class Context;
@@ -61,6 +73,15 @@ struct Ticket {
 struct BatchQuery {
   Query query = Query::Closest;
   Cull cull = Cull::None;
+  uint32_t max_hits = 16;
+};
+
+// A scene batch's question: BatchQuery's, and the rays' mask (an instance
+// is walked when its mask shares a bit with it).
+struct SceneBatchQuery {
+  Query query = Query::Closest;
+  Cull cull = Cull::None;
+  uint8_t mask = 0xFF;
   uint32_t max_hits = 16;
 };
 
@@ -121,6 +142,9 @@ class Caster {
   // Automatic, a device that is missing or fails leaves the caster on the
   // CPU, and gpu_error() says why.
   Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options = {});
+  // A caster of scene batches alone: no blob, the CPU's workers (the
+  // options' backend is not read). Its blob calls throw UsageError.
+  explicit Caster(CasterOptions options);
   ~Caster();
   Caster(const Caster&) = delete;
   Caster& operator=(const Caster&) = delete;
@@ -129,6 +153,16 @@ class Caster {
   // UsageError when all `frames` slots hold uncollected batches, or for a
   // query out of range.
   Ticket submit(std::span<const Ray> rays, BatchQuery query = {});
+  // A scene batch (see above): the scene's last commit, taken now; call it
+  // from the thread that edits and commits the scene. The rays are copied.
+  // HitOutputs::Point is left out of scene hits (they carry none). Throws
+  // as submit(rays).
+  Ticket submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query = {});
+  // Collects a scene batch (closest or any hit a ray, or Query::All's rows),
+  // as wait(ticket, hits) does; its snapshot is let go.
+  BatchRecord wait(const Ticket& t, std::span<SceneHit> hits);
+  BatchRecord wait(const Ticket& t, SceneHitLists& lists);
+
   // Whether the batch is ready. UsageError for a ticket this caster did not
   // issue or that was already collected.
   bool poll(const Ticket& t);
@@ -188,7 +222,17 @@ class Caster {
   bool load_crossover();     // from options.profile; false when it holds none for this device and blob
   void measure_crossover();  // on the measurement's slot; the background thread's work
 
-  BlobView view_;  // the caller's blob, which must outlive the caster
+  // The caller's blob, which must outlive the caster (none for a caster of
+  // scene batches alone); blob() throws UsageError naming `who` then.
+  std::optional<BlobView> view_;
+  const BlobView& blob(const char* who) const;
+  void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
+  Slot& take_slot();  // a free game slot, Running; UsageError when none
+  // The first half of collecting: checks that the caller collects the
+  // batch into what it asked for (scene hits or not, rows or not, `room`
+  // hits), waits for it and marks it Collecting; release() frees the slot.
+  BatchRecord claim(Slot& s, const Ticket& t, bool scene_wait, bool lists, size_t room);
+  void release(Slot& s, const BatchRecord& r, bool record);
   CasterOptions options_;
   std::unique_ptr<WorkerPool> pool_;
   JobSystem* jobs_ = nullptr;

@@ -12,18 +12,25 @@ namespace meshcast::bench {
 
 namespace {
 
+// A device of `threads` build threads (0: every core) whose allocations
+// are summed into *bytes (Embree's memory monitor).
+RTCDevice new_device(uint32_t threads, std::atomic<int64_t>* bytes) {
+  RTCDevice device = rtcNewDevice(("threads=" + std::to_string(threads)).c_str());
+  if (!device) throw std::runtime_error("Embree: rtcNewDevice failed");
+  rtcSetDeviceMemoryMonitorFunction(
+      device,
+      [](void* user, ssize_t delta, bool) {
+        static_cast<std::atomic<int64_t>*>(user)->fetch_add(delta);
+        return true;
+      },
+      bytes);
+  return device;
+}
+
 class Embree final : public Peer {
  public:
   Embree(const Mesh& mesh, EmbreeMode mode, uint32_t threads) : mode_(mode) {
-    device_ = rtcNewDevice(("threads=" + std::to_string(threads)).c_str());
-    if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
-    rtcSetDeviceMemoryMonitorFunction(
-        device_,
-        [](void* user, ssize_t bytes, bool) {
-          static_cast<std::atomic<int64_t>*>(user)->fetch_add(bytes);
-          return true;
-        },
-        &bytes_);
+    device_ = new_device(threads, &bytes_);
     auto t0 = std::chrono::steady_clock::now();
     scene_ = rtcNewScene(device_);
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -101,15 +108,7 @@ class Embree final : public Peer {
 class EmbreeScene final : public ScenePeer {
  public:
   EmbreeScene(const std::vector<const Mesh*>& meshes, const std::vector<PeerInstance>& instances) {
-    device_ = rtcNewDevice("threads=1");
-    if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
-    rtcSetDeviceMemoryMonitorFunction(
-        device_,
-        [](void* user, ssize_t bytes, bool) {
-          static_cast<std::atomic<int64_t>*>(user)->fetch_add(bytes);
-          return true;
-        },
-        &bytes_);
+    device_ = new_device(1, &bytes_);
     shapes_.reserve(meshes.size());  // Embree keeps pointers into each shape's arrays
     for (const Mesh* mesh : meshes) {
       Shape& s = shapes_.emplace_back();

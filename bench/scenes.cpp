@@ -9,6 +9,7 @@
 
 #include "bench/peer.h"
 #include "builder/layout_names.h"
+#include "check/generate.h"
 #include "cpu/scene.h"
 #include "meshcast/build.h"
 #include "meshcast/scene.h"
@@ -34,19 +35,12 @@ std::vector<PeerInstance> plan_level(const std::vector<Mesh>& meshes, size_t cou
   std::vector<double> diagonal;
   for (const Mesh& m : meshes) diagonal.push_back(m.bounds().diagonal());
   std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0, 1);
   std::uniform_real_distribution<double> size(2, 20), uneven(0.7, 1.4), ground(-5000, 5000), height(0, 20);
   std::vector<PeerInstance> out;
   for (size_t i = 0; i < count; ++i) {
     PeerInstance p;
     p.mesh = uint32_t(i % meshes.size());
-    double q[4] = {n(rng), n(rng), n(rng), n(rng)};
-    const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    for (double& x : q) x /= len;
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+    const std::array<double, 9> r = random_rotation(rng);
     const double base = size(rng) / diagonal[p.mesh];
     double scale[3] = {base, base, base};
     if (i % 4 == 0)

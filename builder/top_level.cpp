@@ -112,10 +112,10 @@ struct Collapser {
 
   // The wide node over binary node `root` (an inner node); returns its index.
   uint32_t collapse(uint32_t root) {
-    uint32_t kids[4] = {root + 1, top.nodes[root].right, 0, 0};
+    uint32_t kids[layout::kTopWidth] = {root + 1, top.nodes[root].right};
     int count = 2;
-    // Open the largest inner child until there are 4.
-    while (count < 4) {
+    // Open the largest inner child until there are kTopWidth.
+    while (count < layout::kTopWidth) {
       int best = -1;
       for (int k = 0; k < count; ++k)
         if (top.nodes[kids[k]].count == 0 && (best < 0 || half_area(top.nodes[kids[k]]) > half_area(top.nodes[kids[best]])))
@@ -127,13 +127,13 @@ struct Collapser {
     }
     const uint32_t index = uint32_t(top.wide.size());
     top.wide.emplace_back();
-    top.wide_from.insert(top.wide_from.end(), 4, layout::kTopEmpty);
-    for (int k = 0; k < 4; ++k) {
+    top.wide_from.insert(top.wide_from.end(), layout::kTopWidth, layout::kTopEmpty);
+    for (int k = 0; k < layout::kTopWidth; ++k) {
       uint32_t slot = layout::kTopEmpty;
       if (k < count) {
         const layout::TopNode& n = top.nodes[kids[k]];
         slot = n.count > 0 ? layout::kTopInstance | n.first : collapse(kids[k]);
-        top.wide_from[4 * size_t(index) + size_t(k)] = kids[k];
+        top.wide_from[layout::kTopWidth * size_t(index) + size_t(k)] = kids[k];
       }
       top.wide[index].slot[k] = slot;  // (collapse() may have moved the node)
     }
@@ -150,11 +150,12 @@ void collapse_top_level(layout::TopLevel& top) {
   const layout::TopNode& root = top.nodes[0];
   for (int a = 0; a < 3; ++a) top.anchor[a] = 0.5 * (root.min[a] + root.max[a]);
   top.wide.reserve(top.nodes.size() / 2 + 1);
-  top.wide_from.reserve(2 * top.nodes.size() + 4);
+  top.wide_from.reserve(layout::kTopWidth * (top.nodes.size() / 2 + 1));
   if (root.count > 0) {  // one instance: a wide root with it in slot 0
     top.wide.emplace_back();
-    top.wide_from = {0, layout::kTopEmpty, layout::kTopEmpty, layout::kTopEmpty};
-    for (int k = 0; k < 4; ++k) top.wide[0].slot[k] = k == 0 ? layout::kTopInstance | root.first : layout::kTopEmpty;
+    top.wide_from.assign(layout::kTopWidth, layout::kTopEmpty);
+    top.wide_from[0] = 0;
+    for (int k = 0; k < layout::kTopWidth; ++k) top.wide[0].slot[k] = k == 0 ? layout::kTopInstance | root.first : layout::kTopEmpty;
   } else {
     Collapser{top}.collapse(0);
   }
@@ -164,9 +165,9 @@ void collapse_top_level(layout::TopLevel& top) {
 void fit_wide_boxes(layout::TopLevel& top) {
   for (int a = 0; a < 3; ++a) top.min[a] = top.nodes[0].min[a], top.max[a] = top.nodes[0].max[a];
   for (size_t w = 0; w < top.wide.size(); ++w)
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < layout::kTopWidth; ++k) {
       layout::TopWideNode& node = top.wide[w];
-      const uint32_t from = top.wide_from[4 * w + size_t(k)];
+      const uint32_t from = top.wide_from[layout::kTopWidth * w + size_t(k)];
       for (int a = 0; a < 3; ++a) {
         if (from == layout::kTopEmpty) {
           node.lo[a][k] = INFINITY, node.hi[a][k] = -INFINITY;  // never entered

@@ -14,9 +14,9 @@ namespace meshcast {
 // so nothing is rounded inward.
 layout::TopLevel build_top_level(const std::vector<layout::PlacedInstance>& placed);
 
-// The 4-wide nodes of top.wide and the anchor, made again from the binary
+// The 8-wide nodes of top.wide and the anchor, made again from the binary
 // nodes (each wide node takes the largest of its binary descendants' boxes
-// apart until it has 4 children or only leaves): O(n), after every build
+// apart until it has 8 children or only leaves): O(n), after every build
 // and refit.
 void collapse_top_level(layout::TopLevel& top);
 // The wide nodes' boxes read again from the binary nodes they were

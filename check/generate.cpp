@@ -193,4 +193,15 @@ Mesh make_city(size_t triangles, uint32_t seed) {
   return city;
 }
 
+std::array<double, 9> random_rotation(std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 1);
+  double q[4] = {n(rng), n(rng), n(rng), n(rng)};
+  const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  for (double& x : q) x /= len;
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+}
+
 }  // namespace meshcast

@@ -1,5 +1,7 @@
 // Deterministic generated meshes for tests and benchmarks.
 #pragma once
+#include <array>
+#include <random>
 #include <cstdint>
 
 #include "meshcast/mesh.h"
@@ -28,5 +30,8 @@ Mesh make_terrain(int nx, int ny, uint32_t seed);
 // spheres of 8 to 96 rings, 0.3 to 6 m across) scattered in the streets and
 // on the roofs: large and tiny triangles side by side, as in a game level.
 Mesh make_city(size_t triangles, uint32_t seed);
+// A rotation drawn uniformly (a unit quaternion from four normal draws),
+// row-major: what scenes' tests and benchmarks turn instances by.
+std::array<double, 9> random_rotation(std::mt19937& rng);
 
 }  // namespace meshcast

@@ -1,14 +1,12 @@
-// A snapshot's walk: the top level's float boxes near its anchor, each instance it reaches
+// A snapshot's walk: the top level's float boxes near its anchor (the
+// chosen instruction set's enter_top tests a node), each instance it reaches
 // walked by its blob's own walker on the ray brought into its frame.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "cpu/scene.h"
+#include "cpu/walk_top.h"
 #include "meshcast/errors.h"
 #include "meshcast/scene.h"
 
@@ -30,55 +28,8 @@ struct WorldRay {
   double org[3];
   float dir[3];
   float tmax;
-  // For the top level's float boxes: the origin relative to the anchor
-  // (rounded), 1 / dir (+-inf for a zero component), and the pad every box
-  // is widened by, kBoxSlack of the farthest the origin is from the scene's
-  // box (which also covers the rounding of the origin and the boxes).
-  float rel[3], inv[3], pad;
-  bool negative[3];  // dir's sign bit: the box's hi plane is met first
+  TopRay top;  // for the top level's float boxes (cpu/walk_top.h)
 };
-
-// The entries into the 4 slots' widened boxes before `cut`: a bit a slot
-// entered, its entry distance in entry[slot]. Written as straight loops
-// over 4 lanes. Near and far planes go by the direction's sign, so a zero
-// component (an infinite inverse) gives -inf or +inf on the right sides,
-// and NaN (0 * inf) only for a ray in a slab's plane, which the min and max
-// below drop (they keep their second operand on NaN, as the walkers' box
-// tests do): the closed box holds that ray.
-int enter_slots(const WorldRay& r, const layout::TopWideNode& n, float cut, float entry[4]) {
-#if defined(__SSE2__)
-  // Every x86-64 processor has SSE2: the 4 slots in one register (the
-  // library's own code is built for the baseline; the walkers are the part
-  // built for each instruction set).
-  __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(cut * (1 + float(kBoxSlack)));
-  const __m128 pad = _mm_set1_ps(r.pad);
-  for (int a = 0; a < 3; ++a) {
-    const __m128 rel = _mm_set1_ps(r.rel[a]), inv = _mm_set1_ps(r.inv[a]);
-    const __m128 t0 = _mm_mul_ps(_mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(n.lo[a]), pad), rel), inv);
-    const __m128 t1 = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(_mm_loadu_ps(n.hi[a]), pad), rel), inv);
-    tn = _mm_max_ps(r.negative[a] ? t1 : t0, tn);  // NaN: the second operand kept
-    tf = _mm_min_ps(r.negative[a] ? t0 : t1, tf);
-  }
-  _mm_storeu_ps(entry, tn);
-  return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
-#else
-  float tn[4], tf[4];
-  for (int k = 0; k < 4; ++k) tn[k] = 0, tf[k] = cut * (1 + float(kBoxSlack));
-  for (int a = 0; a < 3; ++a)
-    for (int k = 0; k < 4; ++k) {
-      const float t0 = (n.lo[a][k] - r.pad - r.rel[a]) * r.inv[a], t1 = (n.hi[a][k] + r.pad - r.rel[a]) * r.inv[a];
-      const float near = r.negative[a] ? t1 : t0, far = r.negative[a] ? t0 : t1;
-      tn[k] = near > tn[k] ? near : tn[k];
-      tf[k] = far < tf[k] ? far : tf[k];
-    }
-  int bits = 0;
-  for (int k = 0; k < 4; ++k) {
-    entry[k] = tn[k];
-    bits |= int(tn[k] <= tf[k]) << k;
-  }
-  return bits;
-#endif
-}
 
 // The world ray in the instance's frame: the translation subtracted in
 // double, the difference rounded to float, then the float inverse.
@@ -106,19 +57,21 @@ bool world_ray_walkable(const RayD& r) {
   return ray_is_walkable(probe);
 }
 
-// The world ray as the top level reads it.
+// The world ray as the top level reads it; the pad is kBoxSlack of the
+// farthest the origin is from the scene's box (which also covers the
+// rounding of the origin and the boxes to float).
 WorldRay world_ray(const layout::TopLevel& top, const RayD& rd) {
   WorldRay r;
   double far = 0;
   for (int a = 0; a < 3; ++a) {
     r.org[a] = rd.org[a], r.dir[a] = rd.dir[a];
-    r.rel[a] = float(rd.org[a] - top.anchor[a]);
-    r.inv[a] = 1.0f / rd.dir[a];
-    r.negative[a] = std::signbit(rd.dir[a]);
+    r.top.rel[a] = float(rd.org[a] - top.anchor[a]);
+    r.top.inv[a] = 1.0f / rd.dir[a];
+    r.top.negative[a] = std::signbit(rd.dir[a]);
     far = std::max({far, std::fabs(rd.org[a] - top.min[a]), std::fabs(rd.org[a] - top.max[a])});
   }
   r.tmax = rd.tmax;
-  r.pad = float(far * kBoxSlack);
+  r.top.pad = float(far * kBoxSlack);
   return r;
 }
 
@@ -126,21 +79,23 @@ WorldRay world_ray(const layout::TopLevel& top, const RayD& rd) {
 // enters before the cut, nearest entry first, whose mask shares a bit
 // with `mask`, goes to visit(instance, its local ray with t_max the cut),
 // which returns the cut from then on (a nearer hit's t, or the same), or
-// a negative number to end the walk.
+// a negative number to end the walk. `enter`: the chosen instruction set's
+// node test.
 template <class Visit>
-void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Visit&& visit) {
+void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, EnterTopFn enter, Visit&& visit) {
   float cut = r.tmax;
-  // A wide node leaves at most 3 entries behind a level, and the binary
-  // tree under it is at most 64 deep (median splits of fewer than 2^32):
-  // the stack cannot fill.
-  constexpr int kStack = 3 * 64 + 4;
+  // A wide node leaves at most 7 entries behind a level, and the binary
+  // tree under it is at most 64 deep (median splits of fewer than 2^32);
+  // a node's test writes 8 past the top: the stack cannot fill.
+  constexpr int kStack = 7 * 64 + 8;
   uint32_t stack[kStack];
   float entries[kStack];
   int top_of = 0;
   stack[top_of] = 0, entries[top_of++] = 0;  // the root node
+  const float widen = 1 + float(kBoxSlack);
   while (top_of > 0) {
     --top_of;
-    if (entries[top_of] > cut * (1 + float(kBoxSlack))) continue;
+    if (entries[top_of] > cut * widen) continue;
     const uint32_t item = stack[top_of];
     if (item & layout::kTopInstance) {
       const layout::PlacedInstance& p = top.placed[item & ~layout::kTopInstance];
@@ -151,18 +106,9 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Visi
       if (cut < 0) return;
       continue;
     }
-    const layout::TopWideNode& n = top.wide[item];
-    float entry[4];
-    int bits = enter_slots(r, n, cut, entry);
-    // Pushed farthest first, so the nearest is walked next.
-    int order[4], count = 0;
-    for (; bits; bits &= bits - 1) {
-      const int k = __builtin_ctz(unsigned(bits));
-      int at = count++;
-      for (; at > 0 && entry[order[at - 1]] < entry[k]; --at) order[at] = order[at - 1];
-      order[at] = k;
-    }
-    for (int i = 0; i < count; ++i) stack[top_of] = n.slot[order[i]], entries[top_of++] = entry[order[i]];
+    // The entered slots go on the stack farthest first: the nearest is
+    // popped next.
+    top_of += enter(r.top, top.wide[item], cut * widen, entries + top_of, stack + top_of);
   }
 }
 
@@ -172,7 +118,7 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Visi
 bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
           uint8_t mask) {
   bool complete = true;
-  walk_top(s.top, world_ray(s.top, rd), mask, [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, world_ray(s.top, rd), mask, enter_top_fn(), [&](const layout::PlacedInstance& p, const Ray& local) {
     Hit h;
     // A local ray the walkers refuse (its direction scaled past their
     // range) is counted, not walked.
@@ -201,7 +147,7 @@ uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> ro
   auto before = [](const SceneHit& a, const SceneHit& b) {
     return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
   };
-  walk_top(s.top, world_ray(s.top, rd), mask, [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, world_ray(s.top, rd), mask, enter_top_fn(), [&](const layout::PlacedInstance& p, const Ray& local) {
     uint32_t own = 0;
     if (s.meshes[p.mesh]->view.trace_all_hits(std::span(&local, 1), cap, std::span(&own, 1), scratch, outputs,
                                               as_instance_sees(cull, p.mirrored != 0)) != 0)

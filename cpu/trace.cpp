@@ -13,6 +13,7 @@
 #endif
 
 #include "cpu/walk.h"
+#include "cpu/walk_top.h"
 #include "layout/queries.h"
 #include "cpu/walk_table.h"
 #include "layout/blob_format.h"
@@ -103,6 +104,22 @@ const IsaChoice& chosen() {
 }
 
 }  // namespace
+
+EnterTopFn enter_top_fn() {
+  const WalkerIsa isa = chosen().isa;
+#if MESHCAST_HAS_ISA_AVX512
+  if (isa == WalkerIsa::Avx512) return &isa_avx512::enter_top;
+#endif
+#if MESHCAST_HAS_ISA_AVX2
+  if (isa == WalkerIsa::Avx2) return &isa_avx2::enter_top;
+#endif
+  (void)isa;
+#if MESHCAST_HAS_ISA_SCALAR
+  return &isa_scalar::enter_top;
+#else
+  return nullptr;  // not reached: choose_isa picks a set this build has
+#endif
+}
 
 std::string_view walker_isa_name(WalkerIsa isa) {
   switch (isa) {

@@ -256,14 +256,19 @@ std::string Caster::why(uint32_t rays) const {
          " the crossover of " + std::to_string(crossover) + " rays (" + note + ")";
 }
 
-Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
-  if (query.query != Query::Closest && query.query != Query::Any && query.query != Query::All)
-    throw UsageError("Caster::submit: query " + std::to_string(uint32_t(query.query)) + " is not a Query");
-  if (query.cull != Cull::None && query.cull != Cull::Back && query.cull != Cull::Front)
-    throw UsageError("Caster::submit: cull " + std::to_string(uint32_t(query.cull)) + " is not a Cull");
-  if (query.query == Query::All && (query.max_hits < 1 || query.max_hits > kMaxHitsLimit))
-    throw UsageError("Caster::submit: max_hits " + std::to_string(query.max_hits) + " is not in 1.." +
+// A batch's query, culling and row length, or UsageError naming the one out of range.
+static void check_query(Query query, Cull cull, uint32_t max_hits) {
+  if (query != Query::Closest && query != Query::Any && query != Query::All)
+    throw UsageError("Caster::submit: query " + std::to_string(uint32_t(query)) + " is not a Query");
+  if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
+    throw UsageError("Caster::submit: cull " + std::to_string(uint32_t(cull)) + " is not a Cull");
+  if (query == Query::All && (max_hits < 1 || max_hits > kMaxHitsLimit))
+    throw UsageError("Caster::submit: max_hits " + std::to_string(max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
+}
+
+Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
+  check_query(query.query, query.cull, query.max_hits);
   blob("Caster::submit");
   Slot& s = take_slot();
   s.query = query;
@@ -285,13 +290,7 @@ Caster::Slot& Caster::take_slot() {
 }
 
 Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
-  if (query.query != Query::Closest && query.query != Query::Any && query.query != Query::All)
-    throw UsageError("Caster::submit: query " + std::to_string(uint32_t(query.query)) + " is not a Query");
-  if (query.cull != Cull::None && query.cull != Cull::Back && query.cull != Cull::Front)
-    throw UsageError("Caster::submit: cull " + std::to_string(uint32_t(query.cull)) + " is not a Cull");
-  if (query.query == Query::All && (query.max_hits < 1 || query.max_hits > kMaxHitsLimit))
-    throw UsageError("Caster::submit: max_hits " + std::to_string(query.max_hits) + " is not in 1.." +
-                     std::to_string(kMaxHitsLimit));
+  check_query(query.query, query.cull, query.max_hits);
   Slot& s = take_slot();
   try {
     s.scene = scene.snapshot();

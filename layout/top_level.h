@@ -26,20 +26,21 @@ struct TopNode {
   uint32_t first, count, right, pad = 0;
 };
 
-// What a walk reads: 4-wide nodes, each slot a child's box in float,
+// What a walk reads: 8-wide nodes, each slot a child's box in float,
 // relative to the top level's anchor (double) and rounded outward, and what
 // the slot holds: a node's index, kTopInstance | an index into `placed`, or
 // kTopEmpty (its box empty: lo +inf, hi -inf, never entered). Float boxes
 // near the anchor keep a level 10 km across to half a millimetre at 10^7
 // from the origin: the anchor carries the distance.
 constexpr uint32_t kTopInstance = 0x80000000u, kTopEmpty = 0xFFFFFFFFu;
+constexpr int kTopWidth = 8;
 struct TopWideNode {
-  float lo[3][4], hi[3][4];  // [axis][slot]
-  uint32_t slot[4];
+  float lo[3][kTopWidth], hi[3][kTopWidth];  // [axis][slot]
+  uint32_t slot[kTopWidth];                   // 8 words side by side: the walkers' order_hits reads them
 };
 
 // The top level: placed instances reordered into tree order, the binary
-// nodes (root first; empty when no instance is placed) and the 4-wide nodes
+// nodes (root first; empty when no instance is placed) and the 8-wide nodes
 // collapsed from them (root first), with their anchor (the root box's
 // centre at the last build) and the root box. Leaves hold at most
 // kTopLeafSize instances: each instance's own box is tested before its
@@ -53,7 +54,7 @@ struct TopLevel {
   double anchor[3] = {0, 0, 0};
   double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};
   std::vector<TopNode> nodes;
-  std::vector<uint32_t> wide_from;  // 4 a wide node: the binary node each slot's box is, or kTopEmpty
+  std::vector<uint32_t> wide_from;  // kTopWidth a wide node: the binary node each slot's box is, or kTopEmpty
 };
 
 }  // namespace meshcast::layout

@@ -21,7 +21,7 @@ jobs=$(nproc)
 cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test scene_test
             hostile_test oracle_test io_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
-walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test)
+walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
   local dir=$1 quick=()
   [[ $2 == quick ]] && quick=(MESHCAST_TEST_QUICK=1)

@@ -30,14 +30,7 @@ struct Level {
 // A random rotation (a unit quaternion from 4 normals) times a scale per
 // axis; `mirror` negates the first column.
 Transform random_transform(std::mt19937& rng, double spread, double offset, bool uniform, bool mirror) {
-  std::normal_distribution<double> n(0, 1);
-  double q[4] = {n(rng), n(rng), n(rng), n(rng)};
-  const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  for (double& x : q) x /= len;
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                       2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                       2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  const std::array<double, 9> r = random_rotation(rng);
   std::uniform_real_distribution<double> s(0.5, 3.0), u(-spread, spread);
   const double base = s(rng);
   const double scale[3] = {base, uniform ? base : s(rng), uniform ? base : s(rng)};
@@ -400,6 +393,7 @@ TEST(Scene, FramesOfMovesAlone) {
   Scene scene = make_scene(level);
   const std::vector<RayD> rays = level_rays(level, quick() ? 200 : 800, 60, 8);
   std::mt19937 rng(4);
+  size_t hits = 0;  // over every frame (instances wander off the rays' targets)
   for (int frame = 0; frame < 20; ++frame) {
     for (int k = 0; k < 8; ++k) {
       const uint32_t id = rng() % uint32_t(level.instances.size());
@@ -412,8 +406,9 @@ TEST(Scene, FramesOfMovesAlone) {
     scene.commit();
     const Judged j = judge(oracle_of(level), rays, trace(scene, rays, Query::Closest, Cull::None, 0x03), Cull::None, 0x03, false);
     EXPECT_EQ(j.wrong, 0u) << "frame " << frame << ": " << j.first_problem;
-    EXPECT_GT(j.hits, rays.size() / 25) << "frame " << frame;
+    hits += j.hits;
   }
+  EXPECT_GT(hits, 20 * rays.size() / 20) << "too few hits to show anything";
 }
 
 TEST(Scene, RefusesBadInput) {

@@ -56,15 +56,18 @@ enum class Query : uint32_t { Closest = 0, Any = 1, All = 2 };
 // hits of one t at the cut, which are kept depends on the walk). A
 // triangle the ray meets exactly on an edge or vertex shared with others
 // is one hit each of them. u and v only when asked for (on the CPU; the
-// Vulkan rows carry t, the triangle and the point).
-struct HitLists {
+// Vulkan rows carry t, the triangle and the point). The same rows hold a
+// scene's hits (SceneHitLists, meshcast/scene.h).
+template <class Record>
+struct HitRows {
   uint32_t max_hits = 16;
   std::vector<uint32_t> found;
-  std::vector<Hit> hits;
-  std::span<const Hit> row(size_t ray) const {
+  std::vector<Record> hits;
+  std::span<const Record> row(size_t ray) const {
     return {hits.data() + ray * max_hits, std::min<size_t>(found[ray], max_hits)};
   }
 };
+using HitLists = HitRows<Hit>;
 // The most hits a ray's row may hold.
 constexpr uint32_t kMaxHitsLimit = 4096;
 

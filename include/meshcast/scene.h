@@ -55,14 +55,7 @@ struct SceneHit {
 // Query::All's answers on a scene, as HitLists: ray i found found[i] hits
 // over every instance it reaches, the nearest min(found[i], max_hits) in row
 // i in order of t, then instance, then triangle.
-struct SceneHitLists {
-  uint32_t max_hits = 16;
-  std::vector<uint32_t> found;
-  std::vector<SceneHit> hits;
-  std::span<const SceneHit> row(size_t ray) const {
-    return {hits.data() + ray * max_hits, std::min<size_t>(found[ray], max_hits)};
-  }
-};
+using SceneHitLists = HitRows<SceneHit>;
 
 // Where an instance stands: world = rotation_scale * local + translation.
 // The 3x3 is row-major and may rotate, scale (non-uniformly too) and mirror

@@ -1,0 +1,39 @@
+// enter_top (cpu/walk_top.h) for one instruction set: the 8 slots in one
+// register of 8 lanes (AVX2, AVX-512) or 8 scalar lanes. Near and far
+// planes go by the direction's sign, so a zero component gives -inf or +inf
+// on the right sides, and NaN (0 * inf) only for a ray in a slab's plane,
+// which min and max drop (they keep their second operand on NaN, as the
+// walkers' box tests do): the closed box holds that ray.
+#include <bit>
+
+#include "cpu/simd.h"
+#include "cpu/walk_top.h"
+
+namespace meshcast {
+MC_ISA_BEGIN
+
+int enter_top(const TopRay& r, const layout::TopWideNode& n, float cut, float* entries, uint32_t* children) {
+  using simd::F8;
+  F8 tn = F8::splat(0.0f), tf = F8::splat(cut);
+  const F8 pad = F8::splat(r.pad);
+  for (int a = 0; a < 3; ++a) {
+    const F8 rel = F8::splat(r.rel[a]), inv = F8::splat(r.inv[a]);
+    const F8 t0 = (F8::load(n.lo[a]) - pad - rel) * inv, t1 = (F8::load(n.hi[a]) + pad - rel) * inv;
+    tn = simd::max(r.negative[a] ? t1 : t0, tn);
+    tf = simd::min(r.negative[a] ? t0 : t1, tf);
+  }
+  const int bits = simd::bits(tn <= tf);
+  if (bits == 0) return 0;
+  if ((bits & (bits - 1)) == 0) {  // one slot (the commonest): no sort
+    alignas(32) float entry[8];
+    tn.store(entry);
+    const int k = __builtin_ctz(unsigned(bits));
+    entries[0] = entry[k], children[0] = n.slot[k];
+    return 1;
+  }
+  simd::order_hits(tn, bits, reinterpret_cast<const uint8_t*>(n.slot), entries, children);
+  return std::popcount(unsigned(bits));
+}
+
+MC_ISA_END
+}  // namespace meshcast

@@ -76,7 +76,7 @@ std::vector<RayD> level_rays(const std::vector<PeerInstance>& level, size_t coun
 // A contender: meshcast's scene or Embree's, behind the same calls.
 struct Contender {
   std::string name;
-  double bytes;
+  std::function<double()> bytes;  // read after the updates: the steady state
   std::function<void(const std::vector<RayD>&, std::vector<SceneHit>&)> trace;
   std::function<void(uint32_t, const Transform&)> move;
   std::function<void()> commit;
@@ -106,16 +106,15 @@ std::vector<SceneRow> bench_scenes(const std::vector<Mesh>& meshes, const Scenes
       for (size_t m = 0; m < blobs.size(); ++m) scene.add_mesh(blobs[m], "mesh " + std::to_string(m));
       for (const PeerInstance& p : level) scene.add_instance(p.mesh, p.transform);
       scene.commit();
+      std::vector<Contender> all;
       // Everything the scene holds besides the blobs: its records of the
       // instances, the tree it refits, the two snapshots it keeps.
-      const double top_bytes = double(scene.top_level_bytes());
-      std::vector<Contender> all;
-      all.push_back({"meshcast " + o.layout, blob_bytes + top_bytes,
+      all.push_back({"meshcast " + o.layout, [&] { return blob_bytes + double(scene.top_level_bytes()); },
                      [&](const std::vector<RayD>& r, std::vector<SceneHit>& h) { scene.trace(r, h); },
                      [&](uint32_t i, const Transform& t) { scene.set_transform(i, t); }, [&] { scene.commit(); }});
       std::unique_ptr<ScenePeer> embree = make_embree_scene(mesh_pointers, level);
       if (embree)
-        all.push_back({embree->name(), double(embree->bytes()),
+        all.push_back({embree->name(), [&] { return double(embree->bytes()); },
                        [&](const std::vector<RayD>& r, std::vector<SceneHit>& h) { embree->trace(r, h); },
                        [&](uint32_t i, const Transform& t) { embree->set_transform(i, t); }, [&] { embree->commit(); }});
       for (Contender& c : all) c.hits.resize(rays.size());
@@ -142,7 +141,7 @@ std::vector<SceneRow> bench_scenes(const std::vector<Mesh>& meshes, const Scenes
             c.commit();
             (whole ? every : tenth).push_back(ms_since(t0));
           }
-        SceneRow r{count, offset, c.name, median_of(c.ns), c.bytes, median_of(tenth), median_of(every)};
+        SceneRow r{count, offset, c.name, median_of(c.ns), c.bytes(), median_of(tenth), median_of(every)};
         size_t hit = 0, same = 0;
         if (at == 0) origin_hits[k] = c.hits;
         for (size_t i = 0; i < rays.size(); ++i) {

@@ -148,7 +148,6 @@ void collapse_top_level(layout::TopLevel& top) {
   top.wide_from.clear();
   if (top.nodes.empty()) return;
   const layout::TopNode& root = top.nodes[0];
-  for (int a = 0; a < 3; ++a) top.anchor[a] = 0.5 * (root.min[a] + root.max[a]);
   top.wide.reserve(top.nodes.size() / 2 + 1);
   top.wide_from.reserve(layout::kTopWidth * (top.nodes.size() / 2 + 1));
   if (root.count > 0) {  // one instance: a wide root with it in slot 0
@@ -163,7 +162,14 @@ void collapse_top_level(layout::TopLevel& top) {
 }
 
 void fit_wide_boxes(layout::TopLevel& top) {
-  for (int a = 0; a < 3; ++a) top.min[a] = top.nodes[0].min[a], top.max[a] = top.nodes[0].max[a];
+  if (top.nodes.empty()) return;
+  // The anchor follows the root box on every fit: a ray's origin is rounded
+  // to float relative to it, and the walk's pad is sized by the distance to
+  // the root box, so the two must stay together as instances wander.
+  for (int a = 0; a < 3; ++a) {
+    top.min[a] = top.nodes[0].min[a], top.max[a] = top.nodes[0].max[a];
+    top.anchor[a] = 0.5 * (top.min[a] + top.max[a]);
+  }
   for (size_t w = 0; w < top.wide.size(); ++w)
     for (int k = 0; k < layout::kTopWidth; ++k) {
       layout::TopWideNode& node = top.wide[w];
@@ -180,6 +186,7 @@ void fit_wide_boxes(layout::TopLevel& top) {
 }
 
 void refit_top_level(layout::TopLevel& top) {
+  if (top.nodes.empty()) return;  // nothing placed: nothing to fit
   for (size_t n = top.nodes.size(); n-- > 0;) {
     layout::TopNode& node = top.nodes[n];
     for (int a = 0; a < 3; ++a) node.min[a] = INFINITY, node.max[a] = -INFINITY;

@@ -2,6 +2,7 @@
 #include "meshcast/scene.h"
 
 #include <atomic>
+#include <mutex>
 #include <cmath>
 
 #include "builder/top_level.h"
@@ -29,6 +30,10 @@ struct Scene::Edits {
   // next commit writes into it: its arrays are reused, not allocated and
   // faulted in again every frame.
   std::shared_ptr<SceneSnapshot> current, previous;
+  // What traces see: the last commit, read and replaced under the mutex
+  // (traces may run on other threads than the one that commits).
+  mutable std::mutex committed_mutex;
+  std::shared_ptr<const SceneSnapshot> committed = std::make_shared<SceneSnapshot>();
 
   Instance& at(InstanceId id, const char* who) {
     if (id >= instances.size() || instances[id].removed)
@@ -83,13 +88,21 @@ void place(layout::PlacedInstance& p, const Transform& t, const SceneMesh& mesh,
 
 }  // namespace
 
-Scene::Scene() : edits_(std::make_unique<Edits>()), committed_(std::make_shared<SceneSnapshot>()) {}
+Scene::Scene() : edits_(std::make_unique<Edits>()) {}
 Scene::~Scene() = default;
 Scene::Scene(Scene&&) noexcept = default;
 Scene& Scene::operator=(Scene&&) noexcept = default;
 
 MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
-  edits_->meshes.push_back(std::make_shared<const SceneMesh>(std::move(blob), name));
+  auto mesh = std::make_shared<const SceneMesh>(std::move(blob), name);  // validates
+  // The world boxes come from the header's bounds (not every layout's
+  // validation reads them): finite, min <= max.
+  const layout::BlobHeader& h = layout::header_of(mesh->bytes.data());
+  for (int a = 0; a < 3; ++a)
+    if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
+      throw InputError(name + ": the blob's bounds on axis " + std::to_string(a) + " are not a finite box (" +
+                       std::to_string(h.bounds_min[a]) + " to " + std::to_string(h.bounds_max[a]) + ")");
+  edits_->meshes.push_back(std::move(mesh));
   return MeshId(edits_->meshes.size() - 1);
 }
 
@@ -136,7 +149,7 @@ constexpr uint32_t kRefitsBeforeRebuild = 16;
 
 void Scene::commit() {
   Edits& e = *edits_;
-  if (!e.rebuild && e.refits < kRefitsBeforeRebuild) {
+  if (!e.rebuild && e.refits < kRefitsBeforeRebuild && !e.built.nodes.empty()) {
     // Moves and masks only: the same instances in the same places of the
     // tree, their records and the boxes refreshed.
     for (layout::PlacedInstance& p : e.built.placed) p = e.instances[p.id].placed;
@@ -169,10 +182,15 @@ void Scene::commit() {
     next->top.anchor[a] = e.built.anchor[a], next->top.min[a] = e.built.min[a], next->top.max[a] = e.built.max[a];
   e.previous = std::move(e.current);
   e.current = next;
-  committed_ = std::move(next);
+  std::lock_guard<std::mutex> lock(e.committed_mutex);
+  e.committed = std::move(next);
 }
 
-std::shared_ptr<const SceneSnapshot> Scene::snapshot() const { return committed_; }
+std::shared_ptr<const SceneSnapshot> Scene::snapshot() const {
+  if (!edits_) throw UsageError("Scene: this scene was moved from");
+  std::lock_guard<std::mutex> lock(edits_->committed_mutex);
+  return edits_->committed;
+}
 
 size_t Scene::instance_count() const { return edits_->live; }
 
@@ -190,12 +208,12 @@ size_t Scene::top_level_bytes() const {
 
 uint64_t Scene::trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
                       uint8_t mask) const {
-  return trace_snapshot(*committed_, rays, hits, outputs, query, cull, mask);
+  return trace_snapshot(*snapshot(), rays, hits, outputs, query, cull, mask);
 }
 
 uint64_t Scene::trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists, HitOutputs outputs, Cull cull,
                                uint8_t mask) const {
-  return trace_all_hits_snapshot(*committed_, rays, lists, outputs, cull, mask);
+  return trace_all_hits_snapshot(*snapshot(), rays, lists, outputs, cull, mask);
 }
 
 uint64_t Scene::trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
@@ -205,7 +223,7 @@ uint64_t Scene::trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOu
     for (int a = 0; a < 3; ++a) wide[i].org[a] = rays[i].org[a], wide[i].dir[a] = rays[i].dir[a];
     wide[i].tmax = rays[i].tmax;
   }
-  return trace_snapshot(*committed_, wide, hits, outputs, query, cull, mask);
+  return trace_snapshot(*snapshot(), wide, hits, outputs, query, cull, mask);
 }
 
 }  // namespace meshcast

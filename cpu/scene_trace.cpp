@@ -18,8 +18,8 @@ namespace {
 // instance rounded (its origin relative to the instance in float, then the
 // float inverse), so where a walker meets a triangle can lie off the world
 // ray by about 2^-22 of the distance from the ray's origin (more for
-// strongly non-uniform scales). 2^-16 of the origin's distance to the far
-// corner of the whole scene's box covers every instance the ray can reach
+// strongly non-uniform scales). 2^-16 of the farthest the origin is from
+// the whole scene's box's planes, axis by axis, covers every instance the ray can reach
 // (worked out once a ray: a few centimetres for a ray inside a level 10 km
 // across, far inside the smallest instance a game places).
 constexpr double kBoxSlack = 0x1p-16;

@@ -22,9 +22,9 @@ struct TopRay {
 
 // Tests node `n`'s 8 slots against [0, cut]. The entered slots' contents
 // and entry distances go to children[] and entries[] farthest first, the
-// nearest last (all 8 of each are written; those past the count hold
-// nothing of use); returns how many were entered. An entry is rounded down
-// by a few ulps (it only ever culls, so it culls no more).
+// nearest last (up to 8 of each are written; those past the count hold
+// nothing of use); returns how many were entered. An entry may be rounded
+// down by a few ulps (it only ever culls, so it culls no more).
 using EnterTopFn = int (*)(const TopRay& r, const layout::TopWideNode& n, float cut, float* entries,
                            uint32_t* children);
 

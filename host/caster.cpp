@@ -291,9 +291,10 @@ Caster::Slot& Caster::take_slot() {
 
 Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
   check_query(query.query, query.cull, query.max_hits);
+  std::shared_ptr<const SceneSnapshot> frame = scene.snapshot();  // UsageError for a moved-from scene
   Slot& s = take_slot();
   try {
-    s.scene = scene.snapshot();
+    s.scene = std::move(frame);
     s.scene_query = query;
     s.query = {query.query, query.cull, query.max_hits};
     s.submit_ms = now_ms();

@@ -42,7 +42,7 @@ struct TopWideNode {
 // The top level: placed instances reordered into tree order, the binary
 // nodes (root first; empty when no instance is placed) and the 8-wide nodes
 // collapsed from them (root first), with their anchor (the root box's
-// centre at the last build) and the root box. Leaves hold at most
+// centre, at every build and refit) and the root box. Leaves hold at most
 // kTopLeafSize instances: each instance's own box is tested before its
 // walk. A walk reads `placed`, `wide`, the anchor and the box; builds and
 // refits work on the binary nodes and `wide_from`, which a scene's

@@ -16,7 +16,6 @@
 #include <thread>
 
 #include "meshcast/caster.h"
-#include "cpu/scene.h"
 #include "check/generate.h"
 #include "tests/testing.h"
 
@@ -542,21 +541,23 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
   o.jobs = &late;
   Caster caster(o);
   EXPECT_THROW(caster.submit(std::vector<Ray>(1)), UsageError);  // no blob
+  // What each batch must answer, walked from its frame's snapshot when it
+  // was submitted (the snapshot is not kept: only the caster holds it).
   struct InFlight {
     host::Ticket ticket;
-    std::shared_ptr<const SceneSnapshot> frame;
     host::SceneBatchQuery query;
+    std::vector<SceneHit> want;
+    SceneHitLists want_rows;
   };
   std::deque<InFlight> flight;
   size_t changed = 0;
   auto collect = [&] {
-    const InFlight f = flight.front();
+    const InFlight f = std::move(flight.front());
     flight.pop_front();
     if (f.query.query == Query::All) {
-      SceneHitLists got, want;
-      want.max_hits = f.query.max_hits;
+      SceneHitLists got;
+      const SceneHitLists& want = f.want_rows;
       caster.wait(f.ticket, got);
-      trace_all_hits_snapshot(*f.frame, rays, want, HitOutputs::None, f.query.cull, f.query.mask);
       ASSERT_EQ(got.found, want.found);
       for (size_t i = 0; i < want.hits.size(); ++i) {
         EXPECT_EQ(got.hits[i].instance, want.hits[i].instance) << "record " << i;
@@ -564,9 +565,9 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
       }
       return;
     }
-    std::vector<SceneHit> got(rays.size()), want(rays.size()), now(rays.size());
+    std::vector<SceneHit> got(rays.size()), now(rays.size());
+    const std::vector<SceneHit>& want = f.want;
     caster.wait(f.ticket, got);
-    trace_snapshot(*f.frame, rays, want, HitOutputs::None, f.query.query, f.query.cull, f.query.mask);
     scene.trace(rays, now, HitOutputs::None, f.query.query, f.query.cull, f.query.mask);
     for (size_t i = 0; i < rays.size(); ++i) {
       EXPECT_EQ(got[i].instance, want[i].instance) << "ray " << i;
@@ -579,7 +580,14 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
     const host::SceneBatchQuery q = frame % 3 == 0   ? host::SceneBatchQuery{Query::All, Cull::None, 0xFF, 32}
                                     : frame % 3 == 1 ? host::SceneBatchQuery{Query::Closest, Cull::None, 0xFF}
                                                      : host::SceneBatchQuery{Query::Any, Cull::Back, 0x03};
-    flight.push_back({caster.submit(scene, rays, q), scene.snapshot(), q});
+    InFlight f{caster.submit(scene, rays, q), q, std::vector<SceneHit>(rays.size()), {}};
+    if (q.query == Query::All) {
+      f.want_rows.max_hits = q.max_hits;
+      scene.trace_all_hits(rays, f.want_rows, HitOutputs::None, q.cull, q.mask);
+    } else {
+      scene.trace(rays, f.want, HitOutputs::None, q.query, q.cull, q.mask);
+    }
+    flight.push_back(std::move(f));
     if (flight.size() == 3) collect();
     // The next frame: moves, a hidden and a shown instance, one added, one
     // removed every 4th frame.

@@ -43,13 +43,21 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
   if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_object() || !doc.contains("instances") ||
       !doc["instances"].is_array())
     throw InputError(path + ": a scene file is an object with \"meshes\" (an object) and \"instances\" (an array)");
+  // A misspelt key would otherwise leave its field at the default unseen.
+  for (const auto& [key, value] : doc.items())
+    if (key != "meshes" && key != "instances") throw InputError(path + ": \"" + key + "\" is not a scene file's key (meshes, instances)");
   SceneFile out;
   std::map<std::string, MeshId> ids;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   for (const auto& [name, file] : doc["meshes"].items()) {
     if (!file.is_string()) throw InputError(path + ": meshes." + name + " is not a file name");
     const std::string mesh_path = (folder / file.get<std::string>()).string();
-    Loaded mesh = load_input(mesh_path, layout, report);
+    Loaded mesh;
+    try {
+      mesh = load_input(mesh_path, layout, report);
+    } catch (const InputError& e) {  // the mesh file's own message, and where the scene names it
+      throw InputError(path + ": meshes." + name + ": " + e.what());
+    }
     out.blob_bytes += mesh.blob.size();
     ids[name] = out.scene.add_mesh(std::move(mesh.blob), mesh_path);
     out.mesh_names.push_back(name);
@@ -59,6 +67,9 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
     const std::string where = path + ": instances[" + std::to_string(index++) + "]";
     if (!i.is_object() || !i.contains("mesh") || !i["mesh"].is_string())
       throw InputError(where + " is not an object with a \"mesh\" name");
+    for (const auto& [key, value] : i.items())
+      if (key != "mesh" && key != "rotation_scale" && key != "translation" && key != "mask" && key != "enabled")
+        throw InputError(where + ": \"" + key + "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled)");
     const auto mesh = ids.find(i["mesh"].get<std::string>());
     if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + i["mesh"].get<std::string>() + "\" is not in \"meshes\"");
     Transform t;

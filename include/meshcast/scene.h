@@ -19,7 +19,8 @@
 // commit(), which builds the top-level tree over the enabled instances'
 // world boxes into a new immutable snapshot. A trace holds the snapshot it
 // started with, so a commit on another thread never shows it a half-made
-// world; the Scene itself (its edits and commit) is for one thread at a time.
+// world: traces may run on any threads beside the one thread that edits and
+// commits (the edits themselves are for one thread at a time).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -101,9 +102,12 @@ class Scene {
   // The hit of each world ray under `query` (Closest or Any; All has
   // trace_all_hits) against the committed scene, among the instances whose mask shares a bit with
   // `mask`; `cull` as BlobView::trace, the front face as the instance shows
-  // it in the world. Returns the rays not walkable (a non-finite origin or
-  // one beyond 2^100, a direction or t_max BlobView would refuse), answered
-  // as misses. UsageError when hits is shorter than rays or for Query::All.
+  // it in the world; `outputs`: Uv at most (a scene hit has no point).
+  // Returns the rays not walkable: a non-finite origin or one beyond 2^100,
+  // a direction or t_max BlobView would refuse (answered as misses), or a
+  // ray some instance's frame cannot take (its direction scaled past the
+  // walkers' range: that instance is not walked, the others are). UsageError
+  // when hits is shorter than rays, for Query::All or HitOutputs::Point.
   uint64_t trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitOutputs outputs = HitOutputs::None,
                  Query query = Query::Closest, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Float rays, their origins taken as doubles.
@@ -127,8 +131,7 @@ class Scene {
 
  private:
   struct Edits;
-  std::unique_ptr<Edits> edits_;
-  std::shared_ptr<const SceneSnapshot> committed_;
+  std::unique_ptr<Edits> edits_;  // and the committed snapshot, behind a mutex
 };
 
 // A snapshot's traces: the same as Scene's, on the frame it holds.

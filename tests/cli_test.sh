@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
 # The meshcast program end to end: every subcommand, its JSON, and its errors
 # (clear message naming the input, non-zero exit, no crash).
+# Usage: cli_test.sh MESHCAST DATA [all|benches|rest]: the benchmarks'
+# smoke runs (most of the time) apart from the rest, so CTest runs the two
+# halves side by side.
 set -uo pipefail
 meshcast=$1
 data=$2
+part=${3:-all}
+[[ $part == all || $part == benches || $part == rest ]] || { echo "cli_test.sh: part '$part' is not all, benches or rest"; exit 2; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 failures=0
@@ -33,6 +38,28 @@ fi
 printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n' >"$work/tiny_square.off"
 # A binary STL of 2 facets (84 + 100 bytes), for the truncated-STL check.
 { head -c 80 /dev/zero; printf '\x02\x00\x00\x00'; head -c 100 /dev/zero; } >"$work/tiny_bin.stl"
+# Most of the benchmarks, each on the fewest rays (they need only the mesh).
+benches() {
+  check bench-encodings 0 "csv: .*encodings.csv" -- "$meshcast" bench encodings "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+  check bench-trees 0 "AABBTreePNS/Float3" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+  check bench-splitters 0 "FixedLeafSize" -- "$meshcast" bench splitters "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+  check bench-trees-all 0 "StacklessLBVH left first" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+  check bench-order 0 "BreadthFirstTrianglesLast" -- "$meshcast" bench order "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+  check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --only SKDTree,OctTree --out-dir "$work"
+  check bench-pairing 0 "bunny00 rotated 45, pairs baked|terrain_2M" -- "$meshcast" bench pairing --data "$data" --rays 8 --repeat 1 --out-dir "$work"
+  check bench-latency 0 "crossover \\(automatic backend" -- "$meshcast" bench latency "$mesh" --frame-ms 1 --out-dir "$work"
+  check bench-robustness 0 "leaks plain" -- "$meshcast" bench robustness "$mesh" --rays 8 --repeat 1
+  check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$mesh" --rays 8 --repeat 1
+}
+if [[ $part == benches ]]; then
+  benches
+  echo "$passes passed, $failures failed"
+  exit $((failures > 0))
+fi
+[[ $part == all ]] && benches
+# Two more, in this half: the halves take about as long.
+check bench-error 0 "plots: " -- "$meshcast" bench error "$mesh" --rays 8 --repeat 1 --out-dir "$work"
+check bench-auto 0 "choices more than 10% from the best" -- "$meshcast" bench auto "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check rays 0 "rays ->" -- "$meshcast" rays "$mesh" --kind long --count 500 --seed 3 --out "$work/r.rays"
 check rays-kind 2 "kind" -- "$meshcast" rays "$mesh" --kind sideways --count 5 --out "$work/x.rays"
 check build 0 "bytes/triangle" -- "$meshcast" build "$mesh" --layout quadtree/float3soa4 --leaf 4 --out "$work/m.blob"
@@ -78,17 +105,6 @@ if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
             <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then
   echo "FAIL hits of two layouts differ"; failures=$((failures + 1))
 fi
-check bench-encodings 0 "csv: .*encodings.csv" -- "$meshcast" bench encodings "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-trees 0 "AABBTreePNS/Float3" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-splitters 0 "FixedLeafSize" -- "$meshcast" bench splitters "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-trees-all 0 "StacklessLBVH left first" -- "$meshcast" bench trees "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-order 0 "BreadthFirstTrianglesLast" -- "$meshcast" bench order "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-combos 0 "SKDTree/CompressedStrip" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --only SKDTree,OctTree --out-dir "$work"
-check bench-pairing 0 "bunny00 rotated 45, pairs baked|terrain_2M" -- "$meshcast" bench pairing --data "$data" --rays 8 --repeat 1 --out-dir "$work"
-check bench-latency 0 "crossover \\(automatic backend" -- "$meshcast" bench latency "$mesh" --frame-ms 1 --out-dir "$work"
-check bench-robustness 0 "leaks plain" -- "$meshcast" bench robustness "$mesh" --rays 8 --repeat 1
-check bench-error 0 "plots: " -- "$meshcast" bench error "$mesh" --rays 8 --repeat 1 --out-dir "$work"
-check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$mesh" --rays 8 --repeat 1
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
 check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
@@ -103,7 +119,6 @@ check auto-json 0 '^\{"input"' -- "$meshcast" info "$mesh" --layout auto --json
 check auto-impossible 2 "no layout meets the limits \(at most 1.00 bytes" -- "$meshcast" info "$mesh" --layout auto --max-bytes 1
 check auto-goal 2 "valid goals: speed memory" -- "$meshcast" info "$mesh" --layout auto --goal fast
 check no-triangle-ids 0 "remap: none" -- "$meshcast" info "$mesh" --layout QuadTree/Float3SOA4 --no-triangle-ids
-check bench-auto 0 "choices more than 10% from the best" -- "$meshcast" bench auto "$mesh" --rays 8 --repeat 1 --out-dir "$work"
 check pairing 0 "of triangles paired" -- "$meshcast" info "$mesh" --layout AABBTree/Float3SOA4 --pairing
 check zerobyte 0 "nodes +0 +0\.00" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Indexed24
 check zerobyte-stats 0 "shuffled; box cache off" -- "$meshcast" info "$mesh" --layout ZeroByteHybrid/Indexed24 --hybrid-leaf 64 --no-box-cache

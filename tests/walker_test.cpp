@@ -32,6 +32,55 @@ void check_queries(const BlobView& blob, const NamedMesh& reference, RayKind kin
   testing::check_queries(cpu, reference, kind, part, tolerance, 256, what);
 }
 
+// Every node's box, as the walker decodes it (half floats, 7-bit codes,
+// SKD regions included), contains every corner its triangle format decodes
+// below it. Checked on the blob check_layout walks: building every layout
+// for every mesh once more took 40 s of the Release run.
+void check_node_bounds(const std::vector<uint8_t>& blob, const std::string& name, const NamedMesh& m) {
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  size_t corners = 0;
+  layout::for_each_leaf_path(blob.data(), [&](uint32_t block, uint32_t count, const std::vector<layout::PathBox>& path) {
+    ASSERT_FALSE(path.empty()) << name << " on " << m.name << ": a leaf with no box above it";
+    for (uint32_t i = 0; i < count; ++i) {
+      float v[3][3];
+      layout::decode_triangle(blob.data(), h.tree_offset + block, i, v);
+      for (int c = 0; c < 3; ++c, ++corners)
+        for (const layout::PathBox& b : path)
+          for (int a = 0; a < 3; ++a)
+            ASSERT_TRUE(b.min[a] <= v[c][a] && v[c][a] <= b.max[a])
+                << name << " on " << m.name << ": corner outside a box above it (depth " << (&b - path.data()) << ")";
+    }
+  });
+  EXPECT_EQ(corners, 3 * m.mesh->triangles.size()) << name << " on " << m.name;
+}
+
+// Every triangle format keeps each stored corner within its stated bound of
+// the input vertex (0 for the float formats: stored exactly), checked on the
+// decoded blob against the input mesh (a triangle format is the same
+// encoder under every tree: the QuadTree and BruteForce layouts cover them).
+void check_stored_corners(const std::vector<uint8_t>& blob, const std::string& name, const NamedMesh& m) {
+  float bound[3];
+  displacement_bound(blob, bound);
+  Box3 box = m.mesh->bounds();
+  for (int a = 0; a < 3; ++a)  // small: a few 2^-21 of the extent at most
+    EXPECT_LE(bound[a], (box.max[a] - box.min[a]) * 0x1p-15f + std::fabs(box.max[a]) * 0x1p-22f + 1e-37f) << name;
+  Mesh stored = stored_mesh(blob);
+  // Stored corners are the input corners within the bound, in the same
+  // order or (strips, pair blocks) a rotation of it: the winding is kept.
+  auto near = [&](size_t t, int c, int k) {
+    for (int a = 0; a < 3; ++a)
+      if (!(std::fabs(double(stored.corner(t, c)[a]) - m.mesh->corner(t, k)[a]) <= bound[a])) return false;
+    return true;
+  };
+  bool rotates = name.find("Strip") != std::string::npos || name.find("PairSOA4") != std::string::npos;
+  for (size_t t = 0; t < m.mesh->triangles.size(); ++t) {
+    int found = -1;
+    for (int rot = 0; rot < (rotates ? 3 : 1) && found < 0; ++rot)
+      if (near(t, 0, rot) && near(t, 1, (rot + 1) % 3) && near(t, 2, (rot + 2) % 3)) found = rot;
+    ASSERT_GE(found, 0) << name << " on " << m.name << ", triangle " << t << " not the input's corners in order";
+  }
+}
+
 void check_layout(const std::string& layout_name_, bool large) {
   BuildOptions options = parse_layout(layout_name_);
   static const std::vector<std::string> covering_names = covering_layouts(layout_names());
@@ -40,6 +89,12 @@ void check_layout(const std::string& layout_name_, bool large) {
     if (large && m.name != "terrain_1M") continue;
     std::vector<uint8_t> blob = build_blob(*m.mesh, options, m.name);
     ASSERT_EQ(layout::validate(blob), "") << m.name;
+    if (!large) {
+      // The largest public meshes take long to decode corner by corner; bunny00 and the dragon suffice.
+      const bool brute = uint32_t(options.layout.tree) == MC_TREE_BRUTEFORCE;
+      if (!brute && m.name != "armadillo" && m.name != "refined_elephant") check_node_bounds(blob, layout_name_, m);
+      if (brute || layout_name_.rfind("QuadTree/", 0) == 0) check_stored_corners(blob, layout_name_, m);
+    }
     const BlobView view(blob, m.name);
     double diag = m.mesh->bounds().diagonal();
     double tolerance = 1e-5 * diag;
@@ -197,66 +252,6 @@ TEST(WalkerVsOracleLarge, PNSHoldsTheSourcesLargestScene) {
   for (const Ray& r : rays) answers.push_back(oracle.closest(r));
   Agreement a = compare(terrain, rays, trace_all(blob, rays), answers, 1e-5 * terrain.bounds().diagonal());
   EXPECT_EQ(a.wrong + a.t_errors, 0u) << a.first_problem;
-}
-
-// Every node's box, as the walker decodes it (half floats, 7-bit codes,
-// SKD regions included), contains every corner its triangle format decodes
-// below it, for every layout.
-TEST(NodeBoundsContainDecodedCorners, EveryLayoutEveryMesh) {
-  for (const NamedMesh& m : test_meshes(false))
-    for (const std::string& name : layout_names()) {
-      if (m.name == "armadillo" || m.name == "refined_elephant") continue;  // bunny00 and the dragon suffice
-      if (name.rfind("BruteForce/", 0) == 0) continue;
-      std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
-      const layout::BlobHeader& h = layout::header_of(blob.data());
-      size_t corners = 0;
-      layout::for_each_leaf_path(blob.data(), [&](uint32_t block, uint32_t count, const std::vector<layout::PathBox>& path) {
-        ASSERT_FALSE(path.empty()) << name << " on " << m.name << ": a leaf with no box above it";
-        for (uint32_t i = 0; i < count; ++i) {
-          float v[3][3];
-          layout::decode_triangle(blob.data(), h.tree_offset + block, i, v);
-          for (int c = 0; c < 3; ++c, ++corners)
-            for (const layout::PathBox& b : path)
-              for (int a = 0; a < 3; ++a)
-                ASSERT_TRUE(b.min[a] <= v[c][a] && v[c][a] <= b.max[a])
-                    << name << " on " << m.name << ": corner outside a box above it (depth " << (&b - path.data()) << ")";
-        }
-      });
-      EXPECT_EQ(corners, 3 * m.mesh->triangles.size()) << name;
-    }
-}
-
-// Every triangle format keeps each stored corner within its stated bound of
-// the input vertex (0 for the float formats: stored exactly), checked on the
-// decoded blob against the input mesh.
-TEST(StoredCornersWithinBound, EveryFormatEveryMesh) {
-  for (const NamedMesh& m : test_meshes(false))
-    for (const std::string& name : layout_names()) {
-      if (name.rfind("QuadTree/", 0) != 0 && name.rfind("BruteForce/", 0) != 0) continue;
-      std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
-      float bound[3];
-      displacement_bound(blob, bound);
-      Box3 box = m.mesh->bounds();
-      for (int a = 0; a < 3; ++a)  // small: a few 2^-21 of the extent at most
-        EXPECT_LE(bound[a], (box.max[a] - box.min[a]) * 0x1p-15f + std::fabs(box.max[a]) * 0x1p-22f + 1e-37f) << name;
-      Mesh stored = stored_mesh(blob);
-      // Stored corners are the input corners within the bound, in the same
-      // order or (strips, pair blocks) a rotation of it: the winding is kept.
-      auto near = [&](size_t t, int c, int k) {
-        for (int a = 0; a < 3; ++a)
-          if (!(std::fabs(double(stored.corner(t, c)[a]) - m.mesh->corner(t, k)[a]) <= bound[a])) return false;
-        return true;
-      };
-      bool rotates = name.find("Strip") != std::string::npos || name.find("PairSOA4") != std::string::npos;
-      size_t rotated = 0;
-      for (size_t t = 0; t < m.mesh->triangles.size(); ++t) {
-        int found = -1;
-        for (int rot = 0; rot < (rotates ? 3 : 1) && found < 0; ++rot)
-          if (near(t, 0, rot) && near(t, 1, (rot + 1) % 3) && near(t, 2, (rot + 2) % 3)) found = rot;
-        ASSERT_GE(found, 0) << name << " on " << m.name << ", triangle " << t << " not the input's corners in order";
-        rotated += found != 0;
-      }
-    }
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "bench/error.h"
 
+#include "bench/timing.h"
 #include "bench/measure.h"
 
 #include <algorithm>
@@ -53,10 +54,6 @@ void judge(const Mesh& mesh, const std::vector<Ray>& rays, const std::vector<Hit
   row.rays = rays.size();
 }
 
-double median_ms(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 
@@ -117,7 +114,7 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
       }
       ErrorRow row;
       row.backend = "Vulkan " + std::string(c.method) + " (device time)", row.layout = c.layout;
-      row.us_per_ray = median_ms(ms) * 1000.0 / double(rays.size());
+      row.us_per_ray = median(ms) * 1000.0 / double(rays.size());
       finish(row, blob, hits);
     }
   }

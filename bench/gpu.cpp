@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 
+#include "bench/timing.h"
 #include "bench/measure.h"
 #include "check/agreement.h"
 #include "builder/error_bounds.h"
@@ -19,10 +20,6 @@ namespace meshcast::bench {
 
 namespace {
 
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 
@@ -73,13 +70,13 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
     const layout::BlobHeader& h = layout::header_of(blob.data());
     auto figure = seed.find(c.layout);
     GpuRow row{c.method, c.layout, figure == seed.end() ? "" : figure->second};
-    row.device_us = median_of(device_ms) * 1000.0 / double(rays.size());
-    row.wall_us = median_of(wall_ms) * 1000.0 / double(rays.size());
+    row.device_us = median(device_ms) * 1000.0 / double(rays.size());
+    row.wall_us = median(wall_ms) * 1000.0 / double(rays.size());
     row.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;
     method->trace(rays, hits);  // the closest hits, judged
     row.disagreements = oracle_mistakes(mesh, blob, rays, hits, oracle);
-    row.any_to_closest = median_of(any_ms) / median_of(closest_ms);
-    row.all_to_closest = median_of(all_ms) / median_of(closest_ms);
+    row.any_to_closest = median(any_ms) / median(closest_ms);
+    row.all_to_closest = median(all_ms) / median(closest_ms);
     rows.push_back(row);
   }
   // The CPU's recommended layout, one thread, as the source's yellow row.

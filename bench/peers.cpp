@@ -9,6 +9,7 @@
 #include <memory>
 #include <thread>
 
+#include "bench/timing.h"
 #include "bench/peer.h"
 #include "builder/layout_names.h"
 #include "builder/ray_sets.h"
@@ -25,10 +26,6 @@ std::vector<std::string> default_peer_layouts() {
 }
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 using layout::QuerySpec;
 
@@ -135,21 +132,17 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
       }
 
   std::vector<PeerRow> rows;
-  auto median_of = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   for (size_t s = 0; s < sets.size(); ++s) {
     double embree_default = 0;
     std::vector<PeerRow> set_rows;
     for (Contender& c : all) {
       if (c.ns[s].empty()) continue;  // a query the contender does not answer
-      PeerRow r{name, o.kinds[sets[s].kind], c.name, c.is_peer, median_of(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
+      PeerRow r{name, o.kinds[sets[s].kind], c.name, c.is_peer, median(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
       r.query = o.queries[sets[s].query];
       // The same contender's closest hit on the same rays, when measured.
       for (size_t t = 0; t < sets.size(); ++t)
         if (sets[t].kind == sets[s].kind && o.queries[sets[t].query] == "closest")
-          r.to_closest = r.ns_per_ray / median_of(c.ns[t]);
+          r.to_closest = r.ns_per_ray / median(c.ns[t]);
       if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;  // the first peer is the default build
       set_rows.push_back(r);
     }

@@ -7,6 +7,7 @@
 #include <functional>
 #include <random>
 
+#include "bench/timing.h"
 #include "bench/peer.h"
 #include "builder/layout_names.h"
 #include "check/generate.h"
@@ -17,15 +18,6 @@
 namespace meshcast::bench {
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double median_of(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
 
 // A level: instance i is a copy of mesh i % meshes, 2 to 20 m across,
 // turned at random; every 4th scaled unevenly (0.7 to 1.4 an axis), every
@@ -141,7 +133,7 @@ std::vector<SceneRow> bench_scenes(const std::vector<Mesh>& meshes, const Scenes
             c.commit();
             (whole ? every : tenth).push_back(ms_since(t0));
           }
-        SceneRow r{count, offset, c.name, median_of(c.ns), c.bytes(), median_of(tenth), median_of(every)};
+        SceneRow r{count, offset, c.name, median(c.ns), c.bytes(), median(tenth), median(every)};
         size_t hit = 0, same = 0;
         if (at == 0) origin_hits[k] = c.hits;
         for (size_t i = 0; i < rays.size(); ++i) {

@@ -132,6 +132,7 @@ struct Collapser {
       uint32_t slot = layout::kTopEmpty;
       if (k < count) {
         const layout::TopNode& n = top.nodes[kids[k]];
+        static_assert(layout::kTopLeafSize == 1, "a leaf's slot names its one instance");
         slot = n.count > 0 ? layout::kTopInstance | n.first : collapse(kids[k]);
         top.wide_from[layout::kTopWidth * size_t(index) + size_t(k)] = kids[k];
       }

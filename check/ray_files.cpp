@@ -8,8 +8,13 @@ namespace meshcast {
 
 namespace {
 
+// A file of records: a 4-byte magic, a uint32 count, then the records
+// (their bytes as they lie in memory: every format here is little-endian).
+static_assert(std::endian::native == std::endian::little, "the files' records are their structs' bytes");
+
 template <class Record>
-std::vector<Record> read_records(const std::string& path, const char magic[4], size_t record_bytes) {
+std::vector<Record> read_records(const std::string& path, const char magic[4]) {
+  constexpr size_t record_bytes = sizeof(Record);
   std::vector<uint8_t> b = read_file(path);
   if (b.size() < 8 || std::memcmp(b.data(), magic, 4) != 0)
     throw InputError(path + ": not a " + std::string(magic, 4) + " file (bad magic or shorter than 8 bytes)");
@@ -24,6 +29,23 @@ std::vector<Record> read_records(const std::string& path, const char magic[4], s
   return out;
 }
 
+// Each item written as to_record(item); at most kMaxRayCount (a ray file
+// and its hits file hold one record a ray).
+template <class Record, class Item, class ToRecord>
+void write_records(const std::string& path, const char magic[4], const std::vector<Item>& items, ToRecord to_record) {
+  if (items.size() > kMaxRayCount)
+    throw InputError(path + ": " + std::to_string(items.size()) + " records, more than a " + std::string(magic, 4) +
+                     " file may hold (" + std::to_string(kMaxRayCount) + ")");
+  std::vector<uint8_t> b(8 + items.size() * sizeof(Record));
+  const uint32_t n = uint32_t(items.size());
+  std::memcpy(b.data(), magic, 4), std::memcpy(b.data() + 4, &n, 4);
+  for (size_t i = 0; i < items.size(); ++i) {
+    const Record r = to_record(items[i]);
+    std::memcpy(b.data() + 8 + i * sizeof(Record), &r, sizeof(Record));
+  }
+  write_file(path, b.data(), b.size());
+}
+
 struct HitRecord {
   float t;
   uint32_t triangle;
@@ -36,32 +58,23 @@ struct SceneHitRecord {
 
 }  // namespace
 
-std::vector<Ray> read_rays(const std::string& path) { return read_records<Ray>(path, "RAYS", 28); }
+static_assert(sizeof(Ray) == 28 && sizeof(RayD) == 40 && sizeof(HitRecord) == 8 && sizeof(SceneHitRecord) == 12,
+              "the records of README's file formats");
+
+std::vector<Ray> read_rays(const std::string& path) { return read_records<Ray>(path, "RAYS"); }
 
 void write_rays(const std::string& path, const std::vector<Ray>& rays) {
-  if (rays.size() > kMaxRayCount)
-    throw InputError(path + ": " + std::to_string(rays.size()) + " rays, more than a rays file may hold (" +
-                     std::to_string(kMaxRayCount) + ")");
-  const uint32_t n = uint32_t(rays.size());
-  static_assert(sizeof(Ray) == 28 && std::endian::native == std::endian::little, "a Ray is its record");
-  write_file(path, {{"RAYS", 4}, {&n, 4}, {rays.data(), rays.size() * sizeof(Ray)}});
+  write_records<Ray>(path, "RAYS", rays, [](const Ray& r) { return r; });
 }
 
 std::vector<Hit> read_hits(const std::string& path) {
   std::vector<Hit> hits;
-  for (const HitRecord& r : read_records<HitRecord>(path, "HITS", 8)) hits.push_back({r.t, r.triangle});
+  for (const HitRecord& r : read_records<HitRecord>(path, "HITS")) hits.push_back({r.t, r.triangle});
   return hits;
 }
 
 void write_hits(const std::string& path, const std::vector<Hit>& hits) {
-  std::vector<uint8_t> b(8 + hits.size() * 8);
-  uint32_t n = uint32_t(hits.size());
-  std::memcpy(b.data(), "HITS", 4), std::memcpy(b.data() + 4, &n, 4);
-  for (size_t i = 0; i < hits.size(); ++i) {
-    HitRecord r{hits[i].t, hits[i].triangle};
-    std::memcpy(b.data() + 8 + i * 8, &r, 8);
-  }
-  write_file(path, b.data(), b.size());
+  write_records<HitRecord>(path, "HITS", hits, [](const Hit& h) { return HitRecord{h.t, h.triangle}; });
 }
 
 HitLists read_hit_lists(const std::string& path) {
@@ -109,32 +122,21 @@ void write_hit_lists(const std::string& path, const HitLists& lists) {
   write_file(path, b.data(), b.size());
 }
 
-std::vector<RayD> read_scene_rays(const std::string& path) { return read_records<RayD>(path, "RAYD", 40); }
+std::vector<RayD> read_scene_rays(const std::string& path) { return read_records<RayD>(path, "RAYD"); }
 
 void write_scene_rays(const std::string& path, const std::vector<RayD>& rays) {
-  if (rays.size() > kMaxRayCount)
-    throw InputError(path + ": " + std::to_string(rays.size()) + " rays, more than a rays file may hold (" +
-                     std::to_string(kMaxRayCount) + ")");
-  const uint32_t n = uint32_t(rays.size());
-  static_assert(sizeof(RayD) == 40 && std::endian::native == std::endian::little, "a RayD is its record");
-  write_file(path, {{"RAYD", 4}, {&n, 4}, {rays.data(), rays.size() * sizeof(RayD)}});
+  write_records<RayD>(path, "RAYD", rays, [](const RayD& r) { return r; });
 }
 
 std::vector<SceneHit> read_scene_hits(const std::string& path) {
   std::vector<SceneHit> hits;
-  for (const SceneHitRecord& r : read_records<SceneHitRecord>(path, "HITI", 12)) hits.push_back({r.t, r.instance, r.triangle});
+  for (const SceneHitRecord& r : read_records<SceneHitRecord>(path, "HITI")) hits.push_back({r.t, r.instance, r.triangle});
   return hits;
 }
 
 void write_scene_hits(const std::string& path, const std::vector<SceneHit>& hits) {
-  std::vector<uint8_t> b(8 + hits.size() * 12);
-  const uint32_t n = uint32_t(hits.size());
-  std::memcpy(b.data(), "HITI", 4), std::memcpy(b.data() + 4, &n, 4);
-  for (size_t i = 0; i < hits.size(); ++i) {
-    const SceneHitRecord r{hits[i].t, hits[i].instance, hits[i].triangle};
-    std::memcpy(b.data() + 8 + i * 12, &r, 12);
-  }
-  write_file(path, b.data(), b.size());
+  write_records<SceneHitRecord>(path, "HITI", hits,
+                                [](const SceneHit& h) { return SceneHitRecord{h.t, h.instance, h.triangle}; });
 }
 
 bool is_scene_rays_file(const std::string& path) {

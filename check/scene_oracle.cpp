@@ -94,4 +94,16 @@ double SceneOracle::distance_to_edge(size_t instance, uint32_t triangle, const R
   return edge_distance(p, c, c + 3, c + 6);
 }
 
+double SceneOracle::distance_to_uv(size_t instance, uint32_t triangle, const RayD& ray, double t, double u,
+                                   double v) const {
+  const double* c = placed_.at(instance).corners.data() + 9 * size_t(triangle);
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double at_uv = c[a] + u * (c[3 + a] - c[a]) + v * (c[6 + a] - c[a]);
+    const double d = ray.org[a] + t * ray.dir[a] - at_uv;
+    d2 += d * d;
+  }
+  return std::sqrt(d2);
+}
+
 }  // namespace meshcast

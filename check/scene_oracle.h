@@ -40,6 +40,10 @@ class SceneOracle {
   double distance_to(size_t instance, uint32_t triangle, const RayD& ray, double t) const;
   // The distance from o + t d to the nearest edge of that triangle.
   double distance_to_edge(size_t instance, uint32_t triangle, const RayD& ray, double t) const;
+  // The distance from o + t d to the point of that triangle at barycentric
+  // (u, v): corner 0 + u (corner 1 - corner 0) + v (corner 2 - corner 0),
+  // the corners in the mesh's order (a hit's u, v).
+  double distance_to_uv(size_t instance, uint32_t triangle, const RayD& ray, double t, double u, double v) const;
   // The index of instance id `id` among those given.
   size_t index_of(uint32_t id) const;
 

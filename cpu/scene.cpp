@@ -20,6 +20,9 @@ struct Scene::Edits {
   };
   std::vector<Instance> instances;  // by InstanceId
   size_t live = 0;
+  // Whether anything was edited since the last commit (a commit of nothing
+  // keeps the snapshot it has).
+  bool changed = true;
   // Since the last build of the top level: whether an instance was added,
   // removed, shown or hidden (the tree must be built again), and how many
   // commits refit it instead (moves and masks only).
@@ -52,7 +55,9 @@ namespace {
 void place(layout::PlacedInstance& p, const Transform& t, const SceneMesh& mesh, const char* who) {
   const float* m = t.rotation_scale;
   for (int i = 0; i < 9; ++i)
-    if (!std::isfinite(m[i])) throw UsageError(std::string(who) + ": rotation_scale[" + std::to_string(i) + "] is not finite");
+    if (!(std::fabs(m[i]) <= 0x1p40f))
+      throw UsageError(std::string(who) + ": rotation_scale[" + std::to_string(i) + "] " + std::to_string(m[i]) +
+                       " is not finite or beyond 2^40");
   for (int a = 0; a < 3; ++a)
     if (!(std::fabs(t.translation[a]) <= double(kMaxCoordinate)))
       throw UsageError(std::string(who) + ": translation[" + std::to_string(a) + "] " + std::to_string(t.translation[a]) +
@@ -83,17 +88,27 @@ void place(layout::PlacedInstance& p, const Transform& t, const SceneMesh& mesh,
     for (int k = 0; k < 3; ++k) centre += e(r, k) * c[k], extent += std::fabs(e(r, k)) * half[k];
     extent += (extent + std::fabs(centre - t.translation[r])) * 0x1p-20;
     p.box_min[r] = centre - extent, p.box_max[r] = centre + extent;
+    // The top level's float boxes and the rays' pads stay finite.
+    if (!(std::fabs(p.box_min[r]) <= double(kMaxCoordinate) && std::fabs(p.box_max[r]) <= double(kMaxCoordinate)))
+      throw UsageError(std::string(who) + ": the instance's world box on axis " + std::to_string(r) + " (" +
+                       std::to_string(p.box_min[r]) + " to " + std::to_string(p.box_max[r]) + ") reaches beyond 2^100");
   }
 }
 
 }  // namespace
 
 Scene::Scene() : edits_(std::make_unique<Edits>()) {}
+
+Scene::Edits& Scene::edits(const char* who) const {
+  if (!edits_) throw UsageError(std::string(who) + ": this scene was moved from");
+  return *edits_;
+}
 Scene::~Scene() = default;
 Scene::Scene(Scene&&) noexcept = default;
 Scene& Scene::operator=(Scene&&) noexcept = default;
 
 MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
+  Edits& e = edits("Scene::add_mesh");
   auto mesh = std::make_shared<const SceneMesh>(std::move(blob), name);  // validates
   // The world boxes come from the header's bounds (not every layout's
   // validation reads them): finite, min <= max.
@@ -102,44 +117,58 @@ MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
       throw InputError(name + ": the blob's bounds on axis " + std::to_string(a) + " are not a finite box (" +
                        std::to_string(h.bounds_min[a]) + " to " + std::to_string(h.bounds_max[a]) + ")");
-  edits_->meshes.push_back(std::move(mesh));
-  return MeshId(edits_->meshes.size() - 1);
+  e.meshes.push_back(std::move(mesh));
+  e.changed = true;
+  return MeshId(e.meshes.size() - 1);
 }
 
 InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask) {
-  if (mesh >= edits_->meshes.size())
+  Edits& e = edits("Scene::add_instance");
+  if (mesh >= e.meshes.size())
     throw UsageError("Scene::add_instance: mesh " + std::to_string(mesh) + " is unknown (" +
-                     std::to_string(edits_->meshes.size()) + " added)");
+                     std::to_string(e.meshes.size()) + " added)");
+  // The top level's slots tell an instance by its high bit (kTopInstance).
+  if (e.instances.size() >= layout::kTopInstance)
+    throw UsageError("Scene::add_instance: a scene holds at most 2^31 instances, removed ones counted");
   Edits::Instance i;
-  i.placed.id = uint32_t(edits_->instances.size());
+  i.placed.id = uint32_t(e.instances.size());
   i.placed.mesh = mesh;
   i.placed.mask = mask;
-  place(i.placed, transform, *edits_->meshes[mesh], "Scene::add_instance");
-  edits_->instances.push_back(i);
-  ++edits_->live;
-  edits_->rebuild = true;
+  place(i.placed, transform, *e.meshes[mesh], "Scene::add_instance");
+  e.instances.push_back(i);
+  ++e.live;
+  e.rebuild = e.changed = true;
   return i.placed.id;
 }
 
 void Scene::set_transform(InstanceId instance, const Transform& transform) {
-  Edits::Instance& i = edits_->at(instance, "Scene::set_transform");
+  Edits& e = edits("Scene::set_transform");
+  Edits::Instance& i = e.at(instance, "Scene::set_transform");
   layout::PlacedInstance moved = i.placed;  // unchanged should the transform be refused
-  place(moved, transform, *edits_->meshes[moved.mesh], "Scene::set_transform");
+  place(moved, transform, *e.meshes[moved.mesh], "Scene::set_transform");
   i.placed = moved;
+  e.changed = true;
 }
 
-void Scene::set_mask(InstanceId instance, uint8_t mask) { edits_->at(instance, "Scene::set_mask").placed.mask = mask; }
+void Scene::set_mask(InstanceId instance, uint8_t mask) {
+  Edits& e = edits("Scene::set_mask");
+  e.at(instance, "Scene::set_mask").placed.mask = mask;
+  e.changed = true;
+}
 
 void Scene::set_enabled(InstanceId instance, bool enabled) {
-  Edits::Instance& i = edits_->at(instance, "Scene::set_enabled");
-  edits_->rebuild |= i.enabled != enabled;
+  Edits& e = edits("Scene::set_enabled");
+  Edits::Instance& i = e.at(instance, "Scene::set_enabled");
+  e.rebuild |= i.enabled != enabled;
+  e.changed |= i.enabled != enabled;
   i.enabled = enabled;
 }
 
 void Scene::remove_instance(InstanceId instance) {
-  edits_->at(instance, "Scene::remove_instance").removed = true;
-  --edits_->live;
-  edits_->rebuild = true;
+  Edits& e = edits("Scene::remove_instance");
+  e.at(instance, "Scene::remove_instance").removed = true;
+  --e.live;
+  e.rebuild = e.changed = true;
 }
 
 // A refit keeps the tree's splits while instances wander; after this many
@@ -148,7 +177,9 @@ void Scene::remove_instance(InstanceId instance) {
 constexpr uint32_t kRefitsBeforeRebuild = 16;
 
 void Scene::commit() {
-  Edits& e = *edits_;
+  Edits& e = edits("Scene::commit");
+  if (!e.changed) return;  // the committed snapshot is this frame's
+  e.changed = false;
   if (!e.rebuild && e.refits < kRefitsBeforeRebuild && !e.built.nodes.empty()) {
     // Moves and masks only: the same instances in the same places of the
     // tree, their records and the boxes refreshed.
@@ -187,15 +218,15 @@ void Scene::commit() {
 }
 
 std::shared_ptr<const SceneSnapshot> Scene::snapshot() const {
-  if (!edits_) throw UsageError("Scene: this scene was moved from");
-  std::lock_guard<std::mutex> lock(edits_->committed_mutex);
-  return edits_->committed;
+  Edits& e = edits("Scene::snapshot");
+  std::lock_guard<std::mutex> lock(e.committed_mutex);
+  return e.committed;
 }
 
-size_t Scene::instance_count() const { return edits_->live; }
+size_t Scene::instance_count() const { return edits("Scene::instance_count").live; }
 
 size_t Scene::top_level_bytes() const {
-  const Edits& e = *edits_;
+  const Edits& e = edits("Scene::top_level_bytes");
   auto walked = [](const layout::TopLevel& t) {
     return t.placed.capacity() * sizeof(layout::PlacedInstance) + t.wide.capacity() * sizeof(layout::TopWideNode);
   };

@@ -7,6 +7,7 @@
 
 #include "cpu/scene.h"
 #include "cpu/walk_top.h"
+#include "layout/queries.h"
 #include "meshcast/errors.h"
 #include "meshcast/scene.h"
 
@@ -116,9 +117,9 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Ente
 // could not take it (its local ray not walkable): that instance is not
 // walked and the ray counted.
 bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
-          uint8_t mask) {
+          uint8_t mask, EnterTopFn enter) {
   bool complete = true;
-  walk_top(s.top, world_ray(s.top, rd), mask, enter_top_fn(), [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, world_ray(s.top, rd), mask, enter, [&](const layout::PlacedInstance& p, const Ray& local) {
     Hit h;
     // A local ray the walkers refuse (its direction scaled past their
     // range) is counted, not walked.
@@ -141,13 +142,13 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
 // merged in, the nearest kept in order of t, instance, triangle. Returns
 // the hits found, or with `complete` false a ray some frame could not take.
 uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> row, std::vector<Hit>& scratch,
-                  HitOutputs outputs, Cull cull, uint8_t mask, bool& complete) {
+                  HitOutputs outputs, Cull cull, uint8_t mask, EnterTopFn enter, bool& complete) {
   const uint32_t cap = uint32_t(row.size());
   uint32_t found = 0, kept = 0;
   auto before = [](const SceneHit& a, const SceneHit& b) {
     return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
   };
-  walk_top(s.top, world_ray(s.top, rd), mask, enter_top_fn(), [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, world_ray(s.top, rd), mask, enter, [&](const layout::PlacedInstance& p, const Ray& local) {
     uint32_t own = 0;
     if (s.meshes[p.mesh]->view.trace_all_hits(std::span(&local, 1), cap, std::span(&own, 1), scratch, outputs,
                                               as_instance_sees(cull, p.mirrored != 0)) != 0)
@@ -170,6 +171,13 @@ uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> ro
   return found;
 }
 
+// UsageError naming `who` for what a scene's walk cannot answer, checked
+// before any ray is walked (an empty scene refuses it too).
+void check_request(const char* who, HitOutputs outputs, Query query, Cull cull) {
+  layout::check_query(who, query, cull);
+  if (has(outputs, HitOutputs::Point)) throw UsageError(std::string(who) + ": a scene hit carries no point (HitOutputs::Point)");
+}
+
 }  // namespace
 
 uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,
@@ -179,22 +187,25 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
                      " hits; the hits span must hold one hit a ray");
   if (query == Query::All)
     throw UsageError("Scene::trace: Query::All has a list of hits a ray: Scene::trace_all_hits answers it");
-  if (has(outputs, HitOutputs::Point)) throw UsageError("Scene::trace: a scene hit carries no point (HitOutputs::Point)");
+  check_request("Scene::trace", outputs, query, cull);
+  const EnterTopFn enter = enter_top_fn();
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     hits[i] = SceneHit{};
-    if (snapshot.top.wide.empty()) continue;
+    // Refused whatever the scene holds (an empty one too).
     if (!world_ray_walkable(rays[i])) {
       ++skipped;
       continue;
     }
-    if (!walk(snapshot, rays[i], hits[i], outputs, query, cull, mask)) ++skipped;
+    if (snapshot.top.wide.empty()) continue;
+    if (!walk(snapshot, rays[i], hits[i], outputs, query, cull, mask, enter)) ++skipped;
   }
   return skipped;
 }
 
 uint64_t trace_all_hits_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, SceneHitLists& lists,
                                  HitOutputs outputs, Cull cull, uint8_t mask) {
+  check_request("Scene::trace_all_hits", outputs, Query::All, cull);
   if (lists.max_hits < 1 || lists.max_hits > kMaxHitsLimit)
     throw UsageError("Scene::trace_all_hits: max_hits " + std::to_string(lists.max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
@@ -206,21 +217,21 @@ uint64_t trace_all_hits_snapshot(const SceneSnapshot& snapshot, std::span<const 
 uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint32_t max_hits,
                           std::span<uint32_t> found, std::span<SceneHit> rows, HitOutputs outputs, Cull cull,
                           uint8_t mask) {
-  if (has(outputs, HitOutputs::Point))
-    throw UsageError("Scene::trace_all_hits: a scene hit carries no point (HitOutputs::Point)");
+  check_request("Scene::trace_all_hits", outputs, Query::All, cull);
+  const EnterTopFn enter = enter_top_fn();
   std::vector<Hit> scratch(max_hits);
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     const std::span<SceneHit> row = rows.subspan(i * max_hits, max_hits);
     std::fill(row.begin(), row.end(), SceneHit{});
     found[i] = 0;
-    if (snapshot.top.wide.empty()) continue;
     if (!world_ray_walkable(rays[i])) {
       ++skipped;
       continue;
     }
+    if (snapshot.top.wide.empty()) continue;
     bool complete = true;
-    found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, complete);
+    found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, enter, complete);
     skipped += !complete;
   }
   return skipped;

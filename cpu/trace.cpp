@@ -175,12 +175,7 @@ namespace {
 // The walkers' flags word: only the outputs' own bits (the query's and the
 // culling's share the word), checked names for the rest.
 uint32_t flags_of(const char* who, HitOutputs outputs, Query query, Cull cull) {
-  if (query != Query::Closest && query != Query::Any && query != Query::All)
-    throw UsageError(std::string(who) + ": query " + std::to_string(uint32_t(query)) +
-                     " is not Query::Closest, Query::Any or Query::All");
-  if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
-    throw UsageError(std::string(who) + ": cull " + std::to_string(uint32_t(cull)) +
-                     " is not Cull::None, Cull::Back or Cull::Front");
+  layout::check_query(who, query, cull);
   return (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | layout::query_bits(query, cull);
 }
 

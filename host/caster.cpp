@@ -258,10 +258,7 @@ std::string Caster::why(uint32_t rays) const {
 
 // A batch's query, culling and row length, or UsageError naming the one out of range.
 static void check_query(Query query, Cull cull, uint32_t max_hits) {
-  if (query != Query::Closest && query != Query::Any && query != Query::All)
-    throw UsageError("Caster::submit: query " + std::to_string(uint32_t(query)) + " is not a Query");
-  if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
-    throw UsageError("Caster::submit: cull " + std::to_string(uint32_t(cull)) + " is not a Cull");
+  layout::check_query("Caster::submit", query, cull);
   if (query == Query::All && (max_hits < 1 || max_hits > kMaxHitsLimit))
     throw UsageError("Caster::submit: max_hits " + std::to_string(max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
@@ -289,6 +286,25 @@ Caster::Slot& Caster::take_slot() {
                    " frames hold batches not yet collected; wait() for one before submitting more");
 }
 
+void Caster::size_slot(Slot& s, size_t n, bool scene) {
+  if (n > UINT32_MAX)
+    throw UsageError("Caster::submit: " + std::to_string(n) + " rays, more than a batch holds (2^32 - 1)");
+  s.submit_ms = now_ms();
+  s.n = uint32_t(n);
+  const bool all = s.query.query == Query::All;
+  const size_t answers = all ? size_t(s.n) * s.query.max_hits : s.n;
+  if (scene) s.scene_hits.resize(answers);
+  else s.hits.resize(answers);
+  s.found.resize(all ? s.n : 0);
+}
+
+void Caster::free_slot(Slot& s) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  s.scene.reset();
+  s.state = Slot::Free;
+  changed_.notify_all();
+}
+
 Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
   check_query(query.query, query.cull, query.max_hits);
   std::shared_ptr<const SceneSnapshot> frame = scene.snapshot();  // UsageError for a moved-from scene
@@ -297,18 +313,11 @@ Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatch
     s.scene = std::move(frame);
     s.scene_query = query;
     s.query = {query.query, query.cull, query.max_hits};
-    s.submit_ms = now_ms();
-    s.n = uint32_t(rays.size());
+    size_slot(s, rays.size(), true);
     s.world.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-    const bool all = query.query == Query::All;
-    s.scene_hits.resize(all ? size_t(s.n) * query.max_hits : s.n);
-    s.found.resize(all ? s.n : 0);
     start_cpu(s);
-  } catch (...) {  // nothing started: the slot is free again
-    std::lock_guard<std::mutex> lock(mutex_);
-    s.scene.reset();
-    s.state = Slot::Free;
-    changed_.notify_all();
+  } catch (...) {
+    free_slot(s);
     throw;
   }
   return {s.id, s.index};
@@ -316,12 +325,9 @@ Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatch
 
 void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   try {
-    s.submit_ms = now_ms();
-    s.n = uint32_t(rays.size());
+    size_slot(s, rays.size(), false);
     s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
     const bool all = s.query.query == Query::All;
-    s.hits.resize(all ? size_t(s.n) * s.query.max_hits : s.n);
-    s.found.resize(all ? s.n : 0);
     // The GPU's rows of every hit carry no u, v (gpu::BatchMethod): such a batch is the CPU's.
     const bool gpu_answers = !(all && has(options_.hit_outputs, HitOutputs::Uv));
     if (backend == Backend::Vulkan && gpu_available() && s.n > 0 && gpu_answers) {
@@ -335,10 +341,8 @@ void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
       }
     }
     start_cpu(s);
-  } catch (...) {  // nothing started: the slot is free again
-    std::lock_guard<std::mutex> lock(mutex_);
-    s.state = Slot::Free;
-    changed_.notify_all();
+  } catch (...) {
+    free_slot(s);
     throw;
   }
 }

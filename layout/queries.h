@@ -18,6 +18,16 @@ constexpr uint32_t query_bits(Query query, Cull cull) {
          (cull == Cull::Back ? MC_CULL_BACK : cull == Cull::Front ? MC_CULL_FRONT : 0u);
 }
 
+// UsageError naming `who` for a query or a culling outside its enum (an
+// integer cast into it): every entry point checks before it walks.
+inline void check_query(const std::string& who, Query query, Cull cull) {
+  if (query != Query::Closest && query != Query::Any && query != Query::All)
+    throw UsageError(who + ": query " + std::to_string(uint32_t(query)) +
+                     " is not Query::Closest, Query::Any or Query::All");
+  if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
+    throw UsageError(who + ": cull " + std::to_string(uint32_t(cull)) + " is not Cull::None, Cull::Back or Cull::Front");
+}
+
 // closest, any, all; UsageError naming `option` for anything else.
 inline Query query_named(const std::string& name, const std::string& option) {
   if (name == "closest") return Query::Closest;

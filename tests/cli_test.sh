@@ -86,6 +86,16 @@ check trace-scene 0 '"instances":3.*"rays":500' -- "$meshcast" trace "$work/leve
 if [[ $(head -c 4 "$work/h.hiti") != HITI || $(stat -c %s "$work/h.hiti") -ne 6008 ]]; then
   echo "FAIL trace-scene: the HITI file's magic or size"; failures=$((failures + 1))
 fi
+# One instance where the mesh stands: the scene's closest hits are the
+# mesh's own (the ray reaches the instance's frame unrounded): the same t
+# bits and triangles as `trace` on the mesh, instance 0 wherever it hits.
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh"}]}' "$mesh" >"$work/one.json"
+check trace-scene-one 0 "500 rays" -- "$meshcast" trace "$work/one.json" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/one.hiti"
+check trace-mesh-one 0 "500 rays" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/one.hits"
+if ! diff <(od -An -tu4 -v -w8 -j8 "$work/one.hits" | awk '{print $1, ($2 == 4294967295 ? "miss" : 0), $2}') \
+          <(od -An -tu4 -v -w12 -j8 "$work/one.hiti" | awk '{print $1, ($2 == 4294967295 ? "miss" : $2), $3}') >/dev/null; then
+  echo "FAIL trace-scene-one: the scene's hits differ from the mesh's"; failures=$((failures + 1))
+fi
 check render-scene 0 "3 instances of 2 meshes.*scene.png" -- "$meshcast" render "$work/level.json" --png "$work/scene.png" --width 64 --height 48
 printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "translation": [1, 2]}]}' "$mesh" >"$work/short.json"
 check scene-short-translation 2 "short.json: instances\[0\].translation is not an array of 3 numbers" -- "$meshcast" trace "$work/short.json" --rays "$work/r.rays" --out "$work/x.hiti"

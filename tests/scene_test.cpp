@@ -103,15 +103,38 @@ std::vector<RayD> level_rays(const Level& level, size_t count, double spread, ui
   return rays;
 }
 
-// How far, in the world, a scene hit may stray from the oracle's where only
-// rounding decides: 1e-5 of the distance from the ray's origin to the hit
-// plus the instance's scale (the ray's place in an instance's frame is
-// rounded to float, about 2^-22 of that distance; a layout's own error is
-// in the stored mesh the oracle uses).
-double slack(const RayD& r, double t) {
-  const double len = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
-  return 1e-5 * (t * len + 4);
-}
+// One ray's rules, check/agreement.h's compare() for scenes: how far a
+// scene hit may stray from the oracle's where only rounding decides (1e-5 of
+// the distance from the ray's origin to the hit plus the instance's scale:
+// the ray's place in an instance's frame is rounded to float, about 2^-22 of
+// that distance; a layout's own error is in the stored mesh the oracle
+// uses), and which differences are ties.
+struct RayRules {
+  RayRules(const SceneOracle& o, const RayD& ray)
+      : oracle(o), r(ray),
+        len(std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2])) {}
+  const SceneOracle& oracle;
+  const RayD& r;
+  const double len;
+  double slack(double t) const { return 1e-5 * (t * len + 4); }
+  bool same_t(double t, double oracle_t) const { return std::fabs(t - oracle_t) * len <= slack(oracle_t); }
+  bool near_end(double t) const { return t * len <= slack(t) || std::fabs(t - r.tmax) * len <= slack(t); }
+  // The hit's triangle meets the ray at its t.
+  bool meets(const SceneHit& h) const {
+    return oracle.distance_to(oracle.index_of(h.instance), h.triangle, r, h.t) <= slack(h.t);
+  }
+  // A hit the oracle does not have: on the ray, at its triangle's edge or
+  // at the segment's ends.
+  bool extra_is_tie(const SceneHit& h) const {
+    return meets(h) && (oracle.distance_to_edge(oracle.index_of(h.instance), h.triangle, r, h.t) <= slack(h.t) ||
+                        near_end(h.t));
+  }
+  // An oracle hit the walk does not have: a graze of its edge, or at the
+  // segment's ends.
+  bool missing_is_tie(const SceneOracleHit& o) const {
+    return oracle.distance_to_edge(oracle.index_of(o.instance), o.triangle, r, o.t) <= slack(o.t) || near_end(o.t);
+  }
+};
 
 struct Judged {
   size_t hits = 0, ties = 0, wrong = 0;
@@ -121,83 +144,76 @@ struct Judged {
   }
 };
 
-// The rules of check/agreement.h's compare(), for scenes: the oracle's
-// instance, triangle and t; where only rounding decides (another triangle
-// at the same place, a graze of the hit triangle's edge, the segment's
-// ends) a tie. `any`: a hit names a triangle the ray meets at its t.
+std::string named(uint32_t instance, uint32_t triangle) {
+  return "instance " + std::to_string(instance) + " triangle " + std::to_string(triangle);
+}
+
+// The oracle's instance, triangle and t; where only rounding decides
+// (another triangle at the same place, a graze of the hit triangle's edge,
+// the segment's ends) a tie. `any`: a hit is one of the oracle's hits under
+// the same culling and mask (or a tie), any of them.
 Judged judge(const SceneOracle& oracle, const std::vector<RayD>& rays, const std::vector<SceneHit>& hits, Cull cull,
              uint8_t mask, bool any) {
   Judged j;
   for (size_t i = 0; i < rays.size(); ++i) {
-    const RayD& r = rays[i];
+    const RayRules rules(oracle, rays[i]);
     const SceneHit& h = hits[i];
-    const SceneOracleHit o = oracle.closest(r, cull, mask);
-    const std::string where = "ray " + std::to_string(i);
-    const double tlen = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
-    auto near_end = [&](double t) { return t * tlen <= slack(r, t) || std::fabs(t - r.tmax) * tlen <= slack(r, t); };
+    const SceneOracleHit o = oracle.closest(rays[i], cull, mask);
+    const std::string where = "ray " + std::to_string(i) + ": ";
     if (h.instance == kNoHit && o.instance == kNoHit) continue;
     if (h.instance != kNoHit) ++j.hits;
     if (h.instance != kNoHit && o.instance != kNoHit) {
-      const size_t at = oracle.index_of(h.instance);
-      const bool meets = oracle.distance_to(at, h.triangle, r, h.t) <= slack(r, h.t);
       if (any) {
-        if (!meets) j.fail(where + ": any-hit's triangle is not on the ray at its t");
+        const std::vector<SceneOracleHit> every = oracle.all(rays[i], cull, mask);
+        const auto m = std::find_if(every.begin(), every.end(), [&](const SceneOracleHit& e) {
+          return e.instance == h.instance && e.triangle == h.triangle;
+        });
+        if (m != every.end() ? !rules.same_t(h.t, m->t) : !rules.extra_is_tie(h))
+          j.fail(where + "any-hit's " + named(h.instance, h.triangle) + " at " + std::to_string(h.t) +
+                 " is not a hit under this culling and mask");
         continue;
       }
       const bool same = h.instance == o.instance && h.triangle == o.triangle;
-      if (std::fabs(h.t - o.t) * tlen > slack(r, o.t)) j.fail(where + ": t " + std::to_string(h.t) + " against " + std::to_string(o.t));
-      else if (!same && !meets) j.fail(where + ": instance " + std::to_string(h.instance) + " triangle " + std::to_string(h.triangle) + " against " + std::to_string(o.instance) + "/" + std::to_string(o.triangle));
+      if (!rules.same_t(h.t, o.t)) j.fail(where + "t " + std::to_string(h.t) + " against " + std::to_string(o.t));
+      else if (!same && !rules.meets(h)) j.fail(where + named(h.instance, h.triangle) + " against " + named(o.instance, o.triangle));
       else if (!same) ++j.ties;
     } else if (h.instance == kNoHit) {
-      const size_t at = oracle.index_of(o.instance);
-      if (oracle.distance_to_edge(at, o.triangle, r, o.t) <= slack(r, o.t) || near_end(o.t)) ++j.ties;
-      else j.fail(where + ": a miss where the oracle hits instance " + std::to_string(o.instance) + " triangle " + std::to_string(o.triangle) + " at " + std::to_string(o.t));
+      if (rules.missing_is_tie(o)) ++j.ties;
+      else j.fail(where + "a miss where the oracle hits " + named(o.instance, o.triangle) + " at " + std::to_string(o.t));
     } else {
-      const size_t at = oracle.index_of(h.instance);
-      if (oracle.distance_to(at, h.triangle, r, h.t) <= slack(r, h.t) &&
-          (oracle.distance_to_edge(at, h.triangle, r, h.t) <= slack(r, h.t) || near_end(h.t)))
-        ++j.ties;
-      else j.fail(where + ": a hit of instance " + std::to_string(h.instance) + " triangle " + std::to_string(h.triangle) + " where the oracle misses");
+      if (rules.extra_is_tie(h)) ++j.ties;
+      else j.fail(where + "a hit of " + named(h.instance, h.triangle) + " where the oracle misses");
     }
   }
   return j;
 }
 
 // Query::All: each row against the oracle's set, under the same rules
-// pair by pair (a triangle of one set and not the other is a tie only where
-// rounding decides: a graze of its edge, the segment's ends); rows in order
-// of t, found[i] the row's length (rows long enough for every hit).
+// pair by pair; rows in order of t, found[i] the row's length (rows long
+// enough for every hit).
 Judged judge_all(const SceneOracle& oracle, const std::vector<RayD>& rays, const SceneHitLists& lists, Cull cull,
                  uint8_t mask) {
   Judged j;
   for (size_t i = 0; i < rays.size(); ++i) {
-    const RayD& r = rays[i];
-    const std::vector<SceneOracleHit> want = oracle.all(r, cull, mask);
+    const RayRules rules(oracle, rays[i]);
+    const std::vector<SceneOracleHit> want = oracle.all(rays[i], cull, mask);
     const std::span<const SceneHit> row = lists.row(i);
-    const std::string where = "ray " + std::to_string(i);
-    if (lists.found[i] != row.size()) j.fail(where + ": found " + std::to_string(lists.found[i]) + " hits for a row of " + std::to_string(row.size()));
+    const std::string where = "ray " + std::to_string(i) + ": ";
+    if (lists.found[i] != row.size()) j.fail(where + "found " + std::to_string(lists.found[i]) + " hits for a row of " + std::to_string(row.size()));
     for (size_t k = 1; k < row.size(); ++k)
-      if (row[k].t < row[k - 1].t) j.fail(where + ": the row is not in order of t");
-    const double tlen = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
-    auto near_end = [&](double t) { return t * tlen <= slack(r, t) || std::fabs(t - r.tmax) * tlen <= slack(r, t); };
+      if (row[k].t < row[k - 1].t) j.fail(where + "the row is not in order of t");
     j.hits += row.size();
     for (const SceneOracleHit& o : want) {
       const auto m = std::find_if(row.begin(), row.end(), [&](const SceneHit& h) { return h.instance == o.instance && h.triangle == o.triangle; });
-      if (m != row.end()) {
-        if (std::fabs(m->t - o.t) * tlen > slack(r, o.t)) j.fail(where + ": t " + std::to_string(m->t) + " against " + std::to_string(o.t));
-        continue;
-      }
-      if (oracle.distance_to_edge(oracle.index_of(o.instance), o.triangle, r, o.t) <= slack(r, o.t) || near_end(o.t)) ++j.ties;
-      else j.fail(where + ": instance " + std::to_string(o.instance) + " triangle " + std::to_string(o.triangle) + " missing");
+      if (m != row.end() ? !rules.same_t(m->t, o.t) : !rules.missing_is_tie(o))
+        j.fail(where + named(o.instance, o.triangle) + (m != row.end() ? " at t " + std::to_string(m->t) + " against " + std::to_string(o.t) : " missing"));
+      else if (m == row.end()) ++j.ties;
     }
     for (const SceneHit& h : row) {
       if (std::any_of(want.begin(), want.end(), [&](const SceneOracleHit& o) { return o.instance == h.instance && o.triangle == h.triangle; }))
         continue;
-      const size_t at = oracle.index_of(h.instance);
-      if (oracle.distance_to(at, h.triangle, r, h.t) <= slack(r, h.t) &&
-          (oracle.distance_to_edge(at, h.triangle, r, h.t) <= slack(r, h.t) || near_end(h.t)))
-        ++j.ties;
-      else j.fail(where + ": instance " + std::to_string(h.instance) + " triangle " + std::to_string(h.triangle) + " is no hit");
+      if (rules.extra_is_tie(h)) ++j.ties;
+      else j.fail(where + named(h.instance, h.triangle) + " is no hit");
     }
   }
   return j;
@@ -246,6 +262,35 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
   EXPECT_EQ(all.wrong, 0u) << layout << " at " << offset << ", Query::All: " << all.first_problem;
   EXPECT_LE(all.ties, all.hits / 100 + 2) << layout << " at " << offset << ", Query::All";
   EXPECT_GT(all.hits, rays.size() / 5) << layout << " at " << offset << ", Query::All: too few hits to show anything";
+  // Rows of 2 where more are hit: the nearest 2 of the full rows (judged
+  // above, here two-sided), every hit still counted.
+  SceneHitLists full, short_rows;
+  full.max_hits = 256, short_rows.max_hits = 2;
+  EXPECT_EQ(scene.trace_all_hits(rays, full), 0u);
+  EXPECT_EQ(scene.trace_all_hits(rays, short_rows), 0u);
+  size_t overflowing = 0, differ = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    overflowing += full.found[i] > 2;
+    differ += short_rows.found[i] != full.found[i];
+    for (size_t k = 0; k < std::min<size_t>(2, full.found[i]); ++k)
+      differ += short_rows.row(i)[k].instance != full.row(i)[k].instance ||
+                short_rows.row(i)[k].triangle != full.row(i)[k].triangle || short_rows.row(i)[k].t != full.row(i)[k].t;
+  }
+  EXPECT_EQ(differ, 0u) << layout << " at " << offset << ": rows of 2 against rows of 256";
+  EXPECT_GT(overflowing, rays.size() / 50) << layout << " at " << offset << ": too few rays hit more than twice";
+  // u, v: the hit's point on its triangle's world corners.
+  std::vector<SceneHit> uv(rays.size());
+  EXPECT_EQ(scene.trace(rays, uv, HitOutputs::Uv), 0u);
+  size_t off_triangle = 0, with_uv = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (uv[i].instance == kNoHit) continue;
+    ++with_uv;
+    const RayRules rules(oracle, rays[i]);
+    off_triangle += oracle.distance_to_uv(oracle.index_of(uv[i].instance), uv[i].triangle, rays[i], uv[i].t, uv[i].u,
+                                          uv[i].v) > rules.slack(uv[i].t);
+  }
+  EXPECT_EQ(off_triangle, 0u) << layout << " at " << offset << ": u, v away from the hit's point";
+  EXPECT_GT(with_uv, rays.size() / 5) << layout << " at " << offset;
   if (offset != 0) {
     // The same level at the origin: the same instance and triangle for every
     // ray but a rounding's worth, the same t to float rounding.
@@ -298,14 +343,24 @@ TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
       }
       rays[i].tmax = INFINITY;
     }
+    // Each ray aims at a point inside its sphere at t = 1: it enters
+    // before and leaves after. The sphere's outside faces the world on the
+    // plain instance; the mirror turns its corners the other way round, so
+    // the world sees its outside as back faces (the oracle's rule).
     for (Query q : {Query::Closest, Query::Any})
-      for (Cull c : {Cull::None, Cull::Back}) {
+      for (Cull c : {Cull::None, Cull::Back, Cull::Front}) {
         const std::vector<SceneHit> hits = trace(scene, rays, q, c);
-        size_t leaks = 0;
+        size_t leaks = 0, wrong_side = 0;
         // Past its sphere a ray may go on to the other: any hit may be there.
-        for (size_t i = 0; i < count; ++i)
+        for (size_t i = 0; i < count; ++i) {
           leaks += q == Query::Any ? hits[i].instance == kNoHit : hits[i].instance != (i % 2 ? 1u : 0u);
+          const bool mirrored_one = i % 2 == 1;
+          if (q == Query::Closest && c != Cull::None)
+            wrong_side += (c == Cull::Back) != mirrored_one ? !(hits[i].t < 1) : !(hits[i].t > 1);
+          if (q == Query::Closest && c == Cull::None) wrong_side += !(hits[i].t < 1);
+        }
         EXPECT_EQ(leaks, 0u) << layout << ", query " << int(q) << ", cull " << int(c);
+        EXPECT_EQ(wrong_side, 0u) << layout << ", query " << int(q) << ", cull " << int(c);
       }
   }
 }
@@ -480,6 +535,35 @@ TEST(Scene, RefusesBadInput) {
   EXPECT_GE(lists.found[0], 2u);  // through both poles: every triangle around each, once
   EXPECT_EQ(lists.row(0)[0].instance, id);
   EXPECT_FLOAT_EQ(lists.row(0)[0].t, 4.0f);
+  // A query or culling outside its enum, a point asked of a scene hit:
+  // refused before any ray is walked, on an empty scene too.
+  Scene empty;
+  empty.commit();
+  for (const Scene* s : {&scene, &empty}) {
+    EXPECT_THROW(s->trace(rays, hits, HitOutputs::None, Query(7)), UsageError);
+    EXPECT_THROW(s->trace(rays, hits, HitOutputs::None, Query::Closest, Cull(9)), UsageError);
+    EXPECT_THROW(s->trace(rays, hits, HitOutputs::Point), UsageError);
+    EXPECT_THROW(s->trace_all_hits(rays, lists, HitOutputs::None, Cull(9)), UsageError);
+  }
+  // The rays no scene walks are counted whatever the scene holds.
+  EXPECT_EQ(empty.trace(rays, hits), 3u);
+  // A 3x3 entry beyond 2^40; a world box beyond 2^100 (a sphere 10^18
+  // across scaled by 2^40, 2^99 from the origin).
+  Transform huge;
+  huge.rotation_scale[0] = 0x1p41f;
+  EXPECT_THROW(scene.add_instance(m, huge), UsageError);
+  const MeshId big = scene.add_mesh(build_blob(make_sphere(4, 6, 1e18f, {0, 0, 0}), parse_layout("AABBTree/Float3"), "big"), "big");
+  Transform wide;
+  wide.rotation_scale[0] = wide.rotation_scale[4] = wide.rotation_scale[8] = 0x1p40f;
+  EXPECT_NO_THROW(scene.add_instance(big, wide));
+  wide.translation[0] = 0x1p99;
+  EXPECT_THROW(scene.add_instance(big, wide), UsageError);
+  // A moved-from scene refuses every call.
+  Scene moved = std::move(empty);
+  EXPECT_THROW(empty.commit(), UsageError);
+  EXPECT_THROW(empty.add_instance(0, Transform{}), UsageError);
+  EXPECT_THROW(empty.instance_count(), UsageError);
+  EXPECT_THROW(empty.trace(rays, hits), UsageError);
 }
 
 }  // namespace

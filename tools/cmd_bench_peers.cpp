@@ -54,13 +54,13 @@ void add_bench_peers(CLI::App* bench) {
       std::vector<bench::PeerRow> r = bench::bench_peers(mesh, std::filesystem::path(input).stem().string(), o);
       rows.insert(rows.end(), r.begin(), r.end());
     }
-    std::printf("\n%s, meshcast walkers: %s; one thread tracing, %zu rays a set, median of %u interleaved rounds; ratio: to Embree default "
+    std::printf("\n%s; one thread tracing, %zu rays a set, median of %u interleaved rounds; ratio: to Embree default "
                 "on the same rays and query (any: Embree's rtcOccluded1); / closest: time against the same row's closest "
                 "hit on the same rays; bytes a triangle all included (meshcast: the whole blob with its remap; Embree: "
                 "its scene plus the mesh it keeps); build: one thread / all cores (meshcast's builder is serial)\n\n"
                 "| mesh | rays | query | layout or peer | ns/ray | ratio | / closest | B/tri | build ms (1 / all) |\n"
                 "|---|---|---|---|---:|---:|---:|---:|---:|\n",
-                processor_name().c_str(), std::string(walker_isa_name(walker_isa())).c_str(), o.rays, o.rounds);
+                bench_machine().c_str(), o.rays, o.rounds);
     OutputText csv(args->out_dir + "/peers.csv");
     csv << "mesh,rays,contender,peer,ns_per_ray,ratio_to_embree_default,bytes_per_triangle,build_ms_one_thread,"
            "build_ms_all_cores,query,ratio_to_closest\n";

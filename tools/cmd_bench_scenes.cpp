@@ -12,37 +12,32 @@ namespace meshcast::tools {
 
 void add_bench_scenes(CLI::App* bench) {
   struct Args {
-    std::string meshes = "data/bunny00.off,data/armadillo.off,data/ChineseDragon-10kv.off", counts = "1000,10000",
-                out_dir = "out";
+    std::string meshes = "data/bunny00.off,data/armadillo.off,data/ChineseDragon-10kv.off", out_dir = "out";
     bench::ScenesOptions options;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = bench->add_subcommand("scenes", "issue 21: a level of placed meshes beside Embree's instancing");
   cmd->add_option("--meshes", args->meshes, "comma-separated mesh files placed in turn (default bunny00, armadillo, the dragon)");
-  cmd->add_option("--counts", args->counts, "comma-separated instance counts, a level each (default 1000,10000)");
+  cmd->add_option("--counts", args->options.counts, "comma-separated instance counts, a level each (default 1000,10000)")
+      ->delimiter(',')
+      ->check(CLI::Range(size_t(1), size_t(1000000)));
   cmd->add_option("--layout", args->options.layout, "the meshes' layout");
   cmd->add_option("--rays", args->options.rays, "rays a level")->check(CLI::Range(size_t(100), size_t(1000000)));
   cmd->add_option("--rounds", args->options.rounds, "interleaved rounds; the median is reported")->check(CLI::Range(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where scenes.csv goes");
   cmd->callback([args] {
-    bench::ScenesOptions o = args->options;
-    o.counts.clear();
-    for (const std::string& c : split(args->counts)) {
-      const size_t n = std::stoul(c);
-      if (n < 1 || n > 1000000) throw InputError("--counts: " + c + " is not 1 to 1000000 instances");
-      o.counts.push_back(n);
-    }
+    const bench::ScenesOptions& o = args->options;
     std::vector<Mesh> meshes;
     for (const std::string& m : split(args->meshes)) meshes.push_back(bench_mesh(m));
     std::filesystem::create_directories(args->out_dir);
     const std::vector<bench::SceneRow> rows = bench::bench_scenes(meshes, o);
-    std::printf("\n%s, meshcast walkers: %s; one thread, %zu rays a level, median of %u interleaved rounds; bytes all "
+    std::printf("\n%s; one thread, %zu rays a level, median of %u interleaved rounds; bytes all "
                 "included (meshcast: the blobs and the top level; Embree: its scenes and the meshes it keeps); update: "
                 "a tenth / every instance moved, then the commit (median of 8 frames); as at the origin: the rays "
                 "answered with the same instance and triangle as the level at the origin\n\n"
                 "| instances | offset | contender | ns/ray | ratio | MB | update ms (tenth / all) | hit | as at the origin |\n"
                 "|---:|---:|---|---:|---:|---:|---:|---:|---:|\n",
-                processor_name().c_str(), std::string(walker_isa_name(walker_isa())).c_str(), o.rays, o.rounds);
+                bench_machine().c_str(), o.rays, o.rounds);
     OutputText csv(args->out_dir + "/scenes.csv");
     csv << "instances,offset,contender,ns_per_ray,bytes,update_tenth_ms,update_all_ms,hit_fraction,same_as_origin\n";
     double meshcast_ns = 0;

@@ -19,39 +19,40 @@ namespace {
 
 // trace on a scene file: RAYD or RAYS rays in, a HITI file out.
 void trace_scene(const std::string& input, const std::string& rays_path, const std::string& out, const LayoutArgs& layout,
-                 Query query, Cull cull, uint32_t repeat, bool json) {
+                 const std::string& query_name, const std::string& cull_name, uint32_t repeat, bool json) {
+  const Query query = layout::query_named(query_name, "--query");
+  const Cull cull = layout::cull_named(cull_name, "--cull");
   auto t0 = std::chrono::steady_clock::now();
   SceneFile file = load_scene_file(input, layout, json ? stderr : stdout);
   const double load_ms = ms_since(t0);
-  std::vector<RayD> rays;
-  if (is_scene_rays_file(rays_path)) {
-    rays = read_scene_rays(rays_path);
-  } else {
-    for (const Ray& r : read_rays(rays_path))
-      rays.push_back({{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax});
-  }
-  std::vector<SceneHit> hits(rays.size());
+  // Double origins (RAYD) or float ones (RAYS, Scene's float-ray trace).
+  const bool double_origins = is_scene_rays_file(rays_path);
+  const std::vector<RayD> rays_d = double_origins ? read_scene_rays(rays_path) : std::vector<RayD>{};
+  const std::vector<Ray> rays_f = double_origins ? std::vector<Ray>{} : read_rays(rays_path);
+  const size_t ray_count = double_origins ? rays_d.size() : rays_f.size();
+  std::vector<SceneHit> hits(ray_count);
   std::vector<double> pass_ms;
   uint64_t skipped = 0;
   for (uint32_t r = 0; r < repeat; ++r) {
     auto t1 = std::chrono::steady_clock::now();
-    skipped = file.scene.trace(rays, hits, HitOutputs::None, query, cull);
+    skipped = double_origins ? file.scene.trace(rays_d, hits, HitOutputs::None, query, cull)
+                             : file.scene.trace(rays_f, hits, HitOutputs::None, query, cull);
     pass_ms.push_back(ms_since(t1));
   }
   write_scene_hits(out, hits);
   size_t hit_count = 0;
   for (const SceneHit& h : hits) hit_count += h.instance != kNoHit;
-  const double ns = rays.empty() ? 0 : median(pass_ms) * 1e6 / double(rays.size());
+  const double ns = ray_count == 0 ? 0 : median(pass_ms) * 1e6 / double(ray_count);
   if (json) {
     print_json({{"input", input}, {"meshes", file.mesh_names.size()}, {"instances", file.instances},
-                {"blob_bytes", file.blob_bytes}, {"load_ms", load_ms}, {"query", int(query)}, {"cull", int(cull)},
-                {"rays", rays.size()}, {"hits", hit_count}, {"invalid_rays", skipped}, {"repeat", repeat},
+                {"blob_bytes", file.blob_bytes}, {"load_ms", load_ms}, {"query", query_name}, {"cull", cull_name},
+                {"rays", ray_count}, {"hits", hit_count}, {"invalid_rays", skipped}, {"repeat", repeat},
                 {"ns_per_ray", ns}});
     return;
   }
   std::printf("%s: %zu meshes (%llu blob bytes), %zu instances, loaded and built in %.1f ms\n", input.c_str(),
               file.mesh_names.size(), (unsigned long long)file.blob_bytes, file.instances, load_ms);
-  std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", rays.size(), hit_count,
+  std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", ray_count, hit_count,
               (unsigned long long)skipped);
   std::printf("cast: %.1f ns/ray (median of %u passes, one thread) -> %s\n", ns, repeat, out.c_str());
 }
@@ -97,7 +98,7 @@ void add_trace(CLI::App& app) {
     if (is_scene_file(args->input)) {
       if (args->backend != "cpu") throw InputError("trace " + args->input + ": scenes are cast on the CPU (--backend cpu)");
       if (query == Query::All) throw InputError("trace " + args->input + ": --query all on a scene has no hits file yet (the library answers it: Scene::trace_all_hits)");
-      trace_scene(args->input, args->rays, args->out, args->layout, query, cull, args->repeat, args->json);
+      trace_scene(args->input, args->rays, args->out, args->layout, args->query, args->cull, args->repeat, args->json);
       return;
     }
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.

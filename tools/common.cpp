@@ -152,12 +152,7 @@ void print_json(const nlohmann::ordered_json& object) {
   std::printf("%s\n", object.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+
 
 SectionBytes section_bytes(const std::vector<uint8_t>& blob) {
   const layout::BlobHeader& h = layout::header_of(blob.data());
@@ -182,6 +177,10 @@ std::string processor_name() {
   }
   const bool avx512 = flags.find(" avx512f") != std::string::npos, avx2 = flags.find(" avx2") != std::string::npos;
   return name + (avx512 ? " (AVX-512)" : avx2 ? " (AVX2, no AVX-512)" : " (no AVX2)");
+}
+
+std::string bench_machine() {
+  return processor_name() + ", meshcast walkers: " + std::string(walker_isa_name(walker_isa()));
 }
 
 std::vector<std::string> split(const std::string& text) {

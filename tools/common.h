@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/timing.h"
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "meshcast/mesh.h"
@@ -30,11 +31,8 @@ Loaded load_mesh_or_blob(const std::string& path, const MeshBuilder& build);
 // Options of --layout and --leaf, with the defaults of the foundation issue.
 BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std::string& splitter = "");
 
-inline double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double median(std::vector<double> v);
+using bench::median;
+using bench::ms_since;
 
 // Bytes of each blob section and per triangle.
 struct SectionBytes {
@@ -46,6 +44,8 @@ SectionBytes section_bytes(const std::vector<uint8_t>& blob);
 // The processor, as /proc/cpuinfo names it, with its widest vector set
 // (a benchmark's figures count only with it).
 std::string processor_name();
+// A benchmark table's first words: the processor and the walkers' instruction set.
+std::string bench_machine();
 // The parts of a comma-separated list, empty parts dropped.
 std::vector<std::string> split(const std::string& text);
 

@@ -52,14 +52,13 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
   for (const auto& [name, file] : doc["meshes"].items()) {
     if (!file.is_string()) throw InputError(path + ": meshes." + name + " is not a file name");
     const std::string mesh_path = (folder / file.get<std::string>()).string();
-    Loaded mesh;
-    try {
-      mesh = load_input(mesh_path, layout, report);
-    } catch (const InputError& e) {  // the mesh file's own message, and where the scene names it
+    try {  // the mesh file's own message, and where the scene names it
+      Loaded mesh = load_input(mesh_path, layout, report);
+      out.blob_bytes += mesh.blob.size();
+      ids[name] = out.scene.add_mesh(std::move(mesh.blob), mesh_path);
+    } catch (const InputError& e) {
       throw InputError(path + ": meshes." + name + ": " + e.what());
     }
-    out.blob_bytes += mesh.blob.size();
-    ids[name] = out.scene.add_mesh(std::move(mesh.blob), mesh_path);
     out.mesh_names.push_back(name);
   }
   size_t index = 0;

@@ -228,6 +228,10 @@ class Caster {
   const BlobView& blob(const char* who) const;
   void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
   Slot& take_slot();  // a free game slot, Running; UsageError when none
+  // A taken slot's batch of n rays under s.query: the clock started, room
+  // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
+  void size_slot(Slot& s, size_t n, bool scene);
+  void free_slot(Slot& s);  // what started the batch threw: nothing runs
   // The first half of collecting: checks that the caller collects the
   // batch into what it asked for (scene hits or not, rows or not, `room`
   // hits), waits for it and marks it Collecting; release() frees the slot.

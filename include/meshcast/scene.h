@@ -87,8 +87,9 @@ class Scene {
 
   // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
   // share a bit with it for the instance to be walked). UsageError for an
-  // unknown mesh, a transform that is not finite or not invertible, or a
-  // translation beyond 2^100 (kMaxCoordinate).
+  // unknown mesh, a transform that is not finite or not invertible, a 3x3
+  // or inverse entry beyond 2^40, a translation or world box beyond 2^100
+  // (kMaxCoordinate), or a 2^31st instance.
   InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF);
   void set_transform(InstanceId instance, const Transform& transform);
   void set_mask(InstanceId instance, uint8_t mask);
@@ -131,6 +132,7 @@ class Scene {
 
  private:
   struct Edits;
+  Edits& edits(const char* who) const;  // UsageError naming `who` on a moved-from scene
   std::unique_ptr<Edits> edits_;  // and the committed snapshot, behind a mutex
 };
 

@@ -23,7 +23,8 @@ namespace {
 // the whole scene's box's planes, axis by axis, covers every instance the ray can reach
 // (worked out once a ray: a few centimetres for a ray inside a level 10 km
 // across, far inside the smallest instance a game places).
-constexpr double kBoxSlack = 0x1p-16;
+constexpr double kBoxSlack = MC_TOP_BOX_SLACK;  // 2^-16
+static_assert(kBoxSlack == 0x1p-16);
 
 struct WorldRay {
   double org[3];

@@ -285,4 +285,26 @@
 // Hit triangle for a miss.
 #define MC_NO_HIT 0xFFFFFFFFu
 
+// A scene's top level (layout/top_level.h), as the Vulkan scene method
+// reads the snapshot's arrays unchanged: a placed instance's record and
+// its fields' bytes, an 8-wide node's (lo[3][8], hi[3][8] floats, then 8
+// slot words), and what a slot holds.
+#define MC_PLACED_BYTES 128u
+#define MC_PLACED_ID_AT 0u
+#define MC_PLACED_MESH_AT 4u
+#define MC_PLACED_MASK_AT 8u
+#define MC_PLACED_MIRRORED_AT 12u
+#define MC_PLACED_TO_LOCAL_AT 16u      // 9 floats, row-major
+#define MC_PLACED_TRANSLATION_AT 56u   // 3 doubles
+#define MC_TOP_NODE_BYTES 224u
+#define MC_TOP_LO_AT 0u
+#define MC_TOP_HI_AT 96u
+#define MC_TOP_SLOT_AT 192u
+#define MC_TOP_WIDTH 8u
+#define MC_TOP_INSTANCE 0x80000000u    // | an index into the placed records
+#define MC_TOP_EMPTY 0xFFFFFFFFu
+// The pad every top-level box is widened by, of the ray origin's farthest
+// distance from the scene's box (cpu/scene_trace.cpp says why).
+#define MC_TOP_BOX_SLACK 1.52587890625e-05  // 2^-16
+
 #endif

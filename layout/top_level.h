@@ -3,8 +3,11 @@
 // the commit) in the tree's order, and a binary tree over their world boxes
 // in double (worlds far from the origin keep their precision there too).
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "layout/formats.h"
 
 namespace meshcast::layout {
 
@@ -48,6 +51,15 @@ struct TopWideNode {
 // refits work on the binary nodes and `wide_from`, which a scene's
 // snapshots leave out.
 constexpr uint32_t kTopLeafSize = 1;
+
+// The records as layout/formats.h describes them to the shaders.
+static_assert(sizeof(PlacedInstance) == MC_PLACED_BYTES && offsetof(PlacedInstance, mesh) == MC_PLACED_MESH_AT &&
+              offsetof(PlacedInstance, mask) == MC_PLACED_MASK_AT && offsetof(PlacedInstance, mirrored) == MC_PLACED_MIRRORED_AT &&
+              offsetof(PlacedInstance, to_local) == MC_PLACED_TO_LOCAL_AT &&
+              offsetof(PlacedInstance, translation) == MC_PLACED_TRANSLATION_AT);
+static_assert(sizeof(TopWideNode) == MC_TOP_NODE_BYTES && offsetof(TopWideNode, hi) == MC_TOP_HI_AT &&
+              offsetof(TopWideNode, slot) == MC_TOP_SLOT_AT && kTopWidth == int(MC_TOP_WIDTH) &&
+              kTopInstance == MC_TOP_INSTANCE && kTopEmpty == MC_TOP_EMPTY);
 struct TopLevel {
   std::vector<PlacedInstance> placed;
   std::vector<TopWideNode> wide;

@@ -8,13 +8,23 @@
 
 layout(std430, set = 0, binding = 0) readonly buffer Blob { uint blob_words[]; };
 
-uint blob_u32(uint byte_offset) { return blob_words[byte_offset >> 2]; }
-float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_words[byte_offset >> 2]); }
+// The scene method (MC_SCENE) binds every mesh's blob in one buffer, each
+// at a word offset: the blob an instance walks starts at blob_base. Offsets
+// everywhere else are the blob's own, as the CPU reads them.
+#ifdef MC_SCENE
+uint blob_base = 0u;
+#define MC_BLOB_WORD(w) (blob_base + (w))
+#else
+#define MC_BLOB_WORD(w) (w)
+#endif
+
+uint blob_u32(uint byte_offset) { return blob_words[MC_BLOB_WORD(byte_offset >> 2)]; }
+float blob_f32(uint byte_offset) { return uintBitsToFloat(blob_u32(byte_offset)); }
 // Three floats in a row (a box corner, a vertex).
 vec3 blob_vec3(uint byte_offset) {
   return vec3(blob_f32(byte_offset), blob_f32(byte_offset + 4u), blob_f32(byte_offset + 8u));
 }
-uint header(uint word) { return blob_words[word]; }
+uint header(uint word) { return blob_words[MC_BLOB_WORD(word)]; }
 
 // remap_entry of layout/blob_format.h: the used-slot bitmap (64-bit words), the
 // rank of each word, then the bit-packed entries; or in input order (no
@@ -34,7 +44,7 @@ uint remap_entry(uint slot) {
   // it spans at most two 32-bit words.
   const uint64_t at = uint64_t(base + 12u * words) * 8ul + uint64_t(index) * uint64_t(bits);
   const uint word = uint(at >> 5), shift = uint(at & 31ul);
-  const uint64_t pair = uint64_t(blob_words[word]) | (uint64_t(blob_words[word + 1u]) << 32);
+  const uint64_t pair = uint64_t(blob_words[MC_BLOB_WORD(word)]) | (uint64_t(blob_words[MC_BLOB_WORD(word + 1u)]) << 32);
   return uint((pair >> shift) & ((1ul << bits) - 1ul));
 }
 

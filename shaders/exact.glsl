@@ -25,6 +25,30 @@ float fma_exact(float a, float b, float c) {
   return float(s);
 }
 
+// a / b rounded once, as the CPU's IEEE division: Vulkan bounds a float
+// division's error at 2.5 ulp (and a double one no tighter), so the
+// quotient taken in double, rounded to float, may be one float ulp off.
+// Of it and its two neighbours the correctly rounded one leaves the least
+// remainder a - q b, exact in double (a float product fits in a double;
+// the difference of two doubles within a factor of 2 is exact); a tie (a
+// quotient half way) goes to the even one. Zeros and infinities as IEEE.
+float div_exact(float a, float b) {
+  const uint sign = (floatBitsToUint(a) ^ floatBitsToUint(b)) & 0x80000000u;
+  if (a == 0.0 || isinf(b)) return uintBitsToFloat(sign);
+  if (b == 0.0 || isinf(a)) return uintBitsToFloat(sign | 0x7F800000u);
+  const float q = float(double(a) / double(b));
+  const uint m = floatBitsToUint(abs(q));
+  if (m == 0u || m >= 0x7F800000u) return q;  // under- or overflow: no neighbour to weigh
+  uint best = m;
+  precise double r = abs(double(a) - double(uintBitsToFloat(sign | m)) * double(b));
+  for (int step = -1; step <= 1; step += 2) {
+    const uint n = uint(int(m) + step);
+    precise double rn = abs(double(a) - double(uintBitsToFloat(sign | n)) * double(b));
+    if (rn < r || (rn == r && (n & 1u) == 0u)) best = n, r = rn;
+  }
+  return uintBitsToFloat(sign | best);
+}
+
 // IEEE binary16 to float, exactly (ldexp is exact in Vulkan; subnormal
 // halves are kept, never flushed).
 float half_to_float_exact(uint h) {

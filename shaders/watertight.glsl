@@ -15,7 +15,15 @@
 // Whether the batch's culling drops the face a determinant of this sign
 // shows (positive: the front face, corners counter-clockwise seen from the
 // origin).
+#ifdef MC_SCENE
+// The scene method walks a mirrored instance with its faces turned: what
+// the world sees as front is the blob's back (cpu/scene_trace.cpp's
+// as_instance_sees).
+bool instance_mirrored = false;
+bool culled(bool positive) { return (kFlags & (positive != instance_mirrored ? MC_CULL_FRONT : MC_CULL_BACK)) != 0u; }
+#else
 bool culled(bool positive) { return (kFlags & (positive ? MC_CULL_FRONT : MC_CULL_BACK)) != 0u; }
+#endif
 
 #define kSettleTiny uintBitsToFloat(0x0D800000u)  // 2^-100, cpu/intersect.h kSettleTiny
 #define kSettleHuge uintBitsToFloat(0x7E800000u)  // 2^126, cpu/intersect.h kSettleHuge

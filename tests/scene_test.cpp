@@ -2,10 +2,15 @@
 // mirrored instances, at the origin and 10^6 and 10^7 units from it,
 // against the double-precision scene oracle (check/scene_oracle.h); the
 // closed sphere and the grid far away; edits and commits; bad input.
+// gpu_scene_test (MESHCAST_TEST_GPU) walks the same levels and probes
+// through the Vulkan scene method (gpu/scene.h) on the recommended layout,
+// on the machine's device (lavapipe in CI) with the validation layers on,
+// and checks it against the CPU bit for bit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 
@@ -14,9 +19,41 @@
 #include "check/scene_oracle.h"
 #include "meshcast/scene.h"
 #include "tests/testing.h"
+#ifdef MESHCAST_TEST_GPU
+#include <map>
+
+#include "gpu/scene.h"
+#include "gpu/vulkan.h"
+#include "layout/queries.h"
+#endif
 
 namespace meshcast::testing {
 namespace {
+
+#ifdef MESHCAST_TEST_GPU
+constexpr bool kGpu = true;
+gpu::Context& context() {
+  static gpu::Context ctx(gpu::DeviceChoice{"", true});
+  return ctx;
+}
+// The scene method for a query, culling and outputs, made once.
+gpu::SceneMethod& scene_method(Query query, Cull cull, HitOutputs outputs) {
+  static std::map<uint32_t, std::unique_ptr<gpu::SceneMethod>> made;
+  const uint32_t flags = layout::query_bits(query, cull) | (has(outputs, HitOutputs::Uv) ? MC_HIT_UV : 0u);
+  std::unique_ptr<gpu::SceneMethod>& m = made[flags];
+  if (!m) m = std::make_unique<gpu::SceneMethod>(context(), flags);
+  return *m;
+}
+#else
+constexpr bool kGpu = false;
+#endif
+
+// The layouts the levels are built in: the GPU build walks the one its
+// scene method reads.
+std::vector<std::string> walked_layouts() {
+  if (kGpu) return {"OctTreeCompressed/ClusterBitPackSOA8"};
+  return {"OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4"};
+}
 
 // A level: its meshes (as their blobs store them), blobs and instances.
 struct Level {
@@ -219,10 +256,16 @@ Judged judge_all(const SceneOracle& oracle, const std::vector<RayD>& rays, const
   return j;
 }
 
+// The scene's answers: the CPU's, or in the GPU build the Vulkan scene
+// method's on the committed snapshot.
 std::vector<SceneHit> trace(const Scene& scene, const std::vector<RayD>& rays, Query query = Query::Closest,
-                            Cull cull = Cull::None, uint8_t mask = 0xFF) {
+                            Cull cull = Cull::None, uint8_t mask = 0xFF, HitOutputs outputs = HitOutputs::None) {
   std::vector<SceneHit> hits(rays.size());
-  EXPECT_EQ(scene.trace(rays, hits, HitOutputs::None, query, cull, mask), 0u);
+#ifdef MESHCAST_TEST_GPU
+  EXPECT_EQ(scene_method(query, cull, outputs).trace(*scene.snapshot(), rays, hits, mask), 0u);
+#else
+  EXPECT_EQ(scene.trace(rays, hits, outputs, query, cull, mask), 0u);
+#endif
   return hits;
 }
 
@@ -279,8 +322,7 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
   EXPECT_EQ(differ, 0u) << layout << " at " << offset << ": rows of 2 against rows of 256";
   EXPECT_GT(overflowing, rays.size() / 50) << layout << " at " << offset << ": too few rays hit more than twice";
   // u, v: the hit's point on its triangle's world corners.
-  std::vector<SceneHit> uv(rays.size());
-  EXPECT_EQ(scene.trace(rays, uv, HitOutputs::Uv), 0u);
+  const std::vector<SceneHit> uv = trace(scene, rays, Query::Closest, Cull::None, 0xFF, HitOutputs::Uv);
   size_t off_triangle = 0, with_uv = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     if (uv[i].instance == kNoHit) continue;
@@ -309,9 +351,7 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Layouts, SceneVsOracle,
-                         ::testing::Combine(::testing::Values("OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3",
-                                                              "QuadTreeHalfFloat/Indexed8BitPackSOA4"),
-                                            ::testing::Values(0.0, 1e6, 1e7)));
+                         ::testing::Combine(::testing::ValuesIn(walked_layouts()), ::testing::Values(0.0, 1e6, 1e7)));
 
 // A closed sphere 10^7 units away, plain and mirrored, rays from all
 // around it through its inside: every ray hits, under every query and
@@ -319,7 +359,8 @@ INSTANTIATE_TEST_SUITE_P(Layouts, SceneVsOracle,
 // one, whose outside the world sees turned).
 TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
   const Mesh sphere = make_sphere(24, 32, 2.0f, {0, 0, 0});
-  for (const char* layout : {"OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3"}) {
+  for (const std::string& layout : walked_layouts()) {
+    if (layout.rfind("QuadTree", 0) == 0) continue;  // the octtree and the AABB tree suffice
     Scene scene;
     const MeshId m = scene.add_mesh(build_blob(sphere, parse_layout(layout), "sphere"), "sphere");
     std::mt19937 rng(3);
@@ -370,7 +411,8 @@ TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
 // same triangle as the grid at the origin.
 TEST(Scene, GridFarAwayLeaksNothingThroughSharedEdgesAndVertices) {
   const Mesh grid = make_grid_plane(16, 16);
-  for (const char* layout : {"OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3"}) {
+  for (const std::string& layout : walked_layouts()) {
+    if (layout.rfind("QuadTree", 0) == 0) continue;  // the octtree and the AABB tree suffice
     const std::vector<uint8_t> blob = build_blob(grid, parse_layout(layout), "grid");
     std::vector<SceneHit> answers[2];
     for (int far = 0; far < 2; ++far) {
@@ -443,6 +485,55 @@ TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
   }
 }
 
+#ifdef MESHCAST_TEST_GPU
+// The Vulkan scene method against the CPU on the same snapshot: the same
+// instance, triangle and bits of t, u and v for every ray under every
+// culling and mask, at the origin and 10^7 away (Query::Any may take
+// another hit where two boxes are entered at the same distance: the
+// same rays hit).
+TEST(SceneOnTheGpu, AnswersAsTheCpuBitForBit) {
+  for (const double offset : {0.0, 1e7}) {
+    const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 60, 100, offset, 7);
+    const Scene scene = make_scene(level);
+    const std::vector<RayD> rays = level_rays(level, 1500, 100, 11);
+    for (const Cull cull : {Cull::None, Cull::Back, Cull::Front})
+      for (const uint8_t mask : {uint8_t(0xFF), uint8_t(0x02)})
+        for (const Query query : {Query::Closest, Query::Any}) {
+          const std::vector<SceneHit> gpu = trace(scene, rays, query, cull, mask, HitOutputs::Uv);
+          std::vector<SceneHit> cpu(rays.size());
+          ASSERT_EQ(scene.trace(rays, cpu, HitOutputs::Uv, query, cull, mask), 0u);
+          size_t differ = 0, hits = 0;
+          for (size_t i = 0; i < rays.size(); ++i) {
+            hits += cpu[i].instance != kNoHit;
+            if (query == Query::Any) {
+              differ += (gpu[i].instance == kNoHit) != (cpu[i].instance == kNoHit);
+              continue;
+            }
+            differ += std::memcmp(&gpu[i], &cpu[i], sizeof(SceneHit)) != 0;
+          }
+          EXPECT_EQ(differ, 0u) << "offset " << offset << ", cull " << int(cull) << ", mask " << int(mask)
+                                << ", query " << int(query);
+          EXPECT_GT(hits, rays.size() / 10);
+        }
+  }
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+
+// Snapshots whose meshes are in another layout, every hit and the point:
+// refused with the reason.
+TEST(SceneOnTheGpu, RefusesWhatItDoesNotRead) {
+  Scene scene;
+  scene.add_instance(scene.add_mesh(build_blob(make_sphere(4, 6, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "s"), "s"),
+                     Transform{});
+  scene.commit();
+  const std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}};
+  std::vector<SceneHit> hits(1);
+  EXPECT_THROW(scene_method(Query::Closest, Cull::None, HitOutputs::None).trace(*scene.snapshot(), rays, hits), InputError);
+  EXPECT_THROW(gpu::SceneMethod(context(), MC_QUERY_ALL), UsageError);
+  EXPECT_THROW(gpu::SceneMethod(context(), MC_HIT_POINT), UsageError);
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+#else
 // Frames that only move instances and change masks refit the top level
 // (16 in a row, then a build): every frame against the oracle, moves large
 // enough to carry instances across the level.
@@ -565,6 +656,8 @@ TEST(Scene, RefusesBadInput) {
   EXPECT_THROW(empty.instance_count(), UsageError);
   EXPECT_THROW(empty.trace(rays, hits), UsageError);
 }
+
+#endif  // MESHCAST_TEST_GPU
 
 }  // namespace
 }  // namespace meshcast::testing

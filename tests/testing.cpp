@@ -115,10 +115,17 @@ const std::vector<Ray>& test_rays(const NamedMesh& m, RayKind kind, size_t count
 }
 
 namespace {
+// The tree reads the mesh it was built over: the cache holds that mesh too
+// (a stored mesh made for one test may be gone by the next that names it).
 const OracleTree& oracle_tree(const NamedMesh& m) {
-  static std::map<std::string, std::unique_ptr<OracleTree>> trees;
-  if (!trees.count(m.name)) trees[m.name] = std::make_unique<OracleTree>(*m.mesh);
-  return *trees[m.name];
+  struct Built {
+    std::shared_ptr<const Mesh> mesh;
+    std::unique_ptr<OracleTree> tree;
+  };
+  static std::map<std::string, Built> trees;
+  Built& b = trees[m.name];
+  if (!b.tree) b.mesh = m.mesh, b.tree = std::make_unique<OracleTree>(*b.mesh);
+  return *b.tree;
 }
 }  // namespace
 

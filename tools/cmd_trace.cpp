@@ -6,6 +6,7 @@
 #include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "gpu/method.h"
+#include "gpu/scene.h"
 #include "gpu/vulkan.h"
 #include "layout/queries.h"
 #include "tools/commands.h"
@@ -17,58 +18,81 @@ namespace meshcast::tools {
 
 namespace {
 
-// trace on a scene file: RAYD or RAYS rays in, a HITI file out.
-void trace_scene(const std::string& input, const std::string& rays_path, const std::string& out, const LayoutArgs& layout,
-                 const std::string& query_name, const std::string& cull_name, uint32_t repeat, bool json) {
-  const Query query = layout::query_named(query_name, "--query");
-  const Cull cull = layout::cull_named(cull_name, "--cull");
+struct TraceArgs {
+  std::string input, rays, out;
+  LayoutArgs layout;
+  uint32_t repeat = 5;
+  bool json = false;
+  std::string backend = "cpu", method = "bruteforce", device, query = "closest", cull = "none";
+  uint32_t max_hits = 16;
+};
+
+// trace on a scene file: RAYD or RAYS rays in, a HITI file out; on the
+// CPU (one thread) or the Vulkan scene method (gpu/scene.h), whose meshes
+// are built in the layout it reads unless --layout names another.
+void trace_scene(TraceArgs a) {
+  const Query query = layout::query_named(a.query, "--query");
+  const Cull cull = layout::cull_named(a.cull, "--cull");
+  if (query == Query::All)
+    throw InputError("trace " + a.input + ": --query all on a scene has no hits file yet (the library answers it: Scene::trace_all_hits)");
+  const bool vulkan = a.backend == "vulkan";
+  if (vulkan && a.layout.layout == "auto") a.layout.layout = "OctTreeCompressed/ClusterBitPackSOA8";
   auto t0 = std::chrono::steady_clock::now();
-  SceneFile file = load_scene_file(input, layout, json ? stderr : stdout);
+  SceneFile file = load_scene_file(a.input, a.layout, a.json ? stderr : stdout);
   const double load_ms = ms_since(t0);
-  // Double origins (RAYD) or float ones (RAYS, Scene's float-ray trace).
-  const bool double_origins = is_scene_rays_file(rays_path);
-  const std::vector<RayD> rays_d = double_origins ? read_scene_rays(rays_path) : std::vector<RayD>{};
-  const std::vector<Ray> rays_f = double_origins ? std::vector<Ray>{} : read_rays(rays_path);
+  // Double origins (RAYD) or float ones (RAYS: Scene's float-ray trace on
+  // the CPU; the GPU method reads RAYD records, so they are widened).
+  const bool double_origins = is_scene_rays_file(a.rays);
+  const std::vector<Ray> rays_f = double_origins ? std::vector<Ray>{} : read_rays(a.rays);
+  std::vector<RayD> rays_d = double_origins ? read_scene_rays(a.rays) : std::vector<RayD>{};
+  if (vulkan && !double_origins)
+    for (const Ray& r : rays_f) rays_d.push_back({{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax});
   const size_t ray_count = double_origins ? rays_d.size() : rays_f.size();
   std::vector<SceneHit> hits(ray_count);
   std::vector<double> pass_ms;
   uint64_t skipped = 0;
-  for (uint32_t r = 0; r < repeat; ++r) {
-    auto t1 = std::chrono::steady_clock::now();
-    skipped = double_origins ? file.scene.trace(rays_d, hits, HitOutputs::None, query, cull)
-                             : file.scene.trace(rays_f, hits, HitOutputs::None, query, cull);
-    pass_ms.push_back(ms_since(t1));
+  std::string device = "CPU, one thread";
+  if (vulkan) {
+    gpu::Context ctx(gpu::DeviceChoice{a.device, false});
+    device = ctx.device_name();
+    gpu::SceneMethod method(ctx, layout::query_bits(query, cull));
+    const std::shared_ptr<const SceneSnapshot> frame = file.scene.snapshot();
+    for (uint32_t r = 0; r < a.repeat; ++r) {
+      auto t1 = std::chrono::steady_clock::now();
+      skipped = method.trace(*frame, rays_d, hits);
+      pass_ms.push_back(ms_since(t1));
+    }
+  } else {
+    for (uint32_t r = 0; r < a.repeat; ++r) {
+      auto t1 = std::chrono::steady_clock::now();
+      skipped = double_origins ? file.scene.trace(rays_d, hits, HitOutputs::None, query, cull)
+                               : file.scene.trace(rays_f, hits, HitOutputs::None, query, cull);
+      pass_ms.push_back(ms_since(t1));
+    }
   }
-  write_scene_hits(out, hits);
+  write_scene_hits(a.out, hits);
   size_t hit_count = 0;
   for (const SceneHit& h : hits) hit_count += h.instance != kNoHit;
   const double ns = ray_count == 0 ? 0 : median(pass_ms) * 1e6 / double(ray_count);
-  if (json) {
-    print_json({{"input", input}, {"meshes", file.mesh_names.size()}, {"instances", file.instances},
-                {"blob_bytes", file.blob_bytes}, {"load_ms", load_ms}, {"query", query_name}, {"cull", cull_name},
-                {"rays", ray_count}, {"hits", hit_count}, {"invalid_rays", skipped}, {"repeat", repeat},
-                {"ns_per_ray", ns}});
+  if (a.json) {
+    print_json({{"input", a.input}, {"meshes", file.mesh_names.size()}, {"instances", file.instances},
+                {"blob_bytes", file.blob_bytes}, {"load_ms", load_ms}, {"device", device}, {"query", a.query},
+                {"cull", a.cull}, {"rays", ray_count}, {"hits", hit_count}, {"invalid_rays", skipped},
+                {"repeat", a.repeat}, {"ns_per_ray", ns}});
     return;
   }
-  std::printf("%s: %zu meshes (%llu blob bytes), %zu instances, loaded and built in %.1f ms\n", input.c_str(),
+  std::printf("%s: %zu meshes (%llu blob bytes), %zu instances, loaded and built in %.1f ms\n", a.input.c_str(),
               file.mesh_names.size(), (unsigned long long)file.blob_bytes, file.instances, load_ms);
   std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", ray_count, hit_count,
               (unsigned long long)skipped);
-  std::printf("cast: %.1f ns/ray (median of %u passes, one thread) -> %s\n", ns, repeat, out.c_str());
+  std::printf("cast on %s: %.1f ns/ray (median of %u passes, wall clock) -> %s\n", device.c_str(), ns, a.repeat,
+              a.out.c_str());
 }
 
 }  // namespace
 
 void add_trace(CLI::App& app) {
-  struct Args {
-    std::string input, rays, out;
-    LayoutArgs layout;
-    uint32_t repeat = 5;
-    bool json = false;
-    std::string backend = "cpu", method = "bruteforce", device, query = "closest", cull = "none";
-    uint32_t max_hits = 16;
-  };
-  auto args = std::make_shared<Args>();
+  auto args = std::make_shared<TraceArgs>();
   CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh, blob or scene (.json), write a hits file");
   cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), blob or scene file (.json: RAYD or RAYS rays in, HITI hits out)")->required();
   cmd->add_option("--rays", args->rays, "rays file")->required();
@@ -96,9 +120,7 @@ void add_trace(CLI::App& app) {
     const Query query = layout::query_named(args->query, "--query");
     const Cull cull = layout::cull_named(args->cull, "--cull");
     if (is_scene_file(args->input)) {
-      if (args->backend != "cpu") throw InputError("trace " + args->input + ": scenes are cast on the CPU (--backend cpu)");
-      if (query == Query::All) throw InputError("trace " + args->input + ": --query all on a scene has no hits file yet (the library answers it: Scene::trace_all_hits)");
-      trace_scene(args->input, args->rays, args->out, args->layout, args->query, args->cull, args->repeat, args->json);
+      trace_scene(*args);
       return;
     }
     // --layout auto for the Vulkan backend: a layout a method reads, and that method.

@@ -1,0 +1,129 @@
+#include "gpu/scene.h"
+
+#include <cstring>
+
+#include "builder/layout_names.h"
+#include "cpu/scene.h"
+#include "gpu/vulkan.h"
+#include "layout/blob_format.h"
+#include "layout/formats.h"
+#include "meshcast/errors.h"
+#include "shaders/scene_octtree.h"
+
+namespace meshcast::gpu {
+
+namespace {
+
+// The shader's layout of the top buffer (shaders/scene_octtree.comp):
+// header words, the meshes' first words, then the records.
+constexpr uint32_t kTopNodes = 18, kTopPlacedAt = 19, kTopWideAt = 20, kTopMeshBase = 24;
+constexpr uint32_t kSceneHitWords = 6;
+constexpr uint32_t kGroup = 64;
+
+struct ScenePush {
+  uint32_t ray_base, ray_count, mask;
+};
+
+// A Mapped buffer of at least `bytes`, made again only to grow.
+void fit(std::unique_ptr<Buffer>& b, Context& ctx, uint64_t bytes, const char* what) {
+  if (!b || b->size() < bytes) b.reset(), b = std::make_unique<Buffer>(ctx, std::max<uint64_t>(bytes, 256), what);
+}
+
+}  // namespace
+
+SceneMethod::SceneMethod(Context& ctx, uint32_t flags) : ctx_(ctx), flags_(flags) {
+  const uint32_t known = MC_HIT_UV | MC_QUERY_ANY | MC_CULL_BACK | MC_CULL_FRONT;
+  if ((flags & ~known) || ((flags & MC_CULL_BACK) && (flags & MC_CULL_FRONT)))
+    throw UsageError("GPU scene method: flags " + std::to_string(flags) +
+                     " are not MC_HIT_UV, MC_QUERY_ANY and one MC_CULL_* (every hit and the point are the CPU's)");
+  pipeline_ = std::make_unique<Pipeline>(ctx, scene_octtree_spv, sizeof scene_octtree_spv, 7, sizeof(ScenePush), 1,
+                                         flags, 1);
+  unused_ = std::make_unique<Buffer>(ctx, 16, "unused binding");
+}
+
+SceneMethod::~SceneMethod() = default;
+
+void SceneMethod::upload_blobs(const SceneSnapshot& s) {
+  if (blobs_ && s.meshes == uploaded_) return;
+  std::vector<uint8_t> all;
+  std::vector<uint32_t> base;
+  for (const auto& m : s.meshes) {
+    const layout::BlobHeader& h = layout::header_of(m->bytes.data());
+    if (h.tree_format != MC_TREE_OCTTREECOMPRESSED || h.triangle_format != MC_TRI_CLUSTERBITPACKSOA8)
+      throw InputError(m->name + ": the GPU scene method reads OctTreeCompressed/ClusterBitPackSOA8 blobs, not " +
+                       layout_name(h.tree_format, h.triangle_format));
+    if ((all.size() + m->bytes.size()) / 4 >= (uint64_t(1) << 32))
+      throw InputError(m->name + ": the scene's blobs pass 2^32 words, more than the GPU scene method addresses");
+    base.push_back(uint32_t(all.size() / 4));
+    all.insert(all.end(), m->bytes.begin(), m->bytes.end());
+    all.resize((all.size() + 3) / 4 * 4);  // the next blob on a word
+  }
+  auto blobs = std::make_unique<Buffer>(ctx_, std::max<size_t>(all.size(), 16), "scene blobs", 0, Memory::DeviceLocal);
+  if (!all.empty()) blobs->upload(all);
+  blobs_ = std::move(blobs);
+  uploaded_ = s.meshes;
+  mesh_base_ = std::move(base);
+}
+
+uint64_t SceneMethod::trace(const SceneSnapshot& s, std::span<const RayD> rays, std::span<SceneHit> hits, uint8_t mask) {
+  if (hits.size() < rays.size())
+    throw UsageError("GPU scene method: " + std::to_string(rays.size()) + " rays but room for " +
+                     std::to_string(hits.size()) + " hits");
+  if (rays.empty()) return 0;
+  if (rays.size() >= (uint64_t(1) << 32) / kSceneHitWords)
+    throw UsageError("GPU scene method: " + std::to_string(rays.size()) + " rays in one batch, more than it addresses");
+  upload_blobs(s);
+  // The top buffer: the header, the meshes' first words, the placed
+  // records and the wide nodes as the snapshot holds them.
+  const layout::TopLevel& t = s.top;
+  const uint64_t placed_at = kTopMeshBase + mesh_base_.size();
+  const uint64_t wide_at = placed_at + t.placed.size() * (MC_PLACED_BYTES / 4);
+  const uint64_t words = wide_at + t.wide.size() * (MC_TOP_NODE_BYTES / 4);
+  if (words >= (uint64_t(1) << 32)) throw UsageError("GPU scene method: the top level passes 2^32 words");
+  fit(top_, ctx_, words * 4, "scene top level");
+  auto* top = static_cast<uint32_t*>(top_->data());
+  std::memset(top, 0, kTopMeshBase * 4);
+  for (int a = 0; a < 3; ++a) {
+    std::memcpy(top + 2 * a, &t.anchor[a], 8);
+    std::memcpy(top + 6 + 2 * a, &t.min[a], 8);
+    std::memcpy(top + 12 + 2 * a, &t.max[a], 8);
+  }
+  top[kTopNodes] = uint32_t(t.wide.size());
+  top[kTopPlacedAt] = uint32_t(placed_at), top[kTopWideAt] = uint32_t(wide_at);
+  std::memcpy(top + kTopMeshBase, mesh_base_.data(), mesh_base_.size() * 4);
+  std::memcpy(top + placed_at, t.placed.data(), t.placed.size() * sizeof(layout::PlacedInstance));
+  std::memcpy(top + wide_at, t.wide.data(), t.wide.size() * sizeof(layout::TopWideNode));
+  // The rays as RAYD records, the answers 6 words a ray.
+  static_assert(sizeof(RayD) == 40, "a RAYD record");
+  const uint32_t n = uint32_t(rays.size());
+  fit(rays_, ctx_, uint64_t(n) * sizeof(RayD), "scene ray buffer");
+  fit(hits_, ctx_, uint64_t(n) * kSceneHitWords * 4, "scene hit buffer");
+  std::memcpy(rays_->data(), rays.data(), rays.size_bytes());
+  pipeline_->bind({blobs_.get(), rays_.get(), unused_.get(), unused_.get(), unused_.get(), top_.get(), hits_.get()});
+  const uint32_t most = ctx_.limits().maxComputeWorkGroupCount[0];
+  ctx_.submit([&](VkCommandBuffer cb) {
+    for (uint32_t first = 0; first < n;) {
+      const uint32_t groups = std::min<uint32_t>((n - first + kGroup - 1) / kGroup, most);
+      const ScenePush push{first, n, mask};
+      pipeline_->dispatch(cb, 0, &push, groups, 1, 1);
+      first += std::min<uint32_t>(groups * kGroup, n - first);
+    }
+    // The answers (mapped memory) made visible to the host that reads them.
+    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    ctx_.vk().CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
+                                 nullptr, 0, nullptr);
+  });
+  const auto* out = static_cast<const uint32_t*>(hits_->data());
+  uint64_t skipped = 0;
+  for (uint32_t i = 0; i < n; ++i, out += kSceneHitWords) {
+    SceneHit& h = hits[i];
+    std::memcpy(&h.t, out, 4);
+    h.instance = out[1], h.triangle = out[2];
+    std::memcpy(&h.u, out + 3, 4), std::memcpy(&h.v, out + 4, 4);
+    skipped += out[5];
+  }
+  return skipped;
+}
+
+}  // namespace meshcast::gpu

@@ -1,0 +1,56 @@
+// The Vulkan scene method (issue 21): shaders/scene_octtree.comp walks a
+// snapshot's top level and then each instance's blob, reading the bytes
+// Scene::commit() made (the placed records and wide nodes, copied
+// unchanged) and the blobs the CPU walks. Every mesh must be in the
+// recommended layout, OctTreeCompressed/ClusterBitPackSOA8.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "meshcast/scene.h"
+
+namespace meshcast {
+struct SceneMesh;
+}
+
+namespace meshcast::gpu {
+
+class Context;
+class Buffer;
+class Pipeline;
+
+class SceneMethod {
+ public:
+  // `flags`: MC_HIT_UV, MC_QUERY_ANY and MC_CULL_*, the batches' outputs,
+  // query and culling (the shader's specialization constant). UsageError
+  // for every hit (MC_QUERY_ALL) or a point (MC_HIT_POINT): the CPU
+  // answers those.
+  SceneMethod(Context& ctx, uint32_t flags);
+  ~SceneMethod();
+  SceneMethod(const SceneMethod&) = delete;
+  SceneMethod& operator=(const SceneMethod&) = delete;
+
+  // trace_snapshot's answers on the GPU: each world ray's hit among the
+  // instances whose mask shares a bit with `mask`, bit for bit the CPU's.
+  // Returns the rays not walkable (trace_snapshot's count). InputError
+  // naming a mesh in another layout; GpuError from Vulkan. The blobs are
+  // uploaded once for as long as the snapshots bring the same meshes (the
+  // method holds those meshes until then).
+  uint64_t trace(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,
+                 uint8_t mask = 0xFF);
+
+ private:
+  void upload_blobs(const SceneSnapshot& snapshot);
+  Context& ctx_;
+  const uint32_t flags_;
+  std::unique_ptr<Pipeline> pipeline_;
+  std::unique_ptr<Buffer> blobs_, top_, rays_, hits_, unused_;
+  // The meshes blobs_ holds, in the snapshot's order: held, so that a mesh
+  // made later can never take the address of one uploaded here.
+  std::vector<std::shared_ptr<const SceneMesh>> uploaded_;
+  std::vector<uint32_t> mesh_base_;    // each one's first word in blobs_
+};
+
+}  // namespace meshcast::gpu

@@ -15,10 +15,11 @@ namespace meshcast {
 struct Scene::Edits {
   std::vector<std::shared_ptr<const SceneMesh>> meshes;
   struct Instance {
-    layout::PlacedInstance placed;  // inverse and world box kept up to date
+    layout::PlacedInstance placed;  // the walk's record, kept up to date
     bool enabled = true, removed = false;
   };
   std::vector<Instance> instances;  // by InstanceId
+  std::vector<WorldBox> boxes;      // by InstanceId: what builds and refits read
   size_t live = 0;
   // Whether anything was edited since the last commit (a commit of nothing
   // keeps the snapshot it has).
@@ -28,7 +29,11 @@ struct Scene::Edits {
   // commits refit it instead (moves and masks only).
   bool rebuild = true;
   uint32_t refits = 0;
-  layout::TopLevel built;  // the last build, refitted since: what snapshots copy
+  // The last build, refitted since: its wide nodes, anchor and root box
+  // (`placed` unused) and the instance at each place of the tree; what
+  // snapshots copy.
+  layout::TopLevel built;
+  std::vector<uint32_t> order;
   // The last two snapshots made. Once no batch holds the older one, the
   // next commit writes into it: its arrays are reused, not allocated and
   // faulted in again every frame.
@@ -52,7 +57,7 @@ namespace {
 // M c + T and half extents |M| e, in double, padded by 2^-20 of their size
 // (the rounding of the float inverse; what a ray's own rounding adds is the
 // walk's slack, see scene_trace.cpp).
-void place(layout::PlacedInstance& p, const Transform& t, const SceneMesh& mesh, const char* who) {
+void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const SceneMesh& mesh, const char* who) {
   const float* m = t.rotation_scale;
   for (int i = 0; i < 9; ++i)
     if (!(std::fabs(m[i]) <= 0x1p40f))
@@ -87,11 +92,11 @@ void place(layout::PlacedInstance& p, const Transform& t, const SceneMesh& mesh,
     double centre = t.translation[r], extent = 0;
     for (int k = 0; k < 3; ++k) centre += e(r, k) * c[k], extent += std::fabs(e(r, k)) * half[k];
     extent += (extent + std::fabs(centre - t.translation[r])) * 0x1p-20;
-    p.box_min[r] = centre - extent, p.box_max[r] = centre + extent;
+    box.min[r] = centre - extent, box.max[r] = centre + extent;
     // The top level's float boxes and the rays' pads stay finite.
-    if (!(std::fabs(p.box_min[r]) <= double(kMaxCoordinate) && std::fabs(p.box_max[r]) <= double(kMaxCoordinate)))
+    if (!(std::fabs(box.min[r]) <= double(kMaxCoordinate) && std::fabs(box.max[r]) <= double(kMaxCoordinate)))
       throw UsageError(std::string(who) + ": the instance's world box on axis " + std::to_string(r) + " (" +
-                       std::to_string(p.box_min[r]) + " to " + std::to_string(p.box_max[r]) + ") reaches beyond 2^100");
+                       std::to_string(box.min[r]) + " to " + std::to_string(box.max[r]) + ") reaches beyond 2^100");
   }
 }
 
@@ -134,8 +139,10 @@ InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t 
   i.placed.id = uint32_t(e.instances.size());
   i.placed.mesh = mesh;
   i.placed.mask = mask;
-  place(i.placed, transform, *e.meshes[mesh], "Scene::add_instance");
+  WorldBox box;
+  place(i.placed, box, transform, *e.meshes[mesh], "Scene::add_instance");
   e.instances.push_back(i);
+  e.boxes.push_back(box);
   ++e.live;
   e.rebuild = e.changed = true;
   return i.placed.id;
@@ -145,8 +152,10 @@ void Scene::set_transform(InstanceId instance, const Transform& transform) {
   Edits& e = edits("Scene::set_transform");
   Edits::Instance& i = e.at(instance, "Scene::set_transform");
   layout::PlacedInstance moved = i.placed;  // unchanged should the transform be refused
-  place(moved, transform, *e.meshes[moved.mesh], "Scene::set_transform");
+  WorldBox box;
+  place(moved, box, transform, *e.meshes[moved.mesh], "Scene::set_transform");
   i.placed = moved;
+  e.boxes[instance] = box;
   e.changed = true;
 }
 
@@ -180,18 +189,17 @@ void Scene::commit() {
   Edits& e = edits("Scene::commit");
   if (!e.changed) return;  // the committed snapshot is this frame's
   e.changed = false;
-  if (!e.rebuild && e.refits < kRefitsBeforeRebuild && !e.built.nodes.empty()) {
+  if (!e.rebuild && e.refits < kRefitsBeforeRebuild && !e.built.wide.empty()) {
     // Moves and masks only: the same instances in the same places of the
-    // tree, their records and the boxes refreshed.
-    for (layout::PlacedInstance& p : e.built.placed) p = e.instances[p.id].placed;
-    refit_top_level(e.built);
+    // tree, the boxes fitted again (the records are copied below).
+    refit_top_level(e.boxes, e.order, e.built);
     ++e.refits;
   } else {
-    std::vector<layout::PlacedInstance> placed;
-    placed.reserve(e.live);
+    std::vector<uint32_t> ids;
+    ids.reserve(e.live);
     for (const Edits::Instance& i : e.instances)
-      if (i.enabled && !i.removed) placed.push_back(i.placed);
-    e.built = build_top_level(placed);
+      if (i.enabled && !i.removed) ids.push_back(i.placed.id);
+    build_top_level(e.boxes, ids, e.built, e.order);
     e.rebuild = false, e.refits = 0;
   }
   // The snapshot: what a walk reads, copied (the last one may still be
@@ -207,7 +215,8 @@ void Scene::commit() {
     next = std::make_shared<SceneSnapshot>();
   }
   next->meshes = e.meshes;
-  next->top.placed.assign(e.built.placed.begin(), e.built.placed.end());
+  next->top.placed.resize(e.order.size());
+  for (size_t k = 0; k < e.order.size(); ++k) next->top.placed[k] = e.instances[e.order[k]].placed;
   next->top.wide.assign(e.built.wide.begin(), e.built.wide.end());
   for (int a = 0; a < 3; ++a)
     next->top.anchor[a] = e.built.anchor[a], next->top.min[a] = e.built.min[a], next->top.max[a] = e.built.max[a];
@@ -230,8 +239,8 @@ size_t Scene::top_level_bytes() const {
   auto walked = [](const layout::TopLevel& t) {
     return t.placed.capacity() * sizeof(layout::PlacedInstance) + t.wide.capacity() * sizeof(layout::TopWideNode);
   };
-  size_t bytes = e.instances.capacity() * sizeof(Edits::Instance) + walked(e.built) +
-                 e.built.nodes.capacity() * sizeof(layout::TopNode) + e.built.wide_from.capacity() * sizeof(uint32_t);
+  size_t bytes = e.instances.capacity() * sizeof(Edits::Instance) + e.boxes.capacity() * sizeof(WorldBox) +
+                 walked(e.built) + e.order.capacity() * sizeof(uint32_t);
   for (const auto& s : {e.current, e.previous})
     if (s) bytes += walked(s->top);
   return bytes;

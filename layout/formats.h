@@ -289,7 +289,7 @@
 // reads the snapshot's arrays unchanged: a placed instance's record and
 // its fields' bytes, an 8-wide node's (lo[3][8], hi[3][8] floats, then 8
 // slot words), and what a slot holds.
-#define MC_PLACED_BYTES 128u
+#define MC_PLACED_BYTES 80u
 #define MC_PLACED_ID_AT 0u
 #define MC_PLACED_MESH_AT 4u
 #define MC_PLACED_MASK_AT 8u

@@ -1,7 +1,8 @@
 // A scene's top level (issue 21): the records one Scene::commit() makes and
-// every trace of that frame reads. The instances that are walked (enabled at
-// the commit) in the tree's order, and a binary tree over their world boxes
-// in double (worlds far from the origin keep their precision there too).
+// every trace of that frame reads: the instances that are walked (enabled at
+// the commit) in the tree's order, and 8-wide nodes over their world boxes
+// (builder/top_level.h builds them from boxes in double: worlds far from the
+// origin keep their precision there too).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -11,7 +12,9 @@
 
 namespace meshcast::layout {
 
-// An instance as the walk meets it.
+// An instance as the walk meets it (80 bytes: what the walk reads and no
+// more; its world box lives with the scene's edits, builds and refits read
+// it there).
 struct PlacedInstance {
   uint32_t id;        // the caller's InstanceId
   uint32_t mesh;      // index into the snapshot's meshes
@@ -19,14 +22,6 @@ struct PlacedInstance {
   uint32_t mirrored;  // 1 when rotation_scale's determinant is negative: the world sees its faces turned
   float to_local[9];  // the inverse of rotation_scale, row-major, rounded to float
   double translation[3];
-  double box_min[3], box_max[3];  // what the instance's triangles cover in the world, padded outward
-};
-
-// `count` > 0: a leaf over placed[first, first + count); 0: an inner node,
-// its children this node + 1 and `right`.
-struct TopNode {
-  double min[3], max[3];
-  uint32_t first, count, right, pad = 0;
 };
 
 // What a walk reads: 8-wide nodes, each slot a child's box in float,
@@ -34,7 +29,8 @@ struct TopNode {
 // the slot holds: a node's index, kTopInstance | an index into `placed`, or
 // kTopEmpty (its box empty: lo +inf, hi -inf, never entered). Float boxes
 // near the anchor keep a level 10 km across to half a millimetre at 10^7
-// from the origin: the anchor carries the distance.
+// from the origin: the anchor carries the distance. A node's children
+// follow it in the array (refits go from the last node to the first).
 constexpr uint32_t kTopInstance = 0x80000000u, kTopEmpty = 0xFFFFFFFFu;
 constexpr int kTopWidth = 8;
 struct TopWideNode {
@@ -42,15 +38,15 @@ struct TopWideNode {
   uint32_t slot[kTopWidth];                   // 8 words side by side: the walkers' order_hits reads them
 };
 
-// The top level: placed instances reordered into tree order, the binary
-// nodes (root first; empty when no instance is placed) and the 8-wide nodes
-// collapsed from them (root first), with their anchor (the root box's
-// centre, at every build and refit) and the root box. Leaves hold at most
-// kTopLeafSize instances: each instance's own box is tested before its
-// walk. A walk reads `placed`, `wide`, the anchor and the box; builds and
-// refits work on the binary nodes and `wide_from`, which a scene's
-// snapshots leave out.
-constexpr uint32_t kTopLeafSize = 1;
+// The top level: the placed instances in the tree's order, the 8-wide nodes
+// (root first; none when nothing is placed), their anchor (the root box's
+// centre, at every build and refit) and the root box, in double.
+struct TopLevel {
+  std::vector<PlacedInstance> placed;
+  std::vector<TopWideNode> wide;
+  double anchor[3] = {0, 0, 0};
+  double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};
+};
 
 // The records as layout/formats.h describes them to the shaders.
 static_assert(sizeof(PlacedInstance) == MC_PLACED_BYTES && offsetof(PlacedInstance, mesh) == MC_PLACED_MESH_AT &&
@@ -60,13 +56,5 @@ static_assert(sizeof(PlacedInstance) == MC_PLACED_BYTES && offsetof(PlacedInstan
 static_assert(sizeof(TopWideNode) == MC_TOP_NODE_BYTES && offsetof(TopWideNode, hi) == MC_TOP_HI_AT &&
               offsetof(TopWideNode, slot) == MC_TOP_SLOT_AT && kTopWidth == int(MC_TOP_WIDTH) &&
               kTopInstance == MC_TOP_INSTANCE && kTopEmpty == MC_TOP_EMPTY);
-struct TopLevel {
-  std::vector<PlacedInstance> placed;
-  std::vector<TopWideNode> wide;
-  double anchor[3] = {0, 0, 0};
-  double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};
-  std::vector<TopNode> nodes;
-  std::vector<uint32_t> wide_from;  // kTopWidth a wide node: the binary node each slot's box is, or kTopEmpty
-};
 
 }  // namespace meshcast::layout

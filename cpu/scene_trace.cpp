@@ -1,5 +1,5 @@
 // A snapshot's walk: the top level's float boxes near its anchor (the
-// chosen instruction set's enter_top tests a node), each instance it reaches
+// chosen instruction set's walk_top, cpu/walk_top.h), each instance it reaches
 // walked by its blob's own walker on the ray brought into its frame.
 #include <algorithm>
 #include <cfloat>
@@ -77,50 +77,35 @@ WorldRay world_ray(const layout::TopLevel& top, const RayD& rd) {
   return r;
 }
 
-// The top level's walk for one ray: every instance whose box the ray
-// enters before the cut, nearest entry first, whose mask shares a bit
-// with `mask`, goes to visit(instance, its local ray with t_max the cut),
-// which returns the cut from then on (a nearer hit's t, or the same), or
-// a negative number to end the walk. `enter`: the chosen instruction set's
-// node test.
+// The chosen instruction set's top-level walk (cpu/walk_top.h) for one
+// ray, each instance it reaches handed to visit(instance, its local ray
+// with t_max the cut), which returns the cut from then on, or a negative
+// number to end the walk.
 template <class Visit>
-void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, EnterTopFn enter, Visit&& visit) {
-  float cut = r.tmax;
-  // A wide node leaves at most 7 entries behind a level, and the binary
-  // tree under it is at most 64 deep (median splits of fewer than 2^32);
-  // a node's test writes 8 past the top: the stack cannot fill.
-  constexpr int kStack = 7 * 64 + 8;
-  uint32_t stack[kStack];
-  float entries[kStack];
-  int top_of = 0;
-  stack[top_of] = 0, entries[top_of++] = 0;  // the root node
-  const float widen = 1 + float(kBoxSlack);
-  while (top_of > 0) {
-    --top_of;
-    if (entries[top_of] > cut * widen) continue;
-    const uint32_t item = stack[top_of];
-    if (item & layout::kTopInstance) {
-      const layout::PlacedInstance& p = top.placed[item & ~layout::kTopInstance];
-      if ((p.mask & mask) == 0) continue;
-      Ray local = to_local(r, p);
-      local.tmax = cut;
-      cut = visit(p, local);
-      if (cut < 0) return;
-      continue;
-    }
-    // The entered slots go on the stack farthest first: the nearest is
-    // popped next.
-    top_of += enter(r.top, top.wide[item], cut * widen, entries + top_of, stack + top_of);
-  }
+void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, WalkTopFn walk, Visit&& visit) {
+  struct Context {
+    const layout::TopLevel& top;
+    const WorldRay& r;
+    Visit& visit;
+  } context{top, r, visit};
+  walk(top, r.top, r.tmax, mask,
+       [](void* c, uint32_t placed, float cut) {
+         Context& x = *static_cast<Context*>(c);
+         const layout::PlacedInstance& p = x.top.placed[placed];
+         Ray local = to_local(x.r, p);
+         local.tmax = cut;
+         return x.visit(p, local);
+       },
+       &context);
 }
 
 // Closest or any hit of one ray. Returns false when some instance's frame
 // could not take it (its local ray not walkable): that instance is not
 // walked and the ray counted.
 bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
-          uint8_t mask, EnterTopFn enter) {
+          uint8_t mask, WalkTopFn walk_fn) {
   bool complete = true;
-  walk_top(s.top, world_ray(s.top, rd), mask, enter, [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, world_ray(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
     Hit h;
     // A local ray the walkers refuse (its direction scaled past their
     // range) is counted, not walked.
@@ -143,13 +128,13 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs out
 // merged in, the nearest kept in order of t, instance, triangle. Returns
 // the hits found, or with `complete` false a ray some frame could not take.
 uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> row, std::vector<Hit>& scratch,
-                  HitOutputs outputs, Cull cull, uint8_t mask, EnterTopFn enter, bool& complete) {
+                  HitOutputs outputs, Cull cull, uint8_t mask, WalkTopFn walk_fn, bool& complete) {
   const uint32_t cap = uint32_t(row.size());
   uint32_t found = 0, kept = 0;
   auto before = [](const SceneHit& a, const SceneHit& b) {
     return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
   };
-  walk_top(s.top, world_ray(s.top, rd), mask, enter, [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, world_ray(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
     uint32_t own = 0;
     if (s.meshes[p.mesh]->view.trace_all_hits(std::span(&local, 1), cap, std::span(&own, 1), scratch, outputs,
                                               as_instance_sees(cull, p.mirrored != 0)) != 0)
@@ -189,7 +174,7 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
   if (query == Query::All)
     throw UsageError("Scene::trace: Query::All has a list of hits a ray: Scene::trace_all_hits answers it");
   check_request("Scene::trace", outputs, query, cull);
-  const EnterTopFn enter = enter_top_fn();
+  const WalkTopFn walk_fn = walk_top_fn();
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     hits[i] = SceneHit{};
@@ -199,7 +184,7 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
       continue;
     }
     if (snapshot.top.wide.empty()) continue;
-    if (!walk(snapshot, rays[i], hits[i], outputs, query, cull, mask, enter)) ++skipped;
+    if (!walk(snapshot, rays[i], hits[i], outputs, query, cull, mask, walk_fn)) ++skipped;
   }
   return skipped;
 }
@@ -219,7 +204,7 @@ uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> r
                           std::span<uint32_t> found, std::span<SceneHit> rows, HitOutputs outputs, Cull cull,
                           uint8_t mask) {
   check_request("Scene::trace_all_hits", outputs, Query::All, cull);
-  const EnterTopFn enter = enter_top_fn();
+  const WalkTopFn walk_fn = walk_top_fn();
   std::vector<Hit> scratch(max_hits);
   uint64_t skipped = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
@@ -232,7 +217,7 @@ uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> r
     }
     if (snapshot.top.wide.empty()) continue;
     bool complete = true;
-    found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, enter, complete);
+    found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, walk_fn, complete);
     skipped += !complete;
   }
   return skipped;

@@ -105,17 +105,17 @@ const IsaChoice& chosen() {
 
 }  // namespace
 
-EnterTopFn enter_top_fn() {
+WalkTopFn walk_top_fn() {
   const WalkerIsa isa = chosen().isa;
 #if MESHCAST_HAS_ISA_AVX512
-  if (isa == WalkerIsa::Avx512) return &isa_avx512::enter_top;
+  if (isa == WalkerIsa::Avx512) return &isa_avx512::walk_top;
 #endif
 #if MESHCAST_HAS_ISA_AVX2
-  if (isa == WalkerIsa::Avx2) return &isa_avx2::enter_top;
+  if (isa == WalkerIsa::Avx2) return &isa_avx2::walk_top;
 #endif
   (void)isa;
 #if MESHCAST_HAS_ISA_SCALAR
-  return &isa_scalar::enter_top;
+  return &isa_scalar::walk_top;
 #else
   return nullptr;  // not reached: choose_isa picks a set this build has
 #endif

@@ -1,8 +1,7 @@
-// The test of a scene's 8-wide top-level node (layout/top_level.h),
-// compiled once an instruction set like the walkers (cpu/isa.h): the 8
-// slots' boxes at once, the entered ones ordered for the walk. The scene's
-// walk (cpu/scene_trace.cpp) calls the chosen set's (enter_top_fn(),
-// cpu/trace.cpp).
+// The walk of a scene's top level (layout/top_level.h), compiled once an
+// instruction set like the walkers (cpu/isa.h), its node test inlined. The
+// scene's walk (cpu/scene_trace.cpp) calls the chosen set's (walk_top_fn(),
+// cpu/trace.cpp) and walks each instance it is handed.
 #pragma once
 #include <cstdint>
 
@@ -20,28 +19,32 @@ struct TopRay {
   bool negative[3];
 };
 
-// Tests node `n`'s 8 slots against [0, cut]. The entered slots' contents
-// and entry distances go to children[] and entries[] farthest first, the
-// nearest last (up to 8 of each are written; those past the count hold
-// nothing of use); returns how many were entered. An entry may be rounded
-// down by a few ulps (it only ever culls, so it culls no more).
-using EnterTopFn = int (*)(const TopRay& r, const layout::TopWideNode& n, float cut, float* entries,
-                           uint32_t* children);
+// The top level's walk for one ray: every instance whose box the ray
+// enters before the cut (boxes widened by r.pad, the cut by MC_TOP_BOX_SLACK
+// of itself), nearest entry first, whose mask shares a bit with `mask`,
+// goes to visit(context, its index in top.placed, the cut), which returns
+// the cut from then on (a nearer hit's t, or the same), or a negative
+// number to end the walk. A node's 8 slots are tested at once (8 lanes),
+// the entered ones ordered by the walkers' order_hits, one without a sort.
+using VisitInstanceFn = float (*)(void* context, uint32_t placed, float cut);
+using WalkTopFn = void (*)(const layout::TopLevel& top, const TopRay& r, float tmax, uint8_t mask,
+                           VisitInstanceFn visit, void* context);
 
 MC_ISA_BEGIN
-int enter_top(const TopRay& r, const layout::TopWideNode& n, float cut, float* entries, uint32_t* children);
+void walk_top(const layout::TopLevel& top, const TopRay& r, float tmax, uint8_t mask, VisitInstanceFn visit,
+              void* context);
 MC_ISA_END
 #if MESHCAST_HAS_ISA_SCALAR && MC_ISA_ID != 0
-namespace isa_scalar { int enter_top(const TopRay&, const layout::TopWideNode&, float, float*, uint32_t*); }
+namespace isa_scalar { void walk_top(const layout::TopLevel&, const TopRay&, float, uint8_t, VisitInstanceFn, void*); }
 #endif
 #if MESHCAST_HAS_ISA_AVX2 && MC_ISA_ID != 1
-namespace isa_avx2 { int enter_top(const TopRay&, const layout::TopWideNode&, float, float*, uint32_t*); }
+namespace isa_avx2 { void walk_top(const layout::TopLevel&, const TopRay&, float, uint8_t, VisitInstanceFn, void*); }
 #endif
 #if MESHCAST_HAS_ISA_AVX512 && MC_ISA_ID != 2
-namespace isa_avx512 { int enter_top(const TopRay&, const layout::TopWideNode&, float, float*, uint32_t*); }
+namespace isa_avx512 { void walk_top(const layout::TopLevel&, const TopRay&, float, uint8_t, VisitInstanceFn, void*); }
 #endif
 
-// The chosen instruction set's enter_top (the walkers' choice).
-EnterTopFn enter_top_fn();
+// The chosen instruction set's walk_top (the walkers' choice).
+WalkTopFn walk_top_fn();
 
 }  // namespace meshcast

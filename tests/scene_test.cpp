@@ -38,10 +38,11 @@ gpu::Context& context() {
 }
 // The scene method for a query, culling and outputs, made once.
 gpu::SceneMethod& scene_method(Query query, Cull cull, HitOutputs outputs) {
+  gpu::Context& ctx = context();  // made before the methods, so gone after them at exit
   static std::map<uint32_t, std::unique_ptr<gpu::SceneMethod>> made;
   const uint32_t flags = layout::query_bits(query, cull) | (has(outputs, HitOutputs::Uv) ? MC_HIT_UV : 0u);
   std::unique_ptr<gpu::SceneMethod>& m = made[flags];
-  if (!m) m = std::make_unique<gpu::SceneMethod>(context(), flags);
+  if (!m) m = std::make_unique<gpu::SceneMethod>(ctx, flags);
   return *m;
 }
 #else

@@ -97,11 +97,13 @@ if ! diff <(od -An -tu4 -v -w8 -j8 "$work/one.hits" | awk '{print $1, ($2 == 429
   echo "FAIL trace-scene-one: the scene's hits differ from the mesh's"; failures=$((failures + 1))
 fi
 # The Vulkan scene method (lavapipe in CI) on the same scene, culled: the
-# CPU's HITI file byte for byte.
+# CPU's t bits and instances (the triangle may be the other one of an edge
+# both meet at the same t, as gpu_test allows).
 printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh"}, {"mesh": "mesh", "rotation_scale": [-1, 0, 0, 0, 2, 0, 0, 0, 1], "translation": [0.05, 0, 0]}]}' "$mesh" >"$work/two.json"
 check trace-scene-cpu 0 "500 rays" -- "$meshcast" trace "$work/two.json" --layout OctTreeCompressed/ClusterBitPackSOA8 --cull back --rays "$work/r.rays" --out "$work/two-cpu.hiti"
 check trace-scene-vulkan 0 '"device":"[^C]' -- "$meshcast" trace "$work/two.json" --backend vulkan --cull back --rays "$work/r.rays" --out "$work/two-gpu.hiti" --json
-if ! cmp -s "$work/two-cpu.hiti" "$work/two-gpu.hiti"; then
+if ! diff <(od -An -tu4 -v -w12 -j8 "$work/two-cpu.hiti" | awk '{print $1, $2}') \
+          <(od -An -tu4 -v -w12 -j8 "$work/two-gpu.hiti" | awk '{print $1, $2}') >/dev/null; then
   echo "FAIL trace-scene-vulkan: the Vulkan scene method's hits differ from the CPU's"; failures=$((failures + 1))
 fi
 check render-scene 0 "3 instances of 2 meshes.*scene.png" -- "$meshcast" render "$work/level.json" --png "$work/scene.png" --width 64 --height 48

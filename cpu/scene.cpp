@@ -1,6 +1,7 @@
 // Scene: the caller's edits, and commit() turning them into a snapshot.
 #include "meshcast/scene.h"
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <cmath>
@@ -259,10 +260,7 @@ uint64_t Scene::trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists,
 uint64_t Scene::trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
                       uint8_t mask) const {
   std::vector<RayD> wide(rays.size());
-  for (size_t i = 0; i < rays.size(); ++i) {
-    for (int a = 0; a < 3; ++a) wide[i].org[a] = rays[i].org[a], wide[i].dir[a] = rays[i].dir[a];
-    wide[i].tmax = rays[i].tmax;
-  }
+  std::transform(rays.begin(), rays.end(), wide.begin(), widened);
   return trace_snapshot(*snapshot(), wide, hits, outputs, query, cull, mask);
 }
 

@@ -110,11 +110,7 @@ uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
       ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
     }
     record(s.cb, slot, s.n);
-    // The hits (mapped memory) made visible to the host that reads them after the fence.
-    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    ctx_.vk().CmdPipelineBarrier(s.cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, nullptr,
-                         0, nullptr);
+    ctx_.host_barrier(s.cb);  // the hits, read by the host after the fence
     if (s.queries) ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
     check(ctx_.vk().EndCommandBuffer(s.cb), "vkEndCommandBuffer");
     s.recorded = s.n;

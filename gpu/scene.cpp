@@ -108,11 +108,7 @@ uint64_t SceneMethod::trace(const SceneSnapshot& s, std::span<const RayD> rays, 
       pipeline_->dispatch(cb, 0, &push, groups, 1, 1);
       first += std::min<uint32_t>(groups * kGroup, n - first);
     }
-    // The answers (mapped memory) made visible to the host that reads them.
-    VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT, mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    ctx_.vk().CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0,
-                                 nullptr, 0, nullptr);
+    ctx_.host_barrier(cb);  // the answers, read by the host after the fence
   });
   const auto* out = static_cast<const uint32_t*>(hits_->data());
   uint64_t skipped = 0;

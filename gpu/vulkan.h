@@ -101,6 +101,9 @@ class Context {
   void compute_barrier(VkCommandBuffer cb) const;
   // The same, and visible as the arguments of the next indirect dispatch.
   void indirect_barrier(VkCommandBuffer cb) const;
+  // Compute-shader writes to mapped memory made visible to the host that
+  // reads them once the submission's fence signals.
+  void host_barrier(VkCommandBuffer cb) const;
   bool has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const;
 
  private:

@@ -1,7 +1,9 @@
 // meshcast trace MESH|BLOB --rays R.rays --out H.hits [--query closest|any|all]
 // [--max-hits N] [--cull none|back|front]: one thread, the whole batch cast
 // --repeat times, the median pass reported per ray. --query all writes HITN.
+#include <algorithm>
 #include <cstdio>
+#include <iterator>
 
 #include "check/ray_files.h"
 #include "meshcast/blob.h"
@@ -46,7 +48,7 @@ void trace_scene(TraceArgs a) {
   const std::vector<Ray> rays_f = double_origins ? std::vector<Ray>{} : read_rays(a.rays);
   std::vector<RayD> rays_d = double_origins ? read_scene_rays(a.rays) : std::vector<RayD>{};
   if (vulkan && !double_origins)
-    for (const Ray& r : rays_f) rays_d.push_back({{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax});
+    std::transform(rays_f.begin(), rays_f.end(), std::back_inserter(rays_d), widened);
   const size_t ray_count = double_origins ? rays_d.size() : rays_f.size();
   std::vector<SceneHit> hits(ray_count);
   std::vector<double> pass_ms;

@@ -8,6 +8,7 @@
 
 #include "builder/top_level.h"
 #include "cpu/scene.h"
+#include "cpu/walk_table.h"
 #include "layout/blob_format.h"
 #include "meshcast/errors.h"
 
@@ -102,6 +103,12 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
 }
 
 }  // namespace
+
+SceneMesh::SceneMesh(std::vector<uint8_t> blob, std::string mesh_name)
+    : bytes(std::move(blob)),
+      name(std::move(mesh_name)),
+      view(bytes, name),
+      walk(walker_for(layout::header_of(bytes.data()).tree_format, layout::header_of(bytes.data()).triangle_format)) {}
 
 Scene::Scene() : edits_(std::make_unique<Edits>()) {}
 

@@ -12,15 +12,18 @@
 
 namespace meshcast {
 
-// A scene's mesh: its blob's bytes and the view over them (validated once).
+// A scene's mesh: its blob's bytes, the view over them (validated once),
+// and the walker the view chose, which the scene's walk calls with its own
+// request (cpu/walk.h: its hits keep their slots, looked up afterwards).
 struct SceneMesh {
-  SceneMesh(std::vector<uint8_t> blob, std::string mesh_name)
-      : bytes(std::move(blob)), name(std::move(mesh_name)), view(bytes, name) {}
+  SceneMesh(std::vector<uint8_t> blob, std::string mesh_name);  // cpu/scene.cpp
   SceneMesh(const SceneMesh&) = delete;
   SceneMesh& operator=(const SceneMesh&) = delete;
   const std::vector<uint8_t> bytes;
   const std::string name;
   const BlobView view;  // reads `bytes`, declared before it
+  void (*const walk)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
+                     const WalkRequest& request);
 };
 
 class SceneSnapshot {

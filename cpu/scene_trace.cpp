@@ -2,11 +2,14 @@
 // chosen instruction set's walk_top, cpu/walk_top.h), each instance it reaches
 // walked by its blob's own walker on the ray brought into its frame.
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 
 #include "cpu/scene.h"
+#include "cpu/walk.h"
 #include "cpu/walk_top.h"
+#include "layout/blob_format.h"
 #include "layout/queries.h"
 #include "meshcast/errors.h"
 #include "meshcast/scene.h"
@@ -26,23 +29,39 @@ namespace {
 constexpr double kBoxSlack = MC_TOP_BOX_SLACK;  // 2^-16
 static_assert(kBoxSlack == 0x1p-16);
 
+// The origin relative to the top level's anchor, rounded to float.
+std::array<float, 3> relative_origin(const layout::TopLevel& top, const RayD& rd) {
+  return {float(rd.org[0] - top.anchor[0]), float(rd.org[1] - top.anchor[1]), float(rd.org[2] - top.anchor[2])};
+}
+
+// What the top level's boxes are widened by for the ray: kBoxSlack of the
+// farthest its origin is from the scene's box (which also covers the
+// rounding of the origin and the boxes to float).
+float box_pad(const layout::TopLevel& top, const RayD& rd) {
+  double far = 0;
+  for (int a = 0; a < 3; ++a)
+    far = std::max({far, std::fabs(rd.org[a] - top.min[a]), std::fabs(rd.org[a] - top.max[a])});
+  return float(far * kBoxSlack);
+}
+
+// A world ray and the top level's view of it (cpu/walk_top.h).
 struct WorldRay {
-  double org[3];
-  float dir[3];
-  float tmax;
-  TopRay top;  // for the top level's float boxes (cpu/walk_top.h)
+  const RayD& ray;
+  TopRay top;
+  WorldRay(const layout::TopLevel& t, const RayD& rd) : ray(rd), top(relative_origin(t, rd).data(), rd.dir, box_pad(t, rd)) {}
 };
 
 // The world ray in the instance's frame: the translation subtracted in
 // double, the difference rounded to float, then the float inverse.
 Ray to_local(const WorldRay& r, const layout::PlacedInstance& p) {
   float rel[3];
-  for (int a = 0; a < 3; ++a) rel[a] = float(r.org[a] - p.translation[a]);
+  for (int a = 0; a < 3; ++a) rel[a] = float(r.ray.org[a] - p.translation[a]);
   Ray local;
+  const float* dir = r.ray.dir;
   for (int i = 0; i < 3; ++i) {
     const float* row = p.to_local + 3 * i;
     local.org[i] = row[0] * rel[0] + row[1] * rel[1] + row[2] * rel[2];
-    local.dir[i] = row[0] * r.dir[0] + row[1] * r.dir[1] + row[2] * r.dir[2];
+    local.dir[i] = row[0] * dir[0] + row[1] * dir[1] + row[2] * dir[2];
   }
   return local;
 }
@@ -59,24 +78,6 @@ bool world_ray_walkable(const RayD& r) {
   return ray_is_walkable(probe);
 }
 
-// The world ray as the top level reads it; the pad is kBoxSlack of the
-// farthest the origin is from the scene's box (which also covers the
-// rounding of the origin and the boxes to float).
-WorldRay world_ray(const layout::TopLevel& top, const RayD& rd) {
-  WorldRay r;
-  double far = 0;
-  for (int a = 0; a < 3; ++a) {
-    r.org[a] = rd.org[a], r.dir[a] = rd.dir[a];
-    r.top.rel[a] = float(rd.org[a] - top.anchor[a]);
-    r.top.inv[a] = 1.0f / rd.dir[a];
-    r.top.negative[a] = std::signbit(rd.dir[a]);
-    far = std::max({far, std::fabs(rd.org[a] - top.min[a]), std::fabs(rd.org[a] - top.max[a])});
-  }
-  r.tmax = rd.tmax;
-  r.top.pad = float(far * kBoxSlack);
-  return r;
-}
-
 // The chosen instruction set's top-level walk (cpu/walk_top.h) for one
 // ray, each instance it reaches handed to visit(instance, its local ray
 // with t_max the cut), which returns the cut from then on, or a negative
@@ -88,7 +89,7 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Walk
     const WorldRay& r;
     Visit& visit;
   } context{top, r, visit};
-  walk(top, r.top, r.tmax, mask,
+  walk(top, r.top, r.ray.tmax, mask,
        [](void* c, uint32_t placed, float cut) {
          Context& x = *static_cast<Context*>(c);
          const layout::PlacedInstance& p = x.top.placed[placed];
@@ -99,28 +100,56 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Walk
        &context);
 }
 
-// Closest or any hit of one ray. Returns false when some instance's frame
-// could not take it (its local ray not walkable): that instance is not
-// walked and the ray counted.
-bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, HitOutputs outputs, Query query, Cull cull,
-          uint8_t mask, WalkTopFn walk_fn) {
+// What a closest- or any-hit trace asks of each instance's walker: for an
+// instance as the world sees it and for a mirrored one (its culling
+// turned). The hits keep their slots (looked up by finish_scene_hits).
+struct InstanceRequests {
+  WalkRequest as_seen, mirrored;
+  bool any;
+  InstanceRequests(HitOutputs outputs, Query query, Cull cull) : any(query == Query::Any) {
+    const uint32_t uv = uint32_t(outputs) & MC_HIT_UV;
+    as_seen.flags = uv | layout::query_bits(query, cull);
+    mirrored.flags = uv | layout::query_bits(query, as_instance_sees(cull, true));
+    as_seen.keep_slots = mirrored.keep_slots = true;
+  }
+};
+
+// Closest or any hit of one ray, its triangle a slot of *hit_mesh (left
+// alone on a miss). Returns false when some instance's frame could not
+// take it (its local ray not walkable): that instance is not walked and
+// the ray counted.
+bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, const SceneMesh*& hit_mesh,
+          const InstanceRequests& requests, uint8_t mask, WalkTopFn walk_fn) {
   bool complete = true;
-  walk_top(s.top, world_ray(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, WorldRay(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
+    const SceneMesh& mesh = *s.meshes[p.mesh];
     Hit h;
+    uint64_t skipped = 0;
     // A local ray the walkers refuse (its direction scaled past their
     // range) is counted, not walked.
-    if (s.meshes[p.mesh]->view.trace(std::span(&local, 1), std::span(&h, 1), outputs, query,
-                                     as_instance_sees(cull, p.mirrored != 0)) != 0)
-      complete = false;
+    mesh.walk(mesh.bytes.data(), &local, &h, 1, &skipped, p.mirrored ? requests.mirrored : requests.as_seen);
+    if (skipped != 0) complete = false;
     // Equal t: the lower instance id, as the oracle breaks ties.
     if (h.triangle != kNoHit &&
         (h.t < local.tmax || best.instance == kNoHit || (h.t == local.tmax && p.id < best.instance))) {
       best = {h.t, p.id, h.triangle, h.u, h.v};
-      return query == Query::Any ? -1.0f : h.t;
+      hit_mesh = &mesh;
+      return requests.any ? -1.0f : h.t;
     }
     return local.tmax;
   });
   return complete;
+}
+
+// The slots of hits[i] (hit in *meshes[i]) to the caller's triangles. Each
+// lookup may miss the cache twice; made side by side for many rays, the
+// misses overlap (as the walkers' finish_hits).
+void finish_scene_hits(std::span<SceneHit> hits, std::span<const SceneMesh* const> meshes) {
+  for (size_t i = 0; i < hits.size(); ++i)
+    if (const SceneMesh* m = meshes[i]) {
+      const uint8_t* blob = m->bytes.data();
+      hits[i].triangle = layout::remap_entry(blob, layout::header_of(blob), hits[i].triangle);
+    }
 }
 
 // Every hit of one ray into its row (max_hits long, filled with misses):
@@ -134,7 +163,7 @@ uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> ro
   auto before = [](const SceneHit& a, const SceneHit& b) {
     return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
   };
-  walk_top(s.top, world_ray(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
+  walk_top(s.top, WorldRay(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
     uint32_t own = 0;
     if (s.meshes[p.mesh]->view.trace_all_hits(std::span(&local, 1), cap, std::span(&own, 1), scratch, outputs,
                                               as_instance_sees(cull, p.mirrored != 0)) != 0)
@@ -175,16 +204,24 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
     throw UsageError("Scene::trace: Query::All has a list of hits a ray: Scene::trace_all_hits answers it");
   check_request("Scene::trace", outputs, query, cull);
   const WalkTopFn walk_fn = walk_top_fn();
+  const InstanceRequests requests(outputs, query, cull);
   uint64_t skipped = 0;
-  for (size_t i = 0; i < rays.size(); ++i) {
-    hits[i] = SceneHit{};
-    // Refused whatever the scene holds (an empty one too).
-    if (!world_ray_walkable(rays[i])) {
-      ++skipped;
-      continue;
+  constexpr size_t kChunk = 32;
+  const SceneMesh* hit_meshes[kChunk];
+  for (size_t begin = 0; begin < rays.size(); begin += kChunk) {
+    const size_t end = std::min(rays.size(), begin + kChunk);
+    for (size_t i = begin; i < end; ++i) {
+      hits[i] = SceneHit{};
+      hit_meshes[i - begin] = nullptr;
+      // Refused whatever the scene holds (an empty one too).
+      if (!world_ray_walkable(rays[i])) {
+        ++skipped;
+        continue;
+      }
+      if (snapshot.top.wide.empty()) continue;
+      if (!walk(snapshot, rays[i], hits[i], hit_meshes[i - begin], requests, mask, walk_fn)) ++skipped;
     }
-    if (snapshot.top.wide.empty()) continue;
-    if (!walk(snapshot, rays[i], hits[i], outputs, query, cull, mask, walk_fn)) ++skipped;
+    finish_scene_hits(hits.subspan(begin, end - begin), std::span(hit_meshes, end - begin));
   }
   return skipped;
 }

@@ -161,12 +161,17 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
   return true;
 }
 
+WalkFn walker_for(uint32_t tree_format, uint32_t triangle_format) {
+  for (const WalkEntry& e : chosen().table)
+    if (e.tree == tree_format && e.triangles == triangle_format) return e.walk;
+  return nullptr;
+}
+
 BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : bytes_(bytes) {
   std::string why = layout::validate(bytes);
   if (!why.empty()) throw InputError(name + ": " + why);
   const layout::BlobHeader& h = layout::header_of(bytes.data());
-  for (const WalkEntry& e : chosen().table)
-    if (e.tree == h.tree_format && e.triangles == h.triangle_format) walk_ = e.walk;
+  walk_ = walker_for(h.tree_format, h.triangle_format);
   if (!walk_) throw InputError(name + ": no walker for this layout");
 }
 

@@ -19,6 +19,11 @@ struct WalkRequest {
   uint32_t max_hits = 0;
   uint32_t* found = nullptr;
   Hit* lists = nullptr;
+  // Closest and any hit: leave each hit's triangle a slot of the blob
+  // (layout::remap_entry turns it into the caller's triangle; no point is
+  // written). A scene walks an instance one ray at a time: it looks the
+  // slots up afterwards, many rays side by side, as finish_hits does.
+  bool keep_slots = false;
 };
 
 MC_ISA_BEGIN
@@ -117,7 +122,7 @@ inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t
       walk_one(r, c);
       keep_slot(hits[i], c, outputs);
     }
-    finish_hits(blob, rays, hits, begin, end, outputs);
+    if (!request.keep_slots) finish_hits(blob, rays, hits, begin, end, outputs);
   }
 }
 

@@ -31,4 +31,8 @@ namespace isa_avx2 { std::span<const WalkEntry> walk_table(); }
 namespace isa_avx512 { std::span<const WalkEntry> walk_table(); }
 #endif
 
+// The chosen instruction set's walker (walker_isa()) for a tree and
+// triangle format, or nullptr where the catalog has none.
+WalkFn walker_for(uint32_t tree_format, uint32_t triangle_format);
+
 }  // namespace meshcast

@@ -14,32 +14,25 @@ MC_ISA_BEGIN
 
 namespace {
 
-// Node n's 8 slots against [0, cut]: the entered slots' contents and entry
-// distances to children[] and entries[] farthest first, the nearest last
-// (up to 8 of each written); returns how many were entered. An entry may be
-// rounded down by a few ulps (it only ever culls, so it culls no more).
-[[gnu::always_inline]] inline int enter_node(const TopRay& r, const layout::TopWideNode& n, float cut, float* entries,
-                                             uint32_t* children) {
+// Node n's 8 slots against [0, cut]: the entered ones as bits. Each plane
+// is one subtraction (its shift rounded once: the pad, 2^-16 of the scene,
+// dwarfs that) and one product; `entry` holds the entry distances. An entry
+// may be rounded down by a few ulps (it only ever culls, so it culls no
+// more).
+[[gnu::always_inline]] inline int enter_node(const TopRay& r, const layout::TopWideNode& n, float cut,
+                                             simd::F8& entry) {
   using simd::F8;
+  const auto* bytes = reinterpret_cast<const uint8_t*>(&n);
   F8 tn = F8::splat(0.0f), tf = F8::splat(cut);
-  const F8 pad = F8::splat(r.pad);
   for (int a = 0; a < 3; ++a) {
-    const F8 rel = F8::splat(r.rel[a]), inv = F8::splat(r.inv[a]);
-    const F8 t0 = (F8::load(n.lo[a]) - pad - rel) * inv, t1 = (F8::load(n.hi[a]) + pad - rel) * inv;
-    tn = simd::max(r.negative[a] ? t1 : t0, tn);
-    tf = simd::min(r.negative[a] ? t0 : t1, tf);
+    const F8 inv = F8::splat(r.inv[a]);
+    const F8 near = (F8::load(reinterpret_cast<const float*>(bytes + r.near_at[a])) - F8::splat(r.near_shift[a])) * inv;
+    const F8 far = (F8::load(reinterpret_cast<const float*>(bytes + r.far_at[a])) - F8::splat(r.far_shift[a])) * inv;
+    tn = simd::max(near, tn);
+    tf = simd::min(far, tf);
   }
-  const int bits = simd::bits(tn <= tf);
-  if (bits == 0) return 0;
-  if ((bits & (bits - 1)) == 0) {  // one slot (the commonest): no sort
-    alignas(32) float entry[8];
-    tn.store(entry);
-    const int k = __builtin_ctz(unsigned(bits));
-    entries[0] = entry[k], children[0] = n.slot[k];
-    return 1;
-  }
-  simd::order_hits(tn, bits, reinterpret_cast<const uint8_t*>(n.slot), entries, children);
-  return std::popcount(unsigned(bits));
+  entry = tn;
+  return simd::bits(tn <= tf);
 }
 
 }  // namespace
@@ -54,22 +47,34 @@ void walk_top(const layout::TopLevel& top, const TopRay& r, float tmax, uint8_t 
   uint32_t stack[kStack];
   float entries[kStack];
   int top_of = 0;
-  stack[top_of] = 0, entries[top_of++] = 0;  // the root node
   const float widen = 1 + float(MC_TOP_BOX_SLACK);
-  while (top_of > 0) {
-    --top_of;
-    if (entries[top_of] > cut * widen) continue;
-    const uint32_t item = stack[top_of];
+  uint32_t item = 0;  // the root node
+  for (;;) {
     if (item & layout::kTopInstance) {
       const uint32_t placed = item & ~layout::kTopInstance;
-      if ((top.placed[placed].mask & mask) == 0) continue;
-      cut = visit(context, placed, cut);
-      if (cut < 0) return;
-      continue;
+      if (top.placed[placed].mask & mask) {
+        cut = visit(context, placed, cut);
+        if (cut < 0) return;
+      }
+    } else {
+      const layout::TopWideNode& n = top.wide[item];
+      simd::F8 entry;
+      const int bits = enter_node(r, n, cut * widen, entry);
+      if (bits != 0 && (bits & (bits - 1)) == 0) {  // one slot (the commonest): walked next, no stack traffic
+        item = n.slot[__builtin_ctz(unsigned(bits))];
+        continue;
+      }
+      // Several: on the stack farthest first, the nearest popped next.
+      if (bits != 0) {
+        simd::order_hits(entry, bits, reinterpret_cast<const uint8_t*>(n.slot), entries + top_of, stack + top_of);
+        top_of += std::popcount(unsigned(bits));
+      }
     }
-    // The entered slots go on the stack farthest first: the nearest is
-    // popped next.
-    top_of += enter_node(r, top.wide[item], cut * widen, entries + top_of, stack + top_of);
+    do {
+      if (top_of == 0) return;
+      --top_of;
+    } while (entries[top_of] > cut * widen);
+    item = stack[top_of];
   }
 }
 

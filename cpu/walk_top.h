@@ -3,6 +3,8 @@
 // scene's walk (cpu/scene_trace.cpp) calls the chosen set's (walk_top_fn(),
 // cpu/trace.cpp) and walks each instance it is handed.
 #pragma once
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "cpu/isa.h"
@@ -10,17 +12,42 @@
 
 namespace meshcast {
 
-// A world ray as the top level's float boxes read it: the origin relative
-// to the top level's anchor, 1 / dir (+-inf for a zero component), the pad
-// every box is widened by, and the direction's sign bits (a negative
-// component meets a box's hi plane first).
+// A world ray as the top level's float boxes read it, made once a ray:
+// per axis 1 / dir (+-inf for a zero component), where the
+// plane the ray meets first sits in a node (its lo row, or its hi row for a
+// negative component) and the other, and what each is shifted by: the
+// origin relative to the anchor, widened by the pad (the box grows by it on
+// both sides). A node's test then reads its rows at fixed offsets and
+// branches on no sign.
 struct TopRay {
-  float rel[3], inv[3], pad;
-  bool negative[3];
+  float inv[3];
+  float near_shift[3], far_shift[3];  // rel -+ pad: t = (plane - shift) * inv
+  uint32_t near_at[3], far_at[3];     // byte offsets of the rows in a layout::TopWideNode
+
+  // `rel` the origin relative to the top level's anchor (rounded to float),
+  // `dir` the direction, `pad` what every box is widened by. A negative
+  // component (-0 too, whose inverse is -inf) meets the hi plane first.
+  // (A constructor, not a function returning one: gcc built a returned
+  // copy from narrower stores than it read, a stall a ray.)
+  TopRay(const float rel[3], const float dir[3], float pad) {
+    constexpr uint32_t kRow = sizeof(float) * layout::kTopWidth;
+    constexpr uint32_t kLoAt = offsetof(layout::TopWideNode, lo), kHiAt = offsetof(layout::TopWideNode, hi);
+    for (int a = 0; a < 3; ++a) {
+      const uint32_t negative = std::signbit(dir[a]);
+      inv[a] = 1.0f / dir[a];
+      // Without a branch or a blend: a ray's signs are as likely as not.
+      near_at[a] = kRow * a + kLoAt + negative * (kHiAt - kLoAt);
+      far_at[a] = kRow * a + kHiAt - negative * (kHiAt - kLoAt);
+      // The lo plane moves down by the pad, the hi plane up.
+      const float signed_pad = std::copysign(pad, dir[a]);
+      near_shift[a] = rel[a] + signed_pad;
+      far_shift[a] = rel[a] - signed_pad;
+    }
+  }
 };
 
 // The top level's walk for one ray: every instance whose box the ray
-// enters before the cut (boxes widened by r.pad, the cut by MC_TOP_BOX_SLACK
+// enters before the cut (boxes widened by the pad TopRay was made with, the cut by MC_TOP_BOX_SLACK
 // of itself), nearest entry first, whose mask shares a bit with `mask`,
 // goes to visit(context, its index in top.placed, the cut), which returns
 // the cut from then on (a nearer hit's t, or the same), or a negative

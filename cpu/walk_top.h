@@ -47,12 +47,13 @@ struct TopRay {
 };
 
 // The top level's walk for one ray: every instance whose box the ray
-// enters before the cut (boxes widened by the pad TopRay was made with, the cut by MC_TOP_BOX_SLACK
-// of itself), nearest entry first, whose mask shares a bit with `mask`,
-// goes to visit(context, its index in top.placed, the cut), which returns
-// the cut from then on (a nearer hit's t, or the same), or a negative
-// number to end the walk. A node's 8 slots are tested at once (8 lanes),
-// the entered ones ordered by the walkers' order_hits, one without a sort.
+// enters before the cut (boxes widened by the pad TopRay was made with,
+// the cut by MC_TOP_BOX_SLACK of itself), nearest entry first, whose mask
+// shares a bit with `mask`, goes to visit(context, its index in
+// top.placed, the cut), which returns the cut from then on (a nearer hit's
+// t, or the same), or a negative number to end the walk. A node's 8 slots
+// are tested at once (8 lanes), the entered ones ordered by the walkers'
+// order_hits; one entered slot is walked next, without the stack.
 using VisitInstanceFn = float (*)(void* context, uint32_t placed, float cut);
 using WalkTopFn = void (*)(const layout::TopLevel& top, const TopRay& r, float tmax, uint8_t mask,
                            VisitInstanceFn visit, void* context);

@@ -40,10 +40,8 @@ namespace {
 void walk_top(const layout::TopLevel& top, const TopRay& r, float tmax, uint8_t mask, VisitInstanceFn visit,
               void* context) {
   float cut = tmax;
-  // A wide node leaves at most 7 entries behind a level, and the binary
-  // tree under it is at most 64 deep (median splits of fewer than 2^32);
-  // a node's test writes 8 past the top: the stack cannot fill.
-  constexpr int kStack = 7 * 64 + 8;
+  // The stack cannot fill (MC_TOP_MAX_DEPTH, layout/formats.h).
+  constexpr int kStack = 7 * int(MC_TOP_MAX_DEPTH) + 8;
   uint32_t stack[kStack];
   float entries[kStack];
   int top_of = 0;

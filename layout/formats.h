@@ -303,6 +303,11 @@
 #define MC_TOP_WIDTH 8u
 #define MC_TOP_INSTANCE 0x80000000u    // | an index into the placed records
 #define MC_TOP_EMPTY 0xFFFFFFFFu
+// The depth a walk's stack is sized for: median splits of fewer than 2^31
+// instances (Scene's limit) are at most 31 levels deep, and a wide node
+// leaves at most 7 entries behind a level (stack: 7 * depth + 8, the 8 a
+// node's test writes past the top).
+#define MC_TOP_MAX_DEPTH 32u
 // The pad every top-level box is widened by, of the ray origin's farthest
 // distance from the scene's box (cpu/scene_trace.cpp says why).
 #define MC_TOP_BOX_SLACK 1.52587890625e-05  // 2^-16

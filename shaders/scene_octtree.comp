@@ -44,9 +44,8 @@ layout(std430, set = 0, binding = 6) writeonly buffer SceneHits { uint scene_hit
 
 double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_words[word + 1u])); }
 
-// A wide node leaves at most 7 entries behind a level; median splits of
-// fewer than 2^31 instances (Scene's limit) are at most 31 levels deep.
-#define TOP_STACK_SIZE (7u * 32u + 8u)
+// See MC_TOP_MAX_DEPTH (layout/formats.h).
+#define TOP_STACK_SIZE (7u * MC_TOP_MAX_DEPTH + 8u)
 
 // ray_is_walkable of cpu/trace.cpp: an origin within 2^100, a direction
 // within 2^126 and not below 2^-126 on every axis, t_max not NaN nor < 0.

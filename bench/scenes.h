@@ -17,7 +17,7 @@ struct ScenesOptions {
   std::vector<size_t> counts = {1000, 10000};  // instances a level
   std::vector<double> offsets = {0, 1e6, 1e7};  // the level moved this far along every axis
   std::string layout = "OctTreeCompressed/ClusterBitPackSOA8";
-  size_t rays = 10000;
+  size_t rays = 100000;  // a round of 10,000 took 4-7 ms: one interruption moved its median
   uint32_t rounds = 5;
 };
 

@@ -266,9 +266,21 @@ uint64_t Scene::trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists,
 
 uint64_t Scene::trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs, Query query, Cull cull,
                       uint8_t mask) const {
-  std::vector<RayD> wide(rays.size());
-  std::transform(rays.begin(), rays.end(), wide.begin(), widened);
-  return trace_snapshot(*snapshot(), wide, hits, outputs, query, cull, mask);
+  check_scene_hits(rays.size(), hits.size());  // here, not a chunk at a time: it names the caller's sizes
+  // Widened a chunk at a time on the stack: a game's per-frame call
+  // allocates nothing.
+  const std::shared_ptr<const SceneSnapshot> s = snapshot();
+  constexpr size_t kChunk = 256;
+  RayD wide[kChunk];
+  uint64_t skipped = 0;
+  size_t begin = 0;
+  do {  // once at least: an empty batch still has its request checked
+    const size_t n = std::min(kChunk, rays.size() - begin);
+    std::transform(rays.begin() + begin, rays.begin() + begin + n, wide, widened);
+    skipped += trace_snapshot(*s, std::span(wide, n), hits.subspan(begin, n), outputs, query, cull, mask);
+    begin += n;
+  } while (begin < rays.size());
+  return skipped;
 }
 
 }  // namespace meshcast

@@ -32,6 +32,10 @@ class SceneSnapshot {
   layout::TopLevel top;
 };
 
+// UsageError unless the hits span holds one hit a ray (trace_snapshot's
+// check, which Scene's float-ray trace makes before its chunks).
+void check_scene_hits(size_t rays, size_t hits);
+
 // trace_all_hits_snapshot into the caller's storage (a batch's slice): ray
 // i's count in found[i], its row in rows[i * max_hits, (i + 1) * max_hits).
 uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint32_t max_hits,

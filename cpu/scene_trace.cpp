@@ -195,11 +195,15 @@ void check_request(const char* who, HitOutputs outputs, Query query, Cull cull) 
 
 }  // namespace
 
+void check_scene_hits(size_t rays, size_t hits) {
+  if (hits < rays)
+    throw UsageError("Scene::trace: " + std::to_string(rays) + " rays but " + std::to_string(hits) +
+                     " hits; the hits span must hold one hit a ray");
+}
+
 uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,
                         HitOutputs outputs, Query query, Cull cull, uint8_t mask) {
-  if (hits.size() < rays.size())
-    throw UsageError("Scene::trace: " + std::to_string(rays.size()) + " rays but " + std::to_string(hits.size()) +
-                     " hits; the hits span must hold one hit a ray");
+  check_scene_hits(rays.size(), hits.size());
   if (query == Query::All)
     throw UsageError("Scene::trace: Query::All has a list of hits a ray: Scene::trace_all_hits answers it");
   check_request("Scene::trace", outputs, query, cull);

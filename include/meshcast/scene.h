@@ -44,13 +44,13 @@ struct RayD {
 };
 static_assert(sizeof(RayD) == 40, "RayD is the record of a RAYD file");
 
-// A hit in a scene: the instance and the triangle of its mesh (the index in
-// the mesh the blob was built from), t in the world ray's units.
 // A float ray as a RayD: its origin taken as doubles.
 inline RayD widened(const Ray& r) {
   return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax};
 }
 
+// A hit in a scene: the instance and the triangle of its mesh (the index in
+// the mesh the blob was built from), t in the world ray's units.
 struct SceneHit {
   float t = INFINITY;  // INFINITY on a miss
   uint32_t instance = kNoHit;

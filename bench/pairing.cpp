@@ -9,6 +9,7 @@
 #include "check/ray_files.h"
 #include "check/generate.h"
 #include "io/read_mesh.h"
+#include "meshcast/errors.h"
 
 namespace meshcast::bench {
 
@@ -42,14 +43,19 @@ Mesh rotated_with_pairs_baked(const Mesh& in) {
 
 }  // namespace
 
-std::vector<PairingRow> bench_pairing(const std::string& data_dir, size_t ray_count, uint32_t repeat) {
+std::vector<PairingRow> bench_pairing(const std::string& data_dir, size_t ray_count, uint32_t repeat,
+                                      const std::vector<std::string>& only) {
+  auto chosen = [&](const std::string& name) {
+    return only.empty() || std::any_of(only.begin(), only.end(), [&](const std::string& o) { return name.rfind(o, 0) == 0; });
+  };
   std::vector<std::pair<std::string, Mesh>> cases;
   for (const char* name : {"bunny00", "armadillo", "refined_elephant", "ChineseDragon-10kv"}) {
     const std::string path = data_dir + "/" + name + ".off";
-    if (std::filesystem::exists(path)) cases.emplace_back(name, read_mesh(path));
+    if (chosen(name) && std::filesystem::exists(path)) cases.emplace_back(name, read_mesh(path));
   }
-  cases.emplace_back("terrain_2M", make_terrain(1024, 1024, 5));
-  if (!cases.empty() && cases.front().first == "bunny00") {
+  if (chosen("terrain_2M")) cases.emplace_back("terrain_2M", make_terrain(1024, 1024, 5));
+  if (cases.empty()) throw UsageError("bench pairing: no case is named by --only (or its mesh file is not in " + data_dir + ")");
+  if (cases.front().first == "bunny00") {
     cases.emplace_back("bunny00 shuffled", shuffled(cases.front().second));
     cases.emplace_back("bunny00 rotated 45, pairs baked", rotated_with_pairs_baked(cases.front().second));
   }

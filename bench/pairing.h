@@ -23,7 +23,10 @@ struct PairingRow {
 // two copies of bunny00 made hard: its triangle order shuffled, and rotated
 // 45 degrees with its own pairs baked in as consecutive triangles (the seed's
 // third case: an input that looks paired, with pairs chosen before the
-// rotation).
-std::vector<PairingRow> bench_pairing(const std::string& data_dir, size_t rays, uint32_t repeat);
+// rotation). `only`, when not empty: the cases whose names begin with one
+// of its names alone (bunny00: its two copies too; the terrain is made only
+// when named); UsageError when that leaves none.
+std::vector<PairingRow> bench_pairing(const std::string& data_dir, size_t rays, uint32_t repeat,
+                                      const std::vector<std::string>& only = {});
 
 }  // namespace meshcast::bench

@@ -48,7 +48,8 @@ float box_pad(const layout::TopLevel& top, const RayD& rd) {
 struct WorldRay {
   const RayD& ray;
   TopRay top;
-  WorldRay(const layout::TopLevel& t, const RayD& rd) : ray(rd), top(relative_origin(t, rd).data(), rd.dir, box_pad(t, rd)) {}
+  WorldRay(const layout::TopLevel& t, const RayD& rd)
+      : ray(rd), top(relative_origin(t, rd).data(), rd.dir, box_pad(t, rd)) {}
 };
 
 // The world ray in the instance's frame: the translation subtracted in
@@ -193,6 +194,25 @@ void check_request(const char* who, HitOutputs outputs, Query query, Cull cull) 
   if (has(outputs, HitOutputs::Point)) throw UsageError(std::string(who) + ": a scene hit carries no point (HitOutputs::Point)");
 }
 
+// The frame of every ray both traces share, for rays [begin, end): its
+// answer reset (reset(i)), then a world ray the walk cannot take counted
+// (whatever the scene holds, an empty one too), an empty scene answering
+// a miss, and walk(i), false when some instance's frame refused the ray,
+// counted. Returns the rays counted.
+template <class Reset, class Walk>
+uint64_t for_each_world_ray(const SceneSnapshot& snapshot, std::span<const RayD> rays, size_t begin, size_t end,
+                            Reset&& reset, Walk&& walk) {
+  uint64_t skipped = 0;
+  for (size_t i = begin; i < end; ++i) {
+    reset(i);
+    if (!world_ray_walkable(rays[i]))
+      ++skipped;
+    else if (!snapshot.top.wide.empty() && !walk(i))
+      ++skipped;
+  }
+  return skipped;
+}
+
 }  // namespace
 
 void check_scene_hits(size_t rays, size_t hits) {
@@ -214,17 +234,9 @@ uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> ray
   const SceneMesh* hit_meshes[kChunk];
   for (size_t begin = 0; begin < rays.size(); begin += kChunk) {
     const size_t end = std::min(rays.size(), begin + kChunk);
-    for (size_t i = begin; i < end; ++i) {
-      hits[i] = SceneHit{};
-      hit_meshes[i - begin] = nullptr;
-      // Refused whatever the scene holds (an empty one too).
-      if (!world_ray_walkable(rays[i])) {
-        ++skipped;
-        continue;
-      }
-      if (snapshot.top.wide.empty()) continue;
-      if (!walk(snapshot, rays[i], hits[i], hit_meshes[i - begin], requests, mask, walk_fn)) ++skipped;
-    }
+    skipped += for_each_world_ray(
+        snapshot, rays, begin, end, [&](size_t i) { hits[i] = SceneHit{}, hit_meshes[i - begin] = nullptr; },
+        [&](size_t i) { return walk(snapshot, rays[i], hits[i], hit_meshes[i - begin], requests, mask, walk_fn); });
     finish_scene_hits(hits.subspan(begin, end - begin), std::span(hit_meshes, end - begin));
   }
   return skipped;
@@ -247,21 +259,19 @@ uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> r
   check_request("Scene::trace_all_hits", outputs, Query::All, cull);
   const WalkTopFn walk_fn = walk_top_fn();
   std::vector<Hit> scratch(max_hits);
-  uint64_t skipped = 0;
-  for (size_t i = 0; i < rays.size(); ++i) {
-    const std::span<SceneHit> row = rows.subspan(i * max_hits, max_hits);
-    std::fill(row.begin(), row.end(), SceneHit{});
-    found[i] = 0;
-    if (!world_ray_walkable(rays[i])) {
-      ++skipped;
-      continue;
-    }
-    if (snapshot.top.wide.empty()) continue;
-    bool complete = true;
-    found[i] = walk_all(snapshot, rays[i], row, scratch, outputs, cull, mask, walk_fn, complete);
-    skipped += !complete;
-  }
-  return skipped;
+  auto row = [&](size_t i) { return rows.subspan(i * max_hits, max_hits); };
+  return for_each_world_ray(
+      snapshot, rays, 0, rays.size(),
+      [&](size_t i) {
+        const std::span<SceneHit> r = row(i);
+        std::fill(r.begin(), r.end(), SceneHit{});
+        found[i] = 0;
+      },
+      [&](size_t i) {
+        bool complete = true;
+        found[i] = walk_all(snapshot, rays[i], row(i), scratch, outputs, cull, mask, walk_fn, complete);
+        return complete;
+      });
 }
 
 }  // namespace meshcast

@@ -357,8 +357,16 @@ void add_bench_pairing(CLI::App* bench) {
   pair->add_option("--rays", pargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
   pair->add_option("--repeat", pargs->repeat, "passes; the minimum and the median are kept")->check(CLI::Range(1, 1000));
   pair->add_option("--out-dir", pargs->out_dir, "where the CSV goes");
-  pair->callback([pargs, pdata] {
-    std::vector<bench::PairingRow> rows = bench::bench_pairing(*pdata, pargs->rays, pargs->repeat);
+  auto ponly = std::make_shared<std::vector<std::string>>();
+  pair->add_option("--only", *ponly, "comma-separated cases by the start of their names (bunny00, armadillo, terrain_2M, ...)")
+      ->delimiter(',');
+  pair->callback([pargs, pdata, ponly] {
+    std::vector<bench::PairingRow> rows;
+    try {
+      rows = bench::bench_pairing(*pdata, pargs->rays, pargs->repeat, *ponly);
+    } catch (const UsageError& e) {  // --only named no case: a refused value (exit 2)
+      throw CLI::ValidationError("--only", e.what());
+    }
     const double scale = 1000.0 / double(pargs->rays);
     std::printf("\n%zu long rays, one thread, leaf 8; us per ray, minimum of %u passes; paired: before = input order "
                 "(window N = 2), after = the pass (or the input's pairs when the pre-scan skips it)\n\n"

@@ -5,6 +5,7 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstddef>
 
 #include "cpu/scene.h"
 #include "cpu/walk.h"
@@ -15,6 +16,22 @@
 #include "meshcast/scene.h"
 
 namespace meshcast {
+
+TopRay::TopRay(const float rel[3], const float dir[3], float pad) {
+  constexpr uint32_t kRow = sizeof(float) * layout::kTopWidth;
+  constexpr uint32_t kLoAt = offsetof(layout::TopWideNode, lo), kHiAt = offsetof(layout::TopWideNode, hi);
+  for (int a = 0; a < 3; ++a) {
+    const uint32_t negative = std::signbit(dir[a]);
+    inv[a] = 1.0f / dir[a];
+    // Without a branch or a blend: a ray's signs are as likely as not.
+    near_at[a] = kRow * a + kLoAt + negative * (kHiAt - kLoAt);
+    far_at[a] = kRow * a + kHiAt - negative * (kHiAt - kLoAt);
+    // The lo plane moves down by the pad, the hi plane up.
+    const float signed_pad = std::copysign(pad, dir[a]);
+    near_shift[a] = rel[a] + signed_pad;
+    far_shift[a] = rel[a] - signed_pad;
+  }
+}
 
 namespace {
 

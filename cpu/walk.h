@@ -1,5 +1,6 @@
-// Walkers: one per tree family, instantiated per triangle codec. trace()
-// (include/meshcast/blob.h) picks the instantiation from the blob header once per batch.
+// Walkers: one per tree family, instantiated per triangle codec. A
+// BlobView (include/meshcast/blob.h) and a scene's mesh (cpu/scene.h) pick
+// the instantiation from the blob header once (walker_for, cpu/walk_table.h).
 #pragma once
 #include <algorithm>
 #include <cstddef>
@@ -83,7 +84,8 @@ inline void finish_list(const uint8_t* blob, const Ray& ray, Hit* row, uint32_t 
 
 // The batch loop every walker shares: an unwalkable ray becomes a counted
 // miss; walk_one(r, c) walks one ray, shortening c on every hit. Rays go in
-// chunks, walked first, then finished (finish_hits).
+// chunks, walked first, then finished (finish_hits), unless the request
+// keeps the slots.
 template <class WalkOne>
 inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
                          const WalkRequest& request, WalkOne&& walk_one) {

@@ -3,8 +3,6 @@
 // scene's walk (cpu/scene_trace.cpp) calls the chosen set's (walk_top_fn(),
 // cpu/trace.cpp) and walks each instance it is handed.
 #pragma once
-#include <cmath>
-#include <cstddef>
 #include <cstdint>
 
 #include "cpu/isa.h"
@@ -28,22 +26,10 @@ struct TopRay {
   // `dir` the direction, `pad` what every box is widened by. A negative
   // component (-0 too, whose inverse is -inf) meets the hi plane first.
   // (A constructor, not a function returning one: gcc built a returned
-  // copy from narrower stores than it read, a stall a ray.)
-  TopRay(const float rel[3], const float dir[3], float pad) {
-    constexpr uint32_t kRow = sizeof(float) * layout::kTopWidth;
-    constexpr uint32_t kLoAt = offsetof(layout::TopWideNode, lo), kHiAt = offsetof(layout::TopWideNode, hi);
-    for (int a = 0; a < 3; ++a) {
-      const uint32_t negative = std::signbit(dir[a]);
-      inv[a] = 1.0f / dir[a];
-      // Without a branch or a blend: a ray's signs are as likely as not.
-      near_at[a] = kRow * a + kLoAt + negative * (kHiAt - kLoAt);
-      far_at[a] = kRow * a + kHiAt - negative * (kHiAt - kLoAt);
-      // The lo plane moves down by the pad, the hi plane up.
-      const float signed_pad = std::copysign(pad, dir[a]);
-      near_shift[a] = rel[a] + signed_pad;
-      far_shift[a] = rel[a] - signed_pad;
-    }
-  }
+  // copy from narrower stores than it read, a stall a ray. Defined out of
+  // line, in a file compiled once: an inline one made by a walker file of
+  // one instruction set could be the copy the linker keeps.)
+  TopRay(const float rel[3], const float dir[3], float pad);  // cpu/scene_trace.cpp
 };
 
 // The top level's walk for one ray: every instance whose box the ray

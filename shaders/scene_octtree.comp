@@ -91,7 +91,8 @@ void main() {
   const bool walkable = all(lessThanEqual(abs(org), dvec3(max_coordinate))) && directions_walkable(dir, tmax);
   if (!walkable) incomplete = 1u;
   if (walkable && top_words[TOP_NODES] > 0u) {
-    // The world ray as the top level's float boxes read it (world_ray()).
+    // The world ray as the top level's float boxes read it (TopRay of
+    // cpu/walk_top.h: each plane less its shift, rel widened by the pad).
     vec3 rel, inv;
     double far_from_box = 0.0lf;
     for (uint a = 0u; a < 3u; ++a) {
@@ -100,6 +101,7 @@ void main() {
       far_from_box = max(far_from_box, max(abs(org[a] - top_f64(TOP_MIN + 2u * a)), abs(org[a] - top_f64(TOP_MAX + 2u * a))));
     }
     const float pad = float(far_from_box * MC_TOP_BOX_SLACK);
+    precise vec3 lo_shift = rel + vec3(pad), hi_shift = rel - vec3(pad);  // a box grows by the pad
     const float widen = 1.0 + float(MC_TOP_BOX_SLACK);
     const uint placed_at = top_words[TOP_PLACED_AT], wide_at = top_words[TOP_WIDE_AT];
     float cut = tmax;
@@ -148,7 +150,7 @@ void main() {
         }
         continue;
       }
-      // The node's 8 boxes (enter_top of cpu/walk_top.cpp); the entered
+      // The node's 8 boxes (enter_node of cpu/walk_top.cpp); the entered
       // ones pushed farthest first, so the nearest is popped next.
       const uint node = wide_at + item * (MC_TOP_NODE_BYTES / 4u);
       const int base = top;
@@ -159,8 +161,8 @@ void main() {
         for (uint a = 0u; a < 3u; ++a) {
           const float lo = uintBitsToFloat(top_words[node + MC_TOP_LO_AT / 4u + MC_TOP_WIDTH * a + k]);
           const float hi = uintBitsToFloat(top_words[node + MC_TOP_HI_AT / 4u + MC_TOP_WIDTH * a + k]);
-          precise float t0 = (lo - pad - rel[a]) * inv[a];
-          precise float t1 = (hi + pad - rel[a]) * inv[a];
+          precise float t0 = (lo - lo_shift[a]) * inv[a];
+          precise float t1 = (hi - hi_shift[a]) * inv[a];
           const bool negative = sign_bit(dir[a]);
           tn = max_keep(negative ? t1 : t0, tn);
           tf = min_keep(negative ? t0 : t1, tf);

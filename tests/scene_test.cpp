@@ -621,15 +621,13 @@ TEST(Scene, FramesOfMovesAlone) {
   EXPECT_GT(hits, 20 * rays.size() / 20) << "too few hits to show anything";
 }
 
-// Commits with nothing to walk (a new scene, every instance hidden) and
-// moves of hidden instances, frame after frame: misses, no fault.
 // Float rays (Scene's trace of Ray, widened 256 at a time on the stack)
 // answer as the same rays given in double, across chunks; a short hits
 // span is refused with the caller's sizes, an empty batch answers nothing.
 TEST(Scene, FloatRaysAnswerAsTheirDoubleOrigins) {
   const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 40, 60, 0, 13);
   const Scene scene = make_scene(level);
-  const std::vector<RayD> rays_d = level_rays(level, 700, 60, 14);  // 3 chunks, the last part full
+  const std::vector<RayD> rays_d = level_rays(level, 700, 60, 14);
   std::vector<Ray> rays(rays_d.size());
   std::vector<RayD> widened_back(rays_d.size());
   for (size_t i = 0; i < rays.size(); ++i) {
@@ -637,18 +635,22 @@ TEST(Scene, FloatRaysAnswerAsTheirDoubleOrigins) {
     rays[i].tmax = rays_d[i].tmax;
     widened_back[i] = widened(rays[i]);
   }
-  std::vector<SceneHit> from_float(rays.size()), from_double(rays.size());
-  EXPECT_EQ(scene.trace(std::span<const Ray>(rays), from_float, HitOutputs::Uv), 0u);
-  EXPECT_EQ(scene.trace(std::span<const RayD>(widened_back), from_double, HitOutputs::Uv), 0u);
-  size_t hits = 0;
-  for (size_t i = 0; i < rays.size(); ++i) {
-    hits += from_float[i].instance != kNoHit;
-    EXPECT_EQ(std::bit_cast<uint32_t>(from_float[i].t), std::bit_cast<uint32_t>(from_double[i].t)) << i;
-    EXPECT_EQ(from_float[i].instance, from_double[i].instance) << i;
-    EXPECT_EQ(from_float[i].triangle, from_double[i].triangle) << i;
-    EXPECT_EQ(from_float[i].u, from_double[i].u) << i;
+  // A chunk exactly, one past it, and 256 + 256 + 188.
+  for (size_t n : {size_t(256), size_t(257), rays.size()}) {
+    std::vector<SceneHit> from_float(n), from_double(n);
+    EXPECT_EQ(scene.trace(std::span<const Ray>(rays).first(n), from_float, HitOutputs::Uv), 0u);
+    EXPECT_EQ(scene.trace(std::span<const RayD>(widened_back).first(n), from_double, HitOutputs::Uv), 0u);
+    size_t hits = 0;
+    for (size_t i = 0; i < n; ++i) {
+      hits += from_float[i].instance != kNoHit;
+      EXPECT_EQ(std::bit_cast<uint32_t>(from_float[i].t), std::bit_cast<uint32_t>(from_double[i].t)) << n << ": " << i;
+      EXPECT_EQ(from_float[i].instance, from_double[i].instance) << n << ": " << i;
+      EXPECT_EQ(from_float[i].triangle, from_double[i].triangle) << n << ": " << i;
+      EXPECT_EQ(from_float[i].u, from_double[i].u) << n << ": " << i;
+      EXPECT_EQ(from_float[i].v, from_double[i].v) << n << ": " << i;
+    }
+    EXPECT_GT(hits, n / 4) << n;
   }
-  EXPECT_GT(hits, rays.size() / 4);
   std::vector<SceneHit> short_hits(rays.size() - 1);
   try {
     scene.trace(std::span<const Ray>(rays), short_hits);
@@ -660,6 +662,8 @@ TEST(Scene, FloatRaysAnswerAsTheirDoubleOrigins) {
   EXPECT_THROW(scene.trace(std::span<const Ray>(), std::span<SceneHit>(), HitOutputs::Point), UsageError);
 }
 
+// Commits with nothing to walk (a new scene, every instance hidden) and
+// moves of hidden instances, frame after frame: misses, no fault.
 TEST(Scene, CommitsOfNothing) {
   Scene scene;
   scene.commit();

@@ -358,7 +358,8 @@ void add_bench_pairing(CLI::App* bench) {
   pair->add_option("--repeat", pargs->repeat, "passes; the minimum and the median are kept")->check(CLI::Range(1, 1000));
   pair->add_option("--out-dir", pargs->out_dir, "where the CSV goes");
   auto ponly = std::make_shared<std::vector<std::string>>();
-  pair->add_option("--only", *ponly, "comma-separated cases by the start of their names (bunny00, armadillo, terrain_2M, ...)")
+  pair->add_option("--only", *ponly, "comma-separated cases by the start of their names (bunny00 with its shuffled and "
+                  "rotated copies, armadillo, terrain_2M, ...)")
       ->delimiter(',');
   pair->callback([pargs, pdata, ponly] {
     std::vector<bench::PairingRow> rows;

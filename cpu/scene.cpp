@@ -108,7 +108,7 @@ SceneMesh::SceneMesh(std::vector<uint8_t> blob, std::string mesh_name)
     : bytes(std::move(blob)),
       name(std::move(mesh_name)),
       view(bytes, name),
-      walk(walker_for(layout::header_of(bytes.data()).tree_format, layout::header_of(bytes.data()).triangle_format)) {}
+      walk(walker_for(uint32_t(view.layout().tree), uint32_t(view.layout().triangles))) {}
 
 Scene::Scene() : edits_(std::make_unique<Edits>()) {}
 

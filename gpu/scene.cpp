@@ -1,6 +1,7 @@
 #include "gpu/scene.h"
 
 #include <cstring>
+#include <stdexcept>
 
 #include "builder/layout_names.h"
 #include "cpu/scene.h"
@@ -24,12 +25,55 @@ struct ScenePush {
   uint32_t ray_base, ray_count, mask;
 };
 
+// UsageError unless the hits span holds one hit a ray.
+void check_room(size_t rays, size_t hits) {
+  if (hits < rays)
+    throw UsageError("GPU scene method: " + std::to_string(rays) + " rays but room for " + std::to_string(hits) + " hits");
+}
+
 // A Mapped buffer of at least `bytes`, made again only to grow.
 void fit(std::unique_ptr<Buffer>& b, Context& ctx, uint64_t bytes, const char* what) {
   if (!b || b->size() < bytes) b.reset(), b = std::make_unique<Buffer>(ctx, std::max<uint64_t>(bytes, 256), what);
 }
 
 }  // namespace
+
+// What one batch in flight holds (gpu/scene.h).
+struct SceneMethod::Flight {
+  Context& ctx;
+  VkFence fence = VK_NULL_HANDLE;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  bool in_flight = false;
+  explicit Flight(Context& c) : ctx(c) {
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(ctx.vk().CreateFence(ctx.device(), &fci, nullptr, &fence), "vkCreateFence");
+    try {
+      cb = ctx.allocate_command_buffer();
+    } catch (...) {  // on an engine's device nothing may leak
+      ctx.vk().DestroyFence(ctx.device(), fence, nullptr);
+      throw;
+    }
+  }
+  ~Flight() {
+    wait_quietly();
+    ctx.free_command_buffer(cb);
+    ctx.vk().DestroyFence(ctx.device(), fence, nullptr);
+  }
+  Flight(const Flight&) = delete;
+  Flight& operator=(const Flight&) = delete;
+  // GpuError when the device is lost; in_flight stays until the wait succeeds.
+  void wait() {
+    if (!in_flight) return;
+    check(ctx.vk().WaitForFences(ctx.device(), 1, &fence, VK_TRUE, kWaitNs), "waiting for the GPU");
+    in_flight = false;
+  }
+  // The destructor's: a lost device's batch is given up, not thrown.
+  void wait_quietly() {
+    if (in_flight) ctx.vk().WaitForFences(ctx.device(), 1, &fence, VK_TRUE, kWaitNs);
+    in_flight = false;
+  }
+  static constexpr uint64_t kWaitNs = 600ull * 1000 * 1000 * 1000;
+};
 
 SceneMethod::SceneMethod(Context& ctx, uint32_t flags) : ctx_(ctx), flags_(flags) {
   const uint32_t known = MC_HIT_UV | MC_QUERY_ANY | MC_CULL_BACK | MC_CULL_FRONT;
@@ -39,6 +83,7 @@ SceneMethod::SceneMethod(Context& ctx, uint32_t flags) : ctx_(ctx), flags_(flags
   pipeline_ = std::make_unique<Pipeline>(ctx, scene_octtree_spv, sizeof scene_octtree_spv, 7, sizeof(ScenePush), 1,
                                          flags, 1);
   unused_ = std::make_unique<Buffer>(ctx, 16, "unused binding");
+  flight_ = std::make_unique<Flight>(ctx);
 }
 
 SceneMethod::~SceneMethod() = default;
@@ -66,10 +111,15 @@ void SceneMethod::upload_blobs(const SceneSnapshot& s) {
 }
 
 uint64_t SceneMethod::trace(const SceneSnapshot& s, std::span<const RayD> rays, std::span<SceneHit> hits, uint8_t mask) {
-  if (hits.size() < rays.size())
-    throw UsageError("GPU scene method: " + std::to_string(rays.size()) + " rays but room for " +
-                     std::to_string(hits.size()) + " hits");
-  if (rays.empty()) return 0;
+  check_room(rays.size(), hits.size());
+  begin(s, rays, mask);
+  return finish(hits);
+}
+
+void SceneMethod::begin(const SceneSnapshot& s, std::span<const RayD> rays, uint8_t mask) {
+  if (flight_->in_flight) throw std::logic_error("GPU scene method: a batch is still in flight");
+  n_ = 0;
+  if (rays.empty()) return;
   if (rays.size() >= (uint64_t(1) << 32) / kSceneHitWords)
     throw UsageError("GPU scene method: " + std::to_string(rays.size()) + " rays in one batch, more than it addresses");
   upload_blobs(s);
@@ -101,16 +151,29 @@ uint64_t SceneMethod::trace(const SceneSnapshot& s, std::span<const RayD> rays, 
   std::memcpy(rays_->data(), rays.data(), rays.size_bytes());
   pipeline_->bind({blobs_.get(), rays_.get(), unused_.get(), unused_.get(), unused_.get(), top_.get(), hits_.get()});
   const uint32_t most = ctx_.limits().maxComputeWorkGroupCount[0];
-  ctx_.submit([&](VkCommandBuffer cb) {
-    for (uint32_t first = 0; first < n;) {
-      const uint32_t groups = std::min<uint32_t>((n - first + kGroup - 1) / kGroup, most);
-      const ScenePush push{first, n, mask};
-      pipeline_->dispatch(cb, 0, &push, groups, 1, 1);
-      first += std::min<uint32_t>(groups * kGroup, n - first);
-    }
-    ctx_.host_barrier(cb);  // the answers, read by the host after the fence
-  });
-  const auto* out = static_cast<const uint32_t*>(hits_->data());
+  VkCommandBuffer cb = flight_->cb;
+  check(ctx_.vk().ResetCommandBuffer(cb, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  check(ctx_.vk().BeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
+  for (uint32_t first = 0; first < n;) {
+    const uint32_t groups = std::min<uint32_t>((n - first + kGroup - 1) / kGroup, most);
+    const ScenePush push{first, n, mask};
+    pipeline_->dispatch(cb, 0, &push, groups, 1, 1);
+    first += std::min<uint32_t>(groups * kGroup, n - first);
+  }
+  ctx_.host_barrier(cb);  // the answers, read by the host after the fence
+  check(ctx_.vk().EndCommandBuffer(cb), "vkEndCommandBuffer");
+  ctx_.submit_async(cb, flight_->fence);
+  flight_->in_flight = true;
+  n_ = n;
+}
+
+uint64_t SceneMethod::finish(std::span<SceneHit> hits) {
+  check_room(n_, hits.size());
+  flight_->wait();
+  const uint32_t n = n_;
+  const auto* out = static_cast<const uint32_t*>(hits_ ? hits_->data() : nullptr);
   uint64_t skipped = 0;
   for (uint32_t i = 0; i < n; ++i, out += kSceneHitWords) {
     SceneHit& h = hits[i];

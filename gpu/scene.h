@@ -41,16 +41,33 @@ class SceneMethod {
   uint64_t trace(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,
                  uint8_t mask = 0xFF);
 
+  // trace() in two halves, one batch in flight: begin() uploads what it
+  // needs and submits without waiting (the snapshot may go once it
+  // returns); finish() waits for the batch and writes its answers (hits at
+  // least the batch's size, else UsageError), returning trace()'s count.
+  // The host layer's GPU thread runs scene batches so. Not thread-safe: one
+  // caller at a time, and begin() only with no batch in flight
+  // (std::logic_error otherwise).
+  void begin(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint8_t mask = 0xFF);
+  uint64_t finish(std::span<SceneHit> hits);
+
  private:
   void upload_blobs(const SceneSnapshot& snapshot);
   Context& ctx_;
   const uint32_t flags_;
+  uint32_t n_ = 0;  // the rays of the batch begun last
   std::unique_ptr<Pipeline> pipeline_;
   std::unique_ptr<Buffer> blobs_, top_, rays_, hits_, unused_;
   // The meshes blobs_ holds, in the snapshot's order: held, so that a mesh
   // made later can never take the address of one uploaded here.
   std::vector<std::shared_ptr<const SceneMesh>> uploaded_;
   std::vector<uint32_t> mesh_base_;    // each one's first word in blobs_
+  // The command buffer (re-recorded every batch: its sizes and buffers
+  // vary), its fence and whether a batch is in flight (gpu/scene.cpp).
+  // Declared last: destroyed first, it waits for a batch in flight before
+  // the buffers that batch reads go.
+  struct Flight;
+  std::unique_ptr<Flight> flight_;
 };
 
 }  // namespace meshcast::gpu

@@ -12,6 +12,7 @@
 #include "layout/files.h"
 #include "gpu/method.h"
 #if MESHCAST_VULKAN
+#include "gpu/scene.h"
 #include "gpu/vulkan.h"
 #endif
 #include "host/jobs.h"
@@ -73,7 +74,9 @@ Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOpt
 }
 
 Caster::Caster(CasterOptions options) : options_(std::move(options)) {
-  options_.backend = Backend::Cpu;  // nothing for a GPU to read
+  // Scene batches alone: the GPU only when asked for by name (the
+  // Automatic backend's crossover is a blob's).
+  if (options_.backend == Backend::Automatic) options_.backend = Backend::Cpu;
   setup({}, "");
 }
 
@@ -150,6 +153,7 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
       }
       std::vector<std::string> names = options_.gpu_method.empty() ? gpu::method_names()
                                                                      : std::vector<std::string>{options_.gpu_method};
+      if (!view_) names.clear();  // scene batches alone: the context is all they need
       for (const std::string& m : names) {
         try {
           method_ = gpu::make_method(*gpu_, m, blob, name, uint32_t(slots_.size()), uint32_t(options_.hit_outputs));
@@ -159,7 +163,7 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
           if (!options_.gpu_method.empty()) throw;
         }
       }
-      if (!method_)
+      if (!method_ && view_)
         throw GpuError("no GPU method reads " + std::string(layout::tree_format_name(layout::header_of(blob.data()).tree_format)) +
                             "/" + std::string(layout::triangle_format_name(layout::header_of(blob.data()).triangle_format)));
       completion_ = std::thread([this] { gpu_completions(); });
@@ -221,6 +225,7 @@ Caster::~Caster() {
   pool_.reset();
   jobs_ = nullptr;
   query_methods_.clear();  // before the context they were made on
+  scene_methods_.clear();
   method_.reset();
   gpu_.reset();
 }
@@ -315,7 +320,16 @@ Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatch
     s.query = {query.query, query.cull, query.max_hits};
     size_slot(s, rays.size(), true);
     s.world.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-    start_cpu(s);
+    if (s.n > 0 && scene_on_gpu(query)) {
+      s.ran_on = Backend::Vulkan;
+      {
+        std::lock_guard<std::mutex> lock(pending_mutex_);
+        pending_.push_back(&s);  // begun by the GPU thread, after the batches before it
+      }
+      pending_changed_.notify_one();
+    } else {
+      start_cpu(s);
+    }
   } catch (...) {
     free_slot(s);
     throw;
@@ -395,13 +409,41 @@ void Caster::gpu_completions() {
     }
     try {
       if (gpu_failed_) throw GpuError(gpu_error());
-      s->method->wait(s->index);
+      if (s->scene) run_scene_on_gpu(*s);
+      else s->method->wait(s->index);
       complete(*s, Backend::Vulkan);
-    } catch (const GpuError& e) {  // waiting failed: the device is lost
-      gpu_failed(e.what());
+    } catch (const GpuError& e) {  // the device is lost, or (a scene batch) refused what it was asked
+      if (e.lost || !s->scene) gpu_failed(e.what());
+      start_cpu(*s);
+    } catch (const std::exception&) {  // a scene the GPU method does not read (a layout, a limit): the CPU's
       start_cpu(*s);
     }
   }
+}
+
+bool Caster::scene_on_gpu(const SceneBatchQuery& q) const {
+  return options_.backend == Backend::Vulkan && gpu_ != nullptr && !gpu_failed_ && q.query != Query::All;
+}
+
+void Caster::run_scene_on_gpu(Slot& s) {
+#if !MESHCAST_VULKAN
+  (void)s;  // not reached: without the Vulkan backend there is no device
+#else
+  const SceneBatchQuery& q = s.scene_query;
+  const uint32_t flags = (uint32_t(options_.hit_outputs) & MC_HIT_UV) | layout::query_bits(q.query, q.cull);
+  gpu::SceneMethod* method = nullptr;
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::lock_guard<std::mutex> lock(gpu_mutex_);  // the queue and the command pool are shared
+    if (options_.before_gpu_submit) options_.before_gpu_submit();
+    std::shared_ptr<gpu::SceneMethod>& m = scene_methods_[flags];
+    if (!m) m = std::make_shared<gpu::SceneMethod>(*gpu_, flags);
+    method = m.get();
+    method->begin(*s.scene, s.world, q.mask);
+    s.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  method->finish(s.scene_hits);  // waits for the fence alone: blob batches may begin meanwhile
+#endif
 }
 
 void Caster::gpu_failed(const std::string& why) {

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <deque>
+#include <map>
 #include <random>
 #include <cmath>
 #include <cstdlib>
@@ -516,9 +517,13 @@ class LateJobs : public host::JobSystem {
   std::thread thread_;
 };
 
-TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
+// The frames of SceneBatchesSeeTheFrameTheySubmittedIn on `backend`, the
+// sphere in `sphere_layout` (the terrain is in the recommended layout).
+// Returns the batches each backend answered.
+std::map<Backend, int> scene_frames(Backend backend, const char* sphere_layout) {
+  std::map<Backend, int> answered;
   Scene scene;
-  const MeshId sphere = scene.add_mesh(build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "sphere"), "sphere");
+  const MeshId sphere = scene.add_mesh(build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout(sphere_layout), "sphere"), "sphere");
   const MeshId ground = scene.add_mesh(build_blob(make_terrain(6, 6, 3), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "terrain"), "terrain");
   std::mt19937 rng(12);
   std::uniform_real_distribution<double> u(-30, 30);
@@ -537,9 +542,10 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
     r.tmax = INFINITY;
   }
   LateJobs late;
-  CasterOptions o = options(Backend::Cpu, 3);
+  CasterOptions o = options(backend, 3);
   o.jobs = &late;
   Caster caster(o);
+  EXPECT_EQ(caster.gpu_error(), "");
   EXPECT_THROW(caster.submit(std::vector<Ray>(1)), UsageError);  // no blob
   // What each batch must answer, walked from its frame's snapshot when it
   // was submitted (the snapshot is not kept: only the caster holds it).
@@ -557,7 +563,7 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
     if (f.query.query == Query::All) {
       SceneHitLists got;
       const SceneHitLists& want = f.want_rows;
-      caster.wait(f.ticket, got);
+      ++answered[caster.wait(f.ticket, got).ran_on];
       ASSERT_EQ(got.found, want.found);
       for (size_t i = 0; i < want.hits.size(); ++i) {
         EXPECT_EQ(got.hits[i].instance, want.hits[i].instance) << "record " << i;
@@ -567,7 +573,7 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
     }
     std::vector<SceneHit> got(rays.size()), now(rays.size());
     const std::vector<SceneHit>& want = f.want;
-    caster.wait(f.ticket, got);
+    ++answered[caster.wait(f.ticket, got).ran_on];
     scene.trace(rays, now, HitOutputs::None, f.query.query, f.query.cull, f.query.mask);
     for (size_t i = 0; i < rays.size(); ++i) {
       EXPECT_EQ(got[i].instance, want[i].instance) << "ray " << i;
@@ -610,6 +616,64 @@ TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
   EXPECT_THROW(caster.wait(t, plain), UsageError);
   std::vector<SceneHit> hits(rays.size());
   caster.wait(t, hits);
+  EXPECT_EQ(caster.validation_messages(), 0u);
+  return answered;
+}
+
+TEST(Host, SceneBatchesSeeTheFrameTheySubmittedIn) {
+  const std::map<Backend, int> answered = scene_frames(Backend::Cpu, "AABBTree/Float3");
+  EXPECT_EQ(answered.at(Backend::Cpu), 24);
+  EXPECT_EQ(answered.count(Backend::Vulkan), 0u);
+}
+
+// The same frames with Backend::Vulkan: the closest- and any-hit batches
+// are the GPU's (16 of 24), Query::All's the CPU's; with a mesh in a layout
+// the GPU scene method does not read, every batch is the CPU's, answered
+// the same.
+TEST(Host, SceneBatchesOnTheGpuSeeTheFrameTheySubmittedIn) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const std::map<Backend, int> gpu = scene_frames(Backend::Vulkan, "OctTreeCompressed/ClusterBitPackSOA8");
+  EXPECT_EQ(gpu.at(Backend::Vulkan), 16);
+  EXPECT_EQ(gpu.at(Backend::Cpu), 8);
+  const std::map<Backend, int> refused = scene_frames(Backend::Vulkan, "AABBTree/Float3");
+  EXPECT_EQ(refused.at(Backend::Cpu), 24);
+  EXPECT_EQ(refused.count(Backend::Vulkan), 0u);
+}
+
+// A scene batch the GPU refuses (an injected limit) is the CPU's and the
+// GPU stays; after a lost device every scene batch is the CPU's. Each
+// answers as the scene's own walk.
+TEST(Host, SceneBatchesLeaveARefusingOrLostGpuForTheCpu) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  Scene scene;
+  const MeshId ball = scene.add_mesh(build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball"), "ball");
+  for (int i = 0; i < 8; ++i) {
+    Transform t;
+    t.translation[0] = 3.0 * i;
+    scene.add_instance(ball, t);
+  }
+  scene.commit();
+  std::vector<RayD> rays(64);
+  for (size_t i = 0; i < rays.size(); ++i) rays[i] = {{0.37 * double(i), 0.2, -10}, {0, 0, 1}, INFINITY};
+  std::vector<SceneHit> want(rays.size()), got(rays.size());
+  scene.trace(rays, want);
+  int submission = 0;
+  CasterOptions o = options(Backend::Vulkan);
+  o.before_gpu_submit = [&submission] {
+    ++submission;
+    if (submission == 2) throw GpuError("Vulkan: the scene's buffers exceed a limit (injected by the test)");
+    if (submission > 3) throw GpuError("Vulkan: device lost (injected by the test)", true);
+  };
+  Caster caster(o);
+  const Backend expected[] = {Backend::Vulkan, Backend::Cpu, Backend::Vulkan, Backend::Cpu, Backend::Cpu};
+  for (Backend b : expected) {
+    EXPECT_EQ(caster.wait(caster.submit(scene, rays), got).ran_on, b);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      EXPECT_EQ(got[i].instance, want[i].instance) << "ray " << i;
+      EXPECT_EQ(got[i].t, want[i].t) << "ray " << i;
+    }
+  }
+  EXPECT_NE(caster.gpu_error().find("device lost"), std::string::npos) << caster.gpu_error();
 }
 }  // namespace
 }  // namespace meshcast::testing

@@ -15,7 +15,13 @@
 // Scenes (meshcast/scene.h): a batch of world rays against the scene as it
 // was committed when the batch was submitted (the batch holds that
 // snapshot), while the game moves, hides and adds instances and commits the
-// next frames; the CPU's workers walk it.
+// next frames. The CPU's workers walk it, or with Backend::Vulkan the GPU
+// (closest or any hit of meshes in the recommended layout,
+// OctTreeCompressed/ClusterBitPackSOA8: gpu/scene.h), one scene batch on
+// the device at a time, begun in submission order by the caster's GPU
+// thread; Query::All, other layouts, a refused batch and a lost device
+// are the CPU's (BatchRecord::ran_on says which answered). The Automatic
+// backend sends scene batches to the CPU (its crossover is the blob's).
 //
 //   Caster scenes({});                          // no blob: scene batches alone
 //   Ticket f = scenes.submit(scene, world_rays, {Query::Closest, Cull::None, 0xFF});
@@ -50,6 +56,7 @@
 namespace meshcast::gpu {
 class Context;
 class Method;
+class SceneMethod;
 }
 
 namespace meshcast::host {
@@ -142,8 +149,9 @@ class Caster {
   // Automatic, a device that is missing or fails leaves the caster on the
   // CPU, and gpu_error() says why.
   Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options = {});
-  // A caster of scene batches alone: no blob, the CPU's workers (the
-  // options' backend is not read). Its blob calls throw UsageError.
+  // A caster of scene batches alone: no blob; the CPU's workers, or with
+  // Backend::Vulkan the GPU as above (a missing device leaves the CPU and
+  // gpu_error() says why). Its blob calls throw UsageError.
   explicit Caster(CasterOptions options);
   ~Caster();
   Caster(const Caster&) = delete;
@@ -216,6 +224,13 @@ class Caster {
   gpu::Method* method_for(const BatchQuery& q);
   void start_cpu(Slot& s);
   void start_gpu(Slot& s);
+  // Whether a scene batch of this query goes to the GPU (Backend::Vulkan,
+  // a device that has not failed, one hit a ray).
+  bool scene_on_gpu(const SceneBatchQuery& q) const;
+  // A scene batch on the GPU thread: begun, waited for, its answers in the
+  // slot (GpuError for a lost device, InputError or UsageError for a batch
+  // the GPU scene method refuses).
+  void run_scene_on_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
   void gpu_completions();
   void gpu_failed(const std::string& why);
@@ -244,6 +259,9 @@ class Caster {
   std::unique_ptr<gpu::Method> method_;  // the closest hit's, two-sided (and the crossover's)
   std::string method_name_;
   std::map<std::pair<uint32_t, uint32_t>, std::unique_ptr<gpu::Method>> query_methods_;  // (flags, max_hits)
+  // By flags; the GPU thread's alone. shared_ptr: its deleter is made where
+  // the method is (a build without Vulkan makes none and needs none).
+  std::map<uint32_t, std::shared_ptr<gpu::SceneMethod>> scene_methods_;
   std::string gpu_error_;
   std::atomic<bool> gpu_failed_{false};
   std::atomic<uint32_t> crossover_{~0u};
@@ -263,7 +281,7 @@ class Caster {
   std::vector<BatchRecord> records_;
   uint64_t recorded_ = 0;
 
-  std::mutex pending_mutex_;            // GPU batches waiting for their fence, in order
+  std::mutex pending_mutex_;            // GPU batches waiting for their fence (scene batches: to begin), in order
   std::condition_variable pending_changed_;
   std::deque<Slot*> pending_;
   bool stopping_ = false;

@@ -224,8 +224,7 @@ Caster::~Caster() {
   while (calls_in_work_.load(std::memory_order_acquire) != 0) std::this_thread::yield();
   pool_.reset();
   jobs_ = nullptr;
-  query_methods_.clear();  // before the context they were made on
-  scene_methods_.clear();
+  query_methods_.clear();  // before the context they were made on (the scene methods: the GPU thread's, gone with it)
   method_.reset();
   gpu_.reset();
 }
@@ -403,7 +402,10 @@ void Caster::gpu_completions() {
     {
       std::unique_lock<std::mutex> lock(pending_mutex_);
       pending_changed_.wait(lock, [this] { return stopping_ || !pending_.empty(); });
-      if (pending_.empty()) return;
+      if (pending_.empty()) {
+        scene_methods_.clear();  // made and used by this thread alone: let go here too
+        return;
+      }
       s = pending_.front();
       pending_.pop_front();
     }

@@ -137,8 +137,10 @@ struct CasterOptions {
   bool validation = false;      // Vulkan validation layers
   HitOutputs hit_outputs = HitOutputs::None;  // what each hit carries besides t and the triangle, either backend
   std::string profile;          // file with a saved crossover; measured and written when absent
-  // Test hook: called before every GPU submission; throwing GpuError there
-  // acts as a lost device.
+  // Test hook: called before every GPU submission (on the submitting
+  // thread: the caller's, or the caster's GPU thread for scene batches);
+  // throwing GpuError there refuses the batch, or with `lost` set acts as
+  // a lost device.
   std::function<void()> before_gpu_submit;
 };
 

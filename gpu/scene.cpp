@@ -88,17 +88,26 @@ SceneMethod::SceneMethod(Context& ctx, uint32_t flags) : ctx_(ctx), flags_(flags
 
 SceneMethod::~SceneMethod() = default;
 
-void SceneMethod::upload_blobs(const SceneSnapshot& s) {
-  if (blobs_ && s.meshes == uploaded_) return;
-  std::vector<uint8_t> all;
-  std::vector<uint32_t> base;
+std::string SceneMethod::refusal(const SceneSnapshot& s) {
+  uint64_t bytes = 0;
   for (const auto& m : s.meshes) {
     const layout::BlobHeader& h = layout::header_of(m->bytes.data());
     if (h.tree_format != MC_TREE_OCTTREECOMPRESSED || h.triangle_format != MC_TRI_CLUSTERBITPACKSOA8)
-      throw InputError(m->name + ": the GPU scene method reads OctTreeCompressed/ClusterBitPackSOA8 blobs, not " +
-                       layout_name(h.tree_format, h.triangle_format));
-    if ((all.size() + m->bytes.size()) / 4 >= (uint64_t(1) << 32))
-      throw InputError(m->name + ": the scene's blobs pass 2^32 words, more than the GPU scene method addresses");
+      return m->name + ": the GPU scene method reads OctTreeCompressed/ClusterBitPackSOA8 blobs, not " +
+             layout_name(h.tree_format, h.triangle_format);
+    bytes += (m->bytes.size() + 3) / 4 * 4;  // each blob starts on a word
+    if (bytes / 4 >= (uint64_t(1) << 32))
+      return m->name + ": the scene's blobs pass 2^32 words, more than the GPU scene method addresses";
+  }
+  return "";
+}
+
+void SceneMethod::upload_blobs(const SceneSnapshot& s) {
+  if (blobs_ && s.meshes == uploaded_) return;
+  if (const std::string why = refusal(s); !why.empty()) throw InputError(why);
+  std::vector<uint8_t> all;
+  std::vector<uint32_t> base;
+  for (const auto& m : s.meshes) {
     base.push_back(uint32_t(all.size() / 4));
     all.insert(all.end(), m->bytes.begin(), m->bytes.end());
     all.resize((all.size() + 3) / 4 * 4);  // the next blob on a word

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "meshcast/scene.h"
@@ -50,6 +51,11 @@ class SceneMethod {
   // (std::logic_error otherwise).
   void begin(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint8_t mask = 0xFF);
   uint64_t finish(std::span<SceneHit> hits);
+
+  // "" when the method reads every mesh of the snapshot, else why not (a
+  // mesh in another layout, naming it; blobs past what it addresses): what
+  // begin() would refuse, found without copying anything.
+  static std::string refusal(const SceneSnapshot& snapshot);
 
  private:
   void upload_blobs(const SceneSnapshot& snapshot);

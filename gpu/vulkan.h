@@ -38,7 +38,8 @@ struct DeviceChoice {
 // enabled (and shaderBufferInt64Atomics for the bruteforce and aabblist
 // methods); the queue belongs to `queue_family`, which must offer compute,
 // and Vulkan's rule holds that no two threads submit to one queue at once:
-// give meshcast a queue the engine does not submit to from another thread.
+// give meshcast a queue the engine does not submit to from another thread
+// (a Caster's: none the engine submits to at all, see VulkanObjects).
 // The engine's objects must outlive the context, which never destroys them.
 struct ExternalDevice {
   VkInstance instance = VK_NULL_HANDLE;

@@ -319,7 +319,7 @@ Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatch
     s.query = {query.query, query.cull, query.max_hits};
     size_slot(s, rays.size(), true);
     s.world.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-    if (s.n > 0 && scene_on_gpu(query)) {
+    if (s.n > 0 && scene_on_gpu(query, *s.scene)) {
       s.ran_on = Backend::Vulkan;
       {
         std::lock_guard<std::mutex> lock(pending_mutex_);
@@ -414,7 +414,7 @@ void Caster::gpu_completions() {
       if (s->scene) run_scene_on_gpu(*s);
       else s->method->wait(s->index);
       complete(*s, Backend::Vulkan);
-    } catch (const GpuError& e) {  // the device is lost, or (a scene batch) refused what it was asked
+    } catch (const GpuError& e) {  // the device is lost, or (a scene batch, before it began) refused it
       if (e.lost || !s->scene) gpu_failed(e.what());
       start_cpu(*s);
     } catch (const std::exception&) {  // a scene the GPU method does not read (a layout, a limit): the CPU's
@@ -423,8 +423,14 @@ void Caster::gpu_completions() {
   }
 }
 
-bool Caster::scene_on_gpu(const SceneBatchQuery& q) const {
-  return options_.backend == Backend::Vulkan && gpu_ != nullptr && !gpu_failed_ && q.query != Query::All;
+bool Caster::scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const {
+#if !MESHCAST_VULKAN
+  (void)q, (void)frame;
+  return false;
+#else
+  return options_.backend == Backend::Vulkan && gpu_ != nullptr && !gpu_failed_ && q.query != Query::All &&
+         gpu::SceneMethod::refusal(frame).empty();  // a mesh it does not read: the CPU's at once, not after the queue
+#endif
 }
 
 void Caster::run_scene_on_gpu(Slot& s) {
@@ -444,7 +450,13 @@ void Caster::run_scene_on_gpu(Slot& s) {
     method->begin(*s.scene, s.world, q.mask);
     s.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
-  method->finish(s.scene_hits);  // waits for the fence alone: blob batches may begin meanwhile
+  try {
+    method->finish(s.scene_hits);  // waits for the fence alone: blob batches may begin meanwhile
+  } catch (const GpuError& e) {
+    // A batch begun but not finished (its fence never signalled) leaves
+    // the device unusable, whatever the error says: lost.
+    throw GpuError(e.what(), true);
+  }
 #endif
 }
 

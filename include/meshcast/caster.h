@@ -114,8 +114,10 @@ struct Percentiles {
 // void* so this header needs no Vulkan. The device must have shaderInt64 and
 // shaderFloat64 enabled (and shaderBufferInt64Atomics for the bruteforce and
 // aabblist methods), `queue` must be of `queue_family`, which offers compute,
-// and must not be submitted to by the engine from another thread while the
-// caster lives; everything must outlive the caster, which destroys none of it.
+// and must not be submitted to by the engine at all while the caster lives
+// (the caster submits from threads of its own too: the Automatic backend's
+// measurement, and scene batches); everything must outlive the caster,
+// which destroys none of it.
 // get_instance_proc_addr: null for the loader's.
 struct VulkanObjects {
   void* instance = nullptr;
@@ -226,12 +228,13 @@ class Caster {
   gpu::Method* method_for(const BatchQuery& q);
   void start_cpu(Slot& s);
   void start_gpu(Slot& s);
-  // Whether a scene batch of this query goes to the GPU (Backend::Vulkan,
-  // a device that has not failed, one hit a ray).
-  bool scene_on_gpu(const SceneBatchQuery& q) const;
+  // Whether a scene batch of this query on this frame goes to the GPU
+  // (Backend::Vulkan, a device that has not failed, one hit a ray, every
+  // mesh in the layout the GPU scene method reads).
+  bool scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const;
   // A scene batch on the GPU thread: begun, waited for, its answers in the
-  // slot (GpuError for a lost device, InputError or UsageError for a batch
-  // the GPU scene method refuses).
+  // slot (GpuError, `lost` once the batch was begun; InputError or
+  // UsageError for a batch the GPU scene method refuses).
   void run_scene_on_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
   void gpu_completions();

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -19,6 +20,7 @@
 #include "builder/layout_names.h"
 #include "builder/pairing.h"
 #include "layout/aabbtree.h"
+#include "layout/number_text.h"
 #include "layout/codecs.h"
 #include "layout/quadtree.h"
 #include "builder/writer.h"
@@ -198,6 +200,15 @@ std::vector<uint8_t> build_blob(const MeshView& mesh, const BuildOptions& option
   return build_blob(copy_mesh(mesh, name), options, name, report);
 }
 
+// The least extent an axis of a grid format's mesh may have (above 0):
+// where its step reaches FLT_MIN. A mesh box grid divides the extent into
+// MC_BITPACK_MAX steps; a power-of-two grid's step is at most 2^(1 - bits)
+// of the extent (codes = 2^bits - 2).
+static double least_grid_extent(const CodecOps& codec) {
+  if (codec.grid == layout::kGridMeshBox) return double(FLT_MIN) * MC_BITPACK_MAX;
+  return double(FLT_MIN) * 0.5 * (std::ldexp(1.0, int(codec.grid_bits)) - 2);
+}
+
 std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, const std::string& name,
                                 BuildReport* report) {
   auto start = std::chrono::steady_clock::now();
@@ -238,6 +249,16 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
     } else {
       h.quant_offset[a] = 0, h.quant_scale[a] = 0;
     }
+    // A step below FLT_MIN would be a denormal float: rounded coarser than
+    // the format states, flushed to 0 by a GPU (the axis flattened), or 0
+    // outright (float's own underflow). The least extent a grid takes is
+    // about 2^-105 (2.5e-32), beside kMaxCoordinate's 2^100 above.
+    if (grid && extent > 0 && !(h.quant_scale[a] >= FLT_MIN))
+      throw InputError(name + ": the mesh spans " + number_text(extent) + " on axis " + "xyz"[a] + ", less than the " +
+                       number_text(least_grid_extent(codec)) + " that " +
+                       std::string(layout::triangle_format_name(h.triangle_format)) + "'s grid of 2^" +
+                       std::to_string(codec.grid_bits) + " steps needs (a step below 2^-126, the least normal float, "
+                       "would round vertices coarser than stated); build it in a float format (Float3) or scale it up");
   }
   std::vector<uint64_t> packed(grid ? mesh.vertices.size() : 0);
   for (size_t v = 0; v < packed.size(); ++v) {

@@ -39,28 +39,30 @@ RayKind parse_ray_kind(const std::string& name) {
   throw InputError("unknown ray kind '" + name + "'; valid kinds: long, probe, radial");
 }
 
-std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed) {
-  Rng rng{seed * 0x2545F4914F6CDD1Dull + uint64_t(kind)};
-  Box3 box = mesh.bounds();
-  Vec3 c = box.centre();
-  double diag = box.diagonal();
-  std::vector<Ray> rays(count);
+RaySource::RaySource(const Mesh& mesh, RayKind kind, uint64_t seed)
+    : mesh_(mesh), kind_(kind), state_(seed * 0x2545F4914F6CDD1Dull + uint64_t(kind)), box_(mesh.bounds()),
+      diagonal_(box_.diagonal()) {}
+
+void RaySource::fill(std::span<Ray> rays) {
+  Rng rng{state_};
+  const Vec3 c = box_.centre();
+  const double diag = diagonal_;
   for (Ray& r : rays) {
     Vec3 o, d;
     float tmax = INFINITY;
-    if (kind == RayKind::Long) {
+    if (kind_ == RayKind::Long) {
       Vec3 u = rng.unit();
       o = {float(c.x + diag * u.x), float(c.y + diag * u.y), float(c.z + diag * u.z)};
-      Vec3 p = lerp_box(box, rng);
+      Vec3 p = lerp_box(box_, rng);
       d = {p.x - o.x, p.y - o.y, p.z - o.z};
-    } else if (kind == RayKind::Radial) {
+    } else if (kind_ == RayKind::Radial) {
       o = c;
       d = rng.unit();
     } else {
-      size_t t = size_t(rng.uniform() * mesh.triangles.size());
+      size_t t = size_t(rng.uniform() * mesh_.triangles.size());
       double a = rng.uniform(), b = rng.uniform();
       if (a + b > 1) a = 1 - a, b = 1 - b;
-      Vec3 p0 = mesh.corner(t, 0), p1 = mesh.corner(t, 1), p2 = mesh.corner(t, 2);
+      Vec3 p0 = mesh_.corner(t, 0), p1 = mesh_.corner(t, 1), p2 = mesh_.corner(t, 2);
       double e1[3], e2[3], n[3];
       for (int k = 0; k < 3; ++k) e1[k] = double(p1[k]) - p0[k], e2[k] = double(p2[k]) - p0[k];
       n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
@@ -72,6 +74,12 @@ std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_
     }
     r = {{o.x, o.y, o.z}, {d.x, d.y, d.z}, tmax};
   }
+  state_ = rng.s;
+}
+
+std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed) {
+  std::vector<Ray> rays(count);
+  RaySource(mesh, kind, seed).fill(rays);
   return rays;
 }
 

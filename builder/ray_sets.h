@@ -4,6 +4,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -24,5 +25,22 @@ RayKind parse_ray_kind(const std::string& name);
 //          point of a random triangle, in random directions.
 //  Radial: from the centre of the box in random directions; t_max infinite.
 std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed);
+
+// The same rays a part at a time: fill() writes the next rays of the set
+// make_rays(mesh, kind, any count, seed) starts with, so a file of 2^27 rays
+// is written a chunk at a time rather than held whole. Holds the mesh by
+// reference.
+class RaySource {
+ public:
+  RaySource(const Mesh& mesh, RayKind kind, uint64_t seed);
+  void fill(std::span<Ray> rays);
+
+ private:
+  const Mesh& mesh_;
+  RayKind kind_;
+  uint64_t state_;
+  Box3 box_;
+  double diagonal_;
+};
 
 }  // namespace meshcast

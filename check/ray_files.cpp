@@ -1,7 +1,9 @@
 #include "check/ray_files.h"
 
 #include <bit>
+#include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 namespace meshcast {
@@ -12,12 +14,38 @@ namespace {
 // (their bytes as they lie in memory: every format here is little-endian).
 static_assert(std::endian::native == std::endian::little, "the files' records are their structs' bytes");
 
+// What each file of ray_files.h holds, for a message that names what was
+// given where another was expected.
+const char* file_kind(const std::string& magic) {
+  if (magic == "RAYS") return "rays with float origins";
+  if (magic == "RAYD") return "rays with double origins, read by scenes";
+  if (magic == "HITS") return "a mesh's closest or any hits";
+  if (magic == "HITN") return "a mesh's every hit";
+  if (magic == "HITI") return "a scene's hits";
+  return nullptr;
+}
+
+// InputError unless the file's first bytes are `magic` and its header
+// (`header` bytes, the magic's 4 included) is whole.
+void check_magic(const std::string& path, const std::vector<uint8_t>& b, const char magic[4], size_t header) {
+  const std::string expected(magic, 4);
+  if (b.size() < header)
+    throw InputError(path + ": " + std::to_string(b.size()) + " bytes, shorter than a " + expected + " file's " +
+                     std::to_string(header) + "-byte header (" + file_kind(expected) + ")");
+  const std::string found(reinterpret_cast<const char*>(b.data()), 4);
+  if (found == expected) return;
+  if (const char* kind = file_kind(found))
+    throw InputError(path + ": not a " + expected + " file (" + file_kind(expected) + ") but a " + found + " file (" +
+                     kind + ")");
+  throw InputError(path + ": not a " + expected + " file (" + file_kind(expected) + "): its first 4 bytes are not \"" +
+                   expected + "\"");
+}
+
 template <class Record>
 std::vector<Record> read_records(const std::string& path, const char magic[4]) {
   constexpr size_t record_bytes = sizeof(Record);
   std::vector<uint8_t> b = read_file(path);
-  if (b.size() < 8 || std::memcmp(b.data(), magic, 4) != 0)
-    throw InputError(path + ": not a " + std::string(magic, 4) + " file (bad magic or shorter than 8 bytes)");
+  check_magic(path, b, magic, 8);
   uint32_t n;
   std::memcpy(&n, b.data() + 4, 4);
   if (b.size() != 8 + uint64_t(n) * record_bytes)
@@ -67,6 +95,26 @@ void write_rays(const std::string& path, const std::vector<Ray>& rays) {
   write_records<Ray>(path, "RAYS", rays, [](const Ray& r) { return r; });
 }
 
+void write_rays(const std::string& path, size_t count, const std::function<void(std::span<Ray>)>& make) {
+  if (count > kMaxRayCount)
+    throw InputError(path + ": " + std::to_string(count) + " rays, more than a RAYS file may hold (" +
+                     std::to_string(kMaxRayCount) + ")");
+  char header[8] = {'R', 'A', 'Y', 'S'};
+  const uint32_t n = uint32_t(count);
+  std::memcpy(header + 4, &n, 4);
+  constexpr size_t kChunk = size_t(1) << 16;  // 1.75 MiB of records at a time
+  std::vector<Ray> chunk;
+  size_t written = 0;
+  bool header_written = false;
+  write_file_pieces(path, [&]() -> Bytes {
+    if (!header_written) return header_written = true, Bytes{header, sizeof header};
+    chunk.resize(std::min(kChunk, count - written));
+    make(chunk);
+    written += chunk.size();
+    return {chunk.data(), chunk.size() * sizeof(Ray)};
+  });
+}
+
 std::vector<Hit> read_hits(const std::string& path) {
   std::vector<Hit> hits;
   for (const HitRecord& r : read_records<HitRecord>(path, "HITS")) hits.push_back({r.t, r.triangle});
@@ -79,8 +127,7 @@ void write_hits(const std::string& path, const std::vector<Hit>& hits) {
 
 HitLists read_hit_lists(const std::string& path) {
   std::vector<uint8_t> b = read_file(path);
-  if (b.size() < 12 || std::memcmp(b.data(), "HITN", 4) != 0)
-    throw InputError(path + ": not a HITN file (bad magic or shorter than 12 bytes)");
+  check_magic(path, b, "HITN", 12);
   uint32_t n, width;
   std::memcpy(&n, b.data() + 4, 4), std::memcpy(&width, b.data() + 8, 4);
   if (width < 1 || width > kMaxHitsLimit)
@@ -141,7 +188,11 @@ void write_scene_hits(const std::string& path, const std::vector<SceneHit>& hits
 
 bool is_scene_rays_file(const std::string& path) {
   char magic[4] = {};
-  std::ifstream(path, std::ios::binary).read(magic, 4);  // unreadable: read_rays says why
+  std::ifstream in(path, std::ios::binary);
+  in.read(magic, 4);  // unreadable: read_rays says why
+  // Too short to tell by its bytes: by its name, so that an empty .rayd
+  // file is refused as a short RAYD file, not as something else.
+  if (in.gcount() < 4) return std::filesystem::path(path).extension() == ".rayd";
   return std::memcmp(magic, "RAYD", 4) == 0;
 }
 

@@ -10,6 +10,8 @@
 //         uint32 instance, uint32 triangle (a miss: 0xFFFFFFFF twice)
 // All little-endian.
 #pragma once
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,9 +22,13 @@
 
 namespace meshcast {
 
-// Throw InputError naming the file on a bad magic, short or oversized file.
+// Throw InputError naming the file on a bad magic (naming the file's kind
+// where it is another of these), short or oversized file.
 std::vector<Ray> read_rays(const std::string& path);
 void write_rays(const std::string& path, const std::vector<Ray>& rays);
+// A RAYS file of `count` rays that make() writes a chunk at a time, in
+// order: a file of kMaxRayCount rays (3.5 GiB) is never held whole.
+void write_rays(const std::string& path, size_t count, const std::function<void(std::span<Ray>)>& make);
 std::vector<Hit> read_hits(const std::string& path);
 void write_hits(const std::string& path, const std::vector<Hit>& hits);
 // HITN files: InputError naming the file for a bad magic, an N outside
@@ -34,7 +40,8 @@ std::vector<RayD> read_scene_rays(const std::string& path);
 void write_scene_rays(const std::string& path, const std::vector<RayD>& rays);
 std::vector<SceneHit> read_scene_hits(const std::string& path);
 void write_scene_hits(const std::string& path, const std::vector<SceneHit>& hits);
-// Whether the file starts with RAYD (else it is read as a RAYS file).
+// Whether the file starts with RAYD (else it is read as a RAYS file); a
+// file too short to tell, by its name's .rayd.
 bool is_scene_rays_file(const std::string& path);
 
 // Most rays a rays file may hold, and `meshcast rays --count` make: 2^27

@@ -10,6 +10,7 @@
 #include "cpu/scene.h"
 #include "cpu/walk_table.h"
 #include "layout/blob_format.h"
+#include "layout/number_text.h"
 #include "meshcast/errors.h"
 
 namespace meshcast {
@@ -58,16 +59,17 @@ namespace {
 // and the world box of the mesh's bounds under the transform: centre
 // M c + T and half extents |M| e, in double, padded by 2^-20 of their size
 // (the rounding of the float inverse; what a ray's own rounding adds is the
-// walk's slack, see scene_trace.cpp).
+// walk's slack, see scene_trace.cpp) and by the double sums' own rounding,
+// each bound rounded outward.
 void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const SceneMesh& mesh, const char* who) {
   const float* m = t.rotation_scale;
   for (int i = 0; i < 9; ++i)
     if (!(std::fabs(m[i]) <= 0x1p40f))
-      throw UsageError(std::string(who) + ": rotation_scale[" + std::to_string(i) + "] " + std::to_string(m[i]) +
+      throw UsageError(std::string(who) + ": rotation_scale[" + std::to_string(i) + "] " + number_text(m[i]) +
                        " is not finite or beyond 2^40");
   for (int a = 0; a < 3; ++a)
     if (!(std::fabs(t.translation[a]) <= double(kMaxCoordinate)))
-      throw UsageError(std::string(who) + ": translation[" + std::to_string(a) + "] " + std::to_string(t.translation[a]) +
+      throw UsageError(std::string(who) + ": translation[" + std::to_string(a) + "] " + number_text(t.translation[a]) +
                        " is not finite or beyond 2^100");
   auto e = [&](int r, int c) { return double(m[3 * r + c]); };
   const double cof[9] = {e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1), e(0, 2) * e(2, 1) - e(0, 1) * e(2, 2),
@@ -82,7 +84,7 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
     usable = std::isfinite(p.to_local[i]) && std::fabs(p.to_local[i]) <= 0x1p40f;
   }
   if (!usable)
-    throw UsageError(std::string(who) + ": rotation_scale is not invertible (determinant " + std::to_string(det) +
+    throw UsageError(std::string(who) + ": rotation_scale is not invertible (determinant " + number_text(det) +
                      ") or its inverse has an entry beyond 2^40");
   p.mirrored = det < 0;
   for (int a = 0; a < 3; ++a) p.translation[a] = t.translation[a];
@@ -91,14 +93,23 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
   for (int a = 0; a < 3; ++a)
     c[a] = 0.5 * (double(h.bounds_min[a]) + h.bounds_max[a]), half[a] = 0.5 * (double(h.bounds_max[a]) - h.bounds_min[a]);
   for (int r = 0; r < 3; ++r) {
-    double centre = t.translation[r], extent = 0;
-    for (int k = 0; k < 3; ++k) centre += e(r, k) * c[k], extent += std::fabs(e(r, k)) * half[k];
-    extent += (extent + std::fabs(centre - t.translation[r])) * 0x1p-20;
-    box.min[r] = centre - extent, box.max[r] = centre + extent;
+    // `magnitude` bounds every term the centre sums: the double sums'
+    // roundings (the bounds' centre, the products, the additions; a few
+    // 2^-53 of it) are covered by 2^-49 of it. Far from the origin that is
+    // what keeps a small instance's box from collapsing to its centre: at
+    // 10^16 half an ulp of the translation is 2, more than a unit sphere.
+    double centre = t.translation[r], extent = 0, magnitude = std::fabs(t.translation[r]);
+    for (int k = 0; k < 3; ++k) {
+      centre += e(r, k) * c[k], extent += std::fabs(e(r, k)) * half[k];
+      magnitude += std::fabs(e(r, k)) * (std::fabs(c[k]) + half[k]);
+    }
+    extent += (extent + std::fabs(centre - t.translation[r])) * 0x1p-20 + magnitude * 0x1p-49;
+    // Each bound rounded outward: a step beyond the nearest double.
+    box.min[r] = std::nextafter(centre - extent, -INFINITY), box.max[r] = std::nextafter(centre + extent, INFINITY);
     // The top level's float boxes and the rays' pads stay finite.
     if (!(std::fabs(box.min[r]) <= double(kMaxCoordinate) && std::fabs(box.max[r]) <= double(kMaxCoordinate)))
       throw UsageError(std::string(who) + ": the instance's world box on axis " + std::to_string(r) + " (" +
-                       std::to_string(box.min[r]) + " to " + std::to_string(box.max[r]) + ") reaches beyond 2^100");
+                       number_text(box.min[r]) + " to " + number_text(box.max[r]) + ") reaches beyond 2^100");
   }
 }
 
@@ -129,7 +140,7 @@ MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
   for (int a = 0; a < 3; ++a)
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
       throw InputError(name + ": the blob's bounds on axis " + std::to_string(a) + " are not a finite box (" +
-                       std::to_string(h.bounds_min[a]) + " to " + std::to_string(h.bounds_max[a]) + ")");
+                       number_text(h.bounds_min[a]) + " to " + number_text(h.bounds_max[a]) + ")");
   e.meshes.push_back(std::move(mesh));
   e.changed = true;
   return MeshId(e.meshes.size() - 1);

@@ -55,6 +55,14 @@ mode_t new_file_mode() {
 }  // namespace
 
 void write_file(const std::string& path, std::initializer_list<Bytes> pieces) {
+  auto piece = pieces.begin();
+  write_file_pieces(path, [&] {
+    while (piece != pieces.end() && piece->size == 0) ++piece;  // a size of 0 would end the file
+    return piece == pieces.end() ? Bytes{nullptr, 0} : *piece++;
+  });
+}
+
+void write_file_pieces(const std::string& path, const std::function<Bytes()>& next) {
   auto failed = [&](const char* what, int err) {
     return OutputError(path + ": cannot write the file (" + what + ": " + std::strerror(err) + ")");
   };
@@ -79,14 +87,20 @@ void write_file(const std::string& path, std::initializer_list<Bytes> pieces) {
   }
   int err = 0;
   const char* step = "write";
-  for (const Bytes& b : pieces) {
-    const char* p = static_cast<const char*>(b.data);
-    for (size_t left = b.size; left > 0 && !err;) {
-      const ssize_t n = ::write(fd, p, left);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) err = n < 0 ? errno : ENOSPC;
-      else p += n, left -= size_t(n);
+  try {  // next() may throw: the partial file goes
+    for (Bytes b = next(); b.size > 0 && !err; b = next()) {
+      const char* p = static_cast<const char*>(b.data);
+      for (size_t left = b.size; left > 0 && !err;) {
+        const ssize_t n = ::write(fd, p, left);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) err = n < 0 ? errno : ENOSPC;
+        else p += n, left -= size_t(n);
+      }
     }
+  } catch (...) {
+    ::close(fd);
+    if (!in_place) ::unlink(temp.c_str());
+    throw;
   }
   // A replaced file keeps its mode; a new one gets what open() would give.
   const mode_t mode = exists ? (st.st_mode & 07777) : new_file_mode();

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <sstream>
 #include <string>
@@ -41,6 +42,10 @@ class OutputText : public std::ostringstream {
   std::string path_;
 };
 void write_file(const std::string& path, std::initializer_list<Bytes> pieces);
+// The same for a file made a piece at a time (one too large to hold whole):
+// next() returns each piece in turn, then one of size 0. A piece's bytes
+// need only live until the next call.
+void write_file_pieces(const std::string& path, const std::function<Bytes()>& next);
 inline void write_file(const std::string& path, const void* data, size_t size) { write_file(path, {{data, size}}); }
 
 }  // namespace meshcast

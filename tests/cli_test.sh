@@ -112,7 +112,7 @@ if ! diff <(od -An -tu4 -v -w12 -j8 "$work/two-cpu.hiti" | awk '{print $1, $2}')
 fi
 check render-scene 0 "3 instances of 2 meshes.*scene.png" -- "$meshcast" render "$work/level.json" --png "$work/scene.png" --width 64 --height 48
 printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "translation": [1, 2]}]}' "$mesh" >"$work/short.json"
-check scene-short-translation 2 "short.json: instances\[0\].translation is not an array of 3 numbers" -- "$meshcast" trace "$work/short.json" --rays "$work/r.rays" --out "$work/x.hiti"
+check scene-short-translation 2 "short.json: instances\[0\].translation is an array of 2, not an array of 3 numbers" -- "$meshcast" trace "$work/short.json" --rays "$work/r.rays" --out "$work/x.hiti"
 printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "rotation_scale": [1,0,0, 0,0,0, 0,0,1]}]}' "$mesh" >"$work/flat.json"
 check scene-flat 2 "flat.json: instances\[0\]: .*not invertible" -- "$meshcast" trace "$work/flat.json" --rays "$work/r.rays" --out "$work/x.hiti"
 printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "rock"}]}' "$mesh" >"$work/rock.json"
@@ -123,6 +123,43 @@ printf '{"meshes": {"mesh": "%s/none.off"}, "instances": []}' "$work" >"$work/go
 check scene-missing-mesh 2 'gone.json: meshes.mesh: .*none.off' -- "$meshcast" trace "$work/gone.json" --rays "$work/r.rays" --out "$work/x.hiti"
 printf '{"meshes": {' >"$work/cut.json"
 check scene-not-json 2 "cut.json: not JSON" -- "$meshcast" trace "$work/cut.json" --rays "$work/r.rays" --out "$work/x.hiti"
+# Hostile scene files: a value nested 100,000 deep (a message that dumped it
+# overran the stack), a 5 MB name (the message shows 64 bytes of it), a key
+# twice, a NUL in a path, numbers beyond %f's reach.
+python3 - "$mesh" "$work" <<'PY'
+import json, sys
+mesh, work = sys.argv[1], sys.argv[2]
+def scene(name, instance, meshes=None):
+    text = json.dumps({"meshes": meshes or {"mesh": mesh}, "instances": [instance]})
+    open(f"{work}/{name}.json", "w").write(text)
+deep = "[" * 100000 + "]" * 100000
+open(f"{work}/deep.json", "w").write('{"meshes": {"mesh": %s}, "instances": [{"mesh": "mesh", "translation": [0, 0, %s]}]}'
+                                     % (json.dumps(mesh), deep))
+scene("long", {"mesh": "x" * 5000000})
+open(f"{work}/twice.json", "w").write('{"meshes": {"mesh": %s}, "instances": [{"mesh": "mesh", "mask": 1, "mask": 2}]}'
+                                      % json.dumps(mesh))
+scene("nul", {"mesh": "mesh"}, {"mesh": "a\u0000b.off"})
+scene("tiny_det", {"mesh": "mesh", "rotation_scale": [1e-20, 0, 0, 0, 1e-20, 0, 0, 0, 1e-20]})
+scene("huge", {"mesh": "mesh", "translation": [1e300, 0, 0]})
+PY
+check scene-deep 2 'deep.json: instances\[0\].translation holds an array of 1, not a number' -- "$meshcast" trace "$work/deep.json" --rays "$work/r.rays" --out "$work/x.hiti"
+check scene-long-name 2 'long.json: instances\[0\].mesh: "x{64}\.\.\. \(5000000 bytes\)" is not in' -- "$meshcast" trace "$work/long.json" --rays "$work/r.rays" --out "$work/x.hiti"
+if (( $("$meshcast" trace "$work/long.json" --rays "$work/r.rays" --out "$work/x.hiti" 2>&1 | wc -c) > 1000 )); then
+  echo "FAIL scene-long-name: the message echoes the name whole"; failures=$((failures + 1))
+fi
+check scene-key-twice 2 'twice.json: the key "mask" appears twice in one object' -- "$meshcast" trace "$work/twice.json" --rays "$work/r.rays" --out "$work/x.hiti"
+check scene-nul-path 2 'nul.json: meshes.mesh: the file name "a\\x00b.off" holds a NUL character' -- "$meshcast" trace "$work/nul.json" --rays "$work/r.rays" --out "$work/x.hiti"
+check scene-tiny-determinant 2 'tiny_det.json: instances\[0\]: .*determinant 9\.9999[0-9]*e-61\)' -- "$meshcast" trace "$work/tiny_det.json" --rays "$work/r.rays" --out "$work/x.hiti"
+check scene-huge-translation 2 'huge.json: instances\[0\]: .*translation\[0\] 1e\+300 is not finite or beyond 2\^100' -- "$meshcast" trace "$work/huge.json" --rays "$work/r.rays" --out "$work/x.hiti"
+# Options given where they mean nothing, numbers that are not integers, a
+# rays file of the other kind.
+check trace-max-hits-closest 2 "max-hits is for --query all" -- "$meshcast" trace "$mesh" --max-hits 8 --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-max-hits-scene 2 "max-hits is for --query all" -- "$meshcast" trace "$work/one.json" --query any --max-hits 8 --rays "$work/r.rays" --out "$work/hx.hiti"
+check trace-max-hits-float 2 '"1e3" is not an integer \(1\.\.4096\)' -- "$meshcast" trace "$mesh" --query all --max-hits 1e3 --rays "$work/r.rays" --out "$work/hx.hitn"
+printf 'RAYD\0\0\0\0' >"$work/none.rayd"
+check trace-rayd-on-mesh 2 "none.rayd: not a RAYS file \(rays with float origins\) but a RAYD file \(rays with double origins, read by scenes\)" -- "$meshcast" trace "$mesh" --rays "$work/none.rayd" --out "$work/hx.hits"
+: >"$work/empty.rayd"
+check trace-empty-rayd 2 "empty.rayd: 0 bytes, shorter than a RAYD file's 8-byte header" -- "$meshcast" trace "$work/one.json" --rays "$work/empty.rayd" --out "$work/hx.hiti"
 check trace-max-hits-range 2 "max-hits" -- "$meshcast" trace "$mesh" --query all --max-hits 0 --rays "$work/r.rays" --out "$work/hx.hitn"
 # The two hits files agree (same triangle per ray): compare the triangle columns.
 if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \

@@ -238,6 +238,7 @@ TEST(Hostile, HitListFilesRoundTripAndRefuseBadHeaders) {
   const std::string hits_file = make_file("plain.hitn", "HITS" + bytes.substr(4));
   expect_throws<InputError>([&] { read_hit_lists(hits_file); }, {"plain.hitn", "not a HITN file"});
 }
+
 }  // namespace
 }  // namespace meshcast::testing
 
@@ -264,8 +265,12 @@ TEST(Hostile, SceneRayAndHitFilesRoundTripAndRefuseBadHeaders) {
   const std::string cut = make_file("cut.rayd", std::string(raw.begin(), raw.end() - 1));
   expect_throws<InputError>([&] { read_scene_rays(cut); }, {"cut.rayd", "header says 2 records"});
   const std::string plain = make_file("plain.rayd", "RAYS" + std::string(raw.begin() + 4, raw.end()));
-  expect_throws<InputError>([&] { read_scene_rays(plain); }, {"plain.rayd", "not a RAYD file"});
+  expect_throws<InputError>([&] { read_scene_rays(plain); }, {"plain.rayd", "not a RAYD file", "but a RAYS file"});
   EXPECT_FALSE(is_scene_rays_file(plain));
+
+  const std::string empty = make_file("empty.rayd", "");
+  EXPECT_TRUE(is_scene_rays_file(empty));  // by its name: too short to tell by its bytes
+  expect_throws<InputError>([&] { read_scene_rays(empty); }, {"empty.rayd", "0 bytes, shorter than a RAYD file's"});
 
   const std::vector<SceneHit> hits = {{2.5f, 7, 11}, {}};
   const std::string hits_path = (scratch_dir() / "level.hiti").string();
@@ -282,6 +287,31 @@ TEST(Hostile, SceneRayAndHitFilesRoundTripAndRefuseBadHeaders) {
   EXPECT_EQ(hit_bytes.size(), 8u + 2 * 12);
   const std::string short_hits = make_file("short.hiti", std::string(hit_bytes.begin(), hit_bytes.end() - 4));
   expect_throws<InputError>([&] { read_scene_hits(short_hits); }, {"short.hiti", "header says 2 records"});
+}
+
+// A rays file is made and written a chunk at a time (meshcast rays
+// --count 2^27 held 3.5 GiB of rays and a copy of them as bytes): the
+// chunks are the rays make_rays gives at once, bit for bit, whatever the
+// chunks' sizes, and a file of more than one chunk reads back as them.
+TEST(Hostile, RaysFilesAreMadeAChunkAtATime) {
+  const Mesh mesh = make_sphere(8, 16, 1.0f, {0, 0, 0});
+  constexpr size_t kCount = 70000;  // past the writer's chunk of 2^16
+  for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
+    const std::vector<Ray> whole = make_rays(mesh, kind, kCount, 9);
+    std::vector<Ray> pieces(kCount);
+    RaySource source(mesh, kind, 9);
+    for (size_t at = 0, step = 1; at < kCount; at += step, step = step * 3 + 1)
+      source.fill(std::span(pieces).subspan(at, std::min(step, kCount - at)));
+    EXPECT_EQ(std::memcmp(pieces.data(), whole.data(), kCount * sizeof(Ray)), 0) << int(kind);
+    const std::string path = (scratch_dir() / "chunks.rays").string();
+    RaySource streamed(mesh, kind, 9);
+    write_rays(path, kCount, [&](std::span<Ray> rays) { streamed.fill(rays); });
+    const std::vector<Ray> back = read_rays(path);
+    ASSERT_EQ(back.size(), kCount);
+    EXPECT_EQ(std::memcmp(back.data(), whole.data(), kCount * sizeof(Ray)), 0) << int(kind);
+  }
+  expect_throws<InputError>([&] { write_rays("/dev/null", kMaxRayCount + 1, [](std::span<Ray>) {}); },
+                            {"/dev/null", "more than a RAYS file may hold"});
 }
 }  // namespace
 }  // namespace meshcast::testing

@@ -17,6 +17,7 @@
 
 #include "check/generate.h"
 #include "layout/blob_format.h"
+#include "builder/writer.h"
 #include "layout/queries.h"
 #include "tests/testing.h"
 #ifdef MESHCAST_TEST_GPU
@@ -356,6 +357,61 @@ TEST_P(Robustness, ExtremeMagnitudesAndDirectionLengths) {
       }
     ASSERT_GT(rays.size(), 300u);
     expect_answers(s, rays, ("sphere of radius " + std::to_string(radius)).c_str());
+  }
+}
+
+// Meshes under the least extent a grid takes: a sphere of radius 1e-37,
+// and one 1e-38 across squashed to 7.5e-43 in z (its z coordinates
+// denormal). A format that keeps its vertices on a grid refuses them,
+// naming the mesh and the limit (the step would fall below FLT_MIN, where
+// it rounded vertices past the stated bound and flattened z); every other
+// layout, and the automatic choice, builds them and answers as the oracle.
+TEST_P(Robustness, MeshesUnderAGridsLeastExtent) {
+  Mesh squashed = make_sphere(8, 16, 0.5e-38f, {0, 0, 0});
+  for (Vec3& v : squashed.vertices) v.z *= 1.5e-4f;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const auto& [mesh, what] : {std::pair{make_sphere(8, 16, 1e-37f, {0, 0, 0}), "sphere of radius 1e-37"},
+                                   std::pair{squashed, "squashed sphere 1e-38 across"}}) {
+    const Box3 box = mesh.bounds();
+    // (Zero-byte trees' Indexed24 keeps the mesh's floats.)
+    const uint32_t format = automatic() ? MC_TRI_INDEXED24 : uint32_t(options().layout.triangles);
+    if (format != MC_TRI_INDEXED24 && codec_ops(format).grid != layout::kGridNone) {
+      try {
+        build_blob(mesh, options(), what);
+        ADD_FAILURE() << what << ": built on a grid";
+      } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(what), std::string::npos) << message;
+        EXPECT_NE(message.find("2^-126"), std::string::npos) << message;
+      }
+      continue;
+    }
+    if (automatic() && GetParam().find("bytes=") != std::string::npos) {
+      // Under a byte limit the float formats may all be over it: then the
+      // choice is refused, saying so (the grid formats' refusals counted).
+      try {
+        build(mesh, what);
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("no layout meets the limits"), std::string::npos) << e.what();
+        continue;
+      }
+    }
+    // Unit directions from 1.2 extents out, aimed at points of the box.
+    std::vector<Ray> rays;
+    for (int i = 0; i < 200; ++i) {
+      double o[3], d[3], len = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double lo = box.min[a], hi = box.max[a], c = 0.5 * (lo + hi), e = hi - lo;
+        o[a] = c + 1.2 * e * u(rng), d[a] = c + 0.5 * e * u(rng) - o[a];
+      }
+      for (double x : d) len += x * x;
+      Ray r{};
+      for (int a = 0; a < 3; ++a) r.org[a] = float(o[a]), r.dir[a] = float(d[a] / std::sqrt(len));
+      r.tmax = INFINITY;
+      rays.push_back(r);
+    }
+    expect_answers(mesh, rays, what);
   }
 }
 

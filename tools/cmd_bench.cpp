@@ -46,9 +46,9 @@ void add_bench_encodings(CLI::App* bench) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = bench->add_subcommand("encodings", "seed 000 3.11: every triangle encoding, brute force and in a QuadTree");
   cmd->add_option("mesh", args->input, "mesh file (default data/bunny00.off)");
-  cmd->add_option("--rays", args->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
+  cmd->add_option("--rays", args->rays, "long random rays (the source used 1024)")->check(integer_in(1, 1000000));
   cmd->add_option("--repeat", args->repeat, "passes; the minimum (as the source) and the median are reported")
-      ->check(CLI::Range(1, 1000));
+      ->check(integer_in(1, 1000));
   cmd->add_option("--out-dir", args->out_dir, "where encodings.csv and encodings.png go");
   cmd->callback([args] {
     Mesh mesh = bench_mesh(args->input);
@@ -103,8 +103,8 @@ void add_bench_tables(CLI::App* bench) {
     auto targs = std::make_shared<BenchArgs>();
     CLI::App* sub = bench->add_subcommand(table.name, table.what);
     sub->add_option("mesh", targs->input, "mesh file, or terrain_2M for the generated 2M-triangle terrain (default data/bunny00.off)");
-    sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
-    sub->add_option("--repeat", targs->repeat, "passes; minimum and median reported")->check(CLI::Range(1, 1000));
+    sub->add_option("--rays", targs->rays, "long random rays (the source used 1024)")->check(integer_in(1, 1000000));
+    sub->add_option("--repeat", targs->repeat, "passes; minimum and median reported")->check(integer_in(1, 1000));
     sub->add_option("--out-dir", targs->out_dir, "where the CSV and the plot go");
     if (std::string(table.name) == "combos")
       sub->add_option("--only", targs->only, "only the layouts whose name contains one of these, comma separated");
@@ -172,8 +172,8 @@ void add_bench_gpu(CLI::App* bench) {
   auto gdevice = std::make_shared<std::string>();
   CLI::App* gsub = bench->add_subcommand("gpu", "seed 000 7: the GPU methods on the Vulkan device, the CPU's best beside them");
   gsub->add_option("mesh", gargs->input, "mesh file (default data/bunny00.off)");
-  gsub->add_option("--rays", gargs->rays, "long random rays (the source used 1024)")->check(CLI::Range(size_t(1), size_t(1000000)));
-  gsub->add_option("--repeat", gargs->repeat, "passes; the median is reported")->check(CLI::Range(1, 1000));
+  gsub->add_option("--rays", gargs->rays, "long random rays (the source used 1024)")->check(integer_in(1, 1000000));
+  gsub->add_option("--repeat", gargs->repeat, "passes; the median is reported")->check(integer_in(1, 1000));
   gsub->add_option("--device", *gdevice, "Vulkan device: index or part of its name");
   gsub->callback([gargs, gdevice] {
     Mesh mesh = bench_mesh(gargs->input);
@@ -252,8 +252,8 @@ void add_bench_error(CLI::App* bench) {
   auto edevice = std::make_shared<std::string>();
   CLI::App* err = bench->add_subcommand("error", "issue 8: error against run time and bytes, every tree x encoding (and GPU method)");
   err->add_option("meshes", *emeshes, "mesh files or terrain_2M (default bunny00, ChineseDragon-10kv, terrain_2M)");
-  err->add_option("--rays", eargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
-  err->add_option("--repeat", eargs->repeat, "passes; the minimum is kept (GPU: the median)")->check(CLI::Range(1, 1000));
+  err->add_option("--rays", eargs->rays, "long random rays")->check(integer_in(1, 1000000));
+  err->add_option("--repeat", eargs->repeat, "passes; the minimum is kept (GPU: the median)")->check(integer_in(1, 1000));
   err->add_option("--device", *edevice, "also the GPU methods on this Vulkan device (any: the default one)");
   err->add_option("--out-dir", eargs->out_dir, "where the CSV and the plots go");
   err->callback([eargs, emeshes, edevice] {
@@ -328,8 +328,8 @@ void add_bench_robustness(CLI::App* bench) {
   auto rargs = std::make_shared<BenchArgs>();
   CLI::App* rob = bench->add_subcommand("robustness", "issue 8: the watertight test against plain Moller-Trumbore, time and leaks");
   rob->add_option("mesh", rargs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
-  rob->add_option("--rays", rargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
-  rob->add_option("--repeat", rargs->repeat, "passes; the minimum and the median are kept")->check(CLI::Range(1, 1000));
+  rob->add_option("--rays", rargs->rays, "long random rays")->check(integer_in(1, 1000000));
+  rob->add_option("--repeat", rargs->repeat, "passes; the minimum and the median are kept")->check(integer_in(1, 1000));
   rob->callback([rargs] {
     Mesh mesh = bench_mesh(rargs->input);
     std::vector<bench::RobustnessRow> rows = bench::bench_robustness(mesh, rargs->input, rargs->rays, rargs->repeat);
@@ -354,8 +354,8 @@ void add_bench_pairing(CLI::App* bench) {
   auto pdata = std::make_shared<std::string>("data");
   CLI::App* pair = bench->add_subcommand("pairing", "seed 003: triangle pairing, before and after, as the builder's unit");
   pair->add_option("--data", *pdata, "folder of the public meshes (bunny00, armadillo, refined_elephant, ChineseDragon-10kv)");
-  pair->add_option("--rays", pargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
-  pair->add_option("--repeat", pargs->repeat, "passes; the minimum and the median are kept")->check(CLI::Range(1, 1000));
+  pair->add_option("--rays", pargs->rays, "long random rays")->check(integer_in(1, 1000000));
+  pair->add_option("--repeat", pargs->repeat, "passes; the minimum and the median are kept")->check(integer_in(1, 1000));
   pair->add_option("--out-dir", pargs->out_dir, "where the CSV goes");
   auto ponly = std::make_shared<std::vector<std::string>>();
   pair->add_option("--only", *ponly, "comma-separated cases by the start of their names (bunny00 with its shuffled and "
@@ -414,8 +414,8 @@ void add_bench_offset(CLI::App* bench) {
   auto oargs = std::make_shared<BenchArgs>();
   CLI::App* off = bench->add_subcommand("offset", "QuadTreeHalfFloat far from the origin: 0.15 units at 1000, 150 at 30000");
   off->add_option("mesh", oargs->input, "mesh file (default data/bunny00.off), scaled to each case's size");
-  off->add_option("--rays", oargs->rays, "long random rays")->check(CLI::Range(size_t(1), size_t(1000000)));
-  off->add_option("--repeat", oargs->repeat, "passes a measurement (3 measurements each, interleaved)")->check(CLI::Range(1, 1000));
+  off->add_option("--rays", oargs->rays, "long random rays")->check(integer_in(1, 1000000));
+  off->add_option("--repeat", oargs->repeat, "passes a measurement (3 measurements each, interleaved)")->check(integer_in(1, 1000));
   off->callback([oargs] {
     Mesh mesh = bench_mesh(oargs->input);
     std::vector<bench::OffsetRow> rows = bench::bench_offset(mesh, oargs->input, oargs->rays, oargs->repeat);

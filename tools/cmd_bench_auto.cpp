@@ -23,8 +23,8 @@ void add_bench_auto(CLI::App* bench) {
                   "mesh files, terrain_2M or terrain_66k (default bunny00, armadillo, refined_elephant, "
                   "ChineseDragon-10kv, terrain_2M, terrain_66k)");
   cmd->add_option("--rays", args->rays, "long random rays (seed 1; auto's trial uses its own)")
-      ->check(CLI::Range(size_t(1), size_t(1000000)));
-  cmd->add_option("--repeat", args->repeat, "passes; the minimum is kept")->check(CLI::Range(1, 1000));
+      ->check(integer_in(1, 1000000));
+  cmd->add_option("--repeat", args->repeat, "passes; the minimum is kept")->check(integer_in(1, 1000));
   cmd->add_option("--out-dir", args->out_dir, "where auto.csv goes");
   cmd->callback([args] {
     std::vector<std::string> names = args->meshes;

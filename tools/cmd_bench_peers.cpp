@@ -36,8 +36,8 @@ void add_bench_peers(CLI::App* bench) {
                   "comma-separated queries: closest, any (Embree: rtcOccluded1), all (every hit, rows of 16), "
                   "each with a culling as in closest-back or any-front; Embree answers closest and any "
                   "(default: closest,any)");
-  cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(CLI::Range(size_t(100), size_t(1000000)));
-  cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(CLI::Range(1, 100));
+  cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(integer_in(100, 1000000));
+  cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(integer_in(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where peers.csv and peers.png go");
   cmd->callback([args] {
     bench::PeersOptions o;

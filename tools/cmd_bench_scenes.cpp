@@ -20,10 +20,10 @@ void add_bench_scenes(CLI::App* bench) {
   cmd->add_option("--meshes", args->meshes, "comma-separated mesh files placed in turn (default bunny00, armadillo, the dragon)");
   cmd->add_option("--counts", args->options.counts, "comma-separated instance counts, a level each (default 1000,10000)")
       ->delimiter(',')
-      ->check(CLI::Range(size_t(1), size_t(1000000)));
+      ->check(integer_in(1, 1000000));
   cmd->add_option("--layout", args->options.layout, "the meshes' layout");
-  cmd->add_option("--rays", args->options.rays, "rays a level")->check(CLI::Range(size_t(100), size_t(1000000)));
-  cmd->add_option("--rounds", args->options.rounds, "interleaved rounds; the median is reported")->check(CLI::Range(1, 100));
+  cmd->add_option("--rays", args->options.rays, "rays a level")->check(integer_in(100, 1000000));
+  cmd->add_option("--rounds", args->options.rounds, "interleaved rounds; the median is reported")->check(integer_in(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where scenes.csv goes");
   cmd->callback([args] {
     const bench::ScenesOptions& o = args->options;

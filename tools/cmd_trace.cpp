@@ -100,14 +100,15 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--rays", args->rays, "rays file")->required();
   cmd->add_option("--out", args->out, "hits file to write")->required();
   add_layout_options(cmd, args->layout);
-  cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(CLI::Range(1, 1000));
+  cmd->add_option("--repeat", args->repeat, "passes over the batch; the median is reported")->check(integer_in(1, 1000));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   cmd->add_option("--query", args->query,
                   "closest (the nearest hit), any (a hit, the walk ending at the first) or all (every hit along the "
                   "ray, nearest first, written as a HITN file)")
       ->check(CLI::IsMember({"closest", "any", "all"}));
-  cmd->add_option("--max-hits", args->max_hits, "--query all: the hits a ray's row keeps (more are counted, not kept)")
-      ->check(CLI::Range(1u, kMaxHitsLimit));
+  const CLI::Option* max_hits =
+      cmd->add_option("--max-hits", args->max_hits, "--query all: the hits a ray's row keeps (more are counted, not kept)")
+          ->check(integer_in(1, kMaxHitsLimit));
   cmd->add_option("--cull", args->cull,
                   "none (two-sided), back or front: the face culled; the front face's corners run counter-clockwise "
                   "seen from the ray's origin")
@@ -118,9 +119,12 @@ void add_trace(CLI::App& app) {
                                             "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4), octtree (OctTreeCompressed/ClusterBitPackSOA8)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
-  cmd->callback([args] {
+  cmd->callback([args, max_hits] {
     const Query query = layout::query_named(args->query, "--query");
     const Cull cull = layout::cull_named(args->cull, "--cull");
+    // Given with a query that keeps one hit a ray, it would be ignored.
+    if (max_hits->count() > 0 && query != Query::All)
+      throw InputError("trace: --max-hits is for --query all (every hit); --query " + args->query + " keeps one hit a ray");
     if (is_scene_file(args->input)) {
       trace_scene(*args);
       return;
@@ -203,8 +207,8 @@ void add_render(CLI::App& app) {
   cmd->add_option("input", args->input, "mesh file, blob or scene file (.json)")->required();
   add_layout_options(cmd, args->layout);
   cmd->add_option("--png", args->png, "picture to write");
-  cmd->add_option("--width", args->width)->check(CLI::Range(16, 8192));
-  cmd->add_option("--height", args->height)->check(CLI::Range(16, 8192));
+  cmd->add_option("--width", args->width)->check(integer_in(16, 8192));
+  cmd->add_option("--height", args->height)->check(integer_in(16, 8192));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method (see trace --help; default: the one that reads the layout)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");

@@ -45,6 +45,11 @@ struct LayoutArgs {
   std::vector<const CLI::Option*> options;
 };
 void add_layout_options(CLI::App* cmd, LayoutArgs& args);
+
+// The check of an integer option: decimal digits alone, within lo..hi
+// ("1e3" or "2.5" is refused as not an integer, where CLI::Range would
+// read it as a number and call it out of range).
+CLI::Validator integer_in(uint64_t lo, uint64_t hi);
 BuildOptions build_options(const LayoutArgs& args);  // throws InputError for bad names
 // load_mesh_or_blob with these options; with --layout auto the layout is
 // chosen for the mesh, and what was chosen and why is printed to `report`.

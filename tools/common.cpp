@@ -58,6 +58,20 @@ void check_limit(const char* option, double value) {
 
 }  // namespace
 
+CLI::Validator integer_in(uint64_t lo, uint64_t hi) {
+  const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.size() <= 19 &&
+                            std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+        if (!digits) return "\"" + text + "\" is not an integer (" + range + ")";
+        const uint64_t value = std::stoull(text);
+        if (value < lo || value > hi) return text + " is not in " + range;
+        return {};
+      },
+      "INT in " + range);
+}
+
 void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   const size_t before = cmd->get_options().size();
   cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh, or auto (chosen for the mesh)");
@@ -69,15 +83,15 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--gpu", a.gpu, "auto: only layouts a Vulkan method reads as well (CPU and GPU)");
   cmd->add_option("--trial", a.trial, "auto, speed first: time the candidates on this many rays (0: rules only)")
-      ->check(CLI::Range(0u, 1u << 20));
+      ->check(integer_in(0, 1u << 20));
   cmd->add_option("--leaf", a.leaf, "largest triangle count of a leaf (default: 16 for OctTreeCompressed, 8 for the others)")
-      ->check(CLI::Range(1, 31));
+      ->check(integer_in(1, 31));
   cmd->add_option("--splitter", a.splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
   cmd->add_option("--order", a.order,
                   "node order (seed 000 4.3): DepthFirst, DepthFirstTrianglesLast, BreadthFirst or "
                   "BreadthFirstTrianglesLast; the quad trees take all four");
   cmd->add_option("--lbvh-depth", a.lbvh_depth, "StacklessLBVH depth limit D (0: bit_width(triangles) + 1)")
-      ->check(CLI::Range(0u, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
+      ->check(integer_in(0, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
   cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
   cmd->add_option("--grouping", a.grouping, "AABBList batches (seed 000 7): ClosestCentroid (the seed's) or Morton");
   cmd->add_flag("--no-triangle-ids", a.no_triangle_ids,
@@ -86,7 +100,7 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_flag("--no-shuffle", a.zbt_no_shuffle, "zero-byte trees: any bound triangles, not 6 each naming its extreme's corner");
   cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
   cmd->add_option("--hybrid-leaf", a.hybrid_leaf, "ZeroByteHybrid: largest leaf, each one zero-byte tree")
-      ->check(CLI::Range(8u, uint32_t(MC_ZBT_MAX_TRIANGLES)));
+      ->check(integer_in(8, uint32_t(MC_ZBT_MAX_TRIANGLES)));
   const std::vector<CLI::Option*> all = cmd->get_options();
   a.options.assign(all.begin() + std::ptrdiff_t(before), all.end());
 }

@@ -3,9 +3,11 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
+#include "layout/number_text.h"
 #include "meshcast/errors.h"
 #include "tools/common.h"
 
@@ -15,16 +17,66 @@ namespace {
 
 using nlohmann::json;
 
+// Text from the file as a message shows it: control characters (a NUL
+// would end the message where a C string is printed) as \xNN, and at most
+// 64 bytes of it, the length said beside (a 5 MB key is not echoed whole).
+std::string shown(const std::string& text) {
+  constexpr size_t kShown = 64;
+  std::string out;
+  for (size_t i = 0; i < std::min(text.size(), kShown); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7F) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", c);
+      out += escaped;
+    } else {
+      out += char(c);
+    }
+  }
+  if (text.size() > kShown) out += "... (" + std::to_string(text.size()) + " bytes)";
+  return out;
+}
+
+// What a JSON value is, for a message: its type, a number or a string
+// shown short; never the value dumped whole (a nested array 100,000 deep
+// would take the serializer's recursion past the stack).
+std::string described(const json& value) {
+  if (value.is_string()) return "the string \"" + shown(value.get<std::string>()) + "\"";
+  if (value.is_number()) return "the number " + number_text(value.get<double>());
+  if (value.is_array()) return "an array of " + std::to_string(value.size());
+  if (value.is_object()) return "an object";
+  if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
+  return "null";
+}
+
 // The numbers of an array field of `count` entries, or InputError naming it.
 std::vector<double> numbers(const json& value, size_t count, const std::string& where) {
   if (!value.is_array() || value.size() != count)
-    throw InputError(where + " is not an array of " + std::to_string(count) + " numbers");
+    throw InputError(where + " is " + described(value) + ", not an array of " + std::to_string(count) + " numbers");
   std::vector<double> out;
   for (const json& v : value) {
-    if (!v.is_number()) throw InputError(where + " holds " + v.dump() + ", not a number");
+    if (!v.is_number()) throw InputError(where + " holds " + described(v) + ", not a number");
     out.push_back(v.get<double>());
   }
   return out;
+}
+
+// The file parsed, a key twice in one object refused (nlohmann keeps the
+// last one silently, which would hide a misedited scene's first value).
+json parse_refusing_duplicates(std::istream& in, const std::string& path) {
+  std::vector<std::set<std::string>> keys;  // the keys seen, one set an object open
+  auto callback = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    if (event == json::parse_event_t::object_end) keys.pop_back();
+    if (event == json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
+      throw InputError(path + ": the key \"" + shown(parsed.get<std::string>()) + "\" appears twice in one object");
+    return true;
+  };
+  try {
+    return json::parse(in, callback);
+  } catch (const json::exception& e) {
+    throw InputError(path + ": not JSON: " + e.what());
+  }
 }
 
 }  // namespace
@@ -34,30 +86,28 @@ bool is_scene_file(const std::string& path) { return std::filesystem::path(path)
 SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std::FILE* report) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot be opened");
-  json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(path + ": not JSON: " + e.what());
-  }
+  const json doc = parse_refusing_duplicates(in, path);
   if (!doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_object() || !doc.contains("instances") ||
       !doc["instances"].is_array())
     throw InputError(path + ": a scene file is an object with \"meshes\" (an object) and \"instances\" (an array)");
   // A misspelt key would otherwise leave its field at the default unseen.
   for (const auto& [key, value] : doc.items())
-    if (key != "meshes" && key != "instances") throw InputError(path + ": \"" + key + "\" is not a scene file's key (meshes, instances)");
+    if (key != "meshes" && key != "instances") throw InputError(path + ": \"" + shown(key) + "\" is not a scene file's key (meshes, instances)");
   SceneFile out;
   std::map<std::string, MeshId> ids;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   for (const auto& [name, file] : doc["meshes"].items()) {
-    if (!file.is_string()) throw InputError(path + ": meshes." + name + " is not a file name");
+    const std::string where = path + ": meshes." + shown(name);
+    if (!file.is_string()) throw InputError(where + " is " + described(file) + ", not a file name");
+    if (file.get<std::string>().find('\0') != std::string::npos)
+      throw InputError(where + ": the file name \"" + shown(file.get<std::string>()) + "\" holds a NUL character");
     const std::string mesh_path = (folder / file.get<std::string>()).string();
     try {  // the mesh file's own message, and where the scene names it
       Loaded mesh = load_input(mesh_path, layout, report);
       out.blob_bytes += mesh.blob.size();
       ids[name] = out.scene.add_mesh(std::move(mesh.blob), mesh_path);
     } catch (const InputError& e) {
-      throw InputError(path + ": meshes." + name + ": " + e.what());
+      throw InputError(where + ": " + e.what());
     }
     out.mesh_names.push_back(name);
   }
@@ -68,9 +118,9 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
       throw InputError(where + " is not an object with a \"mesh\" name");
     for (const auto& [key, value] : i.items())
       if (key != "mesh" && key != "rotation_scale" && key != "translation" && key != "mask" && key != "enabled")
-        throw InputError(where + ": \"" + key + "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled)");
+        throw InputError(where + ": \"" + shown(key) + "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled)");
     const auto mesh = ids.find(i["mesh"].get<std::string>());
-    if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + i["mesh"].get<std::string>() + "\" is not in \"meshes\"");
+    if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + shown(i["mesh"].get<std::string>()) + "\" is not in \"meshes\"");
     Transform t;
     if (i.contains("rotation_scale")) {
       const std::vector<double> m = numbers(i["rotation_scale"], 9, where + ".rotation_scale");

@@ -45,6 +45,9 @@ struct Mesh {
 // Coordinates beyond this (about 1.27e30) are refused, in meshes and in ray
 // origins: extents, areas and half-float scales computed from them must stay
 // finite in float, and the triangle test's double redo must stay in range.
+// Below, the formats that keep vertices on a grid refuse a mesh whose extent
+// on an axis is above 0 but under about 2^-106 (1.2e-32; the message names
+// the format's own limit): the grid's step would fall below FLT_MIN.
 constexpr float kMaxCoordinate = 0x1p100f;
 
 // A mesh in the caller's own memory, read where it lies: `vertex_count`

@@ -8,7 +8,9 @@ namespace meshcast {
 
 double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, Cull cull) {
   if (!ray_is_walkable(ray)) return INFINITY;
-  const double o[3] = {ray.org[0], ray.org[1], ray.org[2]}, d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
+  // The direction as the walkers read it (a denormal component as 0).
+  const double o[3] = {ray.org[0], ray.org[1], ray.org[2]},
+               d[3] = {walked_direction(ray.dir[0]), walked_direction(ray.dir[1]), walked_direction(ray.dir[2])};
   const double da[3] = {a[0], a[1], a[2]}, db[3] = {b[0], b[1], b[2]}, dc[3] = {c[0], c[1], c[2]};
   return oracle_triangle(o, d, ray.tmax, da, db, dc, cull);
 }
@@ -90,7 +92,7 @@ void OracleTree::visit(const Ray& ray, Cull cull, const double* cut, Take&& take
   auto touches = [&](const Node& n) {
     double tn = 0, tf = ray.tmax;
     for (int a = 0; a < 3; ++a) {
-      double o = ray.org[a], d = ray.dir[a];
+      double o = ray.org[a], d = walked_direction(ray.dir[a]);
       if (d == 0) {
         if (o < n.min[a] || o > n.max[a]) return false;
         continue;

@@ -31,7 +31,8 @@ SceneOracle::SceneOracle(const std::vector<const Mesh*>& meshes, const std::vect
 
 template <class Take>
 void SceneOracle::visit(const RayD& ray, Cull cull, uint8_t mask, const double* cut, Take&& take) const {
-  const double d[3] = {ray.dir[0], ray.dir[1], ray.dir[2]};
+  // The direction as the walkers read it (a denormal component as 0).
+  const double d[3] = {walked_direction(ray.dir[0]), walked_direction(ray.dir[1]), walked_direction(ray.dir[2])};
   for (const Placed& p : placed_) {
     if ((p.instance.mask & mask) == 0) continue;
     // The instance's box in double, inclusive: only a miss of every

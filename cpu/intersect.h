@@ -90,9 +90,9 @@ struct RayPre {
   explicit RayPre(const Ray& r, uint32_t hit_outputs = 0) : outputs(hit_outputs), cull(cull_sign(hit_outputs)) {
     for (int a = 0; a < 3; ++a) {
       org[a] = r.org[a];
-      dir[a] = r.dir[a];
-      inv[a] = 1.0f / r.dir[a];  // +-inf for a zero component: see box_test
-      near_is_max[a] = std::signbit(r.dir[a]) ? 1 : 0;
+      dir[a] = walked_direction(r.dir[a]);
+      inv[a] = 1.0f / dir[a];  // +-inf for a zero component: see box_test
+      near_is_max[a] = std::signbit(dir[a]) ? 1 : 0;
     }
     float ax = std::fabs(dir[0]), ay = std::fabs(dir[1]), az = std::fabs(dir[2]);
     int kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);

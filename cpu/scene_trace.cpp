@@ -61,12 +61,17 @@ float box_pad(const layout::TopLevel& top, const RayD& rd) {
   return float(far * kBoxSlack);
 }
 
-// A world ray and the top level's view of it (cpu/walk_top.h).
+// A world ray and the top level's view of it (cpu/walk_top.h). `dir` is
+// the direction as walked (walked_direction, meshcast/ray.h): the top
+// level's box test and every instance's frame take it.
 struct WorldRay {
   const RayD& ray;
+  float dir[3];
   TopRay top;
   WorldRay(const layout::TopLevel& t, const RayD& rd)
-      : ray(rd), top(relative_origin(t, rd).data(), rd.dir, box_pad(t, rd)) {}
+      : ray(rd),
+        dir{walked_direction(rd.dir[0]), walked_direction(rd.dir[1]), walked_direction(rd.dir[2])},
+        top(relative_origin(t, rd).data(), dir, box_pad(t, rd)) {}
 };
 
 // The world ray in the instance's frame: the translation subtracted in
@@ -75,7 +80,7 @@ Ray to_local(const WorldRay& r, const layout::PlacedInstance& p) {
   float rel[3];
   for (int a = 0; a < 3; ++a) rel[a] = float(r.ray.org[a] - p.translation[a]);
   Ray local;
-  const float* dir = r.ray.dir;
+  const float* dir = r.dir;
   for (int i = 0; i < 3; ++i) {
     const float* row = p.to_local + 3 * i;
     local.org[i] = row[0] * rel[0] + row[1] * rel[1] + row[2] * rel[2];

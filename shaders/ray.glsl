@@ -26,6 +26,15 @@ struct GpuRay {
 
 layout(std430, set = 0, binding = 1) readonly buffer Rays { uint ray_words[]; };
 
+// walked_direction of meshcast/ray.h, for the rays a shader makes itself
+// (the scene method's): a component below FLT_MIN as 0, its sign kept.
+vec3 walked_direction(vec3 d) {
+  vec3 out_d;
+  for (int a = 0; a < 3; ++a)
+    out_d[a] = abs(d[a]) < uintBitsToFloat(0x00800000u) ? uintBitsToFloat(floatBitsToUint(d[a]) & 0x80000000u) : d[a];
+  return out_d;
+}
+
 GpuRay load_ray(uint i) {
   const uint b = i * MC_GPU_RAY_WORDS;
   GpuRay r;

@@ -57,8 +57,9 @@ bool directions_walkable(vec3 dir, float tmax) {
 
 // RayPre of cpu/intersect.h for a ray made here (gpu/rays.cpp makes the
 // blob methods' on the host): 1/d, the dominant axis, the shear.
-GpuRay prepared(vec3 org, vec3 dir, float tmax) {
+GpuRay prepared(vec3 org, vec3 given_dir, float tmax) {
   GpuRay r;
+  const vec3 dir = walked_direction(given_dir);
   r.org = org, r.dir = dir, r.tmax = tmax;
   for (int a = 0; a < 3; ++a) r.inv[a] = div_exact(1.0, dir[a]);
   const float ax = abs(dir.x), ay = abs(dir.y), az = abs(dir.z);
@@ -82,8 +83,9 @@ void main() {
   const uint w = ray * RAYD_WORDS;
   dvec3 org;
   for (uint a = 0u; a < 3u; ++a) org[a] = packDouble2x32(uvec2(ray_words[w + 2u * a], ray_words[w + 2u * a + 1u]));
-  const vec3 dir = vec3(uintBitsToFloat(ray_words[w + 6u]), uintBitsToFloat(ray_words[w + 7u]),
-                        uintBitsToFloat(ray_words[w + 8u]));
+  const vec3 given_dir = vec3(uintBitsToFloat(ray_words[w + 6u]), uintBitsToFloat(ray_words[w + 7u]),
+                              uintBitsToFloat(ray_words[w + 8u]));
+  const vec3 dir = walked_direction(given_dir);  // as WorldRay of cpu/scene_trace.cpp
   const float tmax = uintBitsToFloat(ray_words[w + 9u]);
   float best_t = kInfinity, best_u = 0.0, best_v = 0.0;
   uint best_instance = MC_NO_HIT, best_triangle = MC_NO_HIT, incomplete = 0u;

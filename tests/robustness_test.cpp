@@ -397,9 +397,12 @@ TEST_P(Robustness, MeshesUnderAGridsLeastExtent) {
         continue;
       }
     }
-    // Unit directions from 1.2 extents out, aimed at points of the box.
+    // From 1.2 extents out, aimed at points of the box: unit directions,
+    // and (every other ray) the difference itself, as small as the mesh
+    // (components below FLT_MIN, read as 0: their reciprocals overflowed
+    // and the box test culled boxes these rays cross).
     std::vector<Ray> rays;
-    for (int i = 0; i < 200; ++i) {
+    for (int i = 0; i < 400; ++i) {
       double o[3], d[3], len = 0;
       for (int a = 0; a < 3; ++a) {
         const double lo = box.min[a], hi = box.max[a], c = 0.5 * (lo + hi), e = hi - lo;
@@ -407,7 +410,7 @@ TEST_P(Robustness, MeshesUnderAGridsLeastExtent) {
       }
       for (double x : d) len += x * x;
       Ray r{};
-      for (int a = 0; a < 3; ++a) r.org[a] = float(o[a]), r.dir[a] = float(d[a] / std::sqrt(len));
+      for (int a = 0; a < 3; ++a) r.org[a] = float(o[a]), r.dir[a] = float(i % 2 ? d[a] : d[a] / std::sqrt(len));
       r.tmax = INFINITY;
       rays.push_back(r);
     }

@@ -5,6 +5,7 @@
 // edge or vertex hits one of its triangles.
 #pragma once
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -20,6 +21,13 @@ struct Ray {
   float tmax;
 };
 static_assert(sizeof(Ray) == 28, "Ray is the 7 floats of a rays-file record");
+
+// How every walker, shader and the oracle read a direction component: one
+// below FLT_MIN in magnitude (a denormal) as 0, its sign kept. Its
+// reciprocal would overflow float, which the box test cannot take (a box
+// the ray crosses within t = 1 was culled), and a GPU flushes it to 0
+// anyway. The ray then moves less than 2^-126 a unit of t off its course.
+inline float walked_direction(float d) { return std::fabs(d) < FLT_MIN ? std::copysign(0.0f, d) : d; }
 
 // A miss's triangle number.
 constexpr uint32_t kNoHit = 0xFFFFFFFFu;

@@ -136,6 +136,7 @@ deep = "[" * 100000 + "]" * 100000
 open(f"{work}/deep.json", "w").write('{"meshes": {"mesh": %s}, "instances": [{"mesh": "mesh", "translation": [0, 0, %s]}]}'
                                      % (json.dumps(mesh), deep))
 scene("long", {"mesh": "x" * 5000000})
+scene("long_path", {"mesh": "mesh"}, {"mesh": "y" * 5000000})
 open(f"{work}/twice.json", "w").write('{"meshes": {"mesh": %s}, "instances": [{"mesh": "mesh", "mask": 1, "mask": 2}]}'
                                       % json.dumps(mesh))
 scene("nul", {"mesh": "mesh"}, {"mesh": "a\u0000b.off"})
@@ -147,6 +148,7 @@ check scene-long-name 2 'long.json: instances\[0\].mesh: "x{64}\.\.\. \(5000000 
 if (( $("$meshcast" trace "$work/long.json" --rays "$work/r.rays" --out "$work/x.hiti" 2>&1 | wc -c) > 1000 )); then
   echo "FAIL scene-long-name: the message echoes the name whole"; failures=$((failures + 1))
 fi
+check scene-long-path 2 'long_path.json: meshes.mesh: the file name "y{64}\.\.\. \(5000000 bytes\)" is longer than a path may be' -- "$meshcast" trace "$work/long_path.json" --rays "$work/r.rays" --out "$work/x.hiti"
 check scene-key-twice 2 'twice.json: the key "mask" appears twice in one object' -- "$meshcast" trace "$work/twice.json" --rays "$work/r.rays" --out "$work/x.hiti"
 check scene-nul-path 2 'nul.json: meshes.mesh: the file name "a\\x00b.off" holds a NUL character' -- "$meshcast" trace "$work/nul.json" --rays "$work/r.rays" --out "$work/x.hiti"
 check scene-tiny-determinant 2 'tiny_det.json: instances\[0\]: .*determinant 9\.9999[0-9]*e-61\)' -- "$meshcast" trace "$work/tiny_det.json" --rays "$work/r.rays" --out "$work/x.hiti"

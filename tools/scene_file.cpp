@@ -1,5 +1,6 @@
 #include "tools/scene_file.h"
 
+#include <climits>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -101,6 +102,11 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
     if (!file.is_string()) throw InputError(where + " is " + described(file) + ", not a file name");
     if (file.get<std::string>().find('\0') != std::string::npos)
       throw InputError(where + ": the file name \"" + shown(file.get<std::string>()) + "\" holds a NUL character");
+    // The mesh file's own messages name its path: one longer than a path may
+    // be is refused here, shown short, rather than echoed whole by them.
+    if (file.get<std::string>().size() > PATH_MAX)
+      throw InputError(where + ": the file name \"" + shown(file.get<std::string>()) + "\" is longer than a path may be (" +
+                       std::to_string(PATH_MAX) + " bytes)");
     const std::string mesh_path = (folder / file.get<std::string>()).string();
     try {  // the mesh file's own message, and where the scene names it
       Loaded mesh = load_input(mesh_path, layout, report);

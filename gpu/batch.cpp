@@ -146,21 +146,25 @@ void BatchMethod::finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing
   if (!all()) throw UsageError("GPU method made for one hit a ray: finish() reads its hits");
   Slot& s = slots_.at(slot);
   finish_batch(s, timing);
-  // A row is a HITN row: found, then max_hits (t, triangle) records.
+  // The device's rows stay fixed (found, then max_hits (t, triangle)
+  // records, reserve()); each ray's kept records alone are read back.
   lists.max_hits = max_hits_;
-  lists.found.assign(s.n, 0);
-  lists.hits.assign(size_t(s.n) * max_hits_, Hit{});
+  lists.clear();
+  lists.found.reserve(s.n);
+  lists.offsets.reserve(size_t(s.n) + 1);
   const uint32_t* row = static_cast<const uint32_t*>(s.rows->data());
   const float* ray = static_cast<const float*>(s.rays->data());  // packed: origin, direction first (gpu/rays.h)
   for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_, ray += kRayWords) {
-    lists.found[i] = row[0];
-    for (uint32_t k = 0; k < max_hits_; ++k) {
-      Hit& h = lists.hits[size_t(i) * max_hits_ + k];
+    const uint32_t kept = std::min(row[0], max_hits_);
+    for (uint32_t k = 0; k < kept; ++k) {
+      Hit h;
       std::memcpy(&h.t, &row[1 + 2 * k], 4);
       h.triangle = row[2 + 2 * k];
-      if ((flags_ & MC_HIT_POINT) && h.triangle != MC_NO_HIT)
+      if (flags_ & MC_HIT_POINT)
         for (int a = 0; a < 3; ++a) h.point[a] = ray[a] + h.t * ray[3 + a];
+      lists.hits.push_back(h);
     }
+    lists.end_row(row[0]);
   }
 }
 

@@ -42,8 +42,9 @@ class Method {
   virtual void wait(uint32_t slot) = 0;
   // Hits of the slot's batch into `hits` (at least the batch's size).
   virtual void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
-  // A Query::All method's rows of the slot's batch into `lists` (resized;
-  // max_hits the method's). UsageError for a method made for another query.
+  // A Query::All method's rows of the slot's batch into `lists`, compact
+  // (meshcast/ray.h: cleared, then each ray's kept hits alone; max_hits
+  // the method's). UsageError for a method made for another query.
   virtual void finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing = nullptr) = 0;
 
   // One batch in slot 0, waited for.

@@ -187,11 +187,13 @@ TEST_P(GpuMethods, RowsKeepTheNearestAndCountAll) {
   const std::vector<Ray> rays = rays_down_through(12, 300);
   const std::vector<uint8_t> blob = build_blob(planes, parse_layout(mc.layout), "planes");
   const Mesh stored = moves_vertices(uint32_t(parse_layout(mc.layout).layout.triangles)) ? stored_mesh(blob) : planes;
-  for (uint32_t max_hits : {1u, 3u, 12u}) {
+  for (uint32_t max_hits : {1u, 3u, 12u, kMaxHitsLimit}) {
     HitLists lists;
     gpu::make_method(context(), mc.method, blob, "planes", 1, MC_QUERY_ALL | MC_HIT_POINT, max_hits)->trace_all_hits(rays, lists);
     const std::string what = std::string(mc.method) + ", rows of " + std::to_string(max_hits);
     expect_nearest_rows(stored, rays, lists, what);
+    // Read back compact: the kept hits alone, whatever the device's rows.
+    EXPECT_EQ(lists.hits.size(), rays.size() * std::min(12u, max_hits)) << what;
     for (size_t i = 0; i < rays.size(); ++i)
       for (const Hit& h : lists.row(i)) EXPECT_NEAR(h.point[2], rays[i].org[2] - h.t, 1e-4) << what << ", ray " << i;
   }

@@ -257,7 +257,8 @@ void expect_rows_extend(const HitRows<Record>& every, const HitRows<Record>& few
 // Every hit at the limit (kMaxHitsLimit a ray) on both backends and in a
 // scene batch: 12 stacked planes, rays through all of them, cut short or
 // aimed away. The caller's lists held longer rows before: they are
-// replaced.
+// replaced. A batch whose fixed device rows exceed the device's buffers is
+// refused by the GPU method before it allocates, and the CPU answers it.
 TEST(Host, EveryHitRowsAtTheLimitHoldTheHitsFoundAlone) {
   constexpr int kPlanes = 12;
   const Mesh planes = stacked_planes(kPlanes);
@@ -277,6 +278,17 @@ TEST(Host, EveryHitRowsAtTheLimitHoldTheHitsFoundAlone) {
     HitLists lists = trace_lists(view, rays, 64);  // what the wait replaces
     EXPECT_EQ(caster.wait(caster.submit(rays, limit), lists).ran_on, b);
     expect_rows_extend(lists, few, host::backend_name(b));
+    if (b == Backend::Vulkan) {
+      // 140,000 rows of 4096 hits are 4.6 GB of device rows, beyond any
+      // storage buffer (maxStorageBufferRange is a uint32).
+      std::vector<Ray> many;
+      while (many.size() < 140000) many.insert(many.end(), rays.begin(), rays.end());
+      many.resize(140000);
+      EXPECT_EQ(caster.wait(caster.submit(many, limit), lists).ran_on, Backend::Cpu);
+      EXPECT_TRUE(caster.gpu_available()) << caster.gpu_error();
+      ASSERT_EQ(lists.found.size(), many.size());
+      for (size_t i = 0; i < many.size(); i += 997) EXPECT_EQ(lists.found[i], few.found[i % rays.size()]) << "ray " << i;
+    }
     EXPECT_EQ(caster.validation_messages(), 0u);
   }
   // A scene batch: the planes placed twice, one above the other.

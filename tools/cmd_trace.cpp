@@ -146,6 +146,11 @@ void add_trace(CLI::App& app) {
       // The query and culling are the method's specialization constants.
       const uint32_t flags = layout::query_bits(query, cull);
       std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input, 1, flags, args->max_hits);
+      // A batch beyond the device's buffers (Query::All's fixed device rows
+      // above all) is the input's fault: refused before any pass, exit 2.
+      if (const std::string why = method->refusal(uint32_t(rays.size())); !why.empty())
+        throw InputError("trace " + args->rays + ": " + why + "; cast fewer rays" +
+                         (query == Query::All ? " or lower --max-hits" : "") + ", or use --backend cpu");
       for (uint32_t r = 0; r < args->repeat; ++r) {
         gpu::GpuTiming timing;
         skipped = query == Query::All ? method->trace_all_hits(rays, lists, &timing) : method->trace(rays, hits, &timing);

@@ -72,12 +72,11 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     auto lists = std::make_shared<HitLists>();  // Query::All's rows, kept from pass to pass as a game would
     all.push_back({layout, false, double(blobs.back().size()) / triangles, build, build,
                    [view, lists](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
-                     if (q.query == Query::All) view->trace_all_hits(r, lists->max_hits, lists->found, lists->hits, HitOutputs::None, q.cull);
+                     if (q.query == Query::All) view->trace_all_hits(r, *lists, HitOutputs::None, q.cull);
                      else view->trace(r, h, HitOutputs::None, q.query, q.cull);
                      return true;
                    },
                    {}});
-    lists->found.resize(o.rays), lists->hits.resize(o.rays * lists->max_hits);
   }
   std::vector<std::unique_ptr<Peer>> peers;
   for (EmbreeMode mode : {EmbreeMode::Default, EmbreeMode::Robust, EmbreeMode::Compact}) {

@@ -216,16 +216,22 @@ Agreement compare_all(const Mesh& mesh, const std::vector<Ray>& rays, const HitL
   std::vector<Hit> pair_hits;
   std::vector<OracleHit> pair_oracle;
   std::vector<size_t> pair_ray;
+  // Compact rows (meshcast/ray.h): a row a ray, offsets covering the hits.
+  if (lists.rays() != rays.size() || lists.offsets.size() != rays.size() + 1 || lists.offsets.front() != 0 ||
+      lists.offsets.back() != lists.hits.size() || !std::is_sorted(lists.offsets.begin(), lists.offsets.end())) {
+    wrong(0, "rows for " + std::to_string(lists.rays()) + " rays with " + std::to_string(lists.offsets.size()) +
+                 " offsets over " + std::to_string(lists.hits.size()) + " hits, for " + std::to_string(rays.size()) +
+                 " rays");
+    return a;
+  }
   for (size_t i = 0; i < rays.size(); ++i) {
     const std::span<const Hit> row = lists.row(i);
     if (lists.found[i] > lists.max_hits) {
       wrong(i, std::to_string(lists.found[i]) + " hits found, more than the row's " + std::to_string(lists.max_hits));
       continue;
     }
-    for (size_t k = row.size(); k < lists.max_hits; ++k) {
-      const Hit& unused = lists.hits[i * lists.max_hits + k];
-      if (unused.t != INFINITY || unused.triangle != MC_NO_HIT) wrong(i, "an unused record is not a miss");
-    }
+    if (row.size() != lists.found[i])
+      wrong(i, std::to_string(lists.found[i]) + " hits found but the row keeps " + std::to_string(row.size()));
     for (size_t k = 1; k < row.size(); ++k)
       if (row[k].t < row[k - 1].t || (row[k].t == row[k - 1].t && row[k].triangle <= row[k - 1].triangle))
         wrong(i, "the row is not in order of t, then triangle, or names a triangle twice");

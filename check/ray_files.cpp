@@ -1,5 +1,6 @@
 #include "check/ray_files.h"
 
+#include <algorithm>
 #include <bit>
 #include <algorithm>
 #include <cstring>
@@ -20,7 +21,8 @@ const char* file_kind(const std::string& magic) {
   if (magic == "RAYS") return "rays with float origins";
   if (magic == "RAYD") return "rays with double origins, read by scenes";
   if (magic == "HITS") return "a mesh's closest or any hits";
-  if (magic == "HITN") return "a mesh's every hit";
+  if (magic == "HITN") return "a mesh's every hit, in rows of N records";
+  if (magic == "HITC") return "a mesh's every hit, the rows compact";
   if (magic == "HITI") return "a scene's hits";
   return nullptr;
 }
@@ -125,48 +127,97 @@ void write_hits(const std::string& path, const std::vector<Hit>& hits) {
   write_records<HitRecord>(path, "HITS", hits, [](const Hit& h) { return HitRecord{h.t, h.triangle}; });
 }
 
-HitLists read_hit_lists(const std::string& path) {
-  std::vector<uint8_t> b = read_file(path);
-  check_magic(path, b, "HITN", 12);
-  uint32_t n, width;
-  std::memcpy(&n, b.data() + 4, 4), std::memcpy(&width, b.data() + 8, 4);
-  if (width < 1 || width > kMaxHitsLimit)
-    throw InputError(path + ": " + std::to_string(width) + " records a ray, not in 1.." + std::to_string(kMaxHitsLimit));
+namespace {
+
+// `count` (t, triangle) records at `p` as the next ray's row, `found` hits
+// found in all.
+void add_record_row(HitLists& lists, const uint8_t* p, size_t count, uint32_t found) {
+  for (size_t k = 0; k < count; ++k) {
+    HitRecord r;
+    std::memcpy(&r, p + 8 * k, 8);
+    lists.hits.push_back({r.t, r.triangle});
+  }
+  lists.end_row(found);
+}
+
+// HITC: the counts, then each ray's kept records one after the other.
+HitLists read_compact_rows(const std::string& path, const std::vector<uint8_t>& b, uint32_t n, uint32_t width) {
+  if (b.size() < 12 + 4 * uint64_t(n))
+    throw InputError(path + ": header says " + std::to_string(n) + " rays, whose counts alone take " +
+                     std::to_string(12 + 4 * uint64_t(n)) + " bytes, but the file has " + std::to_string(b.size()) +
+                     " bytes");
+  std::vector<uint32_t> found(n);
+  std::memcpy(found.data(), b.data() + 12, 4 * size_t(n));
+  uint64_t kept = 0;
+  for (uint32_t f : found) kept += std::min(f, width);
+  if (b.size() != 12 + 4 * uint64_t(n) + 8 * kept)
+    throw InputError(path + ": header and counts say " + std::to_string(n) + " rays keeping " + std::to_string(kept) +
+                     " hits (" + std::to_string(12 + 4 * uint64_t(n) + 8 * kept) + " bytes) but the file has " +
+                     std::to_string(b.size()) + " bytes");
+  HitLists lists;
+  lists.max_hits = width;
+  lists.hits.reserve(kept);
+  const uint8_t* p = b.data() + 12 + 4 * size_t(n);
+  for (uint32_t f : found) {
+    const size_t count = std::min(f, width);
+    add_record_row(lists, p, count, f);
+    p += 8 * count;
+  }
+  return lists;
+}
+
+// HITN: a fixed row of `width` records a ray, after its count; the kept
+// ones are read.
+HitLists read_fixed_rows(const std::string& path, const std::vector<uint8_t>& b, uint32_t n, uint32_t width) {
   const uint64_t row = 4 + 8 * uint64_t(width);
   if (b.size() != 12 + n * row)
     throw InputError(path + ": header says " + std::to_string(n) + " rays of " + std::to_string(width) + " records (" +
                      std::to_string(12 + n * row) + " bytes) but the file has " + std::to_string(b.size()) + " bytes");
   HitLists lists;
   lists.max_hits = width;
-  lists.found.resize(n);
-  lists.hits.resize(size_t(n) * width);
   for (size_t i = 0; i < n; ++i) {
     const uint8_t* p = b.data() + 12 + i * row;
-    std::memcpy(&lists.found[i], p, 4);
-    for (size_t k = 0; k < width; ++k) {
-      HitRecord r;
-      std::memcpy(&r, p + 4 + 8 * k, 8);
-      lists.hits[i * width + k] = {r.t, r.triangle};
-    }
+    uint32_t found;
+    std::memcpy(&found, p, 4);
+    add_record_row(lists, p + 4, std::min(found, width), found);
   }
   return lists;
 }
 
+}  // namespace
+
+HitLists read_hit_lists(const std::string& path) {
+  std::vector<uint8_t> b = read_file(path);
+  const bool compact = b.size() >= 4 && std::memcmp(b.data(), "HITC", 4) == 0;
+  check_magic(path, b, compact ? "HITC" : "HITN", 12);
+  uint32_t n, width;
+  std::memcpy(&n, b.data() + 4, 4), std::memcpy(&width, b.data() + 8, 4);
+  if (width < 1 || width > kMaxHitsLimit)
+    throw InputError(path + ": " + std::to_string(width) + " records a ray, not in 1.." + std::to_string(kMaxHitsLimit));
+  return compact ? read_compact_rows(path, b, n, width) : read_fixed_rows(path, b, n, width);
+}
+
 void write_hit_lists(const std::string& path, const HitLists& lists) {
-  const size_t n = lists.found.size(), width = lists.max_hits, row = 4 + 8 * width;
-  std::vector<uint8_t> b(12 + n * row);
-  const uint32_t header[2] = {uint32_t(n), uint32_t(width)};
-  std::memcpy(b.data(), "HITN", 4), std::memcpy(b.data() + 4, header, 8);
-  for (size_t i = 0; i < n; ++i) {
-    uint8_t* p = b.data() + 12 + i * row;
-    std::memcpy(p, &lists.found[i], 4);
-    for (size_t k = 0; k < width; ++k) {
-      const Hit& h = lists.hits[i * width + k];
-      HitRecord r{h.t, h.triangle};
-      std::memcpy(p + 4 + 8 * k, &r, 8);
-    }
-  }
-  write_file(path, b.data(), b.size());
+  const size_t n = lists.rays();
+  if (n > kMaxRayCount)
+    throw InputError(path + ": " + std::to_string(n) + " rays, more than a HITC file may hold (" +
+                     std::to_string(kMaxRayCount) + ")");
+  // The file is read back by the counts alone: every row must keep
+  // exactly min(found, N) records.
+  if (lists.offsets.size() != n + 1 || lists.offsets.back() != lists.hits.size())
+    throw UsageError(path + ": the rows' offsets do not cover their " + std::to_string(n) + " rays and " +
+                     std::to_string(lists.hits.size()) + " hits");
+  for (size_t i = 0; i < n; ++i)
+    if (lists.row(i).size() != std::min(lists.found[i], lists.max_hits))
+      throw UsageError(path + ": ray " + std::to_string(i) + " found " + std::to_string(lists.found[i]) +
+                       " hits but its row keeps " + std::to_string(lists.row(i).size()) + " of at most " +
+                       std::to_string(lists.max_hits));
+  std::vector<HitRecord> records(lists.hits.size());
+  for (size_t k = 0; k < records.size(); ++k) records[k] = {lists.hits[k].t, lists.hits[k].triangle};
+  uint8_t head[12];
+  const uint32_t counts[2] = {uint32_t(n), lists.max_hits};
+  std::memcpy(head, "HITC", 4), std::memcpy(head + 4, counts, 8);
+  write_file(path, {{head, 12}, {lists.found.data(), 4 * n}, {records.data(), records.size() * sizeof(HitRecord)}});
 }
 
 std::vector<RayD> read_scene_rays(const std::string& path) { return read_records<RayD>(path, "RAYD"); }

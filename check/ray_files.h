@@ -1,9 +1,13 @@
 // The two files exchanged with the outside (ARCHITECTURE.md):
 //   rays: "RAYS", uint32 count, per ray 7 float32 (origin, direction, t_max)
 //   hits: "HITS", uint32 count, per ray float32 t (inf: miss), uint32 triangle
-//   every hit (Query::All): "HITN", uint32 count, uint32 N, per ray uint32
-//         hits found, then N records of float32 t, uint32 triangle, in
-//         order of t; unused records t = inf, triangle 0xFFFFFFFF
+//   every hit (Query::All): "HITC", uint32 count, uint32 N, then per ray
+//         uint32 hits found, then per ray its min(found, N) kept records
+//         of float32 t, uint32 triangle, nearest first: 12 + 4 count + 8
+//         (kept hits) bytes, the size following the hits, not count x N
+//   the fixed rows before HITC (read, no longer written): "HITN", uint32
+//         count, uint32 N, per ray uint32 hits found, then N records, the
+//         unused ones t = inf, triangle 0xFFFFFFFF
 //   scene rays: "RAYD", uint32 count, per ray 3 float64 origin, 3 float32
 //         direction, float32 t_max (40 bytes)
 //   scene hits: "HITI", uint32 count, per ray float32 t (inf: miss),
@@ -31,9 +35,12 @@ void write_rays(const std::string& path, const std::vector<Ray>& rays);
 void write_rays(const std::string& path, size_t count, const std::function<void(std::span<Ray>)>& make);
 std::vector<Hit> read_hits(const std::string& path);
 void write_hits(const std::string& path, const std::vector<Hit>& hits);
-// HITN files: InputError naming the file for a bad magic, an N outside
-// 1..kMaxHitsLimit or a size that is not the header's.
+// Every-hit files, HITC or HITN, into compact rows: InputError naming the
+// file for a bad magic, an N outside 1..kMaxHitsLimit or a size that is
+// not the header's (and, for HITC, the counts').
 HitLists read_hit_lists(const std::string& path);
+// A HITC file. InputError beyond kMaxRayCount rays; UsageError for rows
+// that do not keep min(found, max_hits) records each.
 void write_hit_lists(const std::string& path, const HitLists& lists);
 // Scenes' files (issue 21), with read_rays' refusals.
 std::vector<RayD> read_scene_rays(const std::string& path);

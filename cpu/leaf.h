@@ -14,7 +14,8 @@ MC_ISA_BEGIN
 
 // Query::All's hits of one ray so far, triangles still slots: the nearest
 // `cap` (at least 1) in hits[0, min(found, cap)) sorted by t, `found`
-// counting every hit taken.
+// counting every hit taken. Nothing past min(found, cap) is read, so the
+// row needs no filling before the walk.
 struct HitList {
   Hit* hits;
   uint32_t cap;

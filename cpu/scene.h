@@ -36,10 +36,4 @@ class SceneSnapshot {
 // check, which Scene's float-ray trace makes before its chunks).
 void check_scene_hits(size_t rays, size_t hits);
 
-// trace_all_hits_snapshot into the caller's storage (a batch's slice): ray
-// i's count in found[i], its row in rows[i * max_hits, (i + 1) * max_hits).
-uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint32_t max_hits,
-                          std::span<uint32_t> found, std::span<SceneHit> rows, HitOutputs outputs, Cull cull,
-                          uint8_t mask);
-
 }  // namespace meshcast

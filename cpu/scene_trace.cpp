@@ -8,6 +8,7 @@
 #include <cstddef>
 
 #include "cpu/scene.h"
+#include "cpu/scratch.h"
 #include "cpu/walk.h"
 #include "cpu/walk_top.h"
 #include "layout/blob_format.h"
@@ -123,17 +124,22 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Walk
        &context);
 }
 
-// What a closest- or any-hit trace asks of each instance's walker: for an
-// instance as the world sees it and for a mirrored one (its culling
-// turned). The hits keep their slots (looked up by finish_scene_hits).
+// What a trace asks of each instance's walker: for an instance as the
+// world sees it and for a mirrored one (its culling turned). Closest and
+// any hit keep their slots (looked up by finish_scene_hits); Query::All's
+// rows name the caller's triangles, the instance's row written to `row`
+// (max_hits records), its count to *found.
 struct InstanceRequests {
   WalkRequest as_seen, mirrored;
   bool any;
-  InstanceRequests(HitOutputs outputs, Query query, Cull cull) : any(query == Query::Any) {
+  InstanceRequests(HitOutputs outputs, Query query, Cull cull, uint32_t max_hits = 0, uint32_t* found = nullptr,
+                   Hit* row = nullptr)
+      : any(query == Query::Any) {
     const uint32_t uv = uint32_t(outputs) & MC_HIT_UV;
     as_seen.flags = uv | layout::query_bits(query, cull);
     mirrored.flags = uv | layout::query_bits(query, as_instance_sees(cull, true));
     as_seen.keep_slots = mirrored.keep_slots = true;
+    for (WalkRequest* r : {&as_seen, &mirrored}) r->max_hits = max_hits, r->found = found, r->lists = row;
   }
 };
 
@@ -175,34 +181,53 @@ void finish_scene_hits(std::span<SceneHit> hits, std::span<const SceneMesh* cons
     }
 }
 
-// Every hit of one ray into its row (max_hits long, filled with misses):
-// each instance's own hits (its walker's rows, `scratch` max_hits long)
-// merged in, the nearest kept in order of t, instance, triangle. Returns
-// the hits found, or with `complete` false a ray some frame could not take.
-uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, std::span<SceneHit> row, std::vector<Hit>& scratch,
-                  HitOutputs outputs, Cull cull, uint8_t mask, WalkTopFn walk_fn, bool& complete) {
-  const uint32_t cap = uint32_t(row.size());
-  uint32_t found = 0, kept = 0;
+// Query::All's rows of one ray in a thread's scratch (cpu/scratch.h):
+// `own`, the row an instance's walker writes (max_hits records, its count
+// in own_found), and `row`, the ray's nearest max_hits over every instance
+// so far.
+struct ListWalk {
+  std::span<Hit> own;
+  std::span<SceneHit> row;
+  uint32_t own_found = 0;
+  InstanceRequests requests;
+  ListWalk(HitOutputs outputs, Cull cull, uint32_t max_hits)
+      : own(thread_scratch<Hit>(max_hits)),
+        row(thread_scratch<SceneHit>(max_hits)),
+        requests(outputs, Query::All, cull, max_hits, &own_found, own.data()) {}
+};
+
+// Every hit of one ray: each instance's own hits (its walker's row in
+// w.own) merged into w.row, the nearest kept (`kept` of them, the first
+// records of w.row) in order of t, instance, triangle. Returns the hits
+// found, or with `complete` false a ray some frame could not take.
+uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, ListWalk& w, uint32_t& kept, uint8_t mask, WalkTopFn walk_fn,
+                  bool& complete) {
+  const uint32_t cap = uint32_t(w.row.size());
+  uint32_t found = 0;
+  kept = 0;
   auto before = [](const SceneHit& a, const SceneHit& b) {
     return a.t < b.t || (a.t == b.t && (a.instance < b.instance || (a.instance == b.instance && a.triangle < b.triangle)));
   };
   walk_top(s.top, WorldRay(s.top, rd), mask, walk_fn, [&](const layout::PlacedInstance& p, const Ray& local) {
-    uint32_t own = 0;
-    if (s.meshes[p.mesh]->view.trace_all_hits(std::span(&local, 1), cap, std::span(&own, 1), scratch, outputs,
-                                              as_instance_sees(cull, p.mirrored != 0)) != 0)
-      complete = false;
+    const SceneMesh& mesh = *s.meshes[p.mesh];
+    uint64_t skipped = 0;
+    // A local ray the walkers refuse (its direction scaled past their
+    // range) is counted, not walked.
+    mesh.walk(mesh.bytes.data(), &local, nullptr, 1, &skipped, p.mirrored ? w.requests.mirrored : w.requests.as_seen);
+    if (skipped != 0) complete = false;
+    const uint32_t own = w.own_found;
     found += own;
     for (uint32_t k = 0; k < std::min(own, cap); ++k) {
-      const SceneHit h{scratch[k].t, p.id, scratch[k].triangle, scratch[k].u, scratch[k].v};
+      const SceneHit h{w.own[k].t, p.id, w.own[k].triangle, w.own[k].u, w.own[k].v};
       uint32_t at = std::min(kept, cap);
       if (at == cap) {
-        if (!before(h, row[cap - 1])) break;  // this instance's rest is farther still
+        if (!before(h, w.row[cap - 1])) break;  // this instance's rest is farther still
         --at;
       } else {
         ++kept;
       }
-      for (; at > 0 && before(h, row[at - 1]); --at) row[at] = row[at - 1];
-      row[at] = h;
+      for (; at > 0 && before(h, w.row[at - 1]); --at) w.row[at] = w.row[at - 1];
+      w.row[at] = h;
     }
     return local.tmax;  // every hit along the segment: the cut stays
   });
@@ -270,30 +295,22 @@ uint64_t trace_all_hits_snapshot(const SceneSnapshot& snapshot, std::span<const 
   if (lists.max_hits < 1 || lists.max_hits > kMaxHitsLimit)
     throw UsageError("Scene::trace_all_hits: max_hits " + std::to_string(lists.max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
-  lists.found.assign(rays.size(), 0);
-  lists.hits.assign(rays.size() * lists.max_hits, SceneHit{});
-  return trace_scene_rows(snapshot, rays, lists.max_hits, lists.found, lists.hits, outputs, cull, mask);
-}
-
-uint64_t trace_scene_rows(const SceneSnapshot& snapshot, std::span<const RayD> rays, uint32_t max_hits,
-                          std::span<uint32_t> found, std::span<SceneHit> rows, HitOutputs outputs, Cull cull,
-                          uint8_t mask) {
-  check_request("Scene::trace_all_hits", outputs, Query::All, cull);
+  lists.clear();
+  lists.found.reserve(rays.size());
+  lists.offsets.reserve(rays.size() + 1);
   const WalkTopFn walk_fn = walk_top_fn();
-  std::vector<Hit> scratch(max_hits);
-  auto row = [&](size_t i) { return rows.subspan(i * max_hits, max_hits); };
-  return for_each_world_ray(
-      snapshot, rays, 0, rays.size(),
-      [&](size_t i) {
-        const std::span<SceneHit> r = row(i);
-        std::fill(r.begin(), r.end(), SceneHit{});
-        found[i] = 0;
-      },
-      [&](size_t i) {
-        bool complete = true;
-        found[i] = walk_all(snapshot, rays[i], row(i), scratch, outputs, cull, mask, walk_fn, complete);
-        return complete;
-      });
+  ListWalk w(outputs, cull, lists.max_hits);
+  uint64_t skipped = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    uint32_t found = 0, kept = 0;  // a ray not walked: an empty row
+    skipped += for_each_world_ray(snapshot, rays, i, i + 1, [](size_t) {}, [&](size_t) {
+      bool complete = true;
+      found = walk_all(snapshot, rays[i], w, kept, mask, walk_fn, complete);
+      return complete;
+    });
+    lists.add_row(found, w.row.first(kept));
+  }
+  return skipped;
 }
 
 }  // namespace meshcast

@@ -12,6 +12,7 @@
 #include <cpuid.h>
 #endif
 
+#include "cpu/scratch.h"
 #include "cpu/walk.h"
 #include "cpu/walk_top.h"
 #include "layout/queries.h"
@@ -199,28 +200,37 @@ uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutp
   return skipped;
 }
 
-uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs, Cull cull) const {
-  if (lists.max_hits < 1 || lists.max_hits > kMaxHitsLimit)
-    throw UsageError("BlobView::trace_all_hits: max_hits " + std::to_string(lists.max_hits) + " is not in 1.." +
-                     std::to_string(kMaxHitsLimit));
-  lists.found.assign(rays.size(), 0);
-  lists.hits.assign(rays.size() * lists.max_hits, Hit{});
-  return trace_all_hits(rays, lists.max_hits, lists.found, lists.hits, outputs, cull);
-}
+namespace {
 
-uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, uint32_t max_hits, std::span<uint32_t> found,
-                                  std::span<Hit> rows, HitOutputs outputs, Cull cull) const {
+// Query::All walks a few rays at a time into a thread's scratch rows
+// (cpu/scratch.h), at most kScratchRecords records (448 KiB) whatever
+// max_hits, and copies each ray's kept hits out: the answers' memory and
+// time follow the hits found, not rays x max_hits.
+constexpr size_t kScratchRecords = 16384;
+constexpr size_t kMostRaysAWalk = 64;
+
+}  // namespace
+
+uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs, Cull cull) const {
+  const uint32_t max_hits = lists.max_hits;
   if (max_hits < 1 || max_hits > kMaxHitsLimit)
     throw UsageError("BlobView::trace_all_hits: max_hits " + std::to_string(max_hits) + " is not in 1.." +
                      std::to_string(kMaxHitsLimit));
-  if (found.size() < rays.size() || rows.size() / max_hits < rays.size())
-    throw UsageError("BlobView::trace_all_hits: " + std::to_string(rays.size()) + " rays but room for " +
-                     std::to_string(found.size()) + " counts and " + std::to_string(rows.size()) + " hits (" +
-                     std::to_string(max_hits) + " a ray)");
-  WalkRequest request{flags_of("BlobView::trace_all_hits", outputs, Query::All, cull), max_hits, found.data(),
-                      rows.data()};
+  const uint32_t flags = flags_of("BlobView::trace_all_hits", outputs, Query::All, cull);
+  lists.clear();
+  lists.found.reserve(rays.size());
+  lists.offsets.reserve(rays.size() + 1);
+  const size_t per_walk = std::clamp<size_t>(kScratchRecords / max_hits, 1, kMostRaysAWalk);
+  const std::span<Hit> rows = thread_scratch<Hit>(per_walk * max_hits);
+  uint32_t found[kMostRaysAWalk];
+  const WalkRequest request{flags, max_hits, found, rows.data()};
   uint64_t skipped = 0;
-  walk_(bytes_.data(), rays.data(), nullptr, rays.size(), &skipped, request);
+  for (size_t begin = 0; begin < rays.size(); begin += per_walk) {
+    const size_t n = std::min(per_walk, rays.size() - begin);
+    walk_(bytes_.data(), rays.data() + begin, nullptr, n, &skipped, request);
+    for (size_t i = 0; i < n; ++i)
+      lists.add_row(found[i], rows.subspan(i * max_hits, std::min(found[i], max_hits)));
+  }
   return skipped;
 }
 

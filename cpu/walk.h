@@ -13,8 +13,12 @@ namespace meshcast {
 
 // What a batch asks of a walker: `flags`, the MC_HIT_* outputs, the
 // MC_QUERY_* query and the MC_CULL_* culling; for Query::All (MC_QUERY_ALL)
-// where the hits go: found[i], and row i of `lists`, max_hits records (the
-// walker's `hits` are then not written).
+// where the hits go: found[i], and row i of `lists`, the max_hits records
+// from i * max_hits, of which the first min(found[i], max_hits) are
+// written, nearest first, and the rest left as they were (the caller
+// copies the kept ones out: filling whole rows of misses cost more than
+// the walks of rays with few hits). The walker's `hits` are then not
+// written.
 struct WalkRequest {
   uint32_t flags = 0;
   uint32_t max_hits = 0;
@@ -93,7 +97,6 @@ inline void for_each_ray(const uint8_t* blob, const Ray* rays, Hit* hits, size_t
   if (outputs & MC_QUERY_ALL) {
     for (size_t i = 0; i < n; ++i) {
       Hit* row = request.lists + i * request.max_hits;
-      std::fill(row, row + request.max_hits, Hit{});
       request.found[i] = 0;
       if (!ray_is_walkable(rays[i])) {
         ++*skipped;

@@ -17,7 +17,7 @@ uint32_t blob_triangle_format(std::span<const uint8_t> blob) {
 
 BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
                          uint32_t tree, uint32_t triangles, uint32_t slots, uint32_t flags, uint32_t max_hits)
-    : ctx_(ctx), flags_(flags), max_hits_(max_hits), slots_(std::max(slots, 1u)) {
+    : ctx_(ctx), method_(method), flags_(flags), max_hits_(max_hits), slots_(std::max(slots, 1u)) {
   const uint32_t known = MC_HIT_UV | MC_HIT_POINT | MC_QUERY_ANY | MC_QUERY_ALL | MC_CULL_BACK | MC_CULL_FRONT;
   if ((flags & ~known) || ((flags & MC_QUERY_ANY) && (flags & MC_QUERY_ALL)) ||
       ((flags & MC_CULL_BACK) && (flags & MC_CULL_FRONT)))
@@ -71,16 +71,41 @@ std::vector<const Buffer*> BatchMethod::buffers(uint32_t slot) const {
   return {blob_.get(), s.rays.get(), s.keys.get(), s.hits.get(), s.rows.get()};
 }
 
+BatchMethod::SlotBytes BatchMethod::slot_bytes(uint32_t capacity) const {
+  // A row: found, then max_hits (t, triangle) records (shaders/hit_rows.glsl).
+  return {uint64_t(capacity) * kRayWords * 4, uint64_t(capacity) * keys_a_ray() * 8, uint64_t(capacity) * sizeof(Hit),
+          all() ? uint64_t(capacity) * (1 + 2 * max_hits_) * 4 : 16};
+}
+
+std::string BatchMethod::refusal(uint32_t rays) const {
+  const SlotBytes b = slot_bytes(capacity_for(rays));
+  const std::string batch = "GPU method " + method_ + ": a batch of " + std::to_string(rays) + " rays" +
+                            (all() ? " (rows of " + std::to_string(max_hits_) + " hits a ray)" : "") + " needs ";
+  const uint64_t range = ctx_.limits().maxStorageBufferRange;
+  for (auto [bytes, what] : {std::pair{b.rays, "ray buffer"}, std::pair{b.keys, "key buffer"},
+                             std::pair{b.hits, "hit buffer"}, std::pair{b.rows, "hit row buffer"}})
+    if (bytes > range)
+      return batch + "a " + what + " of " + std::to_string(bytes) + " bytes, more than " + ctx_.device_name() +
+             "'s maxStorageBufferRange (" + std::to_string(range) + " bytes)";
+  const uint64_t heap = ctx_.mapped_heap_bytes();
+  if (b.total() > heap)
+    return batch + std::to_string(b.total()) + " bytes of host-visible memory, more than " + ctx_.device_name() +
+           "'s largest host-visible heap (" + std::to_string(heap) + " bytes)";
+  return "";
+}
+
 void BatchMethod::reserve(uint32_t slot, uint32_t n) {
   Slot& s = slots_[slot];
   if (s.capacity >= n) return;
-  // All three made before any is replaced: a refusal (a limit, memory)
-  // leaves the slot as it was.
-  const uint32_t capacity = std::max<uint32_t>(n, 1024);
-  auto rays = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * kRayWords * 4, "ray buffer");
-  auto keys = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * keys_a_ray() * 8, "key buffer");
-  auto hits = std::make_unique<Buffer>(ctx_, uint64_t(capacity) * sizeof(Hit), "hit buffer");
-  auto rows = std::make_unique<Buffer>(ctx_, all() ? uint64_t(capacity) * (1 + 2 * max_hits_) * 4 : 16, "hit row buffer");
+  // Refused before anything is made; then all four made before any is
+  // replaced: a refusal (memory) leaves the slot as it was.
+  if (const std::string why = refusal(n); !why.empty()) throw GpuError(why);
+  const uint32_t capacity = capacity_for(n);
+  const SlotBytes bytes = slot_bytes(capacity);
+  auto rays = std::make_unique<Buffer>(ctx_, bytes.rays, "ray buffer");
+  auto keys = std::make_unique<Buffer>(ctx_, bytes.keys, "key buffer");
+  auto hits = std::make_unique<Buffer>(ctx_, bytes.hits, "hit buffer");
+  auto rows = std::make_unique<Buffer>(ctx_, bytes.rows, "hit row buffer");
   s.rays = std::move(rays), s.keys = std::move(keys), s.hits = std::move(hits), s.rows = std::move(rows);
   s.capacity = capacity;
   s.recorded = 0;  // the command buffer names the old buffers
@@ -146,21 +171,25 @@ void BatchMethod::finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing
   if (!all()) throw UsageError("GPU method made for one hit a ray: finish() reads its hits");
   Slot& s = slots_.at(slot);
   finish_batch(s, timing);
-  // A row is a HITN row: found, then max_hits (t, triangle) records.
+  // The device's rows stay fixed (found, then max_hits (t, triangle)
+  // records, slot_bytes()); each ray's kept records alone are read back.
   lists.max_hits = max_hits_;
-  lists.found.assign(s.n, 0);
-  lists.hits.assign(size_t(s.n) * max_hits_, Hit{});
+  lists.clear();
+  lists.found.reserve(s.n);
+  lists.offsets.reserve(size_t(s.n) + 1);
   const uint32_t* row = static_cast<const uint32_t*>(s.rows->data());
   const float* ray = static_cast<const float*>(s.rays->data());  // packed: origin, direction first (gpu/rays.h)
   for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_, ray += kRayWords) {
-    lists.found[i] = row[0];
-    for (uint32_t k = 0; k < max_hits_; ++k) {
-      Hit& h = lists.hits[size_t(i) * max_hits_ + k];
+    const uint32_t kept = std::min(row[0], max_hits_);
+    for (uint32_t k = 0; k < kept; ++k) {
+      Hit h;
       std::memcpy(&h.t, &row[1 + 2 * k], 4);
       h.triangle = row[2 + 2 * k];
-      if ((flags_ & MC_HIT_POINT) && h.triangle != MC_NO_HIT)
+      if (flags_ & MC_HIT_POINT)
         for (int a = 0; a < 3; ++a) h.point[a] = ray[a] + h.t * ray[3 + a];
+      lists.hits.push_back(h);
     }
+    lists.end_row(row[0]);
   }
 }
 

@@ -3,6 +3,7 @@
 // buffers that grow with the batch, one submission a batch between two timestamps, and the read-back.
 // A method adds its pipelines and records its dispatches.
 #pragma once
+#include <algorithm>
 #include <optional>
 #include <span>
 #include <string>
@@ -34,6 +35,7 @@ class BatchMethod : public Method {
               uint32_t tree, uint32_t triangles, uint32_t slots, uint32_t flags, uint32_t max_hits);
   ~BatchMethod() override;
   uint32_t slots() const override { return uint32_t(slots_.size()); }
+  std::string refusal(uint32_t rays) const override;
   uint64_t begin(uint32_t slot, std::span<const Ray> rays) override;
   bool ready(uint32_t slot) override;
   void wait(uint32_t slot) override;
@@ -56,6 +58,7 @@ class BatchMethod : public Method {
 
   Context& ctx_;
   uint32_t records_ = 0;  // the header's node_count (BruteForce: its records)
+  const std::string method_;
   const uint32_t flags_, max_hits_;
   bool all() const { return (flags_ & MC_QUERY_ALL) != 0; }
 
@@ -70,6 +73,14 @@ class BatchMethod : public Method {
     bool in_flight = false;
     double begin_ms = 0;  // steady clock at begin()
   };
+  // The bytes of a slot's buffers for `capacity` rays, as reserve() makes them.
+  struct SlotBytes {
+    uint64_t rays, keys, hits, rows;
+    uint64_t total() const { return rays + keys + hits + rows; }
+  };
+  SlotBytes slot_bytes(uint32_t capacity) const;
+  static uint32_t capacity_for(uint32_t n) { return std::max<uint32_t>(n, 1024); }
+  // Room for n rays in the slot (GpuError with refusal(n) when it cannot fit).
   void reserve(uint32_t slot, uint32_t n);
   void finish_batch(Slot& s, GpuTiming* timing);
   // shaders/keys.glsl: a row of keys a ray for Query::All, where the method reads keys at all.

@@ -32,6 +32,12 @@ class Method {
  public:
   virtual ~Method() = default;
   virtual uint32_t slots() const = 0;
+  // Why a batch of `rays` cannot run on this device, naming the bytes its
+  // buffers would need and the device's limit they exceed (Query::All's
+  // device rows are max_hits records a ray whatever the hits: 100,000 rays
+  // of 4096 take 3.3 GB); "" when it fits. begin() refuses such a batch
+  // with GpuError before it allocates anything; a caller may ask first.
+  virtual std::string refusal(uint32_t rays) const = 0;
   // Returns the unwalkable rays (answered as misses, as on the CPU). The
   // slot must be idle (never begun, or finished).
   virtual uint64_t begin(uint32_t slot, std::span<const Ray> rays) = 0;
@@ -42,8 +48,9 @@ class Method {
   virtual void wait(uint32_t slot) = 0;
   // Hits of the slot's batch into `hits` (at least the batch's size).
   virtual void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
-  // A Query::All method's rows of the slot's batch into `lists` (resized;
-  // max_hits the method's). UsageError for a method made for another query.
+  // A Query::All method's rows of the slot's batch into `lists`, compact
+  // (meshcast/ray.h: cleared, then each ray's kept hits alone; max_hits
+  // the method's). UsageError for a method made for another query.
   virtual void finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing = nullptr) = 0;
 
   // One batch in slot 0, waited for.

@@ -308,6 +308,15 @@ bool Context::has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const
   return false;
 }
 
+uint64_t Context::mapped_heap_bytes() const {
+  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  uint64_t most = 0;
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
+    if ((memory_.memoryTypes[i].propertyFlags & host) == host)
+      most = std::max<uint64_t>(most, memory_.memoryHeaps[memory_.memoryTypes[i].heapIndex].size);
+  return most;
+}
+
 uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool required) const {
   for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
     if ((bits >> i & 1) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;

@@ -106,6 +106,10 @@ class Context {
   // reads them once the submission's fence signals.
   void host_barrier(VkCommandBuffer cb) const;
   bool has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const;
+  // The largest memory heap with a host-visible, coherent memory type: what
+  // every Memory::Mapped buffer of a batch (rays, keys, hits, rows) is
+  // allocated from, together with whatever else holds it.
+  uint64_t mapped_heap_bytes() const;
 
  private:
   VkCommandBuffer begin();

@@ -50,14 +50,18 @@ struct Caster::Slot {
   uint32_t n = 0;
   std::vector<Ray> rays;
   BatchQuery query;
-  std::vector<Hit> hits;       // a hit a ray, or Query::All's rows of query.max_hits
-  std::vector<uint32_t> found;  // Query::All: hits found a ray
+  std::vector<Hit> hits;  // a hit a ray (closest or any)
+  // Query::All on the CPU: each job's compact rows, which wait()
+  // concatenates (kept from batch to batch, so they stop allocating once
+  // warm; the GPU's rows are compacted when read back).
+  std::vector<HitLists> job_rows;
   gpu::Method* method = nullptr;  // the GPU batch's
   // A scene batch: the snapshot it walks (held until collected), its world
-  // rays, its hits or rows (`found` as above).
+  // rays, its hits or each job's rows.
   std::shared_ptr<const SceneSnapshot> scene;
   std::vector<RayD> world;
   std::vector<SceneHit> scene_hits;
+  std::vector<SceneHitLists> job_scene_rows;
   SceneBatchQuery scene_query;
   Backend ran_on = Backend::Cpu;
   double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
@@ -110,17 +114,18 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
         const SceneBatchQuery& sq = sp->scene_query;
         const HitOutputs outputs = HitOutputs(uint32_t(options_.hit_outputs) & uint32_t(HitOutputs::Uv));
         const std::span<const RayD> world = std::span<const RayD>(sp->world).subspan(first, count);
-        if (sq.query == Query::All)
-          trace_scene_rows(*sp->scene, world, sq.max_hits, std::span<uint32_t>(sp->found).subspan(first, count),
-                           std::span<SceneHit>(sp->scene_hits).subspan(size_t(first) * sq.max_hits, size_t(count) * sq.max_hits),
-                           outputs, sq.cull, sq.mask);
-        else
+        if (sq.query == Query::All) {
+          SceneHitLists& rows = sp->job_scene_rows[job];
+          rows.max_hits = sq.max_hits;
+          trace_all_hits_snapshot(*sp->scene, world, rows, outputs, sq.cull, sq.mask);
+        } else {
           trace_snapshot(*sp->scene, world, std::span<SceneHit>(sp->scene_hits).subspan(first, count), outputs, sq.query,
                          sq.cull, sq.mask);
+        }
       } else if (q.query == Query::All) {
-        view_->trace_all_hits(rays, q.max_hits, std::span<uint32_t>(sp->found).subspan(first, count),
-                              std::span<Hit>(sp->hits).subspan(size_t(first) * q.max_hits, size_t(count) * q.max_hits),
-                              options_.hit_outputs, q.cull);
+        HitLists& rows = sp->job_rows[job];
+        rows.max_hits = q.max_hits;
+        view_->trace_all_hits(rays, rows, options_.hit_outputs, q.cull);
       } else {
         view_->trace(rays, std::span<Hit>(sp->hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
       }
@@ -295,11 +300,10 @@ void Caster::size_slot(Slot& s, size_t n, bool scene) {
     throw UsageError("Caster::submit: " + std::to_string(n) + " rays, more than a batch holds (2^32 - 1)");
   s.submit_ms = now_ms();
   s.n = uint32_t(n);
-  const bool all = s.query.query == Query::All;
-  const size_t answers = all ? size_t(s.n) * s.query.max_hits : s.n;
+  // Query::All's rows are the jobs' own (start_cpu) or the GPU method's.
+  const size_t answers = s.query.query == Query::All ? 0 : s.n;
   if (scene) s.scene_hits.resize(answers);
   else s.hits.resize(answers);
-  s.found.resize(all ? s.n : 0);
 }
 
 void Caster::free_slot(Slot& s) {
@@ -363,10 +367,14 @@ void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
 void Caster::start_cpu(Slot& s) {
   s.ran_on = Backend::Cpu;
   s.cpu_ns = 0;
-  if (s.n == 0) return complete(s, Backend::Cpu);
   // About four jobs a thread, so uneven rays even out; at least 64 rays a job.
   const uint32_t per = std::max<uint32_t>(64, (s.n + 4 * jobs_->threads() - 1) / (4 * jobs_->threads()));
   const uint32_t jobs = (s.n + per - 1) / per;
+  if (s.query.query == Query::All) {  // a job's rows each, in order (none for no rays)
+    if (s.scene) s.job_scene_rows.resize(jobs);
+    else s.job_rows.resize(jobs);
+  }
+  if (s.n == 0) return complete(s, Backend::Cpu);
   s.chunk = per;
   s.jobs_left = jobs;
   // The game's thread, the measurement and the GPU completions may all start
@@ -552,12 +560,18 @@ BatchRecord Caster::wait(const Ticket& t, std::span<SceneHit> hits) {
   return r;
 }
 
+// A CPU batch's rows: its jobs' rows one after the other, in ray order.
+template <class Record>
+static void concatenate(HitRows<Record>& lists, uint32_t max_hits, const std::vector<HitRows<Record>>& jobs) {
+  lists.max_hits = max_hits;
+  lists.clear();
+  for (const HitRows<Record>& rows : jobs) lists.append(rows);
+}
+
 BatchRecord Caster::wait(const Ticket& t, SceneHitLists& lists) {
   Slot& s = slot_of(t);
   const BatchRecord r = claim(s, t, true, true, 0);
-  lists.max_hits = s.scene_query.max_hits;
-  lists.found.assign(s.found.begin(), s.found.end());
-  lists.hits.assign(s.scene_hits.begin(), s.scene_hits.end());
+  concatenate(lists, s.scene_query.max_hits, s.job_scene_rows);
   release(s, r, true);
   return r;
 }
@@ -585,9 +599,7 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLi
     }
   }
   if (!copied && lists) {
-    lists->max_hits = s.query.max_hits;
-    lists->found.assign(s.found.begin(), s.found.end());
-    lists->hits.assign(s.hits.begin(), s.hits.end());
+    concatenate(*lists, s.query.max_hits, s.job_rows);
   } else if (!copied && s.n) {
     std::memcpy(hits.data(), s.hits.data(), s.n * sizeof(Hit));
   }

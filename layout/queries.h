@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "layout/formats.h"
 #include "meshcast/errors.h"
@@ -19,13 +20,15 @@ constexpr uint32_t query_bits(Query query, Cull cull) {
 }
 
 // UsageError naming `who` for a query or a culling outside its enum (an
-// integer cast into it): every entry point checks before it walks.
-inline void check_query(const std::string& who, Query query, Cull cull) {
+// integer cast into it): every entry point checks before it walks. A view:
+// a check that passes allocates nothing (a warm caster's jobs make it).
+inline void check_query(std::string_view who, Query query, Cull cull) {
   if (query != Query::Closest && query != Query::Any && query != Query::All)
-    throw UsageError(who + ": query " + std::to_string(uint32_t(query)) +
+    throw UsageError(std::string(who) + ": query " + std::to_string(uint32_t(query)) +
                      " is not Query::Closest, Query::Any or Query::All");
   if (cull != Cull::None && cull != Cull::Back && cull != Cull::Front)
-    throw UsageError(who + ": cull " + std::to_string(uint32_t(cull)) + " is not Cull::None, Cull::Back or Cull::Front");
+    throw UsageError(std::string(who) + ": cull " + std::to_string(uint32_t(cull)) +
+                     " is not Cull::None, Cull::Back or Cull::Front");
 }
 
 // closest, any, all; UsageError naming `option` for anything else.

@@ -1,8 +1,9 @@
 // Query::All's rows (binding 4), one a ray: the hits found, then kMaxHits
-// records of (t bits, triangle) in order of t, unused ones (inf, MC_NO_HIT):
-// a HITN file's per-ray layout (check/ray_files.h), copied out as it is.
-// While a walk runs, a record's second word is a slot; row_finish turns
-// them into triangles.
+// records of (t bits, triangle) in order of t, of which the first
+// min(found, kMaxHits) are written; the rest are left as they were (the
+// host reads the kept ones alone into compact rows, gpu/batch.cpp, so a
+// ray's time follows its hits, not kMaxHits). While a walk runs, a
+// record's second word is a slot; row_finish turns them into triangles.
 #ifndef MESHCAST_HIT_ROWS_GLSL
 #define MESHCAST_HIT_ROWS_GLSL
 
@@ -19,14 +20,11 @@ void row_set(uint base, uint k, float t, uint entry) {
   rows[base + 2u + 2u * k] = entry;
 }
 
-void row_start(uint ray) {
-  const uint base = row_base(ray);
-  rows[base] = 0u;
-  for (uint k = 0u; k < kMaxHits; ++k) row_set(base, k, kInfinity, MC_NO_HIT);
-}
+void row_start(uint ray) { rows[row_base(ray)] = 0u; }
 
 // One more hit: counted, and kept when among the nearest kMaxHits (the
-// CPU's HitList::add in cpu/leaf.h).
+// CPU's HitList::add in cpu/leaf.h; the last record is read only once
+// written).
 void row_add(uint ray, float t, uint entry) {
   const uint base = row_base(ray), found = rows[base];
   rows[base] = found + 1u;

@@ -73,10 +73,30 @@ check trace 0 "ns/ray" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays"
 check trace-json 0 '"ns_per_ray":' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/h2.hits" --json
 check trace-any 0 '"query":"any"' -- "$meshcast" trace "$mesh" --layout OctTreeCompressed/ClusterBitPackSOA8 --query any --rays "$work/r.rays" --out "$work/ha.hits" --json
 check trace-query-unknown 2 "query" -- "$meshcast" trace "$mesh" --query nearest --rays "$work/r.rays" --out "$work/hx.hits"
-check trace-all 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hn.hitn" --json
-# HITN: magic, 500 rays, rows of 4: 12 + 500 * (4 + 4 * 8) bytes.
-if [[ $(head -c 4 "$work/hn.hitn") != HITN || $(stat -c %s "$work/hn.hitn") -ne 18012 ]]; then
-  echo "FAIL trace-all: the HITN file's magic or size"; failures=$((failures + 1))
+check trace-all 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hn.hitc" --json
+# HITC: magic, 500 rays, N, 500 counts, then the kept records alone: 12 + 500
+# * 4 + 8 * sum(min(count, N)) bytes.
+hitc_size() {  # hitc_size FILE RAYS N: the size the counts call for
+  od -An -tu4 -v -j12 -N$((4 * $2)) "$1" | tr -s ' ' '\n' | awk -v rays="$2" -v n="$3" \
+    'NF { kept += ($1 < n ? $1 : n) } END { print 12 + 4 * rays + 8 * kept }'
+}
+if [[ $(head -c 4 "$work/hn.hitc") != HITC || $(stat -c %s "$work/hn.hitc") -ne $(hitc_size "$work/hn.hitc" 500 4) ]]; then
+  echo "FAIL trace-all: the HITC file's magic or size"; failures=$((failures + 1))
+fi
+# At the most hits a ray keeps, the file follows the hits found: the same
+# counts as rows of 4, every hit kept, far below the 16 MB that 500 rows of
+# 4096 records would take.
+out=$("$meshcast" trace "$mesh" --layout AABBTree/Float3 --query all --max-hits 4096 --cull back --rays "$work/r.rays" --out "$work/hl.hitc" --json --repeat 1 2>&1)
+rc=$?
+every_hit=$(grep -oE '"every_hit":[0-9]+' <<<"$out" | cut -d: -f2)
+if [[ $rc -ne 0 || -z $every_hit || $(stat -c %s "$work/hl.hitc") -ne $((12 + 500 * 4 + 8 * every_hit)) ]] ||
+   ! cmp -s <(head -c 2012 "$work/hn.hitc" | tail -c 2000) <(head -c 2012 "$work/hl.hitc" | tail -c 2000); then
+  echo "FAIL trace-all-limit: exit $rc; the file's size does not follow the ${every_hit:-?} hits found, or its counts differ from rows of 4"
+  echo "$out" | head -20
+  failures=$((failures + 1))
+else
+  echo "ok   trace-all-limit"
+  passes=$((passes + 1))
 fi
 # Scenes: a scene file of the mesh and the blob, one instance mirrored and
 # far away, another hidden; RAYS rays in, a HITI file out (12 + 500 * 12 bytes).
@@ -199,11 +219,15 @@ if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/hv.hits" | awk '{print $2}') \
             <(od -An -tu4 -w8 -j8 "$work/h2.hits" | awk '{print $2}'); then
   echo "FAIL vulkan hits differ from the CPU's"; failures=$((failures + 1))
 fi
-check trace-all-vulkan 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --method aabbtree --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hnv.hitn" --repeat 1 --json
-# Every hit, culled, on the GPU: the CPU's HITN file byte for byte.
-if ! cmp -s "$work/hn.hitn" "$work/hnv.hitn"; then
-  echo "FAIL trace-all-vulkan: the HITN file differs from the CPU's"; failures=$((failures + 1))
+check trace-all-vulkan 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --method aabbtree --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hnv.hitc" --repeat 1 --json
+# Every hit, culled, on the GPU: the CPU's HITC file byte for byte.
+if ! cmp -s "$work/hn.hitc" "$work/hnv.hitc"; then
+  echo "FAIL trace-all-vulkan: the HITC file differs from the CPU's"; failures=$((failures + 1))
 fi
+# A batch whose device rows exceed the device's buffers is refused before
+# any pass, naming the bytes (140,000 rows of 4096: 4.6 GB) and the limit.
+check rays-many 0 "rays ->" -- "$meshcast" rays "$mesh" --kind long --count 140000 --seed 4 --out "$work/many.rays"
+check trace-all-vulkan-refused 2 "140000 rays \(rows of 4096 hits a ray\) needs a hit row buffer of 4588080000 bytes, more than .*maxStorageBufferRange" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --method aabbtree --query all --max-hits 4096 --rays "$work/many.rays" --out "$work/hx.hitc"
 check bench-gpu 0 "\\| lbvh \\| StacklessLBVH/Float3" -- "$meshcast" bench gpu "$mesh" --rays 8 --repeat 1
 check render-cpu 0 "device: CPU" -- "$meshcast" render "$mesh" --png "$work/rc.png" --width 160 --height 120
 check render-vulkan 0 "device: " -- "$meshcast" render "$mesh" --backend vulkan --png "$work/rv.png" --width 160 --height 120

@@ -187,11 +187,13 @@ TEST_P(GpuMethods, RowsKeepTheNearestAndCountAll) {
   const std::vector<Ray> rays = rays_down_through(12, 300);
   const std::vector<uint8_t> blob = build_blob(planes, parse_layout(mc.layout), "planes");
   const Mesh stored = moves_vertices(uint32_t(parse_layout(mc.layout).layout.triangles)) ? stored_mesh(blob) : planes;
-  for (uint32_t max_hits : {1u, 3u, 12u}) {
+  for (uint32_t max_hits : {1u, 3u, 12u, kMaxHitsLimit}) {
     HitLists lists;
     gpu::make_method(context(), mc.method, blob, "planes", 1, MC_QUERY_ALL | MC_HIT_POINT, max_hits)->trace_all_hits(rays, lists);
     const std::string what = std::string(mc.method) + ", rows of " + std::to_string(max_hits);
     expect_nearest_rows(stored, rays, lists, what);
+    // Read back compact: the kept hits alone, whatever the device's rows.
+    EXPECT_EQ(lists.hits.size(), rays.size() * std::min(12u, max_hits)) << what;
     for (size_t i = 0; i < rays.size(); ++i)
       for (const Hit& h : lists.row(i)) EXPECT_NEAR(h.point[2], rays[i].org[2] - h.t, 1e-4) << what << ", ray " << i;
   }
@@ -206,6 +208,35 @@ INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods, ::testing::ValuesIn(gpu::method_la
                              if (ch == '/') ch = '_';
                            return std::string(info.param.method) + "_" + n;
                          });
+
+// A batch whose buffers exceed the device's is refused before anything is
+// allocated, the refusal naming the bytes and the limit: 140,000 rows of
+// 4096 hits are 4.6 GB of device rows (maxStorageBufferRange is a
+// uint32). The method goes on with the batches that fit.
+TEST(Gpu, ABatchBeyondTheDeviceBuffersIsRefusedUpFront) {
+  const Mesh planes = stacked_planes(12);
+  const std::vector<Ray> rays = rays_down_through(12, 300);
+  const std::vector<uint8_t> blob = build_blob(planes, parse_layout("AABBTree/Float3"), "planes");
+  const std::unique_ptr<gpu::Method> method =
+      gpu::make_method(context(), "aabbtree", blob, "planes", 1, MC_QUERY_ALL, kMaxHitsLimit);
+  EXPECT_EQ(method->refusal(uint32_t(rays.size())), "");
+  const std::string why = method->refusal(140000);
+  for (const char* word : {"aabbtree", "140000 rays", "rows of 4096 hits a ray", "hit row buffer of 4588080000 bytes",
+                           "maxStorageBufferRange"})
+    EXPECT_NE(why.find(word), std::string::npos) << "'" << word << "' not in: " << why;
+  std::vector<Ray> many(140000, rays[0]);
+  try {
+    method->begin(0, many);
+    ADD_FAILURE() << "a batch of 140000 rows of 4096 was begun";
+  } catch (const GpuError& e) {
+    EXPECT_EQ(std::string(e.what()), why);
+    EXPECT_FALSE(e.lost);
+  }
+  HitLists lists;
+  method->trace_all_hits(rays, lists);
+  EXPECT_EQ(lists.hits.size(), rays.size() * 12);
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
 
 // AABBList with a pair buffer of 50,000 pairs: 10,000 rays on the 64k
 // terrain (256 batches) go in chunks of 195 rays, so the counter reset and the dispatch

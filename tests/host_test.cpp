@@ -228,6 +228,87 @@ TEST(Host, EveryQueryPerBatchOnBothBackends) {
   }
 }
 
+// Rows of every hit at the limit against rows of 3 of the same rays: the
+// same counts, each row of `every` holding its kept hits alone (the rows'
+// memory follows the hits found, not rays x kMaxHitsLimit) and extending
+// the row of 3 (the same triangles; t within 1e-6 relative, the GPU's
+// own rounding).
+bool same_hit(const Hit& a, const Hit& b) {
+  return a.triangle == b.triangle && std::fabs(a.t - b.t) <= 1e-6f * std::fabs(b.t);
+}
+bool same_hit(const SceneHit& a, const SceneHit& b) {
+  return a.instance == b.instance && a.triangle == b.triangle && a.t == b.t;
+}
+template <class Record>
+void expect_rows_extend(const HitRows<Record>& every, const HitRows<Record>& few, const std::string& what) {
+  ASSERT_EQ(every.max_hits, kMaxHitsLimit) << what;
+  ASSERT_EQ(every.found, few.found) << what;
+  size_t kept = 0;
+  for (uint32_t found : every.found) kept += std::min(found, kMaxHitsLimit);
+  ASSERT_GT(kept, every.found.size()) << what << ": too few hits to show anything";
+  ASSERT_EQ(every.hits.size(), kept) << what << ": rows holding more than the hits found";
+  for (size_t i = 0; i < every.found.size(); ++i) {
+    ASSERT_EQ(every.row(i).size(), std::min(every.found[i], kMaxHitsLimit)) << what << ", ray " << i;
+    for (size_t k = 0; k < few.row(i).size(); ++k)
+      EXPECT_TRUE(same_hit(every.row(i)[k], few.row(i)[k])) << what << ", ray " << i << ", record " << k;
+  }
+}
+
+// Every hit at the limit (kMaxHitsLimit a ray) on both backends and in a
+// scene batch: 12 stacked planes, rays through all of them, cut short or
+// aimed away. The caller's lists held longer rows before: they are
+// replaced. A batch whose fixed device rows exceed the device's buffers is
+// refused by the GPU method before it allocates, and the CPU answers it.
+TEST(Host, EveryHitRowsAtTheLimitHoldTheHitsFoundAlone) {
+  constexpr int kPlanes = 12;
+  const Mesh planes = stacked_planes(kPlanes);
+  std::vector<Ray> rays = rays_down_through(kPlanes, 3000);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (i % 4 == 1) rays[i].tmax = float(i % kPlanes) + 0.5f;
+    if (i % 4 == 2) rays[i].dir[2] = 1;
+  }
+  const std::vector<uint8_t> blob = build_blob(planes, parse_layout("AABBTree/Float3"), "planes");
+  const BlobView view(blob, "planes");
+  const HitLists few = trace_lists(view, rays, 3);
+  const host::BatchQuery limit{Query::All, Cull::None, kMaxHitsLimit};
+  for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
+    if (b == Backend::Vulkan && cpu_only()) continue;
+    Caster caster(blob, "planes", options(b));
+    ASSERT_TRUE(b == Backend::Cpu || caster.gpu_available()) << caster.gpu_error();
+    HitLists lists = trace_lists(view, rays, 64);  // what the wait replaces
+    EXPECT_EQ(caster.wait(caster.submit(rays, limit), lists).ran_on, b);
+    expect_rows_extend(lists, few, host::backend_name(b));
+    if (b == Backend::Vulkan) {
+      // 140,000 rows of 4096 hits are 4.6 GB of device rows, beyond any
+      // storage buffer (maxStorageBufferRange is a uint32).
+      std::vector<Ray> many;
+      while (many.size() < 140000) many.insert(many.end(), rays.begin(), rays.end());
+      many.resize(140000);
+      EXPECT_EQ(caster.wait(caster.submit(many, limit), lists).ran_on, Backend::Cpu);
+      EXPECT_TRUE(caster.gpu_available()) << caster.gpu_error();
+      ASSERT_EQ(lists.found.size(), many.size());
+      for (size_t i = 0; i < many.size(); i += 997) EXPECT_EQ(lists.found[i], few.found[i % rays.size()]) << "ray " << i;
+    }
+    EXPECT_EQ(caster.validation_messages(), 0u);
+  }
+  // A scene batch: the planes placed twice, one above the other.
+  Scene scene;
+  const MeshId mesh = scene.add_mesh(blob, "planes");
+  Transform above;
+  above.translation[2] = 100;
+  scene.add_instance(mesh, Transform{}), scene.add_instance(mesh, above);
+  scene.commit();
+  std::vector<RayD> world;
+  for (const Ray& r : rays) world.push_back({{r.org[0], r.org[1], double(r.org[2]) + 100}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax + 100});
+  SceneHitLists few_scene, got;
+  few_scene.max_hits = 3;
+  scene.trace_all_hits(world, few_scene);
+  Caster scenes(options(Backend::Cpu));
+  got.max_hits = 7;
+  EXPECT_EQ(scenes.wait(scenes.submit(scene, world, {Query::All, Cull::None, 0xFF, kMaxHitsLimit}), got).ran_on, Backend::Cpu);
+  expect_rows_extend(got, few_scene, "scene batch");
+}
+
 // Eight frames of different sizes and rays, collected in reverse order.
 TEST(Host, FramesInFlightNeverMix) {
   Mesh m = make_sphere(24, 48, 1, {0, 0, 0});
@@ -392,6 +473,31 @@ TEST(Host, AWarmCasterAllocatesNothingAFrame) {
   const uint64_t before = g_allocations.load();
   for (int k = 0; k < 20; ++k) frame();
   EXPECT_EQ(g_allocations.load() - before, 0u);
+  // Every hit at the limit, blob and scene batches, on a caster of one
+  // worker (a worker makes its scratch rows on its first every-hit job):
+  // the jobs' rows, the worker's scratch and the caller's lists are kept.
+  CasterOptions one = options(Backend::Cpu, 2);
+  one.threads = 1;
+  Caster every(blob, "sphere", one);
+  Scene scene;
+  scene.add_instance(scene.add_mesh(blob, "sphere"), Transform{});
+  scene.commit();
+  std::vector<RayD> world;
+  for (const Ray& r : a) world.push_back(widened(r));
+  HitLists lists;
+  SceneHitLists scene_lists;
+  auto every_frame = [&] {
+    const host::Ticket ta = every.submit(a, {Query::All, Cull::None, kMaxHitsLimit});
+    const host::Ticket tb = every.submit(scene, world, {Query::All, Cull::None, 0xFF, kMaxHitsLimit});
+    every.wait(ta, lists);
+    every.wait(tb, scene_lists);
+  };
+  for (int k = 0; k < 3; ++k) every_frame();
+  const uint64_t before_every = g_allocations.load();
+  for (int k = 0; k < 20; ++k) every_frame();
+  EXPECT_EQ(g_allocations.load() - before_every, 0u);
+  EXPECT_GT(lists.hits.size(), a.size() / 2);
+  EXPECT_EQ(scene_lists.hits.size(), lists.hits.size());
 }
 
 // An engine's job system: here every run goes to a thread of its own, and

@@ -203,40 +203,78 @@ TEST(Hostile, TruncatedBinaryStlSaysSo) {
 }  // namespace
 }  // namespace meshcast::testing
 
-// HITN files (Query::All's answers): written and read back record for
-// record; a bad magic, a row width outside 1..kMaxHitsLimit and a size
-// that is not the header's are refused with the file's name.
+// Every-hit files (Query::All's answers): HITC written and read back
+// record for record, its size following the kept hits; the fixed HITN rows
+// of earlier files read into the same compact rows; a bad magic, a row
+// width outside 1..kMaxHitsLimit and a size that is not the header's (or
+// the counts') are refused with the file's name; rows that do not keep
+// min(found, max_hits) records are not written.
 namespace meshcast::testing {
 namespace {
+
+std::string u32_bytes(std::initializer_list<uint32_t> words) {
+  std::string out(4 * words.size(), '\0');
+  std::memcpy(out.data(), std::data(words), out.size());
+  return out;
+}
+
+std::string record_bytes(float t, uint32_t triangle) {
+  std::string out(8, '\0');
+  std::memcpy(out.data(), &t, 4), std::memcpy(out.data() + 4, &triangle, 4);
+  return out;
+}
+
 TEST(Hostile, HitListFilesRoundTripAndRefuseBadHeaders) {
   HitLists lists;
   lists.max_hits = 3;
-  lists.found = {0, 2, 5};
-  lists.hits.assign(9, Hit{});
-  lists.hits[3] = {1.5f, 7}, lists.hits[4] = {2.5f, 3};
-  lists.hits[6] = {0.5f, 1}, lists.hits[7] = {0.75f, 2}, lists.hits[8] = {1.0f, 9};
-  const std::string path = (scratch_dir() / "lists.hitn").string();
+  lists.add_row(0, {});
+  const Hit two[] = {{1.5f, 7}, {2.5f, 3}}, three[] = {{0.5f, 1}, {0.75f, 2}, {1.0f, 9}};
+  lists.add_row(2, two);
+  lists.add_row(5, three);  // 5 found, the nearest 3 kept
+  const std::string path = (scratch_dir() / "lists.hitc").string();
   write_hit_lists(path, lists);
   const HitLists back = read_hit_lists(path);
   ASSERT_EQ(back.max_hits, 3u);
   EXPECT_EQ(back.found, lists.found);
-  ASSERT_EQ(back.hits.size(), 9u);
-  for (size_t i = 0; i < 9; ++i) {
+  EXPECT_EQ(back.offsets, (std::vector<size_t>{0, 0, 2, 5}));
+  ASSERT_EQ(back.hits.size(), 5u);
+  for (size_t i = 0; i < 5; ++i) {
     EXPECT_EQ(back.hits[i].t, lists.hits[i].t) << i;
     EXPECT_EQ(back.hits[i].triangle, lists.hits[i].triangle) << i;
   }
   const std::vector<uint8_t> raw = read_file(path);
   std::string bytes(raw.begin(), raw.end());
-  EXPECT_EQ(bytes.size(), 12u + 3 * (4 + 3 * 8));
-  const std::string truncated = make_file("short.hitn", bytes.substr(0, bytes.size() - 1));
-  expect_throws<InputError>([&] { read_hit_lists(truncated); }, {"short.hitn", "header says 3 rays"});
+  EXPECT_EQ(bytes.substr(0, 4), "HITC");
+  EXPECT_EQ(bytes.size(), 12u + 3 * 4 + 5 * 8);  // the kept hits alone
+  const std::string truncated = make_file("short.hitc", bytes.substr(0, bytes.size() - 1));
+  expect_throws<InputError>([&] { read_hit_lists(truncated); }, {"short.hitc", "3 rays keeping 5 hits"});
+  const std::string counts_cut = make_file("counts.hitc", bytes.substr(0, 14));
+  expect_throws<InputError>([&] { read_hit_lists(counts_cut); }, {"counts.hitc", "counts alone take 24 bytes"});
   std::string wide = bytes;
   const uint32_t width = kMaxHitsLimit + 1;
   std::memcpy(wide.data() + 8, &width, 4);
-  const std::string too_wide = make_file("wide.hitn", wide);
-  expect_throws<InputError>([&] { read_hit_lists(too_wide); }, {"wide.hitn", "records a ray"});
-  const std::string hits_file = make_file("plain.hitn", "HITS" + bytes.substr(4));
-  expect_throws<InputError>([&] { read_hit_lists(hits_file); }, {"plain.hitn", "not a HITN file"});
+  const std::string too_wide = make_file("wide.hitc", wide);
+  expect_throws<InputError>([&] { read_hit_lists(too_wide); }, {"wide.hitc", "records a ray"});
+  const std::string hits_file = make_file("plain.hitc", "HITS" + bytes.substr(4));
+  expect_throws<InputError>([&] { read_hit_lists(hits_file); }, {"plain.hitc", "not a HITN file", "but a HITS file"});
+
+  // The fixed rows: two rays of 2 records, the unused one a miss.
+  const std::string fixed = "HITN" + u32_bytes({2, 2}) + u32_bytes({1}) + record_bytes(4.0f, 11) +
+                            record_bytes(INFINITY, MC_NO_HIT) + u32_bytes({3}) + record_bytes(0.25f, 5) +
+                            record_bytes(0.5f, 6);
+  const HitLists old = read_hit_lists(make_file("old.hitn", fixed));
+  EXPECT_EQ(old.found, (std::vector<uint32_t>{1, 3}));
+  EXPECT_EQ(old.offsets, (std::vector<size_t>{0, 1, 3}));
+  ASSERT_EQ(old.hits.size(), 3u);
+  EXPECT_EQ(old.row(0)[0].triangle, 11u);
+  EXPECT_EQ(old.row(1)[1].t, 0.5f);
+  const std::string short_fixed = make_file("short.hitn", fixed.substr(0, fixed.size() - 1));
+  expect_throws<InputError>([&] { read_hit_lists(short_fixed); }, {"short.hitn", "header says 2 rays of 2 records"});
+
+  HitLists uneven = lists;
+  uneven.found[1] = 1;  // a row of 2 for 1 hit found
+  expect_throws<UsageError>([&] { write_hit_lists((scratch_dir() / "uneven.hitc").string(), uneven); },
+                            {"ray 1 found 1 hits but its row keeps 2"});
 }
 
 }  // namespace

@@ -309,11 +309,18 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
   EXPECT_LE(all.ties, all.hits / 100 + 2) << layout << " at " << offset << ", Query::All";
   EXPECT_GT(all.hits, rays.size() / 5) << layout << " at " << offset << ", Query::All: too few hits to show anything";
   // Rows of 2 where more are hit: the nearest 2 of the full rows (judged
-  // above, here two-sided), every hit still counted.
+  // above, here two-sided), every hit still counted. The full rows keep up
+  // to kMaxHitsLimit a ray and hold the hits found alone (compact rows:
+  // their memory follows the hits, not rays x max_hits).
   SceneHitLists full, short_rows;
-  full.max_hits = 256, short_rows.max_hits = 2;
+  full.max_hits = kMaxHitsLimit, short_rows.max_hits = 2;
   EXPECT_EQ(scene.trace_all_hits(rays, full), 0u);
   EXPECT_EQ(scene.trace_all_hits(rays, short_rows), 0u);
+  ASSERT_EQ(full.found.size(), rays.size());
+  size_t kept = 0;
+  for (uint32_t found : full.found) kept += std::min(found, kMaxHitsLimit);
+  ASSERT_EQ(full.hits.size(), kept) << layout << " at " << offset << ": rows holding more than the hits found";
+  EXPECT_LE(full.hits.capacity(), 2 * kept + kMaxHitsLimit) << layout << " at " << offset;
   size_t overflowing = 0, differ = 0;
   for (size_t i = 0; i < rays.size(); ++i) {
     overflowing += full.found[i] > 2;
@@ -797,6 +804,10 @@ TEST(Scene, RefusesBadInput) {
   EXPECT_GE(lists.found[0], 2u);  // through both poles: every triangle around each, once
   EXPECT_EQ(lists.row(0)[0].instance, id);
   EXPECT_FLOAT_EQ(lists.row(0)[0].t, 4.0f);
+  // The rays not walked: empty rows, nothing held for them.
+  for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(lists.found[i], 0u) << "ray " << i;
+  for (size_t i = 1; i < rays.size(); ++i) EXPECT_TRUE(lists.row(i).empty()) << "ray " << i;
+  EXPECT_EQ(lists.hits.size(), 2u);
   // A query or culling outside its enum, a point asked of a scene hit:
   // refused before any ray is walked, on an empty scene too.
   Scene empty;

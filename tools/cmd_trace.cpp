@@ -1,6 +1,7 @@
 // meshcast trace MESH|BLOB --rays R.rays --out H.hits [--query closest|any|all]
 // [--max-hits N] [--cull none|back|front]: one thread, the whole batch cast
-// --repeat times, the median pass reported per ray. --query all writes HITN.
+// --repeat times, the median pass reported per ray. --query all writes HITC
+// (compact rows: the file's size follows the hits found).
 #include <algorithm>
 #include <cstdio>
 #include <iterator>
@@ -104,10 +105,12 @@ void add_trace(CLI::App& app) {
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   cmd->add_option("--query", args->query,
                   "closest (the nearest hit), any (a hit, the walk ending at the first) or all (every hit along the "
-                  "ray, nearest first, written as a HITN file)")
+                  "ray, nearest first, written as a HITC file: per ray the hits found, then the kept hits alone)")
       ->check(CLI::IsMember({"closest", "any", "all"}));
   const CLI::Option* max_hits =
-      cmd->add_option("--max-hits", args->max_hits, "--query all: the hits a ray's row keeps (more are counted, not kept)")
+      cmd->add_option("--max-hits", args->max_hits,
+                      "--query all: the most hits a ray keeps (more are counted, not kept); memory and the file follow "
+                      "the hits found")
           ->check(integer_in(1, kMaxHitsLimit));
   cmd->add_option("--cull", args->cull,
                   "none (two-sided), back or front: the face culled; the front face's corners run counter-clockwise "
@@ -147,6 +150,11 @@ void add_trace(CLI::App& app) {
       // The query and culling are the method's specialization constants.
       const uint32_t flags = layout::query_bits(query, cull);
       std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, args->method, in.blob, args->input, 1, flags, args->max_hits);
+      // A batch beyond the device's buffers (Query::All's fixed device rows
+      // above all) is the input's fault: refused before any pass, exit 2.
+      if (const std::string why = method->refusal(uint32_t(rays.size())); !why.empty())
+        throw InputError("trace " + args->rays + ": " + why + "; cast fewer rays" +
+                         (query == Query::All ? " or lower --max-hits" : "") + ", or use --backend cpu");
       for (uint32_t r = 0; r < args->repeat; ++r) {
         gpu::GpuTiming timing;
         skipped = query == Query::All ? method->trace_all_hits(rays, lists, &timing) : method->trace(rays, hits, &timing);

@@ -37,16 +37,15 @@ class BlobView {
   uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs = HitOutputs::None,
                  Query query = Query::Closest, Cull cull = Cull::None) const;
 
-  // Query::All: every hit of each ray along its segment into `lists`
-  // (resized to the rays; lists.max_hits, 1 to kMaxHitsLimit, says how many
-  // each row keeps). Returns the rays not walkable, as trace() does.
+  // Query::All: every hit of each ray along its segment into `lists`,
+  // compact rows (meshcast/ray.h: cleared, then a row a ray holding its
+  // kept hits alone; lists.max_hits, 1 to kMaxHitsLimit, says how many each
+  // row keeps). Memory and time follow the hits found: lists reused from
+  // frame to frame keep their capacity, and the walk needs a thread's
+  // scratch of at most 16384 records besides. Returns the rays not
+  // walkable, as trace() does. UsageError for max_hits out of range.
   uint64_t trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs = HitOutputs::None,
                           Cull cull = Cull::None) const;
-  // The same into the caller's storage: ray i's count in found[i], its row
-  // in rows[i * max_hits, (i + 1) * max_hits). UsageError when either is
-  // shorter or max_hits is out of range.
-  uint64_t trace_all_hits(std::span<const Ray> rays, uint32_t max_hits, std::span<uint32_t> found, std::span<Hit> rows,
-                          HitOutputs outputs = HitOutputs::None, Cull cull = Cull::None) const;
 
   std::span<const uint8_t> bytes() const { return bytes_; }
   Layout layout() const;

@@ -182,11 +182,14 @@ class Caster {
   // size, else UsageError) and frees the slot; returns that batch's record.
   // UsageError for a Query::All batch (its rows: the overload below).
   BatchRecord wait(const Ticket& t, std::span<Hit> hits);
-  // A Query::All batch's rows into `lists` (resized); UsageError for a
-  // batch of another query.
+  // A Query::All batch's rows into `lists`: compact rows (meshcast/ray.h),
+  // cleared first, their capacity kept; the CPU's jobs' rows are copied
+  // one after the other, the GPU's fixed device rows compacted as they are
+  // read back. UsageError for a batch of another query.
   BatchRecord wait(const Ticket& t, HitLists& lists);
   // The calling thread walks the rays now (the CPU walker, no pool):
-  // closest or any hit, or with `lists` every hit (rows of lists.max_hits).
+  // closest or any hit, or with `lists` every hit (compact rows keeping
+  // lists.max_hits a ray, BlobView::trace_all_hits).
   void trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query = {}) const;
   void trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull = Cull::None) const;
 

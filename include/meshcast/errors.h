@@ -1,7 +1,9 @@
 // Every error meshcast throws is a meshcast::Error; its message names the
 // input (a file, a mesh, a blob, an option, a ticket) and the limit it broke.
 // Errors surface at load, build, validation and submission time; a walk that
-// has begun neither throws nor allocates.
+// has begun neither throws nor allocates (Query::All's compact rows grow
+// between rays with the hits found: std::bad_alloc only when the hits
+// themselves do not fit).
 #pragma once
 #include <stdexcept>
 #include <string>

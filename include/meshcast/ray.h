@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -56,27 +57,59 @@ constexpr bool has(HitOutputs set, HitOutputs flag) { return (uint32_t(set) & ui
 // what a bullet or a sound passes through).
 enum class Query : uint32_t { Closest = 0, Any = 1, All = 2 };
 
-// Query::All's answers for a batch of rays. Ray i found found[i] hits along
-// its segment; the nearest min(found[i], max_hits) of them are row i of
-// `hits` (max_hits records from i * max_hits), in order of t, then triangle;
-// the rest of the row reads as misses (t = inf, kNoHit). A found[i] above
-// max_hits means found[i] - max_hits of the farthest were dropped (among
-// hits of one t at the cut, which are kept depends on the walk). A
+// Query::All's answers for a batch of rays, compact: memory follows the
+// hits found, not rays x max_hits. Ray i found found[i] hits along its
+// segment; the nearest min(found[i], max_hits) of them are row(i), the
+// records hits[offsets[i], offsets[i + 1]), in order of t, then triangle;
+// `hits` holds nothing else (no padding, no misses). offsets has one entry
+// more than the rays, offsets[0] = 0 and the last = hits.size(). A found[i]
+// above max_hits means found[i] - max_hits of the farthest were dropped
+// (among hits of one t at the cut, which are kept depends on the walk). A
 // triangle the ray meets exactly on an edge or vertex shared with others
 // is one hit each of them. u and v only when asked for (on the CPU; the
 // Vulkan rows carry t, the triangle and the point). The same rows hold a
 // scene's hits (SceneHitLists, meshcast/scene.h).
+//
+// A trace clears the rows and appends a row a ray (clear(), add_row());
+// the vectors keep their capacity, so rows reused from frame to frame stop
+// allocating once they have held a frame's hits.
 template <class Record>
 struct HitRows {
   uint32_t max_hits = 16;
   std::vector<uint32_t> found;
+  std::vector<size_t> offsets{0};
   std::vector<Record> hits;
+
+  size_t rays() const { return found.size(); }
   std::span<const Record> row(size_t ray) const {
-    return {hits.data() + ray * max_hits, std::min<size_t>(found[ray], max_hits)};
+    return {hits.data() + offsets[ray], offsets[ray + 1] - offsets[ray]};
+  }
+  // No rays, max_hits kept, the capacity kept.
+  void clear() {
+    found.clear();
+    hits.clear();
+    offsets.assign(1, 0);
+  }
+  // The next ray's row: the records appended to `hits` since the last row
+  // (its kept hits, at most max_hits), `found_hits` found in all.
+  void end_row(uint32_t found_hits) {
+    found.push_back(found_hits);
+    offsets.push_back(hits.size());
+  }
+  void add_row(uint32_t found_hits, std::span<const Record> kept) {
+    hits.insert(hits.end(), kept.begin(), kept.end());
+    end_row(found_hits);
+  }
+  // The rays of `more` after these (rows of the same max_hits).
+  void append(const HitRows& more) {
+    const size_t base = hits.size();
+    found.insert(found.end(), more.found.begin(), more.found.end());
+    hits.insert(hits.end(), more.hits.begin(), more.hits.end());
+    for (size_t i = 1; i < more.offsets.size(); ++i) offsets.push_back(base + more.offsets[i]);
   }
 };
 using HitLists = HitRows<Hit>;
-// The most hits a ray's row may hold.
+// The most hits a ray's row may keep.
 constexpr uint32_t kMaxHitsLimit = 4096;
 
 // Which faces a query sees. A triangle's front face is the one whose

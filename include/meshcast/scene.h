@@ -58,9 +58,9 @@ struct SceneHit {
   float u = 0, v = 0;  // only with HitOutputs::Uv, as Hit's
 };
 
-// Query::All's answers on a scene, as HitLists: ray i found found[i] hits
-// over every instance it reaches, the nearest min(found[i], max_hits) in row
-// i in order of t, then instance, then triangle.
+// Query::All's answers on a scene, compact rows as HitLists: ray i found
+// found[i] hits over every instance it reaches, the nearest min(found[i],
+// max_hits) its row(i) in order of t, then instance, then triangle.
 using SceneHitLists = HitRows<SceneHit>;
 
 // Where an instance stands: world = rotation_scale * local + translation.
@@ -120,8 +120,10 @@ class Scene {
   uint64_t trace(std::span<const Ray> rays, std::span<SceneHit> hits, HitOutputs outputs = HitOutputs::None,
                  Query query = Query::Closest, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Query::All: every hit of each ray along its segment over the committed
-  // scene into `lists` (resized; lists.max_hits, 1 to kMaxHitsLimit, the
-  // row length). Returns the rays not walkable, as trace() does.
+  // scene into `lists`, compact rows (meshcast/ray.h: cleared, then a row a
+  // ray holding its kept hits alone; lists.max_hits, 1 to kMaxHitsLimit,
+  // the most a row keeps), as BlobView::trace_all_hits. Returns the rays
+  // not walkable, as trace() does.
   uint64_t trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists, HitOutputs outputs = HitOutputs::None,
                           Cull cull = Cull::None, uint8_t mask = 0xFF) const;
 

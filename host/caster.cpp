@@ -85,8 +85,34 @@ const BlobView& Caster::blob(const char* who) const {
   return *view_;
 }
 
+namespace {
+
+// CasterOptions' ranges (caster.h), checked before anything is made: a
+// value out of range is the caller's mistake, said so, never bent into
+// range (0 frames would hold no batch, 2^32 - 1 would wrap the slot count,
+// hit_outputs' other bits would reach the GPU's query flags).
+void check_options(const CasterOptions& o) {
+  auto refuse = [](const std::string& what) { throw UsageError("CasterOptions::" + what); };
+  if (o.backend != Backend::Cpu && o.backend != Backend::Vulkan && o.backend != Backend::Automatic)
+    refuse("backend " + std::to_string(int(o.backend)) + " is not Backend::Cpu, Backend::Vulkan or Backend::Automatic");
+  if (o.frames < 1 || o.frames > kMaxCasterFrames)
+    refuse("frames " + std::to_string(o.frames) + " is not in 1.." + std::to_string(kMaxCasterFrames) +
+           " (the batches in flight at most)");
+  if (o.threads > kMaxCasterThreads)
+    refuse("threads " + std::to_string(o.threads) + " is not in 0.." + std::to_string(kMaxCasterThreads) +
+           " (0: every core)");
+  const uint32_t outputs = uint32_t(HitOutputs::Uv | HitOutputs::Point);
+  if (uint32_t(o.hit_outputs) & ~outputs)
+    refuse("hit_outputs " + std::to_string(uint32_t(o.hit_outputs)) +
+           " has bits other than HitOutputs::Uv (1) and HitOutputs::Point (2)");
+  if (o.jobs && o.jobs->threads() == 0)
+    refuse("jobs: its threads() is 0; a job system runs at least one job at a time");
+}
+
+}  // namespace
+
 void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
-  options_.frames = std::max(options_.frames, 1u);
+  check_options(options_);
   if (options_.jobs) {
     jobs_ = options_.jobs;
   } else {
@@ -364,8 +390,11 @@ void Caster::start_cpu(Slot& s) {
   s.ran_on = Backend::Cpu;
   s.cpu_ns = 0;
   if (s.n == 0) return complete(s, Backend::Cpu);
-  // About four jobs a thread, so uneven rays even out; at least 64 rays a job.
-  const uint32_t per = std::max<uint32_t>(64, (s.n + 4 * jobs_->threads() - 1) / (4 * jobs_->threads()));
+  // About four jobs a thread, so uneven rays even out; at least 64 rays a
+  // job. In 64 bits: an engine's threads() may be anything (a count that
+  // dropped to 0 since the constructor checked it sizes as 1).
+  const uint64_t slices = 4ull * std::max(jobs_->threads(), 1u);
+  const uint32_t per = uint32_t(std::max<uint64_t>(64, (s.n + slices - 1) / slices));
   const uint32_t jobs = (s.n + per - 1) / per;
   s.chunk = per;
   s.jobs_left = jobs;

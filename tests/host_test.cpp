@@ -51,6 +51,17 @@ CasterOptions options(Backend b, uint32_t frames = 4) {
   return o;
 }
 
+// `call` must throw E with every one of `words` in its message.
+template <class E, class F>
+void expect_error(F&& call, std::initializer_list<std::string> words) {
+  try {
+    call();
+    ADD_FAILURE() << "no error; expected one saying '" << *words.begin() << "'";
+  } catch (const E& e) {
+    for (const std::string& w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << "'" << w << "' not in: " << e.what();
+  }
+}
+
 #if !MESHCAST_VULKAN
 // Built without Vulkan: a caster asked for it says so and the CPU answers.
 TEST(Host, WithoutTheVulkanBackendTheCpuAnswers) {
@@ -261,14 +272,7 @@ TEST(Host, MisuseIsAUsageError) {
   Caster caster(blob, "sphere", options(Backend::Cpu, 2));
   const std::vector<Ray> rays = make_rays(m, RayKind::Long, 50, 3);
   std::vector<Hit> hits(rays.size()), short_hits(rays.size() - 1);
-  auto expect_usage = [](auto&& call, const std::string& words) {
-    try {
-      call();
-      ADD_FAILURE() << "no error; expected one saying '" << words << "'";
-    } catch (const UsageError& e) {
-      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-    }
-  };
+  auto expect_usage = [](auto&& call, const std::string& words) { expect_error<UsageError>(call, {words}); };
   expect_usage([&] { caster.poll(host::Ticket{12345, 7}); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 7}, hits); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 0}, hits); }, "unknown or already collected");
@@ -277,6 +281,59 @@ TEST(Host, MisuseIsAUsageError) {
   caster.wait(t, hits);
   expect_usage([&] { caster.trace_now(rays, short_hits); }, "room for 49 hits");
   expect_usage([&] { BlobView(blob, "sphere").trace(rays, short_hits); }, "50 rays but room for 49 hits");
+}
+
+// An engine's job system: here every run goes to a thread of its own, and
+// the calls are counted; threads() says `thread_count`.
+class CountingJobs : public host::JobSystem {
+ public:
+  void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
+    runs += 1;
+    threads_.emplace_back([count, &work] {
+      for (uint32_t i = 0; i < count; ++i) work(i);
+    });
+  }
+  uint32_t threads() const override { return thread_count; }
+  ~CountingJobs() override {
+    for (std::thread& t : threads_) t.join();
+  }
+  std::atomic<int> runs{0};
+  std::atomic<uint32_t> thread_count{3};
+
+ private:
+  std::vector<std::thread> threads_;
+};
+
+// An option out of range is refused, naming the option and its range, by
+// both constructors, never bent into range: no frames, more frames or
+// threads than a caster takes, a backend or hit outputs outside their
+// enums, an engine's job system of no threads. The limits themselves are
+// taken.
+TEST(Host, OptionsOutOfRangeAreRefused) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  CountingJobs none;
+  none.thread_count = 0;
+  auto refused = [&](auto change, std::initializer_list<std::string> words) {
+    CasterOptions o = options(Backend::Cpu);
+    change(o);
+    expect_error<UsageError>([&] { Caster c(blob, "sphere", o); }, words);
+    expect_error<UsageError>([&] { Caster c(o); }, words);
+  };
+  refused([](CasterOptions& o) { o.frames = 0; }, {"CasterOptions::frames 0", "1..1024"});
+  refused([](CasterOptions& o) { o.frames = ~0u; }, {"CasterOptions::frames 4294967295", "1..1024"});
+  refused([](CasterOptions& o) { o.threads = 5000; }, {"CasterOptions::threads 5000", "0..1024"});
+  refused([](CasterOptions& o) { o.backend = Backend(7); }, {"CasterOptions::backend 7"});
+  refused([](CasterOptions& o) { o.hit_outputs = HitOutputs(0x100); }, {"CasterOptions::hit_outputs 256", "HitOutputs::Uv"});
+  refused([&](CasterOptions& o) { o.jobs = &none; }, {"CasterOptions::jobs", "threads() is 0"});
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 100, 2);
+  std::vector<Hit> hits(rays.size());
+  Caster one(blob, "sphere", options(Backend::Cpu, 1));
+  const host::Ticket t = one.submit(rays);
+  EXPECT_THROW(one.submit(rays), UsageError);  // its one frame is taken
+  one.wait(t, hits);
+  Caster most(blob, "sphere", options(Backend::Cpu, host::kMaxCasterFrames));
+  most.wait(most.submit(rays), hits);
 }
 
 TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
@@ -393,26 +450,6 @@ TEST(Host, AWarmCasterAllocatesNothingAFrame) {
   for (int k = 0; k < 20; ++k) frame();
   EXPECT_EQ(g_allocations.load() - before, 0u);
 }
-
-// An engine's job system: here every run goes to a thread of its own, and
-// the calls are counted.
-class CountingJobs : public host::JobSystem {
- public:
-  void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
-    runs += 1;
-    threads_.emplace_back([count, &work] {
-      for (uint32_t i = 0; i < count; ++i) work(i);
-    });
-  }
-  uint32_t threads() const override { return 3; }
-  ~CountingJobs() override {
-    for (std::thread& t : threads_) t.join();
-  }
-  std::atomic<int> runs{0};
-
- private:
-  std::vector<std::thread> threads_;
-};
 
 TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
   Mesh m = make_sphere(16, 32, 1, {0, 0, 0});

@@ -128,9 +128,20 @@ struct VulkanObjects {
   void* get_instance_proc_addr = nullptr;
 };
 
+// The most frames and worker threads a caster takes: each frame holds
+// buffers, and on the GPU a fence and a command buffer, for as long as the
+// caster lives; more than these is a mistake, not a need.
+constexpr uint32_t kMaxCasterFrames = 1024;
+constexpr uint32_t kMaxCasterThreads = 1024;
+
+// The caster refuses an option out of range (UsageError naming it and its
+// range) rather than bending it: a backend outside the enum, frames outside
+// 1..kMaxCasterFrames, threads beyond kMaxCasterThreads, hit_outputs with
+// bits other than HitOutputs::Uv and HitOutputs::Point, a job system whose
+// threads() is 0.
 struct CasterOptions {
   Backend backend = Backend::Automatic;
-  uint32_t frames = 4;          // batches in flight at most
+  uint32_t frames = 4;          // batches in flight at most (1..kMaxCasterFrames)
   uint32_t threads = 0;         // CPU workers (0: every core), unless `jobs` is given
   JobSystem* jobs = nullptr;    // an engine's job system (not owned) instead of meshcast's pool
   std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
@@ -148,10 +159,11 @@ struct CasterOptions {
 
 class Caster {
  public:
-  // Validates the blob (InputError naming `name`); the caster reads the
-  // caller's bytes, which must outlive it. With Backend::Vulkan or
-  // Automatic, a device that is missing or fails leaves the caster on the
-  // CPU, and gpu_error() says why.
+  // Validates the blob as BlobView does (InputError naming `name`; the
+  // bytes 4-byte aligned); the caster reads the caller's bytes, which must
+  // outlive it. UsageError for an option out of range (CasterOptions).
+  // With Backend::Vulkan or Automatic, a device that is missing or fails
+  // leaves the caster on the CPU, and gpu_error() says why.
   Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options = {});
   // A caster of scene batches alone: no blob; the CPU's workers, or with
   // Backend::Vulkan the GPU as above (a missing device leaves the CPU and

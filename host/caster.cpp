@@ -457,7 +457,7 @@ bool Caster::scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) 
   (void)q, (void)frame;
   return false;
 #else
-  return options_.backend == Backend::Vulkan && gpu_ != nullptr && !gpu_failed_ && q.query != Query::All &&
+  return options_.backend == Backend::Vulkan && gpu_available() && q.query != Query::All &&
          gpu::SceneMethod::refusal(frame).empty();  // a mesh it does not read: the CPU's at once, not after the queue
 #endif
 }

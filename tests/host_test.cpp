@@ -763,23 +763,43 @@ TEST(Host, BlobAndSceneBatchesShareTheGpu) {
   }
 }
 
+// Eight balls in a row, in the layout the GPU scene method reads, and 64
+// rays across them with the scene's own answers; and the ball's blob, for
+// blob batches beside the scene's.
+struct BallRow {
+  BallRow() {
+    const MeshId id = scene.add_mesh(blob, "ball");
+    for (int i = 0; i < 8; ++i) {
+      Transform t;
+      t.translation[0] = 3.0 * i;
+      scene.add_instance(id, t);
+    }
+    scene.commit();
+    for (size_t i = 0; i < rays.size(); ++i) rays[i] = {{0.37 * double(i), 0.2, -10}, {0, 0, 1}, INFINITY};
+    scene.trace(rays, want);
+  }
+  // A batch's hits are the scene's own (the instance and t: the GPU may
+  // name the other of two triangles met at one t).
+  void expect_answered(const std::vector<SceneHit>& got, const std::string& what) const {
+    for (size_t i = 0; i < rays.size(); ++i) {
+      EXPECT_EQ(got[i].instance, want[i].instance) << what << ", ray " << i;
+      EXPECT_EQ(got[i].t, want[i].t) << what << ", ray " << i;
+    }
+  }
+  Mesh ball = make_sphere(8, 12, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(ball, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball");
+  Scene scene;
+  std::vector<RayD> rays = std::vector<RayD>(64);
+  std::vector<SceneHit> want = std::vector<SceneHit>(64);
+};
+
 // A scene batch the GPU refuses (an injected limit) is the CPU's and the
 // GPU stays; after a lost device every scene batch is the CPU's. Each
 // answers as the scene's own walk.
 TEST(Host, SceneBatchesLeaveARefusingOrLostGpuForTheCpu) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
-  Scene scene;
-  const MeshId ball = scene.add_mesh(build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball"), "ball");
-  for (int i = 0; i < 8; ++i) {
-    Transform t;
-    t.translation[0] = 3.0 * i;
-    scene.add_instance(ball, t);
-  }
-  scene.commit();
-  std::vector<RayD> rays(64);
-  for (size_t i = 0; i < rays.size(); ++i) rays[i] = {{0.37 * double(i), 0.2, -10}, {0, 0, 1}, INFINITY};
-  std::vector<SceneHit> want(rays.size()), got(rays.size());
-  scene.trace(rays, want);
+  const BallRow row;
+  std::vector<SceneHit> got(row.rays.size());
   int submission = 0;
   CasterOptions o = options(Backend::Vulkan);
   o.before_gpu_submit = [&submission] {
@@ -789,14 +809,78 @@ TEST(Host, SceneBatchesLeaveARefusingOrLostGpuForTheCpu) {
   };
   Caster caster(o);
   const Backend expected[] = {Backend::Vulkan, Backend::Cpu, Backend::Vulkan, Backend::Cpu, Backend::Cpu};
+  ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
   for (Backend b : expected) {
-    EXPECT_EQ(caster.wait(caster.submit(scene, rays), got).ran_on, b);
-    for (size_t i = 0; i < rays.size(); ++i) {
-      EXPECT_EQ(got[i].instance, want[i].instance) << "ray " << i;
-      EXPECT_EQ(got[i].t, want[i].t) << "ray " << i;
-    }
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, b);
+    row.expect_answered(got, host::backend_name(b));
   }
+  EXPECT_FALSE(caster.gpu_available());
   EXPECT_NE(caster.gpu_error().find("device lost"), std::string::npos) << caster.gpu_error();
 }
+
+// The device lost at the second scene batch's submission, with blob and
+// scene batches in flight behind it: the batches before it stay the GPU's;
+// that one and every later one, scene or blob, are the CPU's, answered as
+// the CPU answers them; gpu_available() turns false and gpu_error() says
+// why. A caster of scene batches alone says its GPU is available (and its
+// error empty) until then, as a blob's does.
+TEST(Host, ADeviceLostAmidSceneBatchesLeavesTheRestToTheCpu) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const BallRow row;
+  const std::vector<Ray> rays = make_rays(row.ball, RayKind::Long, 300, 6);
+  const std::thread::id game = std::this_thread::get_id();
+  for (bool with_blob : {false, true}) {
+    int scene_submissions = 0;  // the GPU thread's, which submits the scene batches
+    CasterOptions o = options(Backend::Vulkan, 8);
+    o.before_gpu_submit = [&] {
+      if (std::this_thread::get_id() != game && ++scene_submissions == 2)
+        throw GpuError("Vulkan: vkQueueSubmit failed (VK_ERROR_DEVICE_LOST, injected by the test)", true);
+    };
+    const std::unique_ptr<Caster> made = with_blob ? std::make_unique<Caster>(row.blob, "ball", o) : std::make_unique<Caster>(o);
+    Caster& caster = *made;
+    ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    EXPECT_EQ(caster.gpu_error(), "");
+    // In flight at once: blob batch 0, scene batch 0, blob 1, scene 1 (its
+    // submission loses the device), blob 2, scene 2. Blob batch 1 was
+    // begun before scene batch 1 was submitted; blob 2 may have been too,
+    // and is answered after the loss.
+    struct Batch {
+      host::Ticket ticket;
+      bool scene;
+      Backend expected;
+    };
+    std::vector<Batch> batches;
+    for (int k = 0; k < 3; ++k) {
+      if (with_blob) batches.push_back({caster.submit(rays), false, k < 2 ? Backend::Vulkan : Backend::Cpu});
+      batches.push_back({caster.submit(row.scene, row.rays), true, k < 1 ? Backend::Vulkan : Backend::Cpu});
+    }
+    for (const Batch& b : batches) {
+      const std::string what = std::string(b.scene ? "scene" : "blob") + " batch " + std::to_string(b.ticket.id);
+      if (b.scene) {
+        std::vector<SceneHit> got(row.rays.size());
+        EXPECT_EQ(caster.wait(b.ticket, got).ran_on, b.expected) << what;
+        row.expect_answered(got, what);
+      } else {
+        std::vector<Hit> got(rays.size());
+        EXPECT_EQ(caster.wait(b.ticket, got).ran_on, b.expected) << what;
+        expect_same(got, sync_cpu(caster, rays), what);
+      }
+    }
+    EXPECT_FALSE(caster.gpu_available());
+    EXPECT_NE(caster.gpu_error().find("VK_ERROR_DEVICE_LOST"), std::string::npos) << caster.gpu_error();
+    // Then one of each, the CPU's from their submission.
+    std::vector<SceneHit> got(row.rays.size());
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, Backend::Cpu);
+    row.expect_answered(got, "a scene batch after the loss");
+    if (with_blob) {
+      std::vector<Hit> hits(rays.size());
+      EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
+      expect_same(hits, sync_cpu(caster, rays), "a blob batch after the loss");
+    }
+    EXPECT_EQ(scene_submissions, 2);  // none after the loss
+    EXPECT_EQ(caster.validation_messages(), 0u);
+  }
+}
+
 }  // namespace
 }  // namespace meshcast::testing

@@ -214,7 +214,16 @@ class Caster {
   uint32_t crossover() const { return crossover_.load(); }
   bool crossover_known() const { return crossover_known_.load(); }
   void wait_for_crossover();
-  bool gpu_available() const { return method_ != nullptr && !gpu_failed_.load(); }
+  // Whether batches may go to the GPU now: its device was made (the
+  // Vulkan or Automatic backend; for a caster of scene batches alone,
+  // Vulkan) and has not failed since. Blob batches then go where choose()
+  // says, scene batches the GPU scene method reads to the device.
+  bool gpu_available() const { return gpu_ != nullptr && !gpu_failed_.load(); }
+  // Why the GPU is not available although the caster asked for one: the
+  // device, or the method for the blob's layout, could not be made, or the
+  // device was lost (a failed submission, fence or read-back), after which
+  // every batch is the CPU's. "" while it is available, and for
+  // Backend::Cpu (and a caster of scene batches alone on Automatic).
   std::string gpu_error() const;
   std::string device_name() const;
   // Messages from the Vulkan validation layers so far (options.validation).

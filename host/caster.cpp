@@ -4,18 +4,19 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <fstream>
+#include <exception>
 #include <sstream>
 #include <stdexcept>
 
+#include "meshcast/errors.h"
 #include "meshcast/mesh.h"
-#include "layout/files.h"
 #include "gpu/method.h"
 #if MESHCAST_VULKAN
 #include "gpu/scene.h"
 #include "gpu/vulkan.h"
 #endif
 #include "host/jobs.h"
+#include "host/profile.h"
 #include "layout/blob_format.h"
 #include "layout/queries.h"
 #include "cpu/scene.h"
@@ -204,7 +205,7 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
     crossover_known_ = true;
     return;
   }
-  crossover_note_ = "being measured in the background; the CPU answers meanwhile";
+  crossover_note_ = "being measured in the background" + unused_profile() + "; the CPU answers meanwhile";
   measuring_ = std::thread([this] {
     try {
       measure_crossover();  // publishes the crossover, its note and crossover_known_ together
@@ -678,16 +679,20 @@ std::string profile_key(const std::string& device, const BlobView& view) {
 
 }  // namespace
 
+std::string Caster::unused_profile() const {
+  return profile_unused_.empty() ? "" : " (the profile was not used: " + profile_unused_ + ")";
+}
+
 bool Caster::load_crossover() {
   if (options_.profile.empty()) return false;
-  std::ifstream in(options_.profile);
-  std::string magic, saved_key, note;
-  uint32_t crossover = 0;
-  if (!(std::getline(in, magic) && magic == "meshcast-profile 1" && std::getline(in, saved_key) &&
-        saved_key == profile_key(device_name(), *view_) && in >> crossover && std::getline(in >> std::ws, note)))
+  const SavedProfile saved = read_profile(options_.profile, profile_key(device_name(), *view_));
+  if (!saved.crossover) {
+    profile_unused_ = saved.note;
+    profile_replaceable_ = saved.replaceable;
     return false;
-  crossover_ = crossover;
-  crossover_note_ = note + ", loaded from " + options_.profile;
+  }
+  crossover_ = *saved.crossover;
+  crossover_note_ = saved.note + ", loaded from " + options_.profile;
   return true;
 }
 
@@ -747,14 +752,14 @@ void Caster::measure_crossover() {
   note << "at " << sizes[at] << " rays " << device_name() << " took " << gpu[at] << " ms, " << cpu_threads()
        << " CPU threads " << cpu[at] << " ms; measured at start-up";
   const uint32_t crossover = first < sizes.size() ? sizes[first] : ~0u;
-  std::string saved;
-  if (!options_.profile.empty()) {
+  std::string saved = unused_profile();
+  if (!options_.profile.empty() && !profile_replaceable_) {
+    saved += "; not saved: " + options_.profile + " is left as it is";
+  } else if (!options_.profile.empty()) {
     try {
-      OutputText out(options_.profile);
-      out << "meshcast-profile 1\n" << profile_key(device_name(), *view_) << "\n" << crossover << "\n" << note.str() << "\n";
-      out.commit();
+      write_profile(options_.profile, profile_key(device_name(), *view_), crossover, note.str());
     } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
-      saved = std::string("; not saved: ") + e.what();
+      saved += std::string("; not saved: ") + e.what();
     }
   }
   // Published together, after the profile is written: no reader sees a

@@ -4,9 +4,12 @@
 // several threads submitting at once get their own answers (this suite also
 // runs under ThreadSanitizer in scripts/test.sh).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <deque>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <cmath>
@@ -18,6 +21,7 @@
 
 #include "meshcast/caster.h"
 #include "check/generate.h"
+#include "host/profile.h"
 #include "tests/testing.h"
 
 // Every allocation of this program counted, to show that a warm caster
@@ -503,11 +507,121 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
     EXPECT_TRUE(caster.records().empty());  // the measurement's batches are not the game's
   }
   ASSERT_TRUE(std::filesystem::exists(profile));
-  Caster again(blob, "sphere", o);
-  EXPECT_TRUE(again.crossover_known());  // loaded in the constructor
-  EXPECT_EQ(again.crossover(), crossover);
-  EXPECT_NE(again.why(1).find("loaded from"), std::string::npos) << again.why(1);
+  {
+    Caster again(blob, "sphere", o);
+    EXPECT_TRUE(again.crossover_known());  // loaded in the constructor
+    EXPECT_EQ(again.crossover(), crossover);
+    EXPECT_NE(again.why(1).find("loaded from"), std::string::npos) << again.why(1);
+  }
+  // The same profile with a crossover of -1 (which an unsigned read takes
+  // for 4294967295, "never"): not used, and why() says so at once.
+  std::ifstream in(profile);
+  std::string magic, key;
+  std::getline(in, magic), std::getline(in, key);
+  in.close();
+  std::ofstream(profile) << magic << "\n" << key << "\n-1\nedited by hand\n";
+  Caster edited(blob, "sphere", o);  // destroyed at once: its measurement stops after one batch
+  EXPECT_NE(edited.why(1).find("line 3 '-1' is not a batch size"), std::string::npos) << edited.why(1);
   std::filesystem::remove(profile);
+}
+
+// A profile file's hostile contents, as the Automatic backend reads them
+// (host/profile.h): none is used, each says why naming the path, and each
+// is written over only when it is a meshcast profile (damaged, of another
+// version, device or blob), never when it is something else (notes, a
+// binary, a folder); a pipe is refused before it is opened (its open
+// would wait for a writer). A good one is read, "never" included.
+TEST(Host, HostileProfilesAreNotUsedAndSayWhy) {
+  const std::string key = "lavapipe | OctTreeCompressed/ClusterBitPackSOA8 | 96 triangles | 12345";
+  const std::string head = "meshcast-profile 1\n" + key + "\n";
+  auto read = [&](const std::string& name, const std::string& bytes) {
+    return host::read_profile(make_file(name, bytes), key);
+  };
+  const host::SavedProfile good = read("good", head + "4096\nmeasured\n");
+  ASSERT_TRUE(good.crossover.has_value()) << good.note;
+  EXPECT_EQ(*good.crossover, 4096u);
+  EXPECT_EQ(good.note, "measured");
+  EXPECT_EQ(read("never", head + "4294967295\nmeasured\n").crossover, std::optional<uint32_t>(~0u));
+  struct Case {
+    std::string name, bytes, words;
+    bool replaceable;
+  };
+  const Case cases[] = {
+      {"negative", head + "-1\nnote\n", "line 3 '-1' is not a batch size (0 to 4294967295)", true},
+      {"nan", head + "nan\nnote\n", "line 3 'nan' is not a batch size", true},
+      {"huge", head + "99999999999999999999\nnote\n", "line 3 '99999999999999999999' is not", true},
+      {"exponent", head + "1e9\nnote\n", "line 3 '1e9' is not", true},
+      {"suffixed", head + "12abc\nnote\n", "line 3 '12abc' is not", true},
+      {"blank", head + "\nnote\n", "line 3 '' is not", true},
+      {"binary", head + std::string("\x01\xff\0", 3) + "\nnote\n", "line 3 '??" "?' is not", true},
+      {"truncated", head, "truncated or damaged (2 lines where a profile has 4)", true},
+      {"cut", head + "4096\nmeas", "truncated (its last line has no end)", true},
+      {"extra", head + "4096\nnote\nmore\n", "truncated or damaged (5 lines", true},
+      {"another_device", "meshcast-profile 1\nanother GPU | x\n64\nnote\n", "another device or blob ('another GPU | x')", true},
+      {"another_version", "meshcast-profile 2\n" + key + "\n64\nnote\n", "another version ('meshcast-profile 2')", true},
+      {"long", head + "4096\n" + std::string(5000, 'x') + "\n", "longer than a profile (over 4096 bytes)", true},
+      {"empty", "", "not a meshcast profile", false},
+      {"notes", "my own notes\n4096\n", "not a meshcast profile", false},
+      {"elf", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10) + std::string(100000, '\0'), "not a meshcast profile", false},
+  };
+  for (const Case& c : cases) {
+    const host::SavedProfile p = read(c.name, c.bytes);
+    EXPECT_FALSE(p.crossover.has_value()) << c.name;
+    EXPECT_NE(p.note.find((scratch_dir() / c.name).string() + ": "), std::string::npos) << c.name << ": " << p.note;
+    EXPECT_NE(p.note.find(c.words), std::string::npos) << c.name << ": " << p.note;
+    EXPECT_EQ(p.replaceable, c.replaceable) << c.name;
+  }
+  const std::string folder = (scratch_dir() / "profile_folder").string(), pipe = (scratch_dir() / "profile_pipe").string();
+  std::filesystem::create_directory(folder);
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  for (auto [path, words] : {std::pair{folder, "is a directory"}, std::pair{pipe, "not a regular file"}}) {
+    const host::SavedProfile p = host::read_profile(path, key);
+    EXPECT_FALSE(p.crossover.has_value()) << path;
+    EXPECT_NE(p.note.find(path + ": " + words), std::string::npos) << p.note;
+    EXPECT_FALSE(p.replaceable) << path;
+  }
+  const host::SavedProfile absent = host::read_profile((scratch_dir() / "no_profile").string(), key);
+  EXPECT_FALSE(absent.crossover.has_value());
+  EXPECT_EQ(absent.note, "");
+  EXPECT_TRUE(absent.replaceable);
+  // What write_profile writes reads back; a folder that is not there is an OutputError naming the path.
+  const std::string written = (scratch_dir() / "written").string();
+  host::write_profile(written, key, 256, "at 256 rays");
+  EXPECT_EQ(host::read_profile(written, key).crossover, std::optional<uint32_t>(256));
+  const std::string nowhere = (scratch_dir() / "no folder" / "profile").string();
+  expect_error<OutputError>([&] { host::write_profile(nowhere, key, 256, "at 256 rays"); }, {nowhere});
+}
+
+// The Automatic backend on profiles it cannot use: a file of notes is
+// measured over and left as it is, a profile in a folder that is not there
+// is measured and not saved, a folder in the profile's place is not used;
+// why() says each, from the start.
+TEST(Host, AutomaticChoiceOnProfilesItCannotUse) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
+  CasterOptions o = options(Backend::Automatic);
+  o.profile = make_file("notes.txt", "my own notes\n");
+  {
+    Caster caster(blob, "sphere", o);
+    ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    EXPECT_NE(caster.why(1).find(o.profile + ": not a meshcast profile"), std::string::npos) << caster.why(1);
+    caster.wait_for_crossover();
+    EXPECT_NE(caster.why(1).find("measured at start-up"), std::string::npos) << caster.why(1);
+    EXPECT_NE(caster.why(1).find("not saved: " + o.profile + " is left as it is"), std::string::npos) << caster.why(1);
+  }
+  std::ifstream notes(o.profile);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(notes), {}), "my own notes\n");
+  o.profile = (scratch_dir() / "no folder" / "profile").string();
+  {
+    Caster caster(blob, "sphere", o);
+    caster.wait_for_crossover();
+    EXPECT_NE(caster.why(1).find("measured at start-up"), std::string::npos) << caster.why(1);
+    EXPECT_NE(caster.why(1).find("not saved: " + o.profile + ": cannot write"), std::string::npos) << caster.why(1);
+  }
+  o.profile = scratch_dir().string();
+  Caster folder(blob, "sphere", o);
+  EXPECT_NE(folder.why(1).find(o.profile + ": is a directory"), std::string::npos) << folder.why(1);
 }
 
 }  // namespace

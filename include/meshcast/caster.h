@@ -149,7 +149,14 @@ struct CasterOptions {
   std::string gpu_method;       // "" : the one that reads the blob's layout
   bool validation = false;      // Vulkan validation layers
   HitOutputs hit_outputs = HitOutputs::None;  // what each hit carries besides t and the triangle, either backend
-  std::string profile;          // file with a saved crossover; measured and written when absent
+  // A file with a saved crossover (the Automatic backend): read when it
+  // holds one for this device and blob, else measured and written to it.
+  // A file that is not a usable profile (not one, damaged, another
+  // device's) is measured over, and why() says why; it is written over
+  // only when it is a meshcast profile, so a path named by mistake is
+  // left as it is. A profile that cannot be written leaves the crossover
+  // measured and why() saying so.
+  std::string profile;
   // Test hook: called before every GPU submission (on the submitting
   // thread: the caller's, or the caster's GPU thread for scene batches);
   // throwing GpuError there refuses the batch, or with `lost` set acts as
@@ -261,6 +268,11 @@ class Caster {
   void gpu_completions();
   void gpu_failed(const std::string& why);
   bool load_crossover();     // from options.profile; false when it holds none for this device and blob
+  // Why options.profile was not used (host/profile.h), and whether a
+  // measured crossover may be written over it; set by load_crossover().
+  std::string profile_unused_;
+  bool profile_replaceable_ = true;
+  std::string unused_profile() const;  // " (the profile was not used: ...)" for the notes, or ""
   void measure_crossover();  // on the measurement's slot; the background thread's work
 
   // The caller's blob, which must outlive the caster (none for a caster of

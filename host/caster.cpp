@@ -62,6 +62,9 @@ struct Caster::Slot {
   SceneBatchQuery scene_query;
   Backend ran_on = Backend::Cpu;
   double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
+  // What the job system threw when the GPU thread moved the batch to the
+  // CPU (no caller to throw it to then): wait() rethrows it.
+  std::exception_ptr error;
   // CPU batches: jobs of `chunk` rays; the last to finish completes.
   uint32_t chunk = 0;
   std::atomic<uint32_t> jobs_left{0};
@@ -214,6 +217,9 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
     } catch (const std::exception& e) {  // anything else (memory): the GPU stays, the crossover stays unmeasured
       std::lock_guard<std::mutex> lock(mutex_);
       crossover_note_ = std::string("not measured: ") + e.what();
+    } catch (...) {  // an engine's job system may throw a type of its own: nothing may leave this thread
+      std::lock_guard<std::mutex> lock(mutex_);
+      crossover_note_ = "not measured: the job system threw an exception not derived from std::exception";
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -331,9 +337,14 @@ void Caster::size_slot(Slot& s, size_t n, bool scene) {
 
 void Caster::free_slot(Slot& s) {
   std::lock_guard<std::mutex> lock(mutex_);
-  s.scene.reset();
+  free_locked(s);
+}
+
+void Caster::free_locked(Slot& s) {
+  s.scene.reset();  // a scene batch lets its frame go (its arrays may serve a later commit)
+  s.error = nullptr;
   s.state = Slot::Free;
-  changed_.notify_all();
+  changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
 }
 
 Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
@@ -446,10 +457,19 @@ void Caster::gpu_completions() {
       complete(*s, Backend::Vulkan);
     } catch (const GpuError& e) {  // the device is lost, or (a scene batch, before it began) refused it
       if (e.lost || !s->scene) gpu_failed(e.what());
-      start_cpu(*s);
-    } catch (const std::exception&) {  // a scene the GPU method does not read (a layout, a limit): the CPU's
-      start_cpu(*s);
+      cpu_instead(*s);
+    } catch (...) {  // a scene the GPU method does not read (a layout, a limit), or the test hook's own: the CPU's
+      cpu_instead(*s);
     }
+  }
+}
+
+void Caster::cpu_instead(Slot& s) {
+  try {
+    start_cpu(s);
+  } catch (...) {  // the job system's run() threw: the batch is answered with it, and this thread goes on
+    s.error = std::current_exception();
+    complete(s, Backend::Cpu);
   }
 }
 
@@ -558,6 +578,11 @@ BatchRecord Caster::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists,
   // Another thread may collect the same ticket first: then this one throws.
   changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " was collected by another thread");
+  if (s.error) {  // the batch never ran: collected, and answered with why
+    const std::exception_ptr error = s.error;
+    free_locked(s);
+    std::rethrow_exception(error);
+  }
   s.state = Slot::Collecting;
   return {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
 }
@@ -569,9 +594,7 @@ void Caster::release(Slot& s, const BatchRecord& r, bool record) {
     else records_[recorded_ % kRecords] = r;
     ++recorded_;
   }
-  s.scene.reset();  // a scene batch lets its frame go (its arrays may serve a later commit)
-  s.state = Slot::Free;
-  changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
+  free_locked(s);
 }
 
 BatchRecord Caster::wait(const Ticket& t, std::span<SceneHit> hits) {

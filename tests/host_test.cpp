@@ -288,10 +288,16 @@ TEST(Host, MisuseIsAUsageError) {
 }
 
 // An engine's job system: here every run goes to a thread of its own, and
-// the calls are counted; threads() says `thread_count`.
+// the calls are counted. While `fail` is set, run() throws EngineFault (a
+// type of the engine's own, not a std::exception), as a full queue might;
+// threads() says `thread_count`.
+struct EngineFault {
+  int code;
+};
 class CountingJobs : public host::JobSystem {
  public:
   void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
+    if (fail) throw EngineFault{7};
     runs += 1;
     threads_.emplace_back([count, &work] {
       for (uint32_t i = 0; i < count; ++i) work(i);
@@ -302,6 +308,7 @@ class CountingJobs : public host::JobSystem {
     for (std::thread& t : threads_) t.join();
   }
   std::atomic<int> runs{0};
+  std::atomic<bool> fail{false};
   std::atomic<uint32_t> thread_count{3};
 
  private:
@@ -470,6 +477,28 @@ TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
     expect_same(hits, sync_cpu(caster, rays), "on the engine's jobs");
   }
   EXPECT_EQ(jobs.runs.load(), 1);
+}
+
+// An engine's job system whose run() throws (its queue full, say):
+// submit() throws what it threw, as it threw it, and the frame stays free
+// (more failed submissions than frames, then every frame taken).
+TEST(Host, AnEnginesJobSystemThatThrowsFailsTheSubmission) {
+  const Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3SOA4"), "sphere");
+  CountingJobs jobs;
+  CasterOptions o = options(Backend::Cpu, 2);
+  o.jobs = &jobs;
+  Caster caster(blob, "sphere", o);
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 1000, 8);
+  jobs.fail = true;
+  for (int k = 0; k < 3; ++k) EXPECT_THROW(caster.submit(rays), EngineFault);
+  jobs.fail = false;
+  const host::Ticket a = caster.submit(rays), b = caster.submit(rays);
+  for (const host::Ticket& t : {a, b}) {
+    std::vector<Hit> hits(rays.size());
+    caster.wait(t, hits);
+    expect_same(hits, sync_cpu(caster, rays), "after the job system threw");
+  }
 }
 
 // The automatic backend measures the crossover once, writes it to the
@@ -994,6 +1023,44 @@ TEST(Host, ADeviceLostAmidSceneBatchesLeavesTheRestToTheCpu) {
     EXPECT_EQ(scene_submissions, 2);  // none after the loss
     EXPECT_EQ(caster.validation_messages(), 0u);
   }
+}
+
+// An engine's job system that throws on the caster's own threads, where
+// no caller is there to take the exception: a scene batch the GPU refuses
+// (an injected limit), moved to the CPU while run() throws, is collected by
+// rethrowing what it threw, and the caster goes on; the Automatic
+// backend's measurement stops and why() says so. Nothing terminates.
+TEST(Host, AnEnginesJobSystemThatThrowsOnTheCastersThreads) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const BallRow row;
+  std::vector<SceneHit> got(row.rays.size());
+  CountingJobs jobs;
+  int submission = 0;
+  CasterOptions o = options(Backend::Vulkan);
+  o.jobs = &jobs;
+  o.before_gpu_submit = [&submission] {
+    if (++submission == 2) throw GpuError("Vulkan: the scene's buffers exceed a limit (injected by the test)");
+  };
+  {
+    Caster caster(o);
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, Backend::Vulkan);
+    jobs.fail = true;
+    const host::Ticket refused = caster.submit(row.scene, row.rays);
+    EXPECT_THROW(caster.wait(refused, got), EngineFault);
+    EXPECT_THROW(caster.wait(refused, got), UsageError);  // collected
+    jobs.fail = false;
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, Backend::Vulkan);
+    row.expect_answered(got, "after the job system threw");
+    EXPECT_TRUE(caster.gpu_available());
+  }
+  CasterOptions a = options(Backend::Automatic);
+  a.jobs = &jobs;
+  jobs.fail = true;
+  Caster automatic(row.blob, "ball", a);
+  automatic.wait_for_crossover();
+  EXPECT_EQ(automatic.choose(1u << 20), Backend::Cpu);
+  EXPECT_NE(automatic.why(1u << 20).find("not measured: the job system threw"), std::string::npos) << automatic.why(1u << 20);
+  jobs.fail = false;
 }
 
 }  // namespace

@@ -182,7 +182,8 @@ class Caster {
 
   // Copies the rays and starts the batch; returns at once. Throws
   // UsageError when all `frames` slots hold uncollected batches, or for a
-  // query out of range.
+  // query out of range; what an engine's JobSystem::run() throws, as it
+  // threw it (the slot stays free).
   Ticket submit(std::span<const Ray> rays, BatchQuery query = {});
   // A scene batch (see above): the scene's last commit, taken now; call it
   // from the thread that edits and commits the scene. The rays are copied.
@@ -199,7 +200,10 @@ class Caster {
   bool poll(const Ticket& t);
   // Blocks until ready, copies the hits into `hits` (at least the batch's
   // size, else UsageError) and frees the slot; returns that batch's record.
-  // UsageError for a Query::All batch (its rows: the overload below).
+  // UsageError for a Query::All batch (its rows: the overload below). A
+  // batch the caster moved from the GPU to the CPU after submit() returned
+  // (a refused scene batch, a lost device) whose JobSystem::run() threw is
+  // collected by rethrowing what it threw.
   BatchRecord wait(const Ticket& t, std::span<Hit> hits);
   // A Query::All batch's rows into `lists` (resized); UsageError for a
   // batch of another query.
@@ -265,6 +269,9 @@ class Caster {
   // UsageError for a batch the GPU scene method refuses).
   void run_scene_on_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
+  // start_cpu() for a batch the GPU thread moves to the CPU: what the job
+  // system throws is kept in the slot for wait(), as no caller is there.
+  void cpu_instead(Slot& s);
   void gpu_completions();
   void gpu_failed(const std::string& why);
   bool load_crossover();     // from options.profile; false when it holds none for this device and blob
@@ -285,6 +292,7 @@ class Caster {
   // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
   void size_slot(Slot& s, size_t n, bool scene);
   void free_slot(Slot& s);  // what started the batch threw: nothing runs
+  void free_locked(Slot& s);  // free_slot() under mutex_
   // The first half of collecting: checks that the caller collects the
   // batch into what it asked for (scene hits or not, rows or not, `room`
   // hits), waits for it and marks it Collecting; release() frees the slot.

@@ -229,20 +229,41 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
   });
 }
 
+template <class Ready>
+bool Caster::block(std::unique_lock<std::mutex>& lock, Ready ready) {
+  ++blocked_;
+  changed_.wait(lock, [&] { return closing_ || ready(); });
+  --blocked_;
+  if (closing_) changed_.notify_all();  // the destructor waits for blocked_ to be 0 (and for the lock)
+  return ready();
+}
+
 void Caster::wait_for_crossover() {
   std::unique_lock<std::mutex> lock(mutex_);
-  changed_.wait(lock, [this] { return crossover_known_.load(); });
+  if (!block(lock, [this] { return crossover_known_.load(); }))
+    throw UsageError("Caster::wait_for_crossover: the caster was destroyed while waiting");
 }
 
 Caster::~Caster() {
+  // No batch starts from now on, and a thread blocked in wait() or
+  // wait_for_crossover() throws UsageError: its caster is going.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closing_ = true;
+    changed_.notify_all();
+  }
   // The measurement stops after its current batch.
   stop_measuring_ = true;
   if (measuring_.joinable()) measuring_.join();
-  // Collect what is still running, so no job or fence outlives the caster.
+  // Let what is still running finish, so no job or fence outlives the
+  // caster, and every thread that was blocked in a call, or is still
+  // copying a batch's hits out, leave it.
   {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [this] {
-      return std::none_of(slots_.begin(), slots_.end(), [](const auto& s) { return s->state == Slot::Running; });
+      return blocked_ == 0 && std::none_of(slots_.begin(), slots_.end(), [](const auto& s) {
+               return s->state == Slot::Running || s->state == Slot::Collecting;
+             });
     });
   }
   {
@@ -312,6 +333,7 @@ Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
 
 Caster::Slot& Caster::take_slot() {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (closing_) throw UsageError("Caster::submit: the caster is being destroyed");
   for (uint32_t i = 0; i < game_slots_; ++i)
     if (slots_[i]->state == Slot::Free) {
       Slot& s = *slots_[i];
@@ -576,7 +598,11 @@ BatchRecord Caster::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists,
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
   check_collected(t.id, s.scene != nullptr, scene_wait, s.query.query == Query::All, lists, room, s.n);
   // Another thread may collect the same ticket first: then this one throws.
-  changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
+  // The measurement's own batches are waited for while the caster closes.
+  auto ready = [&] { return gone() || s.state == Slot::Ready; };
+  if (s.index >= game_slots_) changed_.wait(lock, ready);
+  else if (!block(lock, ready))
+    throw UsageError("ticket " + std::to_string(t.id) + " was not collected: the caster was destroyed while waiting");
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " was collected by another thread");
   if (s.error) {  // the batch never ran: collected, and answered with why
     const std::exception_ptr error = s.error;

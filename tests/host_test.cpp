@@ -5,6 +5,8 @@
 // runs under ThreadSanitizer in scripts/test.sh).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <deque>
@@ -666,9 +668,11 @@ TEST(Host, AutomaticChoiceOnProfilesItCannotUse) {
 // reused under them, were a held snapshot ever taken for a new frame).
 namespace meshcast::testing {
 namespace {
+// `delay`: how long after run() its work starts, unless open() was called.
 class LateJobs : public host::JobSystem {
  public:
-  LateJobs() : thread_([this] { loop(); }) {}
+  explicit LateJobs(std::chrono::milliseconds delay = std::chrono::milliseconds(3))
+      : delay_(delay), thread_([this] { loop(); }) {}
   ~LateJobs() override {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -680,11 +684,19 @@ class LateJobs : public host::JobSystem {
   void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      queue_.push_back({count, &work, std::chrono::steady_clock::now() + std::chrono::milliseconds(3)});
+      queue_.push_back({count, &work, std::chrono::steady_clock::now() + delay_});
     }
     wake_.notify_all();
   }
   uint32_t threads() const override { return 1; }
+  // Every run from now on starts at once.
+  void open() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      open_ = true;
+    }
+    wake_.notify_all();
+  }
 
  private:
   struct Run {
@@ -699,8 +711,8 @@ class LateJobs : public host::JobSystem {
       if (queue_.empty()) return;
       const Run r = queue_.front();
       queue_.pop_front();
+      wake_.wait_until(lock, r.at, [this] { return open_; });
       lock.unlock();
-      std::this_thread::sleep_until(r.at);
       for (uint32_t i = 0; i < r.count; ++i) (*r.work)(i);
       lock.lock();
     }
@@ -708,7 +720,8 @@ class LateJobs : public host::JobSystem {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<Run> queue_;
-  bool stop_ = false;
+  bool stop_ = false, open_ = false;
+  const std::chrono::milliseconds delay_;
   std::thread thread_;
 };
 
@@ -1063,5 +1076,62 @@ TEST(Host, AnEnginesJobSystemThatThrowsOnTheCastersThreads) {
   jobs.fail = false;
 }
 
+// Whether thread `tid` of this process is asleep (blocked on a lock or a
+// condition variable), as /proc/self/task says: how a test knows that
+// another thread is inside a blocking call.
+bool asleep(pid_t tid) {
+  std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
+  const std::string line((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const size_t name_end = line.rfind(')');  // "tid (name) state ...": the name may hold anything
+  return name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] == 'S';
+}
+
+// A caster destroyed while another thread is blocked in wait(): that
+// thread gets UsageError naming its ticket, and the destructor waits for
+// the batch still running and for that thread to leave (nothing freed
+// under it: this suite runs under ThreadSanitizer, and the CPU host layer
+// under AddressSanitizer). The batch runs only once the waiter has thrown.
+TEST(Host, DestroyingACasterWhileAThreadWaitsThrowsThere) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 200, 4);
+  LateJobs late(std::chrono::seconds(10));  // a bound, should the waiter never throw
+  CasterOptions o = options(Backend::Cpu);
+  o.jobs = &late;
+  auto caster = std::make_unique<Caster>(blob, "sphere", o);
+  Caster* const shared = caster.get();
+  const host::Ticket t = caster->submit(rays);
+  std::atomic<pid_t> tid{0};
+  std::string error;
+  bool returned = false;
+  std::thread waiter([&, shared] {
+    tid = pid_t(::syscall(SYS_gettid));
+    std::vector<Hit> hits(rays.size());
+    try {
+      shared->wait(t, hits);
+      returned = true;
+    } catch (const UsageError& e) {
+      error = e.what();
+    }
+    late.open();
+  });
+  // Blocked in wait(): asleep 50 ms on end (its batch cannot be ready yet).
+  int asleep_for = 0;
+  for (int k = 0; k < 2000 && asleep_for < 10; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    asleep_for = tid != 0 && asleep(tid) ? asleep_for + 1 : 0;
+  }
+  if (asleep_for < 10) {
+    late.open();
+    waiter.join();
+    FAIL() << "the waiting thread never blocked";
+  }
+  caster.reset();
+  waiter.join();
+  EXPECT_FALSE(returned);
+  EXPECT_NE(error.find("ticket " + std::to_string(t.id) + " was not collected: the caster was destroyed while waiting"),
+            std::string::npos)
+      << error;
+}
 }  // namespace
 }  // namespace meshcast::testing

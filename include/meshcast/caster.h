@@ -176,6 +176,11 @@ class Caster {
   // Backend::Vulkan the GPU as above (a missing device leaves the CPU and
   // gpu_error() says why). Its blob calls throw UsageError.
   explicit Caster(CasterOptions options);
+  // Waits for the batches still running (their jobs and fences), so none
+  // outlives the caster. A thread blocked in wait() or wait_for_crossover()
+  // when destruction begins gets UsageError (its batch is not collected)
+  // and the destructor waits for it to leave; no other call may overlap
+  // the destructor (a submit() that does gets UsageError at best).
   ~Caster();
   Caster(const Caster&) = delete;
   Caster& operator=(const Caster&) = delete;
@@ -287,12 +292,17 @@ class Caster {
   std::optional<BlobView> view_;
   const BlobView& blob(const char* who) const;
   void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
-  Slot& take_slot();  // a free game slot, Running; UsageError when none
+  Slot& take_slot();  // a free game slot, Running; UsageError when none, or while the caster closes
   // A taken slot's batch of n rays under s.query: the clock started, room
   // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
   void size_slot(Slot& s, size_t n, bool scene);
   void free_slot(Slot& s);  // what started the batch threw: nothing runs
   void free_locked(Slot& s);  // free_slot() under mutex_
+  // Waits on changed_ under `lock` (mutex_) until ready() or the caster
+  // closes; counted in blocked_, which the destructor waits to be 0.
+  // Returns ready(): false when the caster closed first.
+  template <class Ready>
+  bool block(std::unique_lock<std::mutex>& lock, Ready ready);
   // The first half of collecting: checks that the caller collects the
   // batch into what it asked for (scene hits or not, rows or not, `room`
   // hits), waits for it and marks it Collecting; release() frees the slot.
@@ -320,7 +330,9 @@ class Caster {
   std::mutex gpu_mutex_;                // the GPU method's begin and finish
   std::mutex jobs_mutex_;               // one JobSystem::run at a time (game thread, measurement, completions)
   std::atomic<uint32_t> calls_in_work_{0};  // jobs still inside a slot's work, even after it completed
-  std::condition_variable changed_;     // a slot became ready
+  std::condition_variable changed_;     // a slot became ready or free, the crossover known, the caster closing
+  bool closing_ = false;                // under mutex_: the destructor has begun
+  uint32_t blocked_ = 0;                // under mutex_: threads in block()
   std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
   uint32_t game_slots_ = 0;
   uint64_t next_id_ = 1;

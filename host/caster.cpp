@@ -4,18 +4,19 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <fstream>
+#include <exception>
 #include <sstream>
 #include <stdexcept>
 
+#include "meshcast/errors.h"
 #include "meshcast/mesh.h"
-#include "layout/files.h"
 #include "gpu/method.h"
 #if MESHCAST_VULKAN
 #include "gpu/scene.h"
 #include "gpu/vulkan.h"
 #endif
 #include "host/jobs.h"
+#include "host/profile.h"
 #include "layout/blob_format.h"
 #include "layout/queries.h"
 #include "cpu/scene.h"
@@ -65,6 +66,9 @@ struct Caster::Slot {
   SceneBatchQuery scene_query;
   Backend ran_on = Backend::Cpu;
   double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
+  // What the job system threw when the GPU thread moved the batch to the
+  // CPU (no caller to throw it to then): wait() rethrows it.
+  std::exception_ptr error;
   // CPU batches: jobs of `chunk` rays; the last to finish completes.
   uint32_t chunk = 0;
   std::atomic<uint32_t> jobs_left{0};
@@ -89,8 +93,34 @@ const BlobView& Caster::blob(const char* who) const {
   return *view_;
 }
 
+namespace {
+
+// CasterOptions' ranges (caster.h), checked before anything is made: a
+// value out of range is the caller's mistake, said so, never bent into
+// range (0 frames would hold no batch, 2^32 - 1 would wrap the slot count,
+// hit_outputs' other bits would reach the GPU's query flags).
+void check_options(const CasterOptions& o) {
+  auto refuse = [](const std::string& what) { throw UsageError("CasterOptions::" + what); };
+  if (o.backend != Backend::Cpu && o.backend != Backend::Vulkan && o.backend != Backend::Automatic)
+    refuse("backend " + std::to_string(int(o.backend)) + " is not Backend::Cpu, Backend::Vulkan or Backend::Automatic");
+  if (o.frames < 1 || o.frames > kMaxCasterFrames)
+    refuse("frames " + std::to_string(o.frames) + " is not in 1.." + std::to_string(kMaxCasterFrames) +
+           " (the batches in flight at most)");
+  if (o.threads > kMaxCasterThreads)
+    refuse("threads " + std::to_string(o.threads) + " is not in 0.." + std::to_string(kMaxCasterThreads) +
+           " (0: every core)");
+  const uint32_t outputs = uint32_t(HitOutputs::Uv | HitOutputs::Point);
+  if (uint32_t(o.hit_outputs) & ~outputs)
+    refuse("hit_outputs " + std::to_string(uint32_t(o.hit_outputs)) +
+           " has bits other than HitOutputs::Uv (1) and HitOutputs::Point (2)");
+  if (o.jobs && o.jobs->threads() == 0)
+    refuse("jobs: its threads() is 0; a job system runs at least one job at a time");
+}
+
+}  // namespace
+
 void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
-  options_.frames = std::max(options_.frames, 1u);
+  check_options(options_);
   if (options_.jobs) {
     jobs_ = options_.jobs;
   } else {
@@ -183,7 +213,7 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
     crossover_known_ = true;
     return;
   }
-  crossover_note_ = "being measured in the background; the CPU answers meanwhile";
+  crossover_note_ = "being measured in the background" + unused_profile() + "; the CPU answers meanwhile";
   measuring_ = std::thread([this] {
     try {
       measure_crossover();  // publishes the crossover, its note and crossover_known_ together
@@ -192,6 +222,9 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
     } catch (const std::exception& e) {  // anything else (memory): the GPU stays, the crossover stays unmeasured
       std::lock_guard<std::mutex> lock(mutex_);
       crossover_note_ = std::string("not measured: ") + e.what();
+    } catch (...) {  // an engine's job system may throw a type of its own: nothing may leave this thread
+      std::lock_guard<std::mutex> lock(mutex_);
+      crossover_note_ = "not measured: the job system threw an exception not derived from std::exception";
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -201,20 +234,41 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
   });
 }
 
+template <class Ready>
+bool Caster::block(std::unique_lock<std::mutex>& lock, Ready ready) {
+  ++blocked_;
+  changed_.wait(lock, [&] { return closing_ || ready(); });
+  --blocked_;
+  if (closing_) changed_.notify_all();  // the destructor waits for blocked_ to be 0 (and for the lock)
+  return ready();
+}
+
 void Caster::wait_for_crossover() {
   std::unique_lock<std::mutex> lock(mutex_);
-  changed_.wait(lock, [this] { return crossover_known_.load(); });
+  if (!block(lock, [this] { return crossover_known_.load(); }))
+    throw UsageError("Caster::wait_for_crossover: the caster was destroyed while waiting");
 }
 
 Caster::~Caster() {
+  // No batch starts from now on, and a thread blocked in wait() or
+  // wait_for_crossover() throws UsageError: its caster is going.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closing_ = true;
+    changed_.notify_all();
+  }
   // The measurement stops after its current batch.
   stop_measuring_ = true;
   if (measuring_.joinable()) measuring_.join();
-  // Collect what is still running, so no job or fence outlives the caster.
+  // Let what is still running finish, so no job or fence outlives the
+  // caster, and every thread that was blocked in a call, or is still
+  // copying a batch's hits out, leave it.
   {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [this] {
-      return std::none_of(slots_.begin(), slots_.end(), [](const auto& s) { return s->state == Slot::Running; });
+      return blocked_ == 0 && std::none_of(slots_.begin(), slots_.end(), [](const auto& s) {
+               return s->state == Slot::Running || s->state == Slot::Collecting;
+             });
     });
   }
   {
@@ -284,6 +338,7 @@ Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
 
 Caster::Slot& Caster::take_slot() {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (closing_) throw UsageError("Caster::submit: the caster is being destroyed");
   for (uint32_t i = 0; i < game_slots_; ++i)
     if (slots_[i]->state == Slot::Free) {
       Slot& s = *slots_[i];
@@ -308,9 +363,14 @@ void Caster::size_slot(Slot& s, size_t n, bool scene) {
 
 void Caster::free_slot(Slot& s) {
   std::lock_guard<std::mutex> lock(mutex_);
-  s.scene.reset();
+  free_locked(s);
+}
+
+void Caster::free_locked(Slot& s) {
+  s.scene.reset();  // a scene batch lets its frame go (its arrays may serve a later commit)
+  s.error = nullptr;
   s.state = Slot::Free;
-  changed_.notify_all();
+  changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
 }
 
 Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
@@ -367,8 +427,11 @@ void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
 void Caster::start_cpu(Slot& s) {
   s.ran_on = Backend::Cpu;
   s.cpu_ns = 0;
-  // About four jobs a thread, so uneven rays even out; at least 64 rays a job.
-  const uint32_t per = std::max<uint32_t>(64, (s.n + 4 * jobs_->threads() - 1) / (4 * jobs_->threads()));
+  // About four jobs a thread, so uneven rays even out; at least 64 rays a
+  // job. In 64 bits: an engine's threads() may be anything (a count that
+  // dropped to 0 since the constructor checked it sizes as 1).
+  const uint64_t slices = 4ull * std::max(jobs_->threads(), 1u);
+  const uint32_t per = uint32_t(std::max<uint64_t>(64, (s.n + slices - 1) / slices));
   const uint32_t jobs = (s.n + per - 1) / per;
   if (s.query.query == Query::All) {  // a job's rows each, in order (none for no rays)
     if (s.scene) s.job_scene_rows.resize(jobs);
@@ -424,10 +487,19 @@ void Caster::gpu_completions() {
       complete(*s, Backend::Vulkan);
     } catch (const GpuError& e) {  // the device is lost, or (a scene batch, before it began) refused it
       if (e.lost || !s->scene) gpu_failed(e.what());
-      start_cpu(*s);
-    } catch (const std::exception&) {  // a scene the GPU method does not read (a layout, a limit): the CPU's
-      start_cpu(*s);
+      cpu_instead(*s);
+    } catch (...) {  // a scene the GPU method does not read (a layout, a limit), or the test hook's own: the CPU's
+      cpu_instead(*s);
     }
+  }
+}
+
+void Caster::cpu_instead(Slot& s) {
+  try {
+    start_cpu(s);
+  } catch (...) {  // the job system's run() threw: the batch is answered with it, and this thread goes on
+    s.error = std::current_exception();
+    complete(s, Backend::Cpu);
   }
 }
 
@@ -436,7 +508,7 @@ bool Caster::scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) 
   (void)q, (void)frame;
   return false;
 #else
-  return options_.backend == Backend::Vulkan && gpu_ != nullptr && !gpu_failed_ && q.query != Query::All &&
+  return options_.backend == Backend::Vulkan && gpu_available() && q.query != Query::All &&
          gpu::SceneMethod::refusal(frame).empty();  // a mesh it does not read: the CPU's at once, not after the queue
 #endif
 }
@@ -534,8 +606,17 @@ BatchRecord Caster::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists,
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
   check_collected(t.id, s.scene != nullptr, scene_wait, s.query.query == Query::All, lists, room, s.n);
   // Another thread may collect the same ticket first: then this one throws.
-  changed_.wait(lock, [&] { return gone() || s.state == Slot::Ready; });
+  // The measurement's own batches are waited for while the caster closes.
+  auto ready = [&] { return gone() || s.state == Slot::Ready; };
+  if (s.index >= game_slots_) changed_.wait(lock, ready);
+  else if (!block(lock, ready))
+    throw UsageError("ticket " + std::to_string(t.id) + " was not collected: the caster was destroyed while waiting");
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " was collected by another thread");
+  if (s.error) {  // the batch never ran: collected, and answered with why
+    const std::exception_ptr error = s.error;
+    free_locked(s);
+    std::rethrow_exception(error);
+  }
   s.state = Slot::Collecting;
   return {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
 }
@@ -547,9 +628,7 @@ void Caster::release(Slot& s, const BatchRecord& r, bool record) {
     else records_[recorded_ % kRecords] = r;
     ++recorded_;
   }
-  s.scene.reset();  // a scene batch lets its frame go (its arrays may serve a later commit)
-  s.state = Slot::Free;
-  changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
+  free_locked(s);
 }
 
 BatchRecord Caster::wait(const Ticket& t, std::span<SceneHit> hits) {
@@ -661,16 +740,20 @@ std::string profile_key(const std::string& device, const BlobView& view) {
 
 }  // namespace
 
+std::string Caster::unused_profile() const {
+  return profile_unused_.empty() ? "" : " (the profile was not used: " + profile_unused_ + ")";
+}
+
 bool Caster::load_crossover() {
   if (options_.profile.empty()) return false;
-  std::ifstream in(options_.profile);
-  std::string magic, saved_key, note;
-  uint32_t crossover = 0;
-  if (!(std::getline(in, magic) && magic == "meshcast-profile 1" && std::getline(in, saved_key) &&
-        saved_key == profile_key(device_name(), *view_) && in >> crossover && std::getline(in >> std::ws, note)))
+  const SavedProfile saved = read_profile(options_.profile, profile_key(device_name(), *view_));
+  if (!saved.crossover) {
+    profile_unused_ = saved.note;
+    profile_replaceable_ = saved.replaceable;
     return false;
-  crossover_ = crossover;
-  crossover_note_ = note + ", loaded from " + options_.profile;
+  }
+  crossover_ = *saved.crossover;
+  crossover_note_ = saved.note + ", loaded from " + options_.profile;
   return true;
 }
 
@@ -730,14 +813,14 @@ void Caster::measure_crossover() {
   note << "at " << sizes[at] << " rays " << device_name() << " took " << gpu[at] << " ms, " << cpu_threads()
        << " CPU threads " << cpu[at] << " ms; measured at start-up";
   const uint32_t crossover = first < sizes.size() ? sizes[first] : ~0u;
-  std::string saved;
-  if (!options_.profile.empty()) {
+  std::string saved = unused_profile();
+  if (!options_.profile.empty() && !profile_replaceable_) {
+    saved += "; not saved: " + options_.profile + " is left as it is";
+  } else if (!options_.profile.empty()) {
     try {
-      OutputText out(options_.profile);
-      out << "meshcast-profile 1\n" << profile_key(device_name(), *view_) << "\n" << crossover << "\n" << note.str() << "\n";
-      out.commit();
+      write_profile(options_.profile, profile_key(device_name(), *view_), crossover, note.str());
     } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
-      saved = std::string("; not saved: ") + e.what();
+      saved += std::string("; not saved: ") + e.what();
     }
   }
   // Published together, after the profile is written: no reader sees a

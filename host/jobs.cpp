@@ -7,10 +7,17 @@ namespace meshcast::host {
 WorkerPool::WorkerPool(uint32_t threads) {
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   queue_.reserve(64);
-  for (uint32_t i = 0; i < threads; ++i) workers_.emplace_back([this] { loop(); });
+  try {
+    for (uint32_t i = 0; i < threads; ++i) workers_.emplace_back([this] { loop(); });
+  } catch (...) {  // the system refused a thread: those started are joined, not destroyed joinable (std::terminate)
+    stop();
+    throw;
+  }
 }
 
-WorkerPool::~WorkerPool() {
+WorkerPool::~WorkerPool() { stop(); }
+
+void WorkerPool::stop() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;

@@ -27,6 +27,7 @@ class WorkerPool : public JobSystem {
     uint32_t count, next;
   };
   void loop();
+  void stop();  // the workers finish the queue and are joined
   std::mutex mutex_;
   std::condition_variable wake_;
   std::vector<Run> queue_;  // runs with indices left, oldest first

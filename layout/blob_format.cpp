@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <charconv>
 #include <cfloat>
 #include <cmath>
 #include <vector>
@@ -69,8 +70,14 @@ struct Section { const char* name; uint32_t offset, size; };
 std::string validate(std::span<const uint8_t> blob) {
   if (blob.size() < sizeof(BlobHeader))
     return "blob of " + num(blob.size()) + " bytes is shorter than its header (" + num(sizeof(BlobHeader)) + ")";
-  if (reinterpret_cast<uintptr_t>(blob.data()) % alignof(BlobHeader) != 0)
-    return "blob buffer is not 4-byte aligned; load it into aligned memory";
+  // The header and the sections' words are read in place as 32-bit words.
+  if (const uintptr_t address = reinterpret_cast<uintptr_t>(blob.data()); address % alignof(BlobHeader) != 0) {
+    char hex[2 * sizeof address + 1] = {};
+    std::to_chars(hex, hex + sizeof hex - 1, address, 16);
+    return "blob bytes at 0x" + std::string(hex) + " are not 4-byte aligned (address % 4 = " +
+           num(address % alignof(BlobHeader)) + "): a blob must start at a 4-byte aligned address, as a " +
+           "std::vector<uint8_t>, load_blob and MappedBlob give it";
+  }
   BlobHeader h;
   std::memcpy(&h, blob.data(), sizeof h);
   if (h.magic != MC_BLOB_MAGIC) return "not a meshcast blob (bad magic)";

@@ -4,9 +4,14 @@
 // several threads submitting at once get their own answers (this suite also
 // runs under ThreadSanitizer in scripts/test.sh).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <deque>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <random>
 #include <cmath>
@@ -18,6 +23,7 @@
 
 #include "meshcast/caster.h"
 #include "check/generate.h"
+#include "host/profile.h"
 #include "tests/testing.h"
 
 // Every allocation of this program counted, to show that a warm caster
@@ -49,6 +55,17 @@ CasterOptions options(Backend b, uint32_t frames = 4) {
   CasterOptions o;
   o.backend = b, o.frames = frames, o.validation = true;
   return o;
+}
+
+// `call` must throw E with every one of `words` in its message.
+template <class E, class F>
+void expect_error(F&& call, std::initializer_list<std::string> words) {
+  try {
+    call();
+    ADD_FAILURE() << "no error; expected one saying '" << *words.begin() << "'";
+  } catch (const E& e) {
+    for (const std::string& w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << "'" << w << "' not in: " << e.what();
+  }
 }
 
 #if !MESHCAST_VULKAN
@@ -342,14 +359,7 @@ TEST(Host, MisuseIsAUsageError) {
   Caster caster(blob, "sphere", options(Backend::Cpu, 2));
   const std::vector<Ray> rays = make_rays(m, RayKind::Long, 50, 3);
   std::vector<Hit> hits(rays.size()), short_hits(rays.size() - 1);
-  auto expect_usage = [](auto&& call, const std::string& words) {
-    try {
-      call();
-      ADD_FAILURE() << "no error; expected one saying '" << words << "'";
-    } catch (const UsageError& e) {
-      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-    }
-  };
+  auto expect_usage = [](auto&& call, const std::string& words) { expect_error<UsageError>(call, {words}); };
   expect_usage([&] { caster.poll(host::Ticket{12345, 7}); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 7}, hits); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 0}, hits); }, "unknown or already collected");
@@ -358,6 +368,66 @@ TEST(Host, MisuseIsAUsageError) {
   caster.wait(t, hits);
   expect_usage([&] { caster.trace_now(rays, short_hits); }, "room for 49 hits");
   expect_usage([&] { BlobView(blob, "sphere").trace(rays, short_hits); }, "50 rays but room for 49 hits");
+}
+
+// An engine's job system: here every run goes to a thread of its own, and
+// the calls are counted. While `fail` is set, run() throws EngineFault (a
+// type of the engine's own, not a std::exception), as a full queue might;
+// threads() says `thread_count`.
+struct EngineFault {
+  int code;
+};
+class CountingJobs : public host::JobSystem {
+ public:
+  void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
+    if (fail) throw EngineFault{7};
+    runs += 1;
+    threads_.emplace_back([count, &work] {
+      for (uint32_t i = 0; i < count; ++i) work(i);
+    });
+  }
+  uint32_t threads() const override { return thread_count; }
+  ~CountingJobs() override {
+    for (std::thread& t : threads_) t.join();
+  }
+  std::atomic<int> runs{0};
+  std::atomic<bool> fail{false};
+  std::atomic<uint32_t> thread_count{3};
+
+ private:
+  std::vector<std::thread> threads_;
+};
+
+// An option out of range is refused, naming the option and its range, by
+// both constructors, never bent into range: no frames, more frames or
+// threads than a caster takes, a backend or hit outputs outside their
+// enums, an engine's job system of no threads. The limits themselves are
+// taken.
+TEST(Host, OptionsOutOfRangeAreRefused) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  CountingJobs none;
+  none.thread_count = 0;
+  auto refused = [&](auto change, std::initializer_list<std::string> words) {
+    CasterOptions o = options(Backend::Cpu);
+    change(o);
+    expect_error<UsageError>([&] { Caster c(blob, "sphere", o); }, words);
+    expect_error<UsageError>([&] { Caster c(o); }, words);
+  };
+  refused([](CasterOptions& o) { o.frames = 0; }, {"CasterOptions::frames 0", "1..1024"});
+  refused([](CasterOptions& o) { o.frames = ~0u; }, {"CasterOptions::frames 4294967295", "1..1024"});
+  refused([](CasterOptions& o) { o.threads = 5000; }, {"CasterOptions::threads 5000", "0..1024"});
+  refused([](CasterOptions& o) { o.backend = Backend(7); }, {"CasterOptions::backend 7"});
+  refused([](CasterOptions& o) { o.hit_outputs = HitOutputs(0x100); }, {"CasterOptions::hit_outputs 256", "HitOutputs::Uv"});
+  refused([&](CasterOptions& o) { o.jobs = &none; }, {"CasterOptions::jobs", "threads() is 0"});
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 100, 2);
+  std::vector<Hit> hits(rays.size());
+  Caster one(blob, "sphere", options(Backend::Cpu, 1));
+  const host::Ticket t = one.submit(rays);
+  EXPECT_THROW(one.submit(rays), UsageError);  // its one frame is taken
+  one.wait(t, hits);
+  Caster most(blob, "sphere", options(Backend::Cpu, host::kMaxCasterFrames));
+  most.wait(most.submit(rays), hits);
 }
 
 TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
@@ -500,26 +570,6 @@ TEST(Host, AWarmCasterAllocatesNothingAFrame) {
   EXPECT_EQ(scene_lists.hits.size(), lists.hits.size());
 }
 
-// An engine's job system: here every run goes to a thread of its own, and
-// the calls are counted.
-class CountingJobs : public host::JobSystem {
- public:
-  void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
-    runs += 1;
-    threads_.emplace_back([count, &work] {
-      for (uint32_t i = 0; i < count; ++i) work(i);
-    });
-  }
-  uint32_t threads() const override { return 3; }
-  ~CountingJobs() override {
-    for (std::thread& t : threads_) t.join();
-  }
-  std::atomic<int> runs{0};
-
- private:
-  std::vector<std::thread> threads_;
-};
-
 TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
   Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
   std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3SOA4"), "sphere");
@@ -535,6 +585,28 @@ TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
     expect_same(hits, sync_cpu(caster, rays), "on the engine's jobs");
   }
   EXPECT_EQ(jobs.runs.load(), 1);
+}
+
+// An engine's job system whose run() throws (its queue full, say):
+// submit() throws what it threw, as it threw it, and the frame stays free
+// (more failed submissions than frames, then every frame taken).
+TEST(Host, AnEnginesJobSystemThatThrowsFailsTheSubmission) {
+  const Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3SOA4"), "sphere");
+  CountingJobs jobs;
+  CasterOptions o = options(Backend::Cpu, 2);
+  o.jobs = &jobs;
+  Caster caster(blob, "sphere", o);
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 1000, 8);
+  jobs.fail = true;
+  for (int k = 0; k < 3; ++k) EXPECT_THROW(caster.submit(rays), EngineFault);
+  jobs.fail = false;
+  const host::Ticket a = caster.submit(rays), b = caster.submit(rays);
+  for (const host::Ticket& t : {a, b}) {
+    std::vector<Hit> hits(rays.size());
+    caster.wait(t, hits);
+    expect_same(hits, sync_cpu(caster, rays), "after the job system threw");
+  }
 }
 
 // The automatic backend measures the crossover once, writes it to the
@@ -572,11 +644,121 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
     EXPECT_TRUE(caster.records().empty());  // the measurement's batches are not the game's
   }
   ASSERT_TRUE(std::filesystem::exists(profile));
-  Caster again(blob, "sphere", o);
-  EXPECT_TRUE(again.crossover_known());  // loaded in the constructor
-  EXPECT_EQ(again.crossover(), crossover);
-  EXPECT_NE(again.why(1).find("loaded from"), std::string::npos) << again.why(1);
+  {
+    Caster again(blob, "sphere", o);
+    EXPECT_TRUE(again.crossover_known());  // loaded in the constructor
+    EXPECT_EQ(again.crossover(), crossover);
+    EXPECT_NE(again.why(1).find("loaded from"), std::string::npos) << again.why(1);
+  }
+  // The same profile with a crossover of -1 (which an unsigned read takes
+  // for 4294967295, "never"): not used, and why() says so at once.
+  std::ifstream in(profile);
+  std::string magic, key;
+  std::getline(in, magic), std::getline(in, key);
+  in.close();
+  std::ofstream(profile) << magic << "\n" << key << "\n-1\nedited by hand\n";
+  Caster edited(blob, "sphere", o);  // destroyed at once: its measurement stops after one batch
+  EXPECT_NE(edited.why(1).find("line 3 '-1' is not a batch size"), std::string::npos) << edited.why(1);
   std::filesystem::remove(profile);
+}
+
+// A profile file's hostile contents, as the Automatic backend reads them
+// (host/profile.h): none is used, each says why naming the path, and each
+// is written over only when it is a meshcast profile (damaged, of another
+// version, device or blob), never when it is something else (notes, a
+// binary, a folder); a pipe is refused before it is opened (its open
+// would wait for a writer). A good one is read, "never" included.
+TEST(Host, HostileProfilesAreNotUsedAndSayWhy) {
+  const std::string key = "lavapipe | OctTreeCompressed/ClusterBitPackSOA8 | 96 triangles | 12345";
+  const std::string head = "meshcast-profile 1\n" + key + "\n";
+  auto read = [&](const std::string& name, const std::string& bytes) {
+    return host::read_profile(make_file(name, bytes), key);
+  };
+  const host::SavedProfile good = read("good", head + "4096\nmeasured\n");
+  ASSERT_TRUE(good.crossover.has_value()) << good.note;
+  EXPECT_EQ(*good.crossover, 4096u);
+  EXPECT_EQ(good.note, "measured");
+  EXPECT_EQ(read("never", head + "4294967295\nmeasured\n").crossover, std::optional<uint32_t>(~0u));
+  struct Case {
+    std::string name, bytes, words;
+    bool replaceable;
+  };
+  const Case cases[] = {
+      {"negative", head + "-1\nnote\n", "line 3 '-1' is not a batch size (0 to 4294967295)", true},
+      {"nan", head + "nan\nnote\n", "line 3 'nan' is not a batch size", true},
+      {"huge", head + "99999999999999999999\nnote\n", "line 3 '99999999999999999999' is not", true},
+      {"exponent", head + "1e9\nnote\n", "line 3 '1e9' is not", true},
+      {"suffixed", head + "12abc\nnote\n", "line 3 '12abc' is not", true},
+      {"blank", head + "\nnote\n", "line 3 '' is not", true},
+      {"binary", head + std::string("\x01\xff\0", 3) + "\nnote\n", "line 3 '??" "?' is not", true},
+      {"truncated", head, "truncated or damaged (2 lines where a profile has 4)", true},
+      {"cut", head + "4096\nmeas", "truncated (its last line has no end)", true},
+      {"extra", head + "4096\nnote\nmore\n", "truncated or damaged (5 lines", true},
+      {"another_device", "meshcast-profile 1\nanother GPU | x\n64\nnote\n", "another device or blob ('another GPU | x')", true},
+      {"another_version", "meshcast-profile 2\n" + key + "\n64\nnote\n", "another version ('meshcast-profile 2')", true},
+      {"long", head + "4096\n" + std::string(5000, 'x') + "\n", "longer than a profile (over 4096 bytes)", true},
+      {"empty", "", "not a meshcast profile", false},
+      {"notes", "my own notes\n4096\n", "not a meshcast profile", false},
+      {"elf", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10) + std::string(100000, '\0'), "not a meshcast profile", false},
+  };
+  for (const Case& c : cases) {
+    const host::SavedProfile p = read(c.name, c.bytes);
+    EXPECT_FALSE(p.crossover.has_value()) << c.name;
+    EXPECT_NE(p.note.find((scratch_dir() / c.name).string() + ": "), std::string::npos) << c.name << ": " << p.note;
+    EXPECT_NE(p.note.find(c.words), std::string::npos) << c.name << ": " << p.note;
+    EXPECT_EQ(p.replaceable, c.replaceable) << c.name;
+  }
+  const std::string folder = (scratch_dir() / "profile_folder").string(), pipe = (scratch_dir() / "profile_pipe").string();
+  std::filesystem::create_directory(folder);
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  for (auto [path, words] : {std::pair{folder, "is a directory"}, std::pair{pipe, "not a regular file"}}) {
+    const host::SavedProfile p = host::read_profile(path, key);
+    EXPECT_FALSE(p.crossover.has_value()) << path;
+    EXPECT_NE(p.note.find(path + ": " + words), std::string::npos) << p.note;
+    EXPECT_FALSE(p.replaceable) << path;
+  }
+  const host::SavedProfile absent = host::read_profile((scratch_dir() / "no_profile").string(), key);
+  EXPECT_FALSE(absent.crossover.has_value());
+  EXPECT_EQ(absent.note, "");
+  EXPECT_TRUE(absent.replaceable);
+  // What write_profile writes reads back; a folder that is not there is an OutputError naming the path.
+  const std::string written = (scratch_dir() / "written").string();
+  host::write_profile(written, key, 256, "at 256 rays");
+  EXPECT_EQ(host::read_profile(written, key).crossover, std::optional<uint32_t>(256));
+  const std::string nowhere = (scratch_dir() / "no folder" / "profile").string();
+  expect_error<OutputError>([&] { host::write_profile(nowhere, key, 256, "at 256 rays"); }, {nowhere});
+}
+
+// The Automatic backend on profiles it cannot use: a file of notes is
+// measured over and left as it is, a profile in a folder that is not there
+// is measured and not saved, a folder in the profile's place is not used;
+// why() says each, from the start.
+TEST(Host, AutomaticChoiceOnProfilesItCannotUse) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
+  CasterOptions o = options(Backend::Automatic);
+  o.profile = make_file("notes.txt", "my own notes\n");
+  {
+    Caster caster(blob, "sphere", o);
+    ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    EXPECT_NE(caster.why(1).find(o.profile + ": not a meshcast profile"), std::string::npos) << caster.why(1);
+    caster.wait_for_crossover();
+    EXPECT_NE(caster.why(1).find("measured at start-up"), std::string::npos) << caster.why(1);
+    EXPECT_NE(caster.why(1).find("not saved: " + o.profile + " is left as it is"), std::string::npos) << caster.why(1);
+  }
+  std::ifstream notes(o.profile);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(notes), {}), "my own notes\n");
+  o.profile = (scratch_dir() / "no folder" / "profile").string();
+  {
+    Caster caster(blob, "sphere", o);
+    caster.wait_for_crossover();
+    EXPECT_NE(caster.why(1).find("measured at start-up"), std::string::npos) << caster.why(1);
+    EXPECT_NE(caster.why(1).find("not saved: " + o.profile + ": cannot write"), std::string::npos) << caster.why(1);
+  }
+  o.profile = scratch_dir().string();
+  Caster folder(blob, "sphere", o);
+  EXPECT_NE(folder.why(1).find(o.profile + ": is a directory"), std::string::npos) << folder.why(1);
 }
 
 }  // namespace
@@ -592,9 +774,11 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
 // reused under them, were a held snapshot ever taken for a new frame).
 namespace meshcast::testing {
 namespace {
+// `delay`: how long after run() its work starts, unless open() was called.
 class LateJobs : public host::JobSystem {
  public:
-  LateJobs() : thread_([this] { loop(); }) {}
+  explicit LateJobs(std::chrono::milliseconds delay = std::chrono::milliseconds(3))
+      : delay_(delay), thread_([this] { loop(); }) {}
   ~LateJobs() override {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -606,11 +790,19 @@ class LateJobs : public host::JobSystem {
   void run(uint32_t count, const std::function<void(uint32_t)>& work) override {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      queue_.push_back({count, &work, std::chrono::steady_clock::now() + std::chrono::milliseconds(3)});
+      queue_.push_back({count, &work, std::chrono::steady_clock::now() + delay_});
     }
     wake_.notify_all();
   }
   uint32_t threads() const override { return 1; }
+  // Every run from now on starts at once.
+  void open() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      open_ = true;
+    }
+    wake_.notify_all();
+  }
 
  private:
   struct Run {
@@ -625,8 +817,8 @@ class LateJobs : public host::JobSystem {
       if (queue_.empty()) return;
       const Run r = queue_.front();
       queue_.pop_front();
+      wake_.wait_until(lock, r.at, [this] { return open_; });
       lock.unlock();
-      std::this_thread::sleep_until(r.at);
       for (uint32_t i = 0; i < r.count; ++i) (*r.work)(i);
       lock.lock();
     }
@@ -634,7 +826,8 @@ class LateJobs : public host::JobSystem {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<Run> queue_;
-  bool stop_ = false;
+  bool stop_ = false, open_ = false;
+  const std::chrono::milliseconds delay_;
   std::thread thread_;
 };
 
@@ -832,23 +1025,43 @@ TEST(Host, BlobAndSceneBatchesShareTheGpu) {
   }
 }
 
+// Eight balls in a row, in the layout the GPU scene method reads, and 64
+// rays across them with the scene's own answers; and the ball's blob, for
+// blob batches beside the scene's.
+struct BallRow {
+  BallRow() {
+    const MeshId id = scene.add_mesh(blob, "ball");
+    for (int i = 0; i < 8; ++i) {
+      Transform t;
+      t.translation[0] = 3.0 * i;
+      scene.add_instance(id, t);
+    }
+    scene.commit();
+    for (size_t i = 0; i < rays.size(); ++i) rays[i] = {{0.37 * double(i), 0.2, -10}, {0, 0, 1}, INFINITY};
+    scene.trace(rays, want);
+  }
+  // A batch's hits are the scene's own (the instance and t: the GPU may
+  // name the other of two triangles met at one t).
+  void expect_answered(const std::vector<SceneHit>& got, const std::string& what) const {
+    for (size_t i = 0; i < rays.size(); ++i) {
+      EXPECT_EQ(got[i].instance, want[i].instance) << what << ", ray " << i;
+      EXPECT_EQ(got[i].t, want[i].t) << what << ", ray " << i;
+    }
+  }
+  Mesh ball = make_sphere(8, 12, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(ball, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball");
+  Scene scene;
+  std::vector<RayD> rays = std::vector<RayD>(64);
+  std::vector<SceneHit> want = std::vector<SceneHit>(64);
+};
+
 // A scene batch the GPU refuses (an injected limit) is the CPU's and the
 // GPU stays; after a lost device every scene batch is the CPU's. Each
 // answers as the scene's own walk.
 TEST(Host, SceneBatchesLeaveARefusingOrLostGpuForTheCpu) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
-  Scene scene;
-  const MeshId ball = scene.add_mesh(build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball"), "ball");
-  for (int i = 0; i < 8; ++i) {
-    Transform t;
-    t.translation[0] = 3.0 * i;
-    scene.add_instance(ball, t);
-  }
-  scene.commit();
-  std::vector<RayD> rays(64);
-  for (size_t i = 0; i < rays.size(); ++i) rays[i] = {{0.37 * double(i), 0.2, -10}, {0, 0, 1}, INFINITY};
-  std::vector<SceneHit> want(rays.size()), got(rays.size());
-  scene.trace(rays, want);
+  const BallRow row;
+  std::vector<SceneHit> got(row.rays.size());
   int submission = 0;
   CasterOptions o = options(Backend::Vulkan);
   o.before_gpu_submit = [&submission] {
@@ -858,14 +1071,173 @@ TEST(Host, SceneBatchesLeaveARefusingOrLostGpuForTheCpu) {
   };
   Caster caster(o);
   const Backend expected[] = {Backend::Vulkan, Backend::Cpu, Backend::Vulkan, Backend::Cpu, Backend::Cpu};
+  ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
   for (Backend b : expected) {
-    EXPECT_EQ(caster.wait(caster.submit(scene, rays), got).ran_on, b);
-    for (size_t i = 0; i < rays.size(); ++i) {
-      EXPECT_EQ(got[i].instance, want[i].instance) << "ray " << i;
-      EXPECT_EQ(got[i].t, want[i].t) << "ray " << i;
-    }
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, b);
+    row.expect_answered(got, host::backend_name(b));
   }
+  EXPECT_FALSE(caster.gpu_available());
   EXPECT_NE(caster.gpu_error().find("device lost"), std::string::npos) << caster.gpu_error();
+}
+
+// The device lost at the second scene batch's submission, with blob and
+// scene batches in flight behind it: the batches before it stay the GPU's;
+// that one and every later one, scene or blob, are the CPU's, answered as
+// the CPU answers them; gpu_available() turns false and gpu_error() says
+// why. A caster of scene batches alone says its GPU is available (and its
+// error empty) until then, as a blob's does.
+TEST(Host, ADeviceLostAmidSceneBatchesLeavesTheRestToTheCpu) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const BallRow row;
+  const std::vector<Ray> rays = make_rays(row.ball, RayKind::Long, 300, 6);
+  const std::thread::id game = std::this_thread::get_id();
+  for (bool with_blob : {false, true}) {
+    int scene_submissions = 0;  // the GPU thread's, which submits the scene batches
+    CasterOptions o = options(Backend::Vulkan, 8);
+    o.before_gpu_submit = [&] {
+      if (std::this_thread::get_id() != game && ++scene_submissions == 2)
+        throw GpuError("Vulkan: vkQueueSubmit failed (VK_ERROR_DEVICE_LOST, injected by the test)", true);
+    };
+    const std::unique_ptr<Caster> made = with_blob ? std::make_unique<Caster>(row.blob, "ball", o) : std::make_unique<Caster>(o);
+    Caster& caster = *made;
+    ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
+    EXPECT_EQ(caster.gpu_error(), "");
+    // In flight at once: blob batch 0, scene batch 0, blob 1, scene 1 (its
+    // submission loses the device), blob 2, scene 2. Blob batch 1 was
+    // begun before scene batch 1 was submitted; blob 2 may have been too,
+    // and is answered after the loss.
+    struct Batch {
+      host::Ticket ticket;
+      bool scene;
+      Backend expected;
+    };
+    std::vector<Batch> batches;
+    for (int k = 0; k < 3; ++k) {
+      if (with_blob) batches.push_back({caster.submit(rays), false, k < 2 ? Backend::Vulkan : Backend::Cpu});
+      batches.push_back({caster.submit(row.scene, row.rays), true, k < 1 ? Backend::Vulkan : Backend::Cpu});
+    }
+    for (const Batch& b : batches) {
+      const std::string what = std::string(b.scene ? "scene" : "blob") + " batch " + std::to_string(b.ticket.id);
+      if (b.scene) {
+        std::vector<SceneHit> got(row.rays.size());
+        EXPECT_EQ(caster.wait(b.ticket, got).ran_on, b.expected) << what;
+        row.expect_answered(got, what);
+      } else {
+        std::vector<Hit> got(rays.size());
+        EXPECT_EQ(caster.wait(b.ticket, got).ran_on, b.expected) << what;
+        expect_same(got, sync_cpu(caster, rays), what);
+      }
+    }
+    EXPECT_FALSE(caster.gpu_available());
+    EXPECT_NE(caster.gpu_error().find("VK_ERROR_DEVICE_LOST"), std::string::npos) << caster.gpu_error();
+    // Then one of each, the CPU's from their submission.
+    std::vector<SceneHit> got(row.rays.size());
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, Backend::Cpu);
+    row.expect_answered(got, "a scene batch after the loss");
+    if (with_blob) {
+      std::vector<Hit> hits(rays.size());
+      EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
+      expect_same(hits, sync_cpu(caster, rays), "a blob batch after the loss");
+    }
+    EXPECT_EQ(scene_submissions, 2);  // none after the loss
+    EXPECT_EQ(caster.validation_messages(), 0u);
+  }
+}
+
+// An engine's job system that throws on the caster's own threads, where
+// no caller is there to take the exception: a scene batch the GPU refuses
+// (an injected limit), moved to the CPU while run() throws, is collected by
+// rethrowing what it threw, and the caster goes on; the Automatic
+// backend's measurement stops and why() says so. Nothing terminates.
+TEST(Host, AnEnginesJobSystemThatThrowsOnTheCastersThreads) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const BallRow row;
+  std::vector<SceneHit> got(row.rays.size());
+  CountingJobs jobs;
+  int submission = 0;
+  CasterOptions o = options(Backend::Vulkan);
+  o.jobs = &jobs;
+  o.before_gpu_submit = [&submission] {
+    if (++submission == 2) throw GpuError("Vulkan: the scene's buffers exceed a limit (injected by the test)");
+  };
+  {
+    Caster caster(o);
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, Backend::Vulkan);
+    jobs.fail = true;
+    const host::Ticket refused = caster.submit(row.scene, row.rays);
+    EXPECT_THROW(caster.wait(refused, got), EngineFault);
+    EXPECT_THROW(caster.wait(refused, got), UsageError);  // collected
+    jobs.fail = false;
+    EXPECT_EQ(caster.wait(caster.submit(row.scene, row.rays), got).ran_on, Backend::Vulkan);
+    row.expect_answered(got, "after the job system threw");
+    EXPECT_TRUE(caster.gpu_available());
+  }
+  CasterOptions a = options(Backend::Automatic);
+  a.jobs = &jobs;
+  jobs.fail = true;
+  Caster automatic(row.blob, "ball", a);
+  automatic.wait_for_crossover();
+  EXPECT_EQ(automatic.choose(1u << 20), Backend::Cpu);
+  EXPECT_NE(automatic.why(1u << 20).find("not measured: the job system threw"), std::string::npos) << automatic.why(1u << 20);
+  jobs.fail = false;
+}
+
+// Whether thread `tid` of this process is asleep (blocked on a lock or a
+// condition variable), as /proc/self/task says: how a test knows that
+// another thread is inside a blocking call.
+bool asleep(pid_t tid) {
+  std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
+  const std::string line((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const size_t name_end = line.rfind(')');  // "tid (name) state ...": the name may hold anything
+  return name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] == 'S';
+}
+
+// A caster destroyed while another thread is blocked in wait(): that
+// thread gets UsageError naming its ticket, and the destructor waits for
+// the batch still running and for that thread to leave (nothing freed
+// under it: this suite runs under ThreadSanitizer, and the CPU host layer
+// under AddressSanitizer). The batch runs only once the waiter has thrown.
+TEST(Host, DestroyingACasterWhileAThreadWaitsThrowsThere) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 200, 4);
+  LateJobs late(std::chrono::seconds(10));  // a bound, should the waiter never throw
+  CasterOptions o = options(Backend::Cpu);
+  o.jobs = &late;
+  auto caster = std::make_unique<Caster>(blob, "sphere", o);
+  Caster* const shared = caster.get();
+  const host::Ticket t = caster->submit(rays);
+  std::atomic<pid_t> tid{0};
+  std::string error;
+  bool returned = false;
+  std::thread waiter([&, shared] {
+    tid = pid_t(::syscall(SYS_gettid));
+    std::vector<Hit> hits(rays.size());
+    try {
+      shared->wait(t, hits);
+      returned = true;
+    } catch (const UsageError& e) {
+      error = e.what();
+    }
+    late.open();
+  });
+  // Blocked in wait(): asleep 50 ms on end (its batch cannot be ready yet).
+  int asleep_for = 0;
+  for (int k = 0; k < 2000 && asleep_for < 10; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    asleep_for = tid != 0 && asleep(tid) ? asleep_for + 1 : 0;
+  }
+  if (asleep_for < 10) {
+    late.open();
+    waiter.join();
+    FAIL() << "the waiting thread never blocked";
+  }
+  caster.reset();
+  waiter.join();
+  EXPECT_FALSE(returned);
+  EXPECT_NE(error.find("ticket " + std::to_string(t.id) + " was not collected: the caster was destroyed while waiting"),
+            std::string::npos)
+      << error;
 }
 }  // namespace
 }  // namespace meshcast::testing

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -166,6 +167,31 @@ TEST(Hostile, DirectoriesAndDevicesAreRefusedBeforeReading) {
     expect_throws<InputError>([&] { read_mesh("/dev/zero"); }, {"/dev/zero", "not a regular file"});
     expect_throws<InputError>([&] { read_file("/dev/zero"); }, {"/dev/zero", "not a regular file"});
   }
+}
+
+// A blob must start at a 4-byte aligned address (blob.h): one copied to an
+// odd offset inside a buffer of one's own (a pack file) is refused with an
+// InputError naming its address and how far off it is, never read
+// misaligned; at a multiple of 4 in the same buffer it is walked.
+TEST(Hostile, AMisalignedBlobIsRefusedNamingItsAddress) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  std::vector<uint32_t> words(blob.size() / 4 + 2);  // 4-byte aligned storage
+  uint8_t* const base = reinterpret_cast<uint8_t*>(words.data());
+  for (size_t offset : {1, 2, 3}) {
+    std::copy(blob.begin(), blob.end(), base + offset);
+    const std::span<const uint8_t> bytes(base + offset, blob.size());
+    char address[32];
+    std::snprintf(address, sizeof address, "0x%jx", uintmax_t(reinterpret_cast<uintptr_t>(bytes.data())));
+    expect_throws<InputError>([&] { BlobView(bytes, "pack.dat at " + std::to_string(offset)); },
+                              {"pack.dat at " + std::to_string(offset), std::string("blob bytes at ") + address,
+                               "not 4-byte aligned (address % 4 = " + std::to_string(offset) + ")"});
+  }
+  std::copy(blob.begin(), blob.end(), base + 4);
+  const BlobView view(std::span<const uint8_t>(base + 4, blob.size()), "pack.dat at 4");
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 100, 1);
+  EXPECT_EQ(trace_all(view, rays).size(), rays.size());
+  expect_oracle(m, blob, rays, trace_all(view, rays), "the blob at offset 4");
 }
 
 // Found by the mesh fuzzer: Assimp reads an OBJ face's texture and normal

@@ -6,8 +6,9 @@
 //   view.trace(rays, hits);                                 // this thread
 //
 // A BlobView does not copy the bytes: they must outlive it and stay
-// unchanged. It is only ever read, so any number of threads may trace
-// through one view at once.
+// unchanged, and they must start at a 4-byte aligned address (as a
+// std::vector<uint8_t>, load_blob and MappedBlob give them). It is only
+// ever read, so any number of threads may trace through one view at once.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -26,7 +27,10 @@ class BlobView {
  public:
   // Proves every offset and index of the blob in range (the header, its
   // checksum, every section) before any walk; InputError naming `name` and
-  // what is wrong.
+  // what is wrong. The bytes must start at a 4-byte aligned address (the
+  // walkers read the header's and the sections' 32-bit words in place): a
+  // blob copied to an odd offset inside a buffer of one's own is refused
+  // with InputError naming the address, never read misaligned.
   BlobView(std::span<const uint8_t> bytes, const std::string& name);
 
   // The closest hit of each ray (or with Query::Any, any hit), written to

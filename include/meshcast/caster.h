@@ -128,9 +128,20 @@ struct VulkanObjects {
   void* get_instance_proc_addr = nullptr;
 };
 
+// The most frames and worker threads a caster takes: each frame holds
+// buffers, and on the GPU a fence and a command buffer, for as long as the
+// caster lives; more than these is a mistake, not a need.
+constexpr uint32_t kMaxCasterFrames = 1024;
+constexpr uint32_t kMaxCasterThreads = 1024;
+
+// The caster refuses an option out of range (UsageError naming it and its
+// range) rather than bending it: a backend outside the enum, frames outside
+// 1..kMaxCasterFrames, threads beyond kMaxCasterThreads, hit_outputs with
+// bits other than HitOutputs::Uv and HitOutputs::Point, a job system whose
+// threads() is 0.
 struct CasterOptions {
   Backend backend = Backend::Automatic;
-  uint32_t frames = 4;          // batches in flight at most
+  uint32_t frames = 4;          // batches in flight at most (1..kMaxCasterFrames)
   uint32_t threads = 0;         // CPU workers (0: every core), unless `jobs` is given
   JobSystem* jobs = nullptr;    // an engine's job system (not owned) instead of meshcast's pool
   std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
@@ -138,7 +149,14 @@ struct CasterOptions {
   std::string gpu_method;       // "" : the one that reads the blob's layout
   bool validation = false;      // Vulkan validation layers
   HitOutputs hit_outputs = HitOutputs::None;  // what each hit carries besides t and the triangle, either backend
-  std::string profile;          // file with a saved crossover; measured and written when absent
+  // A file with a saved crossover (the Automatic backend): read when it
+  // holds one for this device and blob, else measured and written to it.
+  // A file that is not a usable profile (not one, damaged, another
+  // device's) is measured over, and why() says why; it is written over
+  // only when it is a meshcast profile, so a path named by mistake is
+  // left as it is. A profile that cannot be written leaves the crossover
+  // measured and why() saying so.
+  std::string profile;
   // Test hook: called before every GPU submission (on the submitting
   // thread: the caller's, or the caster's GPU thread for scene batches);
   // throwing GpuError there refuses the batch, or with `lost` set acts as
@@ -148,22 +166,29 @@ struct CasterOptions {
 
 class Caster {
  public:
-  // Validates the blob (InputError naming `name`); the caster reads the
-  // caller's bytes, which must outlive it. With Backend::Vulkan or
-  // Automatic, a device that is missing or fails leaves the caster on the
-  // CPU, and gpu_error() says why.
+  // Validates the blob as BlobView does (InputError naming `name`; the
+  // bytes 4-byte aligned); the caster reads the caller's bytes, which must
+  // outlive it. UsageError for an option out of range (CasterOptions).
+  // With Backend::Vulkan or Automatic, a device that is missing or fails
+  // leaves the caster on the CPU, and gpu_error() says why.
   Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options = {});
   // A caster of scene batches alone: no blob; the CPU's workers, or with
   // Backend::Vulkan the GPU as above (a missing device leaves the CPU and
   // gpu_error() says why). Its blob calls throw UsageError.
   explicit Caster(CasterOptions options);
+  // Waits for the batches still running (their jobs and fences), so none
+  // outlives the caster. A thread blocked in wait() or wait_for_crossover()
+  // when destruction begins gets UsageError (its batch is not collected)
+  // and the destructor waits for it to leave; no other call may overlap
+  // the destructor (a submit() that does gets UsageError at best).
   ~Caster();
   Caster(const Caster&) = delete;
   Caster& operator=(const Caster&) = delete;
 
   // Copies the rays and starts the batch; returns at once. Throws
   // UsageError when all `frames` slots hold uncollected batches, or for a
-  // query out of range.
+  // query out of range; what an engine's JobSystem::run() throws, as it
+  // threw it (the slot stays free).
   Ticket submit(std::span<const Ray> rays, BatchQuery query = {});
   // A scene batch (see above): the scene's last commit, taken now; call it
   // from the thread that edits and commits the scene. The rays are copied.
@@ -180,7 +205,10 @@ class Caster {
   bool poll(const Ticket& t);
   // Blocks until ready, copies the hits into `hits` (at least the batch's
   // size, else UsageError) and frees the slot; returns that batch's record.
-  // UsageError for a Query::All batch (its rows: the overload below).
+  // UsageError for a Query::All batch (its rows: the overload below). A
+  // batch the caster moved from the GPU to the CPU after submit() returned
+  // (a refused scene batch, a lost device) whose JobSystem::run() threw is
+  // collected by rethrowing what it threw.
   BatchRecord wait(const Ticket& t, std::span<Hit> hits);
   // A Query::All batch's rows into `lists`: compact rows (meshcast/ray.h),
   // cleared first, their capacity kept; the CPU's jobs' rows are copied
@@ -205,7 +233,16 @@ class Caster {
   uint32_t crossover() const { return crossover_.load(); }
   bool crossover_known() const { return crossover_known_.load(); }
   void wait_for_crossover();
-  bool gpu_available() const { return method_ != nullptr && !gpu_failed_.load(); }
+  // Whether batches may go to the GPU now: its device was made (the
+  // Vulkan or Automatic backend; for a caster of scene batches alone,
+  // Vulkan) and has not failed since. Blob batches then go where choose()
+  // says, scene batches the GPU scene method reads to the device.
+  bool gpu_available() const { return gpu_ != nullptr && !gpu_failed_.load(); }
+  // Why the GPU is not available although the caster asked for one: the
+  // device, or the method for the blob's layout, could not be made, or the
+  // device was lost (a failed submission, fence or read-back), after which
+  // every batch is the CPU's. "" while it is available, and for
+  // Backend::Cpu (and a caster of scene batches alone on Automatic).
   std::string gpu_error() const;
   std::string device_name() const;
   // Messages from the Vulkan validation layers so far (options.validation).
@@ -240,9 +277,17 @@ class Caster {
   // UsageError for a batch the GPU scene method refuses).
   void run_scene_on_gpu(Slot& s);
   void complete(Slot& s, Backend ran_on);
+  // start_cpu() for a batch the GPU thread moves to the CPU: what the job
+  // system throws is kept in the slot for wait(), as no caller is there.
+  void cpu_instead(Slot& s);
   void gpu_completions();
   void gpu_failed(const std::string& why);
   bool load_crossover();     // from options.profile; false when it holds none for this device and blob
+  // Why options.profile was not used (host/profile.h), and whether a
+  // measured crossover may be written over it; set by load_crossover().
+  std::string profile_unused_;
+  bool profile_replaceable_ = true;
+  std::string unused_profile() const;  // " (the profile was not used: ...)" for the notes, or ""
   void measure_crossover();  // on the measurement's slot; the background thread's work
 
   // The caller's blob, which must outlive the caster (none for a caster of
@@ -250,11 +295,17 @@ class Caster {
   std::optional<BlobView> view_;
   const BlobView& blob(const char* who) const;
   void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
-  Slot& take_slot();  // a free game slot, Running; UsageError when none
+  Slot& take_slot();  // a free game slot, Running; UsageError when none, or while the caster closes
   // A taken slot's batch of n rays under s.query: the clock started, room
   // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
   void size_slot(Slot& s, size_t n, bool scene);
   void free_slot(Slot& s);  // what started the batch threw: nothing runs
+  void free_locked(Slot& s);  // free_slot() under mutex_
+  // Waits on changed_ under `lock` (mutex_) until ready() or the caster
+  // closes; counted in blocked_, which the destructor waits to be 0.
+  // Returns ready(): false when the caster closed first.
+  template <class Ready>
+  bool block(std::unique_lock<std::mutex>& lock, Ready ready);
   // The first half of collecting: checks that the caller collects the
   // batch into what it asked for (scene hits or not, rows or not, `room`
   // hits), waits for it and marks it Collecting; release() frees the slot.
@@ -282,7 +333,9 @@ class Caster {
   std::mutex gpu_mutex_;                // the GPU method's begin and finish
   std::mutex jobs_mutex_;               // one JobSystem::run at a time (game thread, measurement, completions)
   std::atomic<uint32_t> calls_in_work_{0};  // jobs still inside a slot's work, even after it completed
-  std::condition_variable changed_;     // a slot became ready
+  std::condition_variable changed_;     // a slot became ready or free, the crossover known, the caster closing
+  bool closing_ = false;                // under mutex_: the destructor has begun
+  uint32_t blocked_ = 0;                // under mutex_: threads in block()
   std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
   uint32_t game_slots_ = 0;
   uint64_t next_id_ = 1;

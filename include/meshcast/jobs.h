@@ -13,6 +13,14 @@ namespace meshcast::host {
 // The caster never calls run() from two threads at once (it serializes its
 // own calls), so an implementation need not be thread-safe against itself;
 // it is called from the game's thread and from the caster's own threads.
+//
+// run() may throw (an engine's queue that is full or shutting down): it
+// must then have queued none of the calls. The caster passes the exception
+// on as it was thrown: submit() throws it, wait() rethrows it for a batch
+// the caster's GPU thread moved to the CPU, and the Automatic backend's
+// measurement stops (why() says so). run() must call every work(i) it
+// accepted: the caster waits for them all (wait(), its destructor).
+// threads() must be at least 1 (the caster refuses 0).
 class JobSystem {
  public:
   virtual ~JobSystem() = default;

@@ -20,7 +20,7 @@
 #include "builder/layout_names.h"
 #include "builder/pairing.h"
 #include "layout/aabbtree.h"
-#include "layout/number_text.h"
+#include "layout/message_text.h"
 #include "layout/codecs.h"
 #include "layout/quadtree.h"
 #include "builder/writer.h"
@@ -256,8 +256,8 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
     if (grid && extent > 0 && !(h.quant_scale[a] >= FLT_MIN))
       throw InputError(name + ": the mesh spans " + number_text(extent) + " on axis " + "xyz"[a] + ", less than the " +
                        number_text(least_grid_extent(codec)) + " that " +
-                       std::string(layout::triangle_format_name(h.triangle_format)) + "'s grid of 2^" +
-                       std::to_string(codec.grid_bits) + " steps needs (a step below 2^-126, the least normal float, "
+                       std::string(layout::triangle_format_name(h.triangle_format)) + "'s grid of " +
+                       std::to_string(codec.grid_bits) + "-bit codes needs (a step below 2^-126, the least normal float, "
                        "would round vertices coarser than stated); build it in a float format (Float3) or scale it up");
   }
   std::vector<uint64_t> packed(grid ? mesh.vertices.size() : 0);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -189,7 +188,9 @@ HitLists read_fixed_rows(const std::string& path, const std::vector<uint8_t>& b,
 HitLists read_hit_lists(const std::string& path) {
   std::vector<uint8_t> b = read_file(path);
   const bool compact = b.size() >= 4 && std::memcmp(b.data(), "HITC", 4) == 0;
-  check_magic(path, b, compact ? "HITC" : "HITN", 12);
+  // Named HITC unless it is a HITN file: HITC is what meshcast writes.
+  const bool fixed = b.size() >= 4 && std::memcmp(b.data(), "HITN", 4) == 0;
+  check_magic(path, b, fixed ? "HITN" : "HITC", 12);
   uint32_t n, width;
   std::memcpy(&n, b.data() + 4, 4), std::memcpy(&width, b.data() + 8, 4);
   if (width < 1 || width > kMaxHitsLimit)

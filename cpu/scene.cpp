@@ -10,7 +10,7 @@
 #include "cpu/scene.h"
 #include "cpu/walk_table.h"
 #include "layout/blob_format.h"
-#include "layout/number_text.h"
+#include "layout/message_text.h"
 #include "meshcast/errors.h"
 
 namespace meshcast {

@@ -68,7 +68,7 @@ inline void finish_hits(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
     if (hit.triangle == kNoHit) continue;
     hit.triangle = layout::remap_entry(blob, h, hit.triangle);
     if (outputs & MC_HIT_POINT)
-      for (int a = 0; a < 3; ++a) hit.point[a] = rays[i].org[a] + hit.t * rays[i].dir[a];
+      for (int a = 0; a < 3; ++a) hit.point[a] = rays[i].org[a] + hit.t * walked_direction(rays[i].dir[a]);  // as the GPU
   }
 }
 
@@ -81,7 +81,7 @@ inline void finish_list(const uint8_t* blob, const Ray& ray, Hit* row, uint32_t 
     row[k].triangle = layout::remap_entry(blob, h, row[k].triangle);
     if (!(outputs & MC_HIT_UV)) row[k].u = row[k].v = 0;  // the double redo sets them unasked
     if (outputs & MC_HIT_POINT)
-      for (int a = 0; a < 3; ++a) row[k].point[a] = ray.org[a] + row[k].t * ray.dir[a];
+      for (int a = 0; a < 3; ++a) row[k].point[a] = ray.org[a] + row[k].t * walked_direction(ray.dir[a]);
   }
   std::sort(row, row + used, [](const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.triangle < b.triangle); });
 }

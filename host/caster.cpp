@@ -140,24 +140,32 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
       const uint32_t first = job * sp->chunk, count = std::min(sp->chunk, sp->n - first);
       const std::span<const Ray> rays = sp->scene ? std::span<const Ray>() : std::span<const Ray>(sp->rays).subspan(first, count);
       const BatchQuery& q = sp->query;
-      if (sp->scene) {  // scene hits carry u, v at most
-        const SceneBatchQuery& sq = sp->scene_query;
-        const HitOutputs outputs = HitOutputs(uint32_t(options_.hit_outputs) & uint32_t(HitOutputs::Uv));
-        const std::span<const RayD> world = std::span<const RayD>(sp->world).subspan(first, count);
-        if (sq.query == Query::All) {
-          SceneHitLists& rows = sp->job_scene_rows[job];
-          rows.max_hits = sq.max_hits;
-          trace_all_hits_snapshot(*sp->scene, world, rows, outputs, sq.cull, sq.mask);
+      // What a walk throws (std::bad_alloc growing the rows of every hit)
+      // is the batch's answer, rethrown by wait(): leaving a worker it
+      // would end the process, or leave jobs_left short and wait() hung.
+      try {
+        if (sp->scene) {  // scene hits carry u, v at most
+          const SceneBatchQuery& sq = sp->scene_query;
+          const HitOutputs outputs = HitOutputs(uint32_t(options_.hit_outputs) & uint32_t(HitOutputs::Uv));
+          const std::span<const RayD> world = std::span<const RayD>(sp->world).subspan(first, count);
+          if (sq.query == Query::All) {
+            SceneHitLists& rows = sp->job_scene_rows[job];
+            rows.max_hits = sq.max_hits;
+            trace_all_hits_snapshot(*sp->scene, world, rows, outputs, sq.cull, sq.mask);
+          } else {
+            trace_snapshot(*sp->scene, world, std::span<SceneHit>(sp->scene_hits).subspan(first, count), outputs, sq.query,
+                           sq.cull, sq.mask);
+          }
+        } else if (q.query == Query::All) {
+          HitLists& rows = sp->job_rows[job];
+          rows.max_hits = q.max_hits;
+          view_->trace_all_hits(rays, rows, options_.hit_outputs, q.cull);
         } else {
-          trace_snapshot(*sp->scene, world, std::span<SceneHit>(sp->scene_hits).subspan(first, count), outputs, sq.query,
-                         sq.cull, sq.mask);
+          view_->trace(rays, std::span<Hit>(sp->hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
         }
-      } else if (q.query == Query::All) {
-        HitLists& rows = sp->job_rows[job];
-        rows.max_hits = q.max_hits;
-        view_->trace_all_hits(rays, rows, options_.hit_outputs, q.cull);
-      } else {
-        view_->trace(rays, std::span<Hit>(sp->hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!sp->error) sp->error = std::current_exception();
       }
       sp->cpu_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count();
       if (sp->jobs_left.fetch_sub(1) == 1) complete(*sp, Backend::Cpu);
@@ -650,13 +658,29 @@ static void concatenate(HitRows<Record>& lists, uint32_t max_hits, const std::ve
 BatchRecord Caster::wait(const Ticket& t, SceneHitLists& lists) {
   Slot& s = slot_of(t);
   const BatchRecord r = claim(s, t, true, true, 0);
-  concatenate(lists, s.scene_query.max_hits, s.job_scene_rows);
+  try {
+    concatenate(lists, s.scene_query.max_hits, s.job_scene_rows);
+  } catch (...) {  // std::bad_alloc: the slot is let go, not left Collecting (the destructor waits on it)
+    free_slot(s);
+    throw;
+  }
   release(s, r, true);
   return r;
 }
 
 BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record) {
   BatchRecord r = claim(s, t, false, lists != nullptr, hits.size());
+  try {
+    copy_out(s, r, hits, lists);
+  } catch (...) {  // std::bad_alloc: the slot is let go, not left Collecting (the destructor waits on it)
+    free_slot(s);
+    throw;
+  }
+  release(s, r, record);
+  return r;
+}
+
+void Caster::copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists) {
   bool copied = false;
   if (r.ran_on == Backend::Vulkan) {
     try {
@@ -682,8 +706,6 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLi
   } else if (!copied && s.n) {
     std::memcpy(hits.data(), s.hits.data(), s.n * sizeof(Hit));
   }
-  release(s, r, record);
-  return r;
 }
 
 void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {

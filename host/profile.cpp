@@ -1,5 +1,7 @@
 #include "host/profile.h"
 
+#include "layout/message_text.h"
+
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -20,13 +22,8 @@ constexpr std::string_view kAnyVersion = "meshcast-profile ";
 // read whole (a profile path given a blob by mistake).
 constexpr size_t kMaxProfileBytes = 4096;
 
-// A line of the file as an error quotes it: at most 40 bytes, anything
-// unprintable as '?'.
-std::string quoted(std::string_view line) {
-  std::string q = "'";
-  for (char c : line.substr(0, 40)) q += (c >= 0x20 && c < 0x7f) ? c : '?';
-  return q + (line.size() > 40 ? "...'" : "'");
-}
+// A line of the file as an error quotes it (message_text.h).
+std::string quoted(std::string_view line) { return "'" + shown_text(line, 40) + "'"; }
 
 }  // namespace
 

@@ -690,7 +690,7 @@ TEST(Host, HostileProfilesAreNotUsedAndSayWhy) {
       {"exponent", head + "1e9\nnote\n", "line 3 '1e9' is not", true},
       {"suffixed", head + "12abc\nnote\n", "line 3 '12abc' is not", true},
       {"blank", head + "\nnote\n", "line 3 '' is not", true},
-      {"binary", head + std::string("\x01\xff\0", 3) + "\nnote\n", "line 3 '??" "?' is not", true},
+      {"binary", head + std::string("\x01\xff\0", 3) + "\nnote\n", "line 3 '\\x01\\xFF\\x00' is not", true},
       {"truncated", head, "truncated or damaged (2 lines where a profile has 4)", true},
       {"cut", head + "4096\nmeas", "truncated (its last line has no end)", true},
       {"extra", head + "4096\nnote\nmore\n", "truncated or damaged (5 lines", true},

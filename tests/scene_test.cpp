@@ -18,7 +18,7 @@
 #include "builder/error_bounds.h"
 #include "check/generate.h"
 #include "check/scene_oracle.h"
-#include "layout/number_text.h"
+#include "layout/message_text.h"
 #include "meshcast/scene.h"
 #include "tests/testing.h"
 #ifdef MESHCAST_TEST_GPU
@@ -567,6 +567,37 @@ TEST(Scene, SmallInstancesFarOutKeepTheirHits) {
         EXPECT_GT(hits, rays.size() * 9 / 10) << what;
       }
     }
+  }
+}
+
+// A direction component below FLT_MIN is read as 0 (walked_direction)
+// on every path of a scene ray, by the oracle too. Rays along z through a
+// grid in the plane z = 0 whose y, 2e-39 a unit of t, would carry them
+// from just off the grid's edge y = 0 onto it by t = 5: read as 0, those
+// from y = -1e-41 miss and those from y = +1e-41 hit, everywhere alike.
+// (Its reciprocal overflowed to infinity, and the walkers culled what the
+// oracle, in double, hit.)
+TEST(Scene, DenormalDirectionComponentsAreReadAsZero) {
+  for (const std::string& layout : walked_layouts()) {
+    Level level;
+    level.meshes.push_back(make_grid_plane(16, 16));
+    level.blobs.push_back(build_blob(level.meshes[0], parse_layout(layout), "grid"));
+    if (moves_vertices(uint32_t(parse_layout(layout).layout.triangles))) level.meshes[0] = stored_mesh(level.blobs[0]);
+    level.instances.push_back({0, 0, Transform{}, 0xFF});
+    level.enabled.push_back(true);
+    const Scene scene = make_scene(level);
+    const SceneOracle oracle = oracle_of(level);
+    std::vector<RayD> rays;
+    for (int i = 0; i < 64; ++i) {
+      const double side = i % 2 ? 1e-41 : -1e-41;
+      rays.push_back({{0.5 + 0.23 * i, side, -5}, {0, i % 4 < 2 ? 2e-39f : -2e-39f, 1}, INFINITY});
+    }
+    const std::vector<SceneHit> hits = trace(scene, rays);
+    size_t wrong = 0;
+    for (size_t i = 0; i < rays.size(); ++i) wrong += (hits[i].instance == 0) != (rays[i].org[1] > 0);
+    EXPECT_EQ(wrong, 0u) << layout;
+    const Judged j = judge(oracle, rays, hits, Cull::None, 0xFF, false);
+    EXPECT_EQ(j.wrong, 0u) << layout << ": " << j.first_problem;
   }
 }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "builder/auto_layout.h"
+#include "layout/message_text.h"
 #include "check/ray_files.h"
 #include "gpu/method.h"
 #include "meshcast/blob.h"
@@ -62,11 +63,10 @@ CLI::Validator integer_in(uint64_t lo, uint64_t hi) {
   const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
   return CLI::Validator(
       [lo, hi, range](std::string& text) -> std::string {
-        const bool digits = !text.empty() && text.size() <= 19 &&
-                            std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
-        if (!digits) return "\"" + text + "\" is not an integer (" + range + ")";
-        const uint64_t value = std::stoull(text);
-        if (value < lo || value > hi) return text + " is not in " + range;
+        const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+        if (!digits) return "\"" + shown_text(text) + "\" is not an integer (" + range + ")";
+        // Past 19 digits a number is past 64 bits, and past any range here.
+        if (text.size() > 19 || std::stoull(text) < lo || std::stoull(text) > hi) return shown_text(text) + " is not in " + range;
         return {};
       },
       "INT in " + range);

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "layout/number_text.h"
+#include "layout/message_text.h"
 #include "meshcast/errors.h"
 #include "tools/common.h"
 
@@ -18,31 +18,11 @@ namespace {
 
 using nlohmann::json;
 
-// Text from the file as a message shows it: control characters (a NUL
-// would end the message where a C string is printed) as \xNN, and at most
-// 64 bytes of it, the length said beside (a 5 MB key is not echoed whole).
-std::string shown(const std::string& text) {
-  constexpr size_t kShown = 64;
-  std::string out;
-  for (size_t i = 0; i < std::min(text.size(), kShown); ++i) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c < 0x20 || c == 0x7F) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", c);
-      out += escaped;
-    } else {
-      out += char(c);
-    }
-  }
-  if (text.size() > kShown) out += "... (" + std::to_string(text.size()) + " bytes)";
-  return out;
-}
-
 // What a JSON value is, for a message: its type, a number or a string
 // shown short; never the value dumped whole (a nested array 100,000 deep
 // would take the serializer's recursion past the stack).
 std::string described(const json& value) {
-  if (value.is_string()) return "the string \"" + shown(value.get<std::string>()) + "\"";
+  if (value.is_string()) return "the string \"" + shown_text(value.get<std::string>()) + "\"";
   if (value.is_number()) return "the number " + number_text(value.get<double>());
   if (value.is_array()) return "an array of " + std::to_string(value.size());
   if (value.is_object()) return "an object";
@@ -70,13 +50,14 @@ json parse_refusing_duplicates(std::istream& in, const std::string& path) {
     if (event == json::parse_event_t::object_start) keys.emplace_back();
     if (event == json::parse_event_t::object_end) keys.pop_back();
     if (event == json::parse_event_t::key && !keys.back().insert(parsed.get<std::string>()).second)
-      throw InputError(path + ": the key \"" + shown(parsed.get<std::string>()) + "\" appears twice in one object");
+      throw InputError(path + ": the key \"" + shown_text(parsed.get<std::string>()) + "\" appears twice in one object");
     return true;
   };
   try {
     return json::parse(in, callback);
   } catch (const json::exception& e) {
-    throw InputError(path + ": not JSON: " + e.what());
+    // nlohmann's message quotes the last token read: a 5 MB string's whole.
+    throw InputError(path + ": not JSON: " + shown_text(e.what(), 200));
   }
 }
 
@@ -93,19 +74,19 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
     throw InputError(path + ": a scene file is an object with \"meshes\" (an object) and \"instances\" (an array)");
   // A misspelt key would otherwise leave its field at the default unseen.
   for (const auto& [key, value] : doc.items())
-    if (key != "meshes" && key != "instances") throw InputError(path + ": \"" + shown(key) + "\" is not a scene file's key (meshes, instances)");
+    if (key != "meshes" && key != "instances") throw InputError(path + ": \"" + shown_text(key) + "\" is not a scene file's key (meshes, instances)");
   SceneFile out;
   std::map<std::string, MeshId> ids;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   for (const auto& [name, file] : doc["meshes"].items()) {
-    const std::string where = path + ": meshes." + shown(name);
+    const std::string where = path + ": meshes." + shown_text(name);
     if (!file.is_string()) throw InputError(where + " is " + described(file) + ", not a file name");
     if (file.get<std::string>().find('\0') != std::string::npos)
-      throw InputError(where + ": the file name \"" + shown(file.get<std::string>()) + "\" holds a NUL character");
+      throw InputError(where + ": the file name \"" + shown_text(file.get<std::string>()) + "\" holds a NUL character");
     // The mesh file's own messages name its path: one longer than a path may
     // be is refused here, shown short, rather than echoed whole by them.
     if (file.get<std::string>().size() > PATH_MAX)
-      throw InputError(where + ": the file name \"" + shown(file.get<std::string>()) + "\" is longer than a path may be (" +
+      throw InputError(where + ": the file name \"" + shown_text(file.get<std::string>()) + "\" is longer than a path may be (" +
                        std::to_string(PATH_MAX) + " bytes)");
     const std::string mesh_path = (folder / file.get<std::string>()).string();
     try {  // the mesh file's own message, and where the scene names it
@@ -124,9 +105,9 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
       throw InputError(where + " is not an object with a \"mesh\" name");
     for (const auto& [key, value] : i.items())
       if (key != "mesh" && key != "rotation_scale" && key != "translation" && key != "mask" && key != "enabled")
-        throw InputError(where + ": \"" + shown(key) + "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled)");
+        throw InputError(where + ": \"" + shown_text(key) + "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled)");
     const auto mesh = ids.find(i["mesh"].get<std::string>());
-    if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + shown(i["mesh"].get<std::string>()) + "\" is not in \"meshes\"");
+    if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + shown_text(i["mesh"].get<std::string>()) + "\" is not in \"meshes\"");
     Transform t;
     if (i.contains("rotation_scale")) {
       const std::vector<double> m = numbers(i["rotation_scale"], 9, where + ".rotation_scale");

@@ -178,8 +178,9 @@ class Caster {
   explicit Caster(CasterOptions options);
   // Waits for the batches still running (their jobs and fences), so none
   // outlives the caster. A thread blocked in wait() or wait_for_crossover()
-  // when destruction begins gets UsageError (its batch is not collected)
-  // and the destructor waits for it to leave; no other call may overlap
+  // when destruction begins gets UsageError (its batch is not collected),
+  // unless its batch was ready before it woke (then it collects as usual);
+  // the destructor waits for it to leave either way. No other call may overlap
   // the destructor (a submit() that does gets UsageError at best).
   ~Caster();
   Caster(const Caster&) = delete;
@@ -264,6 +265,9 @@ class Caster {
   void start(Slot& s, std::span<const Ray> rays, Backend backend);
   // `lists`: where a Query::All batch's rows go (null for the others).
   BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record);
+  // collect()'s copy of a claimed batch's answers into the caller's
+  // (the GPU's read back, or the CPU's rows or hits).
+  void copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists);
   // The GPU method for a batch's query, made on first use (under gpu_mutex_).
   gpu::Method* method_for(const BatchQuery& q);
   void start_cpu(Slot& s);

@@ -5,6 +5,7 @@
 // edge or vertex hits one of its triangles.
 #pragma once
 #include <algorithm>
+#include <cassert>
 #include <cfloat>
 #include <cmath>
 #include <cstddef>
@@ -102,6 +103,7 @@ struct HitRows {
   }
   // The rays of `more` after these (rows of the same max_hits).
   void append(const HitRows& more) {
+    assert(&more != this);  // its vectors would grow under the reads
     const size_t base = hits.size();
     found.insert(found.end(), more.found.begin(), more.found.end());
     hits.insert(hits.end(), more.hits.begin(), more.hits.end());

@@ -26,12 +26,13 @@ class Peer {
 
 // Embree 3 (libembree-dev) builds: Default (its fast mode, the default scene
 // flags), Robust (RTC_SCENE_FLAG_ROBUST: no leaks at edges, slower) and
-// Compact (RTC_SCENE_FLAG_COMPACT: triangle4i leaves that index the mesh),
-// built with `threads` threads (0: all cores); tracing is one thread either
+// Compact (RTC_SCENE_FLAG_COMPACT: triangle4i leaves that index the mesh)
+// and High (RTC_BUILD_QUALITY_HIGH: the SAH build with spatial splits, what
+// a user with static meshes who builds once may pick), built with `threads` threads (0: all cores); tracing is one thread either
 // way. bytes(): what Embree allocates for the scene plus the mesh it keeps
 // and reads (12 bytes a vertex, 12 a triangle), shared with it, not copied.
 // nullptr when meshcast was built without Embree.
-enum class EmbreeMode { Default, Robust, Compact };
+enum class EmbreeMode { Default, Robust, Compact, High };
 std::unique_ptr<Peer> make_embree(const Mesh& mesh, EmbreeMode mode = EmbreeMode::Default, uint32_t threads = 1);
 
 // A peer's instanced scene (issue 21): each mesh its own scene, built once;

@@ -23,6 +23,7 @@ struct PeerRow {
   // (its culling is a compile-time option), so `ratio` is 0 for the others.
   std::string query = "closest";
   double to_closest = 0;          // time / the same contender's closest-hit time on the same rays (0: not measured)
+  double ratio_high = 0;          // to Embree's high-quality build (RTC_BUILD_QUALITY_HIGH), as `ratio`
 };
 
 struct PeersOptions {

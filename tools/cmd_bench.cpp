@@ -250,7 +250,7 @@ void add_bench_error(CLI::App* bench) {
   auto eargs = std::make_shared<BenchArgs>();
   auto emeshes = std::make_shared<std::vector<std::string>>();
   auto edevice = std::make_shared<std::string>();
-  CLI::App* err = bench->add_subcommand("error", "issue 8: error against run time and bytes, every tree x encoding (and GPU method)");
+  CLI::App* err = bench->add_subcommand("error", "error against run time and bytes, every tree x encoding (and GPU method)");
   err->add_option("meshes", *emeshes, "mesh files or terrain_2M (default bunny00, ChineseDragon-10kv, terrain_2M)");
   err->add_option("--rays", eargs->rays, "long random rays")->check(integer_in(1, 1000000));
   err->add_option("--repeat", eargs->repeat, "passes; the minimum is kept (GPU: the median)")->check(integer_in(1, 1000));
@@ -326,7 +326,7 @@ void add_bench_error(CLI::App* bench) {
 // Issue 8: the watertight test against Moller-Trumbore.
 void add_bench_robustness(CLI::App* bench) {
   auto rargs = std::make_shared<BenchArgs>();
-  CLI::App* rob = bench->add_subcommand("robustness", "issue 8: the watertight test against plain Moller-Trumbore, time and leaks");
+  CLI::App* rob = bench->add_subcommand("robustness", "the watertight test against plain Moller-Trumbore, time and leaks");
   rob->add_option("mesh", rargs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
   rob->add_option("--rays", rargs->rays, "long random rays")->check(integer_in(1, 1000000));
   rob->add_option("--repeat", rargs->repeat, "passes; the minimum and the median are kept")->check(integer_in(1, 1000));

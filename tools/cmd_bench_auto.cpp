@@ -18,7 +18,7 @@ void add_bench_auto(CLI::App* bench) {
     std::string out_dir = "out";
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = bench->add_subcommand("auto", "issue 9: --layout auto under each setting against every combos layout");
+  CLI::App* cmd = bench->add_subcommand("auto", "--layout auto under each setting against every combos layout");
   cmd->add_option("meshes", args->meshes,
                   "mesh files, terrain_2M or terrain_66k (default bunny00, armadillo, refined_elephant, "
                   "ChineseDragon-10kv, terrain_2M, terrain_66k)");

@@ -16,7 +16,7 @@ void add_bench_scenes(CLI::App* bench) {
     bench::ScenesOptions options;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = bench->add_subcommand("scenes", "issue 21: a level of placed meshes beside Embree's instancing");
+  CLI::App* cmd = bench->add_subcommand("scenes", "a level of placed meshes beside Embree's instancing");
   cmd->add_option("--meshes", args->meshes, "comma-separated mesh files placed in turn (default bunny00, armadillo, the dragon)");
   cmd->add_option("--counts", args->options.counts, "comma-separated instance counts, a level each (default 1000,10000)")
       ->delimiter(',')

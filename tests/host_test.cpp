@@ -57,17 +57,6 @@ CasterOptions options(Backend b, uint32_t frames = 4) {
   return o;
 }
 
-// `call` must throw E with every one of `words` in its message.
-template <class E, class F>
-void expect_error(F&& call, std::initializer_list<std::string> words) {
-  try {
-    call();
-    ADD_FAILURE() << "no error; expected one saying '" << *words.begin() << "'";
-  } catch (const E& e) {
-    for (const std::string& w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << "'" << w << "' not in: " << e.what();
-  }
-}
-
 #if !MESHCAST_VULKAN
 // Built without Vulkan: a caster asked for it says so and the CPU answers.
 TEST(Host, WithoutTheVulkanBackendTheCpuAnswers) {
@@ -359,7 +348,7 @@ TEST(Host, MisuseIsAUsageError) {
   Caster caster(blob, "sphere", options(Backend::Cpu, 2));
   const std::vector<Ray> rays = make_rays(m, RayKind::Long, 50, 3);
   std::vector<Hit> hits(rays.size()), short_hits(rays.size() - 1);
-  auto expect_usage = [](auto&& call, const std::string& words) { expect_error<UsageError>(call, {words}); };
+  auto expect_usage = [](auto&& call, const std::string& words) { expect_throws<UsageError>(call, {words}); };
   expect_usage([&] { caster.poll(host::Ticket{12345, 7}); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 7}, hits); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 0}, hits); }, "unknown or already collected");
@@ -411,8 +400,8 @@ TEST(Host, OptionsOutOfRangeAreRefused) {
   auto refused = [&](auto change, std::initializer_list<std::string> words) {
     CasterOptions o = options(Backend::Cpu);
     change(o);
-    expect_error<UsageError>([&] { Caster c(blob, "sphere", o); }, words);
-    expect_error<UsageError>([&] { Caster c(o); }, words);
+    expect_throws<UsageError>([&] { Caster c(blob, "sphere", o); }, words);
+    expect_throws<UsageError>([&] { Caster c(o); }, words);
   };
   refused([](CasterOptions& o) { o.frames = 0; }, {"CasterOptions::frames 0", "1..1024"});
   refused([](CasterOptions& o) { o.frames = ~0u; }, {"CasterOptions::frames 4294967295", "1..1024"});
@@ -726,7 +715,7 @@ TEST(Host, HostileProfilesAreNotUsedAndSayWhy) {
   host::write_profile(written, key, 256, "at 256 rays");
   EXPECT_EQ(host::read_profile(written, key).crossover, std::optional<uint32_t>(256));
   const std::string nowhere = (scratch_dir() / "no folder" / "profile").string();
-  expect_error<OutputError>([&] { host::write_profile(nowhere, key, 256, "at 256 rays"); }, {nowhere});
+  expect_throws<OutputError>([&] { host::write_profile(nowhere, key, 256, "at 256 rays"); }, {nowhere});
 }
 
 // The Automatic backend on profiles it cannot use: a file of notes is

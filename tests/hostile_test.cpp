@@ -29,18 +29,6 @@ namespace fs = std::filesystem;
 namespace meshcast::testing {
 namespace {
 
-// `f` must throw E whose message holds every one of `words`.
-template <class E, class F>
-void expect_throws(F&& f, std::initializer_list<std::string> words) {
-  try {
-    f();
-    ADD_FAILURE() << "no error; expected one naming '" << *words.begin() << "'";
-  } catch (const E& e) {
-    const std::string msg = e.what();
-    for (const std::string& w : words) EXPECT_NE(msg.find(w), std::string::npos) << "'" << w << "' not in: " << msg;
-  }
-}
-
 const char* kSquare = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n";
 
 // 2. A `tristrips` element: Assimp kept 1 of the 2 triangles of a strip (1 of

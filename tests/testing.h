@@ -1,7 +1,10 @@
 // Shared test helpers: the test meshes, oracle answers computed once per
 // mesh and ray set, and the agreement rules of the foundation issue.
 #pragma once
+#include <gtest/gtest.h>
+
 #include <filesystem>
+#include <initializer_list>
 #include <functional>
 #include <map>
 #include <tuple>
@@ -117,5 +120,17 @@ size_t expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const s
 // trial, memory first, memory under a 2e-6 error bound, and speed under 20
 // bytes a triangle (past the fast layouts).
 std::vector<std::string> auto_settings();
+
+// `call` must throw E whose message holds every one of `words`.
+template <class E, class F>
+void expect_throws(F&& call, std::initializer_list<std::string> words) {
+  try {
+    call();
+    ADD_FAILURE() << "no error; expected one naming '" << *words.begin() << "'";
+  } catch (const E& e) {
+    const std::string message = e.what();
+    for (const std::string& w : words) EXPECT_NE(message.find(w), std::string::npos) << "'" << w << "' not in: " << message;
+  }
+}
 
 }  // namespace meshcast::testing

@@ -53,15 +53,17 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   std::vector<std::unique_ptr<uint8_t[], void (*)(void*)>> aligned;  // the blobs the views read
   std::vector<std::unique_ptr<BlobView>> views;
   blobs.reserve(o.layouts.size());
-  for (const std::string& layout : o.layouts) {
-    std::fprintf(stderr, "  %s: building %s\n", name.c_str(), layout.c_str());
-    const auto t0 = std::chrono::steady_clock::now();
-    // "TREE/TRIANGLES@LEAF": a leaf size other than the default.
+  // "TREE/TRIANGLES@LEAF": a leaf size other than the default.
+  auto options_of = [](const std::string& layout, uint32_t threads) {
     const size_t at = layout.find('@');
     BuildOptions bo = parse_layout(layout.substr(0, at));
     if (at != std::string::npos) bo.leaf_size = uint32_t(std::stoul(layout.substr(at + 1)));
-    blobs.push_back(build_blob(mesh, bo, name));
-    const double build = ms_since(t0);
+    bo.threads = threads;
+    return bo;
+  };
+  for (const std::string& layout : o.layouts) {
+    std::fprintf(stderr, "  %s: building %s\n", name.c_str(), layout.c_str());
+    blobs.push_back(build_blob(mesh, options_of(layout, 1), name));
     // 64-byte aligned, as Embree aligns its nodes and as a mapped blob file
     // is: a heap vector is aligned to 16 only, and a 96-byte node off a cache
     // line costs a third line half the time (about 8% a ray, measured).
@@ -70,7 +72,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     views.push_back(std::make_unique<BlobView>(std::span<const uint8_t>(aligned.back().get(), blobs.back().size()), name));
     const BlobView* view = views.back().get();
     auto lists = std::make_shared<HitLists>();  // Query::All's rows, kept from pass to pass as a game would
-    all.push_back({layout, false, double(blobs.back().size()) / triangles, build, build,
+    all.push_back({layout, false, double(blobs.back().size()) / triangles, 0, 0,
                    [view, lists](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
                      if (q.query == Query::All) view->trace_all_hits(r, *lists, HitOutputs::None, q.cull);
                      else view->trace(r, h, HitOutputs::None, q.query, q.cull);
@@ -79,13 +81,13 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
                    {}});
   }
   std::vector<std::unique_ptr<Peer>> peers;
+  std::vector<EmbreeMode> modes;
   for (EmbreeMode mode : {EmbreeMode::Default, EmbreeMode::High, EmbreeMode::Robust, EmbreeMode::Compact}) {
     std::unique_ptr<Peer> peer = make_embree(mesh, mode, 1);
     if (peer) std::fprintf(stderr, "  %s: built %s\n", name.c_str(), peer->name().c_str());
     if (!peer) break;  // built without Embree
-    const double build_all = make_embree(mesh, mode, 0)->build_ms();
     const Peer* p = peer.get();
-    all.push_back({peer->name(), true, double(peer->bytes()) / triangles, peer->build_ms(), build_all,
+    all.push_back({peer->name(), true, double(peer->bytes()) / triangles, 0, 0,
                    [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
                      if (q.query == Query::All || q.cull != Cull::None) return false;
                      p->trace(r, h, q.query);
@@ -93,6 +95,35 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
                    },
                    {}});
     peers.push_back(std::move(peer));
+    modes.push_back(mode);
+  }
+
+  // Build times: every contender built again in interleaved rounds, on one
+  // thread and on every core, the median of each (a first build pays for
+  // page faults and thread starts that later ones do not).
+  {
+    const uint32_t build_rounds = std::max(3u, o.rounds);
+    std::vector<std::vector<double>> one(all.size()), every(all.size());
+    for (uint32_t round = 0; round < build_rounds; ++round) {
+      size_t c = 0;
+      for (const std::string& layout : o.layouts) {
+        for (uint32_t threads : {1u, 0u}) {
+          const auto t0 = std::chrono::steady_clock::now();
+          const std::vector<uint8_t> again = build_blob(mesh, options_of(layout, threads), name);
+          (threads == 1 ? one : every)[c].push_back(ms_since(t0));
+          if (again != blobs[c])
+            throw std::runtime_error(name + ": " + layout + " built to other bytes on " +
+                                     (threads == 1 ? "one thread" : "every core") + " than on one thread before");
+        }
+        ++c;
+      }
+      for (EmbreeMode mode : modes) {
+        one[c].push_back(make_embree(mesh, mode, 1)->build_ms());
+        every[c].push_back(make_embree(mesh, mode, 0)->build_ms());
+        ++c;
+      }
+    }
+    for (size_t c = 0; c < all.size(); ++c) all[c].build_one = median(one[c]), all[c].build_all = median(every[c]);
   }
 
   // The sets timed: each ray kind under each query asked for.

@@ -25,6 +25,7 @@ AutoCandidate candidate(const AutoLimits& l, const std::string& layout, uint32_t
   c.options = parse_layout(layout);
   c.options.leaf_size = leaf;
   c.options.triangle_ids = l.triangle_ids;
+  c.options.threads = l.build_threads;
   c.label = leaf == kLeaf ? layout : layout + " (leaf " + std::to_string(leaf) + ")";
   c.why = std::move(why);
   return c;

@@ -41,6 +41,7 @@ struct AutoLimits {
   uint32_t trial_rays = 0;
   uint32_t trial_passes = 3;  // the fastest pass of these counts
   bool triangle_ids = true;   // BuildOptions::triangle_ids of every candidate
+  uint32_t build_threads = 0; // BuildOptions::threads of every candidate
 };
 
 // A setting as text, for benches and tests: "speed" or "memory", then any

@@ -38,10 +38,14 @@ struct BuildTree {
 // (StacklessLBVH's D - 1); InputError when such a leaf would exceed
 // `leaf_capacity` primitives (MC_QUAD_MAX_COUNT triangles; fewer when a
 // primitive is a group of triangles, as a pair of seed 003).
+// `threads`: the build's threads (builder/build_threads.h); none, or one,
+// builds on the caller's thread alone, to the same tree.
+class BuildThreads;
 BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit = ~0u,
-                        uint32_t leaf_capacity = MC_QUAD_MAX_COUNT);
+                        uint32_t leaf_capacity = MC_QUAD_MAX_COUNT, BuildThreads* threads = nullptr);
 BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size,
-                     uint32_t depth_limit = ~0u, uint32_t leaf_capacity = MC_QUAD_MAX_COUNT);
+                     uint32_t depth_limit = ~0u, uint32_t leaf_capacity = MC_QUAD_MAX_COUNT,
+                     BuildThreads* threads = nullptr);
 
 // A tree built over groups of triangles (FixedLeafSize's runs of 4, seed
 // 003's pairs) back to triangles: group k is members[start[k] .. start[k+1]),
@@ -86,6 +90,10 @@ std::vector<Grouping> all_groupings();
 struct BinningSplit {
   const std::vector<Box3>& boxes;
   const std::vector<Vec3>& centres;
+  // Optional, 3 bytes a triangle: each triangle's bin on each axis, kept
+  // from binning for the partition (which otherwise works them out again).
+  // Threads splitting disjoint ranges write disjoint bytes.
+  uint8_t* bins = nullptr;
   uint32_t operator()(uint32_t* begin, uint32_t* end, const Box3& cbox) const;
 };
 

@@ -97,7 +97,7 @@ struct MortonSplit {
 // FixedLeafSize: groups of 4 consecutive primitives in Morton order become
 // the primitives of a Binning build with leaves of leaf_size / 4 groups.
 BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vector<Vec3>& centres, uint32_t leaf,
-                                uint32_t depth_limit, uint32_t leaf_capacity) {
+                                uint32_t depth_limit, uint32_t leaf_capacity, BuildThreads* threads) {
   constexpr uint32_t kGroup = 4;
   std::vector<uint32_t> members = morton_order(morton_codes(centres));
   const uint32_t groups = uint32_t((members.size() + kGroup - 1) / kGroup);
@@ -110,33 +110,37 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
   TopDown<BinningSplit> group_top{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}, depth_limit};
   group_top.leaf_capacity = std::max(1u, leaf_capacity / kGroup);  // whole groups within the leaf capacity
   group_top.primitives = "groups of 4";
+  group_top.threads = threads;
   return expand_groups(group_top.run(), members, start);
 }
 
 }  // namespace
 
 BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size, uint32_t depth_limit,
-                     uint32_t leaf_capacity) {
+                     uint32_t leaf_capacity, BuildThreads* threads) {
   leaf_size = std::max(1u, leaf_size);
   std::vector<Vec3> centres = box_centres(boxes);
   switch (splitter) {
-    case Splitter::Binning: return build_binning(boxes, leaf_size, depth_limit, leaf_capacity);
+    case Splitter::Binning: return build_binning(boxes, leaf_size, depth_limit, leaf_capacity, threads);
     case Splitter::LongestAxis: {
       LongestAxisSplit s{centres};
-      return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity}.run();
+      return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity, "triangles", threads}
+          .run();
     }
     case Splitter::Mean: {
       MeanSplit s{centres};
-      return TopDown<MeanSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity}.run();
+      return TopDown<MeanSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity, "triangles", threads}.run();
     }
     case Splitter::Morton: {
       std::vector<uint32_t> codes = morton_codes(centres);
       MortonSplit s{codes};
-      return TopDown<MortonSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity}.run(morton_order(codes));
+      return TopDown<MortonSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity, "triangles", threads}
+          .run(morton_order(codes));
     }
-    case Splitter::FixedLeafSize: return build_fixed_leaf_size(boxes, centres, leaf_size, depth_limit, leaf_capacity);
+    case Splitter::FixedLeafSize:
+      return build_fixed_leaf_size(boxes, centres, leaf_size, depth_limit, leaf_capacity, threads);
   }
-  return build_binning(boxes, leaf_size, depth_limit, leaf_capacity);
+  return build_binning(boxes, leaf_size, depth_limit, leaf_capacity, threads);
 }
 
 BuildTree expand_groups(const BuildTree& g, const std::vector<uint32_t>& members, const std::vector<uint32_t>& start) {

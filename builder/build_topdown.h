@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "builder/binary_tree.h"
+#include "builder/build_threads.h"
 #include "layout/formats.h"
 
 namespace meshcast {
@@ -33,20 +34,34 @@ struct TopDown {
   uint32_t depth_limit = ~0u;
   uint32_t leaf_capacity = MC_QUAD_MAX_COUNT;  // most primitives a leaf at the depth limit may take
   const char* primitives = "triangles";
+  BuildThreads* threads = nullptr;  // none: this thread alone
 
-  uint32_t build(uint32_t first, uint32_t count, uint32_t depth) {
-    uint32_t index = uint32_t(tree.nodes.size());
-    tree.nodes.emplace_back();
-    tree.depth = std::max(tree.depth, depth);
+  // Least triangles on each side of a split that goes to another thread: a
+  // thread's start costs tens of microseconds, a subtree this size about a
+  // millisecond.
+  static constexpr uint32_t kForkGrain = 4096;
+
+  // Nodes in the order a one-thread build makes them (each node, then its
+  // left subtree, then its right); a part built on another thread is
+  // numbered from 0 and appended in its place (append_part).
+  struct Part {
+    std::vector<BuildNode> nodes;
+    uint32_t depth = 0;
+  };
+
+  uint32_t build(Part& part, uint32_t first, uint32_t count, uint32_t depth) {
+    uint32_t index = uint32_t(part.nodes.size());
+    part.nodes.emplace_back();
+    part.depth = std::max(part.depth, depth);
     Box3 box, cbox;
     for (uint32_t i = first; i < first + count; ++i) box.grow(boxes[tree.order[i]]), cbox.grow(centres[tree.order[i]]);
-    tree.nodes[index].box = box;
+    part.nodes[index].box = box;
     if (count > capacity(depth))
       throw InputError("depth limit " + std::to_string(depth_limit + 1) + " holds at most " +
                        std::to_string(capacity(depth)) + " " + primitives + " (" + std::to_string(leaf_capacity) +
                        " a leaf), not " + std::to_string(count) + "; raise the depth limit");
     if (count <= leaf_size || depth >= depth_limit) {
-      tree.nodes[index].first = first, tree.nodes[index].count = count;
+      part.nodes[index].first = first, part.nodes[index].count = count;
       return index;
     }
     uint32_t* begin = tree.order.data() + first;
@@ -65,10 +80,30 @@ struct TopDown {
       else
         left = median(begin, count, cbox);
     }
-    uint32_t l = build(first, left, depth + 1);
-    uint32_t r = build(first + left, count - left, depth + 1);
-    tree.nodes[index].left = l, tree.nodes[index].right = r;
+    uint32_t l = 0, r = 0;
+    if (threads && std::min(left, count - left) >= kForkGrain) {
+      // The two sides touch disjoint ranges of the order.
+      Part right;
+      threads->fork([&] { build(right, first + left, count - left, depth + 1); },
+                    [&] { l = build(part, first, left, depth + 1); });
+      r = append_part(part, right);
+    } else {
+      l = build(part, first, left, depth + 1);
+      r = build(part, first + left, count - left, depth + 1);
+    }
+    part.nodes[index].left = l, part.nodes[index].right = r;
     return index;
+  }
+
+  // `from` after part's nodes, its links moved along; its root's index.
+  static uint32_t append_part(Part& part, const Part& from) {
+    const uint32_t base = uint32_t(part.nodes.size());
+    for (BuildNode n : from.nodes) {
+      if (!n.leaf()) n.left += base, n.right += base;
+      part.nodes.push_back(n);
+    }
+    part.depth = std::max(part.depth, from.depth);
+    return base;
   }
 
   // Most triangles a subtree rooted at `depth` can hold under depth_limit.
@@ -93,8 +128,11 @@ struct TopDown {
       for (uint32_t i = 0; i < boxes.size(); ++i) order[i] = i;
     }
     tree.order = std::move(order);
-    tree.nodes.reserve(2 * boxes.size() / std::max(1u, leaf_size) + 1);
-    build(0, uint32_t(boxes.size()), 0);
+    Part whole;
+    whole.nodes.reserve(2 * boxes.size() / std::max(1u, leaf_size) + 1);
+    build(whole, 0, uint32_t(boxes.size()), 0);
+    tree.nodes = std::move(whole.nodes);
+    tree.depth = whole.depth;
     tree.sah_cost = sah_cost(tree);
     return std::move(tree);
   }

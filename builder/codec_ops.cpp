@@ -7,6 +7,7 @@
 namespace meshcast {
 
 using layout::grid_bits;
+using layout::independent_blocks;
 using layout::measure;
 using layout::moves_floats;
 using layout::nested_blocks;
@@ -16,6 +17,7 @@ CodecOps codec_ops(uint32_t format) {
   if (format == layout::Codec::kFormat)                                                            \
     return {layout::Codec::kFormat,        layout::Codec::kSlotDivisor,   layout::Codec::kGrid,        \
             grid_bits<layout::Codec>(),    nested_blocks<layout::Codec>(), moves_floats<layout::Codec>(), \
+            independent_blocks<layout::Codec>(),                                                   \
             layout::Codec::kLanes,         &measure<layout::Codec>,       &layout::Codec::encode};
   MC_FOR_EACH_TRIANGLE_CODEC(MC_OPS)
 #undef MC_OPS

@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "builder/binary_tree.h"
+#include "builder/build_threads.h"
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "builder/pairing.h"
@@ -104,7 +105,7 @@ BuildTree chunk_tree(const std::vector<Box3>& boxes, std::vector<uint32_t> order
 // Seed 003: the tree over pairs (and the triangles left single), each
 // expanded back to its triangles side by side.
 BuildTree build_paired(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, uint32_t depth_limit,
-                       BuildReport* report) {
+                       BuildReport* report, BuildThreads* threads) {
   if (o.leaf_size < 2) throw InputError("pairing needs leaves of at least 2 triangles (leaf size " + std::to_string(o.leaf_size) + ")");
   Pairing p = pair_triangles(mesh);
   std::vector<uint32_t> members, start{0};
@@ -121,17 +122,17 @@ BuildTree build_paired(const Mesh& mesh, const BuildOptions& o, const std::vecto
   if (report) report->pairing = p.decision, report->paired_ratio = p.paired_ratio;
   // A leaf of leaf_size / 2 units holds at most leaf_size triangles; at the
   // depth limit half the 5-bit count's 31.
-  BuildTree units = build_tree(unit_boxes, o.splitter, o.leaf_size / 2, depth_limit, MC_QUAD_MAX_COUNT / 2);
+  BuildTree units = build_tree(unit_boxes, o.splitter, o.leaf_size / 2, depth_limit, MC_QUAD_MAX_COUNT / 2, threads);
   return expand_groups(units, members, start);
 }
 
 BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec,
-                    uint32_t depth_limit, BuildReport* report) {
+                    uint32_t depth_limit, BuildReport* report, BuildThreads* threads) {
   const uint32_t chunk = layout::brute_chunk(codec.lanes);
   if (o.pairing && (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST))
     throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) +
                      " keeps its own triangle order");
-  if (o.pairing) return build_paired(mesh, o, boxes, depth_limit, report);
+  if (o.pairing) return build_paired(mesh, o, boxes, depth_limit, report, threads);
   if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE) {
     std::vector<uint32_t> input(boxes.size());
     std::iota(input.begin(), input.end(), 0u);
@@ -141,7 +142,7 @@ BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<B
     static_assert(MC_LIST_BATCH % MC_BRUTE_CHUNK == 0 && MC_LIST_BATCH % 128 == 0, "records must tile a batch");
     return chunk_tree(boxes, group_batches(boxes, MC_LIST_BATCH, o.grouping), chunk);
   }
-  return build_tree(boxes, o.splitter, o.leaf_size, depth_limit);
+  return build_tree(boxes, o.splitter, o.leaf_size, depth_limit, MC_QUAD_MAX_COUNT, threads);
 }
 
 }  // namespace
@@ -209,6 +210,10 @@ static double least_grid_extent(const CodecOps& codec) {
   return double(FLT_MIN) * 0.5 * (std::ldexp(1.0, int(codec.grid_bits)) - 2);
 }
 
+// Meshes smaller than this build on the caller's thread alone: a thread's
+// start would cost more than it saves.
+constexpr size_t kParallelTriangles = 16384;
+
 std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, const std::string& name,
                                 BuildReport* report) {
   auto start = std::chrono::steady_clock::now();
@@ -260,14 +265,16 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
                        std::to_string(codec.grid_bits) + "-bit codes needs (a step below 2^-126, the least normal float, "
                        "would round vertices coarser than stated); build it in a float format (Float3) or scale it up");
   }
+  BuildThreads threads(o.threads);
+  BuildThreads* parallel = threads.total() > 1 && mesh.triangles.size() >= kParallelTriangles ? &threads : nullptr;
   std::vector<uint64_t> packed(grid ? mesh.vertices.size() : 0);
-  for (size_t v = 0; v < packed.size(); ++v) {
+  for_each_on(parallel, packed.size(), 4096, [&](uint64_t v) {
     float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
     packed[v] = layout::bitpack_encode(p, h.quant_offset, h.quant_scale);
-  }
+  });
   std::vector<TriCorners> corners(mesh.triangles.size());
   std::vector<Box3> boxes(mesh.triangles.size());
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+  for_each_on(parallel, mesh.triangles.size(), 4096, [&](uint64_t t) {
     for (int c = 0; c < 3; ++c) {
       uint32_t v = mesh.triangles[t][c];
       if (grid) {
@@ -282,7 +289,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
       }
       boxes[t].grow(Vec3{corners[t].v[c][0], corners[t].v[c][1], corners[t].v[c][2]});
     }
-  }
+  });
 
   uint32_t depth_limit = ~0u;
   if (uint32_t(o.layout.tree) == MC_TREE_STACKLESSLBVH) {
@@ -297,12 +304,12 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
   }
   BuildTree tree;
   try {
-    tree = build_for(mesh, o, boxes, codec, depth_limit, report);
+    tree = build_for(mesh, o, boxes, codec, depth_limit, report, parallel);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());
   }
   uint32_t lattice_shift = codec.nested ? snap_to_block_lattices(tree, corners, codec.lanes, h.quant_scale) : 0;
-  Writer writer{corners, tree, codec, h, {}, {}, {}, {}, {}, {}};
+  Writer writer{corners, tree, codec, h, {}, {}, {}, {}, {}, {}, parallel};
   BlobHeader& hd = writer.h;
   writer.measure_leaves();
 

@@ -6,31 +6,6 @@
 
 namespace meshcast {
 
-void Box3::grow(const Vec3& p) {
-  min = {std::min(min.x, p.x), std::min(min.y, p.y), std::min(min.z, p.z)};
-  max = {std::max(max.x, p.x), std::max(max.y, p.y), std::max(max.z, p.z)};
-}
-
-void Box3::grow(const Box3& b) {  // min of minima, max of maxima: an empty b changes nothing
-  min = {std::min(min.x, b.min.x), std::min(min.y, b.min.y), std::min(min.z, b.min.z)};
-  max = {std::max(max.x, b.max.x), std::max(max.y, b.max.y), std::max(max.z, b.max.z)};
-}
-
-Vec3 Box3::centre() const {
-  return {0.5f * (min.x + max.x), 0.5f * (min.y + max.y), 0.5f * (min.z + max.z)};
-}
-
-Vec3 Box3::extent() const { return {max.x - min.x, max.y - min.y, max.z - min.z}; }
-
-double Box3::half_area() const {
-  // In double: float products of extents near 1e-30 underflow to 0 (every
-  // split then costs the same and the tree degenerates into a chain), and
-  // near 1e20 they overflow.
-  if (empty()) return 0.0;
-  const double x = double(max.x) - min.x, y = double(max.y) - min.y, z = double(max.z) - min.z;
-  return x * y + y * z + z * x;
-}
-
 double Box3::diagonal() const {
   Vec3 e = extent();
   return std::sqrt(double(e.x) * e.x + double(e.y) * e.y + double(e.z) * e.z);

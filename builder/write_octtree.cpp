@@ -41,6 +41,7 @@ std::array<int, MC_OCT_WIDTH> octant_slots(const BuildTree& t, const std::vector
         if (pick_child < 0 || cost < cheapest) cheapest = cost, pick_child = int(i), pick_slot = s;
       }
     }
+    if (pick_child < 0) break;  // (never: at most 8 children for 8 slots)
     placed[size_t(pick_child)] = 1;
     slot_child[size_t(pick_slot)] = int(children[size_t(pick_child)]);
   }
@@ -81,13 +82,16 @@ class OctWriter : public TreeWriter {
   }
   void fill(Writer& w) override {
     const BuildTree& t = w.tree;
-    for (uint32_t leaf : plan_.leaves) w.write_leaf(leaf, plan_.leaf_offset[leaf]);
+    w.write_leaves(plan_.leaves, plan_.leaf_offset);
     w.refit();
-    // The header's reach of the nodes' frames (layout/octtree.h), the
-    // largest over the nodes (0 where the root is a leaf).
+    // The nodes, each its own bytes (on the build's threads); then the
+    // header's reach of their frames (layout/octtree.h), the largest over
+    // the nodes (0 where the root is a leaf).
+    for_each_on(w.threads, plan_.binary_of.size(), Writer::kGrain, [&](uint64_t q) {
+      write_oct_node(t, plan_, uint32_t(q), w.bytes.data() + w.h.tree_offset + plan_.node_offset[q]);
+    });
     for (uint32_t q = 0; q < plan_.binary_of.size(); ++q) {
-      uint8_t* node = w.bytes.data() + w.h.tree_offset + plan_.node_offset[q];
-      write_oct_node(t, plan_, q, node);
+      const uint8_t* node = w.bytes.data() + w.h.tree_offset + plan_.node_offset[q];
       for (int a = 0; a < 3; ++a) {
         w.h.node_origin[a] = std::max(w.h.node_origin[a], std::fabs(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a)));
         w.h.node_scale = std::max(w.h.node_scale, layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "builder/binary_tree.h"
+#include "builder/build_threads.h"
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "layout/blob_format.h"
@@ -27,6 +28,7 @@ struct CodecOps {
   uint32_t grid_bits;  // codes a component of the mesh grid (21; CompressedStrip 20)
   bool nested;         // blocks on nested lattices of the grid (BitPackSOA)
   bool moves_floats;   // stores floats it has changed (UncompressedStrip)
+  bool independent;    // leaves may be encoded at once (layout/block.h)
   uint32_t lanes;
   uint32_t (*measure)(layout::TriCorners*, uint32_t);  // bytes of a leaf's block
   void (*encode)(layout::TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
@@ -53,6 +55,7 @@ struct Writer {
   std::vector<uint32_t> remap;
   uint32_t max_block_shift = 0;
   std::vector<uint32_t> leaf_bytes;  // per node: its block's bytes (leaves)
+  BuildThreads* threads = nullptr;   // the build's threads (none: this one)
 
   std::vector<layout::TriCorners> leaf_triangles(uint32_t n) const {
     const BuildNode& leaf = tree.nodes[n];
@@ -65,11 +68,27 @@ struct Writer {
   }
   void measure_leaves() {
     leaf_bytes.assign(tree.nodes.size(), 0);
-    for (uint32_t n = 0; n < tree.nodes.size(); ++n)
-      if (tree.nodes[n].leaf()) {
-        std::vector<layout::TriCorners> tris = leaf_triangles(n);
-        leaf_bytes[n] = codec.measure(tris.data(), tree.nodes[n].count);
-      }
+    auto measure = [&](uint64_t n) {
+      if (!tree.nodes[n].leaf()) return;
+      std::vector<layout::TriCorners> tris = leaf_triangles(uint32_t(n));
+      leaf_bytes[n] = codec.measure(tris.data(), tree.nodes[n].count);
+    };
+    for_each_on(threads, tree.nodes.size(), kGrain, measure);
+  }
+  static constexpr uint64_t kGrain = 512;  // nodes or leaves a chunk of a build thread's work
+
+  // write_leaf(leaves[i], at[leaves[i]]) for every leaf of the list: at once
+  // on the build's threads where the codec's blocks are independent, else
+  // in the list's order (a shared vertex pool fills in that order).
+  void write_leaves(const std::vector<uint32_t>& leaves, const std::vector<uint32_t>& at) {
+    if (!threads || !codec.independent) {
+      for (uint32_t n : leaves) write_leaf(n, at[n]);
+      return;
+    }
+    uint64_t slots = remap.size();
+    for (uint32_t n : leaves) slots = std::max<uint64_t>(slots, (at[n] - h.triangle_base) / h.slot_divisor + tree.nodes[n].count);
+    remap.resize(slots, MC_NO_HIT);  // write_leaf then only writes its own slots
+    threads->for_each(leaves.size(), kGrain, [&](uint64_t i) { write_leaf(leaves[i], at[leaves[i]]); });
   }
 
   // Encodes leaf node n's triangles at tree-section offset `at`. The codec

@@ -18,6 +18,7 @@ namespace meshcast::layout {
 
 struct BitPack {
   static constexpr uint32_t kFormat = MC_TRI_BITPACK;
+  static constexpr bool kIndependentBlocks = true;  // encode writes its block alone (block.h)
   static constexpr uint32_t kSlotDivisor = 24;
   static constexpr uint32_t kLanes = 1;
   static constexpr GridKind kGrid = kGridPowerOfTwo;

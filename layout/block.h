@@ -74,6 +74,10 @@ concept TriangleCodec = requires(TriCorners* tris, uint32_t count, BlockContext&
 //   nested_blocks  blocks on nested lattices of the mesh grid (BitPackSOA)
 //   grid_bits      bits a grid coordinate takes (the BitPack 21 otherwise)
 //   moves_floats   a float format that still moves vertices (cleared bits)
+//   independent_blocks  encode() writes nothing but its own block (no
+//                  shared vertex pool, no shared maximum), so the leaves
+//                  may be encoded on several threads at once; otherwise
+//                  they are encoded one after another, in order
 //   measure        bytes a leaf's block will take (block_bytes otherwise)
 template <class C>
 constexpr bool nested_blocks() {
@@ -88,6 +92,11 @@ constexpr uint32_t grid_bits() {
 template <class C>
 constexpr bool moves_floats() {
   if constexpr (requires { C::kMovesFloats; }) return C::kMovesFloats;
+  else return false;
+}
+template <class C>
+constexpr bool independent_blocks() {
+  if constexpr (requires { C::kIndependentBlocks; }) return C::kIndependentBlocks;
   else return false;
 }
 template <class C>

@@ -9,21 +9,28 @@ std::vector<ClusterBitPackSOA8::Plan> ClusterBitPackSOA8::plan(const TriCorners*
   std::vector<Plan> plans;
   for (uint32_t i = 0; i < count; ++i) {
     const TriCorners& t = tris[i];
-    auto fits = [&](const Plan& p) {
-      if (p.count >= MC_CLUSTER_MAX_TRIANGLES) return false;
+    // Each corner's vertex number in the open cluster (or the fresh ones it
+    // would take), looked up once.
+    auto place = [&](const Plan& p, int at[3]) {
       uint32_t fresh = 0;
-      for (int c = 0; c < 3; ++c)
-        if (std::find(p.vertices.begin(), p.vertices.end(), t.packed[c]) == p.vertices.end() &&
-            std::find(t.packed, t.packed + c, t.packed[c]) == t.packed + c)
-          ++fresh;
-      return p.vertices.size() + fresh <= MC_CLUSTER_MAX_VERTICES;
+      for (int c = 0; c < 3; ++c) {
+        at[c] = int(std::find(p.vertices.begin(), p.vertices.end(), t.packed[c]) - p.vertices.begin());
+        if (at[c] < int(p.vertices.size())) continue;
+        const int same = int(std::find(t.packed, t.packed + c, t.packed[c]) - t.packed);  // an earlier corner's vertex
+        at[c] = same < c ? at[same] : int(p.vertices.size() + fresh++);
+      }
+      return p.vertices.size() + fresh;
     };
-    if (plans.empty() || !fits(plans.back())) plans.push_back({i, 0, {}, {}, 0, false});
+    int at[3];
+    if (plans.empty() || plans.back().count >= MC_CLUSTER_MAX_TRIANGLES ||
+        place(plans.back(), at) > MC_CLUSTER_MAX_VERTICES) {
+      plans.push_back({i, 0, {}, {}, 0, false});
+      place(plans.back(), at);
+    }
     Plan& p = plans.back();
     for (int c = 0; c < 3; ++c) {
-      auto at = std::find(p.vertices.begin(), p.vertices.end(), t.packed[c]);
-      if (at == p.vertices.end()) at = p.vertices.insert(p.vertices.end(), t.packed[c]);
-      p.corner.push_back(uint8_t(at - p.vertices.begin()));
+      if (at[c] == int(p.vertices.size())) p.vertices.push_back(t.packed[c]);
+      p.corner.push_back(uint8_t(at[c]));
     }
     ++p.count;
   }

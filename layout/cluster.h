@@ -24,17 +24,30 @@ namespace meshcast::layout {
 
 struct ClusterBitPackSOA8 {
   static constexpr uint32_t kFormat = MC_TRI_CLUSTERBITPACKSOA8;
+  static constexpr bool kIndependentBlocks = true;  // encode writes its block alone (block.h)
   static constexpr uint32_t kSlotDivisor = 4;  // see cluster_bytes
   static constexpr uint32_t kLanes = MC_CLUSTER_BLOCK_LANES;
   static constexpr GridKind kGrid = kGridPowerOfTwo;
   static constexpr bool kClusters = true;  // cpu/leaf.h: tested cluster by cluster
   static constexpr uint32_t kGridBits = 18;  // see Precision above
 
+  // A list of at most N in place: a leaf is planned twice (measured, then
+  // encoded), and heap lists here cost a tenth of the build.
+  template <class T, uint32_t N>
+  struct Small {
+    T item[N];
+    uint32_t n = 0;
+    const T* begin() const { return item; }
+    const T* end() const { return item + n; }
+    uint32_t size() const { return n; }
+    void push_back(T v) { item[n++] = v; }
+    const T& operator[](uint32_t i) const { return item[i]; }
+  };
   // One cluster's place in a leaf, as the encoder plans it.
   struct Plan {
-    uint32_t first, count;          // triangles of the leaf
-    std::vector<uint64_t> vertices; // their grid words, in vertex-number order
-    std::vector<uint8_t> corner;    // 3 a triangle: vertex numbers
+    uint32_t first, count;                                  // triangles of the leaf
+    Small<uint64_t, MC_CLUSTER_MAX_VERTICES> vertices;      // their grid words, in vertex-number order
+    Small<uint8_t, 3 * MC_CLUSTER_MAX_TRIANGLES> corner;    // 3 a triangle: vertex numbers
     uint64_t origin;                // grid word of the smallest codes
     bool wide;                      // an offset above 16 bits
   };

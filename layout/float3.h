@@ -8,6 +8,7 @@ namespace meshcast::layout {
 
 struct Float3 {
   static constexpr uint32_t kFormat = MC_TRI_FLOAT3;
+  static constexpr bool kIndependentBlocks = true;  // encode writes its block alone (block.h)
   static constexpr uint32_t kSlotDivisor = MC_FLOAT3_TRI_BYTES;  // exactly one slot a triangle
   static constexpr uint32_t kLanes = 1;
   static constexpr GridKind kGrid = kGridNone;

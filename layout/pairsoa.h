@@ -27,6 +27,7 @@ namespace meshcast::layout {
 
 struct Float3PairSOA4 : ReadBack<Float3PairSOA4> {
   static constexpr uint32_t kFormat = MC_TRI_FLOAT3PAIRSOA4;
+  static constexpr bool kIndependentBlocks = true;  // encode writes its block alone (block.h)
   static constexpr uint32_t kLanes = 4;
   static constexpr uint32_t kRowsBytes = 12 * 4 * 4;
   static constexpr uint32_t kBlockBytes = 4 + kRowsBytes;

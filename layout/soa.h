@@ -30,6 +30,7 @@ namespace meshcast::layout {
 template <uint32_t N, uint32_t kId>
 struct Float3SOA {
   static constexpr uint32_t kFormat = kId;
+  static constexpr bool kIndependentBlocks = true;  // encode writes its block alone (block.h)
   static constexpr uint32_t kLanes = N;
   static constexpr uint32_t kBlockBytes = 9 * N * 4;
   static constexpr uint32_t kSlotDivisor = kBlockBytes / N;

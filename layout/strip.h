@@ -107,6 +107,7 @@ struct CompressedRecord {
 template <class Record, uint32_t kId>
 struct Strip : ReadBack<Strip<Record, kId>> {
   static constexpr uint32_t kFormat = kId;
+  static constexpr bool kIndependentBlocks = true;  // encode writes its block alone (block.h)
   static constexpr uint32_t kSlotDivisor = Record::kBytes;  // a leaf of n triangles stores >= n + 2 vertices
   static constexpr uint32_t kLanes = 1;
   static constexpr GridKind kGrid = Record::kGridBits ? kGridPowerOfTwo : kGridNone;

@@ -81,14 +81,16 @@ cmake -S . -B build-asan "${sanitizer_flags[@]}" "-DMESHCAST_ISAS=$widest" -DMES
 cmake --build build-asan -j"$jobs" --target "${cpu_suites[@]}" host_test
 run_suites build-asan quick "${cpu_suites[@]}" host_test
 
-stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan)"
+stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
 # (uninstrumented) threads ever make TSan report what it cannot see.
 cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
-cmake --build build-tsan -j"$jobs" --target host_test
+cmake --build build-tsan -j"$jobs" --target host_test build_test
 # tests/tsan.supp leaves out races inside the Vulkan validation layer's own threads.
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
   build-tsan/bin/host_test
+MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
+  build-tsan/bin/build_test --gtest_brief=1 --gtest_filter=Build.AnyNumberOfThreadsBuildsTheSameBytes
 
 stage "The package: installed and used by the examples (CMake and pkg-config), and as a subproject"
 bash scripts/package_test.sh

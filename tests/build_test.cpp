@@ -194,6 +194,52 @@ TEST(Build, TwoMillionTriangleTerrainBuildsAndValidates) {
   }
 }
 
+// The build's threads never change the blob: every layout, splitter and
+// pairing builds to the same bytes on one thread and on several (the mesh is
+// large enough that the tree is split across threads and leaves are encoded
+// at once), and an error raised on another thread reaches the caller whole.
+TEST(Build, AnyNumberOfThreadsBuildsTheSameBytes) {
+  const Mesh m = make_terrain(96, 96, 3);  // 18,432 triangles
+  auto bytes = [&](BuildOptions o, uint32_t threads) {
+    o.threads = threads;
+    return build_blob(m, o, "terrain");
+  };
+  std::vector<std::string> names;
+  for (Layout layout : all_layouts())
+    if (layout.tree != TreeFormat::ZeroByteTree && layout.tree != TreeFormat::ZeroByteHybrid)  // no binary tree
+      names.push_back(layout_name(layout));
+  for (const std::string& name : covering_layouts(names)) {
+    BuildOptions o;
+    o.layout = parse_layout_name(name);
+    EXPECT_EQ(bytes(o, 5), bytes(o, 1)) << name;
+  }
+  for (Splitter s : all_splitters()) {
+    BuildOptions o = parse_layout("AABBTree/Float3");
+    o.splitter = s;
+    EXPECT_EQ(bytes(o, 4), bytes(o, 1)) << splitter_name(s);
+  }
+  BuildOptions paired;
+  paired.pairing = true;
+  EXPECT_EQ(bytes(paired, 4), bytes(paired, 1));
+
+  // A depth limit too tight for the mesh: refused the same way.
+  BuildOptions tight = parse_layout("StacklessLBVH/Float3");
+  tight.lbvh_depth = 8;
+  std::string one_thread, many;
+  try {
+    bytes(tight, 1);
+  } catch (const InputError& e) {
+    one_thread = e.what();
+  }
+  try {
+    bytes(tight, 4);
+  } catch (const InputError& e) {
+    many = e.what();
+  }
+  EXPECT_NE(one_thread.find("raise the depth limit"), std::string::npos) << one_thread;
+  EXPECT_EQ(many, one_thread);
+}
+
 TEST(Build, RecommendedLayoutFitsSixteenBytesPerTriangleOnBunny) {
   std::optional<Mesh> bunny = data_mesh("bunny00");
   if (!bunny) GTEST_SKIP() << "data/bunny00.off not fetched";

@@ -36,6 +36,7 @@ struct LayoutArgs {
   bool no_triangle_ids = false;  // BuildOptions::triangle_ids
   bool zbt_no_shuffle = false, zbt_no_cache = false;  // zero-byte trees (seed 004)
   uint32_t hybrid_leaf = 256;
+  uint32_t build_threads = 0;  // BuildOptions::threads (0: every core)
   // --layout auto (builder/auto_layout.h): the limits it chooses under.
   std::string goal = "speed";
   double max_bytes = 0, max_error = 0;

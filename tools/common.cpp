@@ -101,6 +101,9 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
   cmd->add_option("--hybrid-leaf", a.hybrid_leaf, "ZeroByteHybrid: largest leaf, each one zero-byte tree")
       ->check(integer_in(8, uint32_t(MC_ZBT_MAX_TRIANGLES)));
+  cmd->add_option("--build-threads", a.build_threads,
+                  "threads the build may use (0: every core); the blob is the same bytes on any number")
+      ->check(integer_in(0, 1024));
   const std::vector<CLI::Option*> all = cmd->get_options();
   a.options.assign(all.begin() + std::ptrdiff_t(before), all.end());
 }
@@ -129,6 +132,7 @@ static Loaded load_as_asked(const std::string& path, const LayoutArgs& a, std::F
     for (const gpu::MethodLayout& m : gpu::method_layouts()) limits.readers.push_back(m.layout);
   limits.trial_rays = a.trial;
   limits.triangle_ids = !a.no_triangle_ids;
+  limits.build_threads = a.build_threads;
   return load_mesh_or_blob(path, [&](const Mesh& mesh, BuildReport* r) {
     AutoChoice choice = choose_layout(mesh, limits, path);
     std::fprintf(report, "%s", describe(limits, choice).c_str());
@@ -159,6 +163,7 @@ BuildOptions build_options(const LayoutArgs& a) {
   o.pairing = a.pairing;
   o.triangle_ids = !a.no_triangle_ids;
   o.zbt_shuffle = !a.zbt_no_shuffle, o.zbt_box_cache = !a.zbt_no_cache, o.hybrid_leaf = a.hybrid_leaf;
+  o.threads = a.build_threads;
   return o;
 }
 

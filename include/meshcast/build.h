@@ -116,6 +116,10 @@ struct BuildOptions {
   // The remap section, which turns a hit's slot into the caller's triangle
   // number. false: left out, hits name triangles by their slot in the blob.
   bool triangle_ids = true;
+  // Threads the build may use at once, the caller's among them (0: one a
+  // hardware thread). The blob is the same bytes on any number: the tree
+  // is split into parts that are put together in one order.
+  uint32_t threads = 0;
 };
 
 // What a build did, for those who ask.

@@ -22,6 +22,10 @@ class Peer {
   // rtcOccluded1, which names no triangle: an occluded ray's hit is t 0,
   // triangle 0).
   virtual void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query = Query::Closest) const = 0;
+  // The same answers on `threads` threads, the peer's own way of spreading
+  // rays over cores.
+  virtual void trace_on_cores(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query,
+                              uint32_t threads) const = 0;
 };
 
 // Embree 3 (libembree-dev) builds: Default (its fast mode, the default scene

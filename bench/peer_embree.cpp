@@ -2,8 +2,13 @@
 // (Embree reads our arrays), rtcIntersect1 per ray, Embree's own memory
 // counted through the device's memory monitor.
 #include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <atomic>
+#include <map>
+#include <memory>
 #include <chrono>
 
 #include "bench/peer.h"
@@ -73,10 +78,27 @@ class Embree final : public Peer {
   double build_ms() const override { return build_ms_; }
   uint64_t bytes() const override { return uint64_t(bytes_.load()) + mesh_bytes_; }
   void trace(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query) const override {
+    trace_range(rays, hits, query, 0, rays.size());
+  }
+  void trace_on_cores(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query, uint32_t threads) const override {
+    // Embree's own way: its rays spread by a TBB loop, in an arena of
+    // `threads` (TBB's workers, as Embree's build uses), kept from call to
+    // call as a game would keep it.
+    std::unique_ptr<tbb::task_arena>& arena = arenas_[threads];
+    if (!arena) arena = std::make_unique<tbb::task_arena>(static_cast<int>(threads));
+    arena->execute([&] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        trace_range(rays, hits, query, r.begin(), r.end());
+      });
+    });
+  }
+
+ private:
+  void trace_range(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query, size_t begin, size_t end) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     if (query == Query::Any) {
-      for (size_t i = 0; i < rays.size(); ++i) {
+      for (size_t i = begin; i < end; ++i) {
         const Ray& r = rays[i];
         RTCRay ray{};
         ray.org_x = r.org[0], ray.org_y = r.org[1], ray.org_z = r.org[2];
@@ -87,7 +109,7 @@ class Embree final : public Peer {
       }
       return;
     }
-    for (size_t i = 0; i < rays.size(); ++i) {
+    for (size_t i = begin; i < end; ++i) {
       const Ray& r = rays[i];
       RTCRayHit rh{};
       rh.ray.org_x = r.org[0], rh.ray.org_y = r.org[1], rh.ray.org_z = r.org[2];
@@ -99,8 +121,8 @@ class Embree final : public Peer {
     }
   }
 
- private:
   EmbreeMode mode_;
+  mutable std::map<uint32_t, std::unique_ptr<tbb::task_arena>> arenas_;  // by thread count
   std::vector<float> vertices_;
   std::vector<unsigned> indices_;
   uint64_t mesh_bytes_ = 0;

@@ -17,6 +17,7 @@
 #include "layout/queries.h"
 #include "meshcast/blob.h"
 #include "meshcast/build.h"
+#include "meshcast/caster.h"
 
 namespace meshcast::bench {
 
@@ -41,7 +42,8 @@ struct Contender {
 
 }  // namespace
 
-std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& o) {
+std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& o,
+                                 std::vector<CoreRow>* cores) {
   const double triangles = double(mesh.triangles.size());
   std::vector<RayKind> kinds;
   for (const std::string& k : o.kinds) kinds.push_back(parse_ray_kind(k));
@@ -146,6 +148,69 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
         const double ns = ms_since(t0) * 1e6 / double(o.rays);
         if (round > 0) c.ns[s].push_back(ns);  // round 0 warms the caches
       }
+
+  // The multi-core rows: the first layout through a Caster's CPU pool and
+  // Embree default through TBB, each on one thread and on every core, in
+  // interleaved rounds of their own; closest and any only (Embree answers
+  // no others).
+  if (cores && o.cores && !o.layouts.empty()) {
+    const uint32_t every = std::max(1u, std::thread::hardware_concurrency());
+    struct Runner {
+      std::string contender;
+      uint32_t threads;
+      std::function<void(const std::vector<Ray>&, std::vector<Hit>&, Query)> trace;
+    };
+    std::vector<std::unique_ptr<host::Caster>> casters;
+    std::vector<Runner> runners;
+    for (uint32_t threads : {1u, every}) {
+      host::CasterOptions co;
+      co.backend = host::Backend::Cpu, co.threads = threads;
+      casters.push_back(std::make_unique<host::Caster>(std::span<const uint8_t>(aligned[0].get(), blobs[0].size()), name, co));
+      host::Caster* c = casters.back().get();
+      runners.push_back({o.layouts[0] + " (Caster, CPU)", threads, [c](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
+                           c->wait(c->submit(r, host::BatchQuery{q}), h);
+                         }});
+    }
+    // Embree on a device of every core: a device of one thread (the
+    // single-thread rows') caps TBB's parallelism for the whole process
+    // while it lives, so those go first. (Their rows are measured.)
+    std::unique_ptr<Peer> embree_all;
+    if (!peers.empty()) {
+      for (Contender& c : all)
+        if (c.is_peer) c.trace = nullptr;
+      peers.clear();
+      embree_all = make_embree(mesh, EmbreeMode::Default, 0);
+    }
+    if (embree_all)
+      for (uint32_t threads : {1u, every}) {
+        const Peer* p = embree_all.get();
+        runners.push_back({p->name() + " (TBB)", threads, [p, threads](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
+                             p->trace_on_cores(r, h, q, threads);
+                           }});
+      }
+    for (size_t k = 0; k < kinds.size(); ++k)
+      for (size_t q = 0; q < queries.size(); ++q) {
+        const Query query = queries[q].query;
+        if ((query != Query::Closest && query != Query::Any) || queries[q].cull != Cull::None) continue;
+        std::vector<std::vector<double>> seconds(runners.size());
+        for (uint32_t round = 0; round < o.rounds + 1; ++round)
+          for (size_t i = 0; i < runners.size(); ++i) {
+            const auto t0 = std::chrono::steady_clock::now();
+            runners[i].trace(rays[k], hits, query);
+            if (round > 0) seconds[i].push_back(ms_since(t0) / 1e3);
+          }
+        std::vector<CoreRow> set_rows;
+        for (size_t i = 0; i < runners.size(); i += 2) {
+          CoreRow r{name, o.kinds[k], o.queries[q], runners[i].contender, every};
+          r.rays_per_s_one = double(o.rays) / median(seconds[i]);
+          r.rays_per_s_all = double(o.rays) / median(seconds[i + 1]);
+          set_rows.push_back(r);
+        }
+        if (embree_all)  // the last pair is Embree default
+          for (CoreRow& r : set_rows) r.ratio_all = set_rows.back().rays_per_s_all / r.rays_per_s_all;
+        cores->insert(cores->end(), set_rows.begin(), set_rows.end());
+      }
+  }
 
   // A counting build (MESHCAST_COUNT_TESTS) also reports each meshcast
   // layout's box and triangle tests a ray, from one more pass (its times are

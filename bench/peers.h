@@ -17,7 +17,7 @@ struct PeerRow {
   double ratio = 0;           // to Embree default on the same mesh and rays (0 without Embree)
   double bytes_per_triangle;  // all included: the blob with its remap; Embree's scene and the mesh it keeps
   double build_ms_one = 0;    // one thread
-  double build_ms_all = 0;    // all cores (meshcast's builder is serial: the same build)
+  double build_ms_all = 0;    // every core (BuildOptions::threads 0; Embree's threads)
   // closest, any (Embree: rtcOccluded1), all (every hit, rows of 16) or
   // closest-back (back faces culled): Embree rows for the first two only
   // (its culling is a compile-time option), so `ratio` is 0 for the others.
@@ -26,17 +26,33 @@ struct PeerRow {
   double ratio_high = 0;          // to Embree's high-quality build (RTC_BUILD_QUALITY_HIGH), as `ratio`
 };
 
+// A multi-core row: rays a second on one thread and on every core, the
+// same rays and query. meshcast: the Caster's CPU batch (its own pool of
+// `threads` workers); Embree: a TBB loop over rtcIntersect1 or
+// rtcOccluded1 in an arena of that many threads.
+struct CoreRow {
+  std::string mesh, kind, query, contender;
+  uint32_t cores = 0;             // "every core": the hardware threads
+  double rays_per_s_one = 0;      // median of the rounds
+  double rays_per_s_all = 0;
+  double scaling() const { return rays_per_s_one > 0 ? rays_per_s_all / rays_per_s_one : 0; }
+  double ratio_all = 0;           // time on every core / Embree default's on every core (0 without Embree)
+};
+
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
   std::vector<std::string> kinds = {"long", "probe", "radial"};  // ray kinds measured
   std::vector<std::string> queries = {"closest", "any"};          // each kind under each query (see PeerRow)
   size_t rays = 10000;               // a set, for each kind
   uint32_t rounds = 7;
+  bool cores = true;                 // the multi-core rows (the first layout and Embree default)
 };
 
 // The meshcast layouts `bench peers` measures unless told otherwise.
 std::vector<std::string> default_peer_layouts();
 
-std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& options);
+// `cores`: the multi-core rows are appended there (when options.cores).
+std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& options,
+                                 std::vector<CoreRow>* cores = nullptr);
 
 }  // namespace meshcast::bench

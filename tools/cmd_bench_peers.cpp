@@ -27,6 +27,7 @@ void add_bench_peers(CLI::App* bench) {
     std::string layouts, kinds = "long,probe,radial", queries = "closest,any", out_dir = "out";
     size_t rays = 10000;
     uint32_t rounds = 7;
+    bool no_cores = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = bench->add_subcommand("peers", "meshcast's layouts beside Embree's default, high-quality, robust and compact builds");
@@ -39,7 +40,10 @@ void add_bench_peers(CLI::App* bench) {
                   "(default: closest,any)");
   cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(integer_in(100, 1000000));
   cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(integer_in(1, 100));
-  cmd->add_option("--out-dir", args->out_dir, "where peers.csv and peers.png go");
+  cmd->add_option("--out-dir", args->out_dir, "where peers.csv, cores.csv and peers.png go");
+  cmd->add_flag("--no-cores", args->no_cores,
+                "leave out the multi-core rows (the first layout through the Caster's CPU workers and Embree default "
+                "through a TBB loop, rays a second on one thread and on every core)");
   cmd->callback([args] {
     bench::PeersOptions o;
     o.layouts = args->layouts.empty() ? bench::default_peer_layouts() : split(args->layouts);
@@ -47,12 +51,14 @@ void add_bench_peers(CLI::App* bench) {
     o.queries = split(args->queries);
     for (const std::string& q : o.queries) layout::query_spec_named(q, "--queries");  // refused before any build
     o.rays = args->rays, o.rounds = args->rounds;
+    o.cores = !args->no_cores;
     std::filesystem::create_directories(args->out_dir);
     std::vector<bench::PeerRow> rows;
+    std::vector<bench::CoreRow> core_rows;
     for (const std::string& input : split(args->meshes)) {
       Mesh mesh = bench_mesh(input);
       std::fprintf(stderr, "%s: %zu triangles\n", input.c_str(), mesh.triangles.size());
-      std::vector<bench::PeerRow> r = bench::bench_peers(mesh, std::filesystem::path(input).stem().string(), o);
+      std::vector<bench::PeerRow> r = bench::bench_peers(mesh, std::filesystem::path(input).stem().string(), o, &core_rows);
       rows.insert(rows.end(), r.begin(), r.end());
     }
     std::printf("\n%s; one thread tracing, %zu rays a set, median of %u interleaved rounds; ratio: to Embree default "
@@ -85,6 +91,24 @@ void add_bench_peers(CLI::App* bench) {
       ++counted[r.contender];
     }
     csv.commit();
+    if (!core_rows.empty()) {
+      const uint32_t every = core_rows[0].cores;
+      std::printf("\nEvery core (%u hardware threads) against one, the same rays: meshcast's Caster (its CPU workers, "
+                  "Backend::Cpu) and Embree default (a TBB loop over rtcIntersect1 / rtcOccluded1), median of %u "
+                  "interleaved rounds; ratio: time on every core to Embree default's on every core\n\n"
+                  "| mesh | rays | query | contender | Mrays/s, 1 thread | Mrays/s, %u threads | scaling | ratio |\n"
+                  "|---|---|---|---|---:|---:|---:|---:|\n",
+                  every, o.rounds, every);
+      OutputText cores_csv(args->out_dir + "/cores.csv");
+      cores_csv << "mesh,rays,query,contender,cores,rays_per_s_one_thread,rays_per_s_all_cores,scaling,ratio_to_embree_all_cores\n";
+      for (const bench::CoreRow& r : core_rows) {
+        std::printf("| %s | %s | %s | %s | %.2f | %.2f | %.2f | %.2f |\n", r.mesh.c_str(), r.kind.c_str(), r.query.c_str(),
+                    r.contender.c_str(), r.rays_per_s_one / 1e6, r.rays_per_s_all / 1e6, r.scaling(), r.ratio_all);
+        cores_csv << r.mesh << "," << r.kind << "," << r.query << "," << r.contender << "," << r.cores << ","
+                  << r.rays_per_s_one << "," << r.rays_per_s_all << "," << r.scaling() << "," << r.ratio_all << "\n";
+      }
+      cores_csv.commit();
+    }
     bench::Series meshcast{"meshcast", {}}, embree{"Embree", {}};
     for (const std::string& c : order) {
       const double n = counted[c];

@@ -195,6 +195,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
         if ((query != Query::Closest && query != Query::Any) || queries[q].cull != Cull::None) continue;
         // A batch of at least kCoreBatch rays (the set repeated): a few
         // milliseconds of work on two cores is within a thread's wake-up.
+        if (rays[k].empty()) continue;
         std::vector<Ray> batch;
         while (batch.size() < kCoreBatch) batch.insert(batch.end(), rays[k].begin(), rays[k].end());
         std::vector<Hit> batch_hits(batch.size());

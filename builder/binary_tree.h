@@ -13,6 +13,17 @@
 
 namespace meshcast {
 
+// Box3::half_area, inline for the builder's loops (the library is built
+// without contracted multiply-adds; the public one stays out of line so a
+// caller's copy cannot round it another way). In double: float products of
+// extents near 1e-30 underflow to 0 (every split then costs the same and
+// the tree degenerates into a chain), and near 1e20 they overflow.
+inline double box_half_area(const Box3& b) {
+  if (b.empty()) return 0.0;
+  const double x = double(b.max.x) - b.min.x, y = double(b.max.y) - b.min.y, z = double(b.max.z) - b.min.z;
+  return x * y + y * z + z * x;
+}
+
 struct BuildNode {
   Box3 box;
   uint32_t left = 0, right = 0;  // children (interior nodes)

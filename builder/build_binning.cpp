@@ -84,7 +84,7 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
     for (int b = kBins - 1; b > 0; --b) {
       acc.grow(bin_box[axis][b].box());
       n += bin_count[axis][b];
-      right_area[b] = acc.half_area(), right_count[b] = n;
+      right_area[b] = box_half_area(acc), right_count[b] = n;
     }
     acc = Box3{};
     n = 0;
@@ -92,7 +92,7 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
       acc.grow(bin_box[axis][b].box());
       n += bin_count[axis][b];
       if (n == 0 || right_count[b + 1] == 0) continue;
-      double cost = acc.half_area() * n + right_area[b + 1] * right_count[b + 1];
+      double cost = box_half_area(acc) * n + right_area[b + 1] * right_count[b + 1];
       if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = b;
     }
   }

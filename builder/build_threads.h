@@ -9,11 +9,13 @@
 #include <cstdint>
 #include <exception>
 #include <mutex>
-#include <system_error>
 #include <thread>
 #include <vector>
 
 namespace meshcast {
+
+// The most BuildOptions::threads may ask for.
+constexpr uint32_t kMaxBuildThreads = 1024;
 
 class BuildThreads {
  public:
@@ -22,31 +24,31 @@ class BuildThreads {
       : total_(threads ? threads : std::max(1u, std::thread::hardware_concurrency())), spare_(int(total_) - 1) {}
   uint32_t total() const { return total_; }
 
-  // Runs side() on a thread of its own when one is spare, else at once on
-  // the caller's; then main() on the caller's; returns when both are done.
-  // An exception from either is rethrown here (side()'s first).
+  // Runs main() on the caller's thread and side() beside it, on a thread
+  // of its own when one is spare (else after main(), on the caller's);
+  // returns when both are done. main()'s exception is rethrown first, as
+  // a one-thread build, which builds main()'s part first, would raise it.
   template <class Side, class Main>
   void fork(Side&& side, Main&& main) {
-    if (!take_spare()) {
-      side();
-      main();
-      return;
-    }
-    std::exception_ptr side_error;
     std::thread worker;
-    try {
-      worker = std::thread([&] {
-        try {
-          side();
-        } catch (...) {
-          side_error = std::current_exception();
-        }
+    std::exception_ptr side_error;
+    if (take_spare()) {
+      try {
+        worker = std::thread([&] {
+          try {
+            side();
+          } catch (...) {
+            side_error = std::current_exception();
+          }
+          spare_.fetch_add(1);
+        });
+      } catch (...) {  // no thread to be had: the caller does both
         spare_.fetch_add(1);
-      });
-    } catch (const std::system_error&) {  // no thread to be had: the caller does both
-      spare_.fetch_add(1);
-      side();
+      }
+    }
+    if (!worker.joinable()) {
       main();
+      side();
       return;
     }
     std::exception_ptr main_error;
@@ -55,9 +57,13 @@ class BuildThreads {
     } catch (...) {
       main_error = std::current_exception();
     }
+    // While it waits this thread runs nothing: its slot is spare meanwhile
+    // (the side's own splits may fork into it).
+    spare_.fetch_add(1);
     worker.join();
-    if (side_error) std::rethrow_exception(side_error);
+    spare_.fetch_sub(1);
     if (main_error) std::rethrow_exception(main_error);
+    if (side_error) std::rethrow_exception(side_error);
   }
 
   // fn(i) for every i in [0, count), in chunks of `grain` handed out in
@@ -85,7 +91,7 @@ class BuildThreads {
     workers.reserve(helpers);
     try {
       for (uint32_t k = 0; k < helpers; ++k) workers.emplace_back(run);
-    } catch (const std::system_error&) {  // fewer threads than asked: those started share the work
+    } catch (...) {  // fewer threads than asked: those started share the work
     }
     run();
     for (std::thread& w : workers) w.join();

@@ -220,6 +220,9 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
   BuildOptions o = options;
   if (o.leaf_size == 0) o.leaf_size = default_leaf_size(o.layout);
   check_mesh(mesh, name);
+  if (o.threads > kMaxBuildThreads)
+    throw InputError(name + ": " + std::to_string(o.threads) + " build threads asked for, more than the " +
+                     std::to_string(kMaxBuildThreads) + " a build takes (0: one a core)");
   if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
     return build_zerobyte_blob(mesh, o, name, report);
   if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)

@@ -4,7 +4,11 @@
 #include <cmath>
 #include <cstring>
 
+#include "builder/binary_tree.h"
+
 namespace meshcast {
+
+double Box3::half_area() const { return box_half_area(*this); }
 
 double Box3::diagonal() const {
   Vec3 e = extent();

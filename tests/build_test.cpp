@@ -2,11 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <functional>
 #include <set>
 
 #include "builder/binary_tree.h"
+#include "builder/build_threads.h"
 #include "check/generate.h"
 #include "layout/blob_format.h"
 #include "layout/leaves.h"
@@ -197,7 +199,7 @@ TEST(Build, TwoMillionTriangleTerrainBuildsAndValidates) {
 // The build's threads never change the blob: every layout, splitter and
 // pairing builds to the same bytes on one thread and on several (the mesh is
 // large enough that the tree is split across threads and leaves are encoded
-// at once), and an error raised on another thread reaches the caller whole.
+// at once), and a refused build is refused the same way on any number.
 TEST(Build, AnyNumberOfThreadsBuildsTheSameBytes) {
   const Mesh m = make_terrain(96, 96, 3);  // 18,432 triangles
   auto bytes = [&](BuildOptions o, uint32_t threads) {
@@ -238,6 +240,48 @@ TEST(Build, AnyNumberOfThreadsBuildsTheSameBytes) {
   }
   EXPECT_NE(one_thread.find("raise the depth limit"), std::string::npos) << one_thread;
   EXPECT_EQ(many, one_thread);
+}
+
+// What a build's thread throws reaches the caller, the caller's own part's
+// first (as a one-thread build, which builds that part first, raises it),
+// and the threads are all there for the next fork.
+TEST(BuildThreads, ExceptionsReachTheCallerAndNoThreadIsLost) {
+  BuildThreads threads(4);
+  auto message = [](auto&& call) {
+    try {
+      call();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("nothing thrown");
+  };
+  EXPECT_EQ(message([&] { threads.fork([] { throw InputError("side"); }, [] {}); }), "side");
+  EXPECT_EQ(message([&] { threads.fork([] {}, [] { throw InputError("main"); }); }), "main");
+  EXPECT_EQ(message([&] { threads.fork([] { throw InputError("side"); }, [] { throw InputError("main"); }); }), "main");
+  EXPECT_EQ(message([&] {
+              threads.for_each(100000, 64, [](uint64_t i) {
+                if (i == 77777) throw InputError("item " + std::to_string(i));
+              });
+            }),
+            "item 77777");
+  // Nested forks, as the tree build makes them, each side counted once.
+  std::atomic<int> ran{0};
+  std::function<void(int)> split = [&](int depth) {
+    if (depth == 0) {
+      ++ran;
+      return;
+    }
+    threads.fork([&] { split(depth - 1); }, [&] { split(depth - 1); });
+  };
+  split(6);
+  EXPECT_EQ(ran.load(), 64);
+  std::vector<uint64_t> out(10000, 0);
+  threads.for_each(out.size(), 7, [&](uint64_t i) { out[i] = i * i; });
+  for (uint64_t i = 0; i < out.size(); ++i) ASSERT_EQ(out[i], i * i);
+
+  BuildOptions too_many;
+  too_many.threads = kMaxBuildThreads + 1;
+  expect_throws<InputError>([&] { build_blob(make_grid_plane(4, 4), too_many, "grid"); }, {"grid", "1025", "1024"});
 }
 
 TEST(Build, RecommendedLayoutFitsSixteenBytesPerTriangleOnBunny) {

@@ -95,7 +95,9 @@ void add_bench_peers(CLI::App* bench) {
       const uint32_t every = core_rows[0].cores;
       std::printf("\nEvery core (%u hardware threads) against one, the same rays: meshcast's Caster (its CPU workers, "
                   "Backend::Cpu) and Embree default (a TBB loop over rtcIntersect1 / rtcOccluded1), batches of the "
-                  "set repeated to 100,000 rays or more, median of %u interleaved rounds; ratio: time on every core to Embree default's on every core\n\n"
+                  "set repeated to 100,000 rays or more, median of %u interleaved rounds (the Caster's times include "
+                  "its copies of the rays in and the hits out); ratio: time on every core to Embree default's on every "
+                  "core\n\n"
                   "| mesh | rays | query | contender | Mrays/s, 1 thread | Mrays/s, %u threads | scaling | ratio |\n"
                   "|---|---|---|---|---:|---:|---:|---:|\n",
                   every, o.rounds, every);

@@ -116,9 +116,11 @@ struct BuildOptions {
   // The remap section, which turns a hit's slot into the caller's triangle
   // number. false: left out, hits name triangles by their slot in the blob.
   bool triangle_ids = true;
-  // Threads the build may use at once, the caller's among them (0: one a
-  // hardware thread). The blob is the same bytes on any number: the tree
-  // is split into parts that are put together in one order.
+  // Threads the build may use at once, the caller's among them, at most
+  // 1024 (0: one a hardware thread). The blob is the same bytes on any
+  // number: the tree is split into parts that are put together in one
+  // order. Meshes under 16,384 triangles build on the caller's thread
+  // alone; a caller running several builds at once may give each 1.
   uint32_t threads = 0;
 };
 

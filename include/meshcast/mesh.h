@@ -35,14 +35,10 @@ struct Box3 {
   bool empty() const { return min.x > max.x; }
   Vec3 centre() const { return {0.5f * (min.x + max.x), 0.5f * (min.y + max.y), 0.5f * (min.z + max.z)}; }
   Vec3 extent() const { return {max.x - min.x, max.y - min.y, max.z - min.z}; }
-  // SAH cost unit: xy + yz + zx, in double: float products of extents near
-  // 1e-30 underflow to 0 (every split then costs the same and the tree
-  // degenerates into a chain), and near 1e20 they overflow.
-  double half_area() const {
-    if (empty()) return 0.0;
-    const double x = double(max.x) - min.x, y = double(max.y) - min.y, z = double(max.z) - min.z;
-    return x * y + y * z + z * x;
-  }
+  // SAH cost unit: xy + yz + zx, in double (1e-30 or 1e30 wide boxes).
+  // Out of line: a caller's copy compiled with fused multiply-adds would
+  // round it otherwise and change the tree the builder chooses.
+  double half_area() const;
   double diagonal() const;
 };
 

@@ -156,9 +156,8 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   if (cores && o.cores && !o.layouts.empty()) {
     constexpr size_t kCoreBatch = 100000;
     const uint32_t every = std::max(1u, std::thread::hardware_concurrency());
-    struct Runner {
+    struct Runner {  // one thread, then every core, for each contender
       std::string contender;
-      uint32_t threads;
       std::function<void(const std::vector<Ray>&, std::vector<Hit>&, Query)> trace;
     };
     std::vector<std::unique_ptr<host::Caster>> casters;
@@ -168,7 +167,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
       co.backend = host::Backend::Cpu, co.threads = threads;
       casters.push_back(std::make_unique<host::Caster>(std::span<const uint8_t>(aligned[0].get(), blobs[0].size()), name, co));
       host::Caster* c = casters.back().get();
-      runners.push_back({o.layouts[0] + " (Caster, CPU)", threads, [c](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
+      runners.push_back({o.layouts[0] + " (Caster, CPU)", [c](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
                            c->wait(c->submit(r, host::BatchQuery{q}), h);
                          }});
     }
@@ -185,7 +184,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     if (embree_all)
       for (uint32_t threads : {1u, every}) {
         const Peer* p = embree_all.get();
-        runners.push_back({p->name() + " (TBB)", threads, [p, threads](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
+        runners.push_back({p->name() + " (TBB)", [p, threads](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
                              p->trace_on_cores(r, h, q, threads);
                            }});
       }

@@ -86,10 +86,13 @@ struct Writer {
       return;
     }
     uint64_t slots = remap.size();
-    for (uint32_t n : leaves) slots = std::max<uint64_t>(slots, (at[n] - h.triangle_base) / h.slot_divisor + tree.nodes[n].count);
+    for (uint32_t n : leaves) slots = std::max<uint64_t>(slots, first_slot(at[n]) + tree.nodes[n].count);
     remap.resize(slots, MC_NO_HIT);  // write_leaf then only writes its own slots
     threads->for_each(leaves.size(), kGrain, [&](uint64_t i) { write_leaf(leaves[i], at[leaves[i]]); });
   }
+
+  // The slot of the first triangle of a block at tree-section offset `at`.
+  uint32_t first_slot(uint32_t at) const { return (at - h.triangle_base) / h.slot_divisor; }
 
   // Encodes leaf node n's triangles at tree-section offset `at`. The codec
   // hands back the triangles as stored (its order, its decoded corners): the
@@ -100,7 +103,7 @@ struct Writer {
     std::vector<layout::TriCorners> tris = leaf_triangles(n);
     layout::BlockContext ctx{h.tree_offset + at, h.vertex_offset, &pool, &last_index, h.quant_scale, &max_block_shift, &h};
     codec.encode(tris.data(), leaf.count, ctx, bytes.data() + h.tree_offset + at);
-    uint32_t slot0 = (at - h.triangle_base) / h.slot_divisor;
+    uint32_t slot0 = first_slot(at);
     if (remap.size() < slot0 + leaf.count) remap.resize(slot0 + leaf.count, MC_NO_HIT);
     leaf.box = Box3{};
     for (uint32_t i = 0; i < leaf.count; ++i) {

@@ -8,7 +8,7 @@
 #include "builder/pairing.h"
 #include "check/ray_files.h"
 #include "check/generate.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "meshcast/errors.h"
 
 namespace meshcast::bench {

@@ -16,7 +16,7 @@
 #include "meshcast/mesh.h"
 #include "meshcast/blob.h"
 #include "fuzz/rays.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "layout/blob_format.h"
 
 using namespace meshcast;

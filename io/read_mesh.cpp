@@ -31,7 +31,7 @@
 // is used, which restores OBJ's shared vertices faithfully. Points and lines
 // are ignored; a file with only those is an error. Assimp's logging stays off:
 // we never create a DefaultLogger, so it uses its NullLogger.
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 
 #include "layout/files.h"
 

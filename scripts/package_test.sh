@@ -1,33 +1,130 @@
 #!/usr/bin/env bash
-# The package as users meet it, from the Release build in build/:
-#  1. `cmake --install` into a scratch prefix; examples/ configured as a
-#     separate project against it (find_package(meshcast CONFIG REQUIRED)),
-#     built and run (each checks its own hits and exits non-zero if wrong);
-#  2. the same examples compiled by hand with pkg-config's flags, and run;
-#  3. tests/consumer: meshcast through add_subdirectory with every package
-#     but the core's disabled (configuring fails if it reaches for one),
-#     built and run.
+# The package as users meet it:
+#  1. the Release build in build/ installed to a scratch prefix; the README's
+#     first program (the text between its markers) built with nothing but
+#     find_package(meshcast REQUIRED), while every package meshcast's other
+#     parts use is disabled (Assimp, Vulkan, CLI11, libpng, JSON,
+#     GoogleTest); the reader component, asked for, finds Assimp and reads
+#     a mesh file; an unknown component is refused;
+#  2. examples/ configured as a separate project against the same prefix,
+#     built and run (each checks its own hits and exits non-zero if wrong),
+#     and compiled by hand with pkg-config's flags;
+#  3. a library-only build (no reader, Vulkan, tools or tests; those
+#     packages disabled) installed to a prefix of its own, as a user without
+#     root would, and the README's program built against it; the reader
+#     component is refused there, naming the option that builds it;
+#  4. tests/consumer: meshcast through add_subdirectory with every package
+#     but the core's disabled (configuring fails if it reaches for one).
+# The library-only build compiles the scalar walkers alone: what it checks
+# is configuration, installation and targets (the installed package of
+# step 1 has every instruction set), at a third of the time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-prefix=$tmp/prefix
+disabled=()
+for pkg in assimp Vulkan VulkanHeaders CLI11 PNG nlohmann_json GTest embree; do
+  disabled+=("-DCMAKE_DISABLE_FIND_PACKAGE_$pkg=ON")
+done
 
+# The README's first program and a scratch project that asks for
+# `components` (a CMake list; empty: none named).
+awk '/<!-- first program begins/ {on = 1; next} /<!-- first program ends/ {on = 0} on && !/^```/' README.md > "$tmp/first.cpp"
+[[ $(wc -l < "$tmp/first.cpp") -ge 10 ]] || { echo "FAIL: no first program between the README's markers"; exit 1; }
+scratch() {  # scratch DIR COMPONENTS TARGETS SOURCE...
+  local dir=$1 components=$2 targets=$3
+  shift 3
+  mkdir -p "$dir"
+  cp "$@" "$dir/"
+  local find="find_package(meshcast REQUIRED)"
+  [[ -n $components ]] && find="find_package(meshcast REQUIRED COMPONENTS $components)"
+  {
+    echo "cmake_minimum_required(VERSION 3.25)"
+    echo "project(scratch LANGUAGES CXX)"
+    echo "$find"
+    for s in "$@"; do
+      echo "add_executable($(basename "${s%.cpp}") $(basename "$s"))"
+      echo "target_link_libraries($(basename "${s%.cpp}") PRIVATE $targets)"
+    done
+  } > "$dir/CMakeLists.txt"
+}
+run_first() {  # run_first BUILD_DIR LABEL: the program saves a blob in its folder
+  (cd "$1" && ./first > first.out) || { echo "FAIL: the README's first program ($2)"; cat "$1/first.out"; exit 1; }
+  echo "  $2: the README's first program: $(tail -1 "$1/first.out")"
+}
+
+# 1. The whole package, used for its core alone with the other packages gone.
+prefix=$tmp/prefix
 cmake --install build --prefix "$prefix" >/dev/null
+scratch "$tmp/core" "" meshcast::meshcast "$tmp/first.cpp"
+cmake --no-warn-unused-cli -S "$tmp/core" -B "$tmp/core/build" -DCMAKE_PREFIX_PATH="$prefix" "${disabled[@]}" >/dev/null
+cmake --build "$tmp/core/build" -j"$jobs" >/dev/null
+run_first "$tmp/core/build" "find_package, no Assimp, Vulkan, CLI11, libpng"
+# The reader component: Assimp is looked for (and refused while disabled).
+cat > "$tmp/read_off.cpp" <<'CPP'
+#include <meshcast/meshcast.h>
+#include <meshcast/read.h>
+
+#include <cstdio>
+
+int main(int argc, char** argv) {
+  const meshcast::Mesh mesh = meshcast::read_mesh(argv[1]);
+  const std::vector<uint8_t> blob = meshcast::build_blob(mesh, {}, argv[1]);
+  const meshcast::Ray down{.org = {0.25f, 0.25f, 1}, .dir = {0, 0, -1}, .tmax = INFINITY};
+  meshcast::Hit hit;
+  meshcast::BlobView(blob, argv[1]).trace({&down, 1}, {&hit, 1});
+  std::printf("%zu triangles read; the ray hits triangle %u\n", mesh.triangles.size(), hit.triangle);
+  return mesh.triangles.size() == 2 && hit.triangle == 0 ? 0 : 1;
+}
+CPP
+printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n' > "$tmp/two.off"
+scratch "$tmp/reader" reader meshcast::reader "$tmp/read_off.cpp"
+if cmake -S "$tmp/reader" -B "$tmp/reader/off" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON \
+     > "$tmp/reader.log" 2>&1; then
+  echo "FAIL: the reader component configured without Assimp"; exit 1
+fi
+cmake -S "$tmp/reader" -B "$tmp/reader/build" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+cmake --build "$tmp/reader/build" -j"$jobs" >/dev/null
+echo "  find_package COMPONENTS reader: $("$tmp/reader/build/read_off" "$tmp/two.off")"
+scratch "$tmp/unknown" "bogus" meshcast::meshcast "$tmp/first.cpp"
+if cmake -S "$tmp/unknown" -B "$tmp/unknown/build" -DCMAKE_PREFIX_PATH="$prefix" > "$tmp/unknown.log" 2>&1 ||
+   ! grep -q "no component 'bogus'" "$tmp/unknown.log"; then
+  echo "FAIL: an unknown component was not refused by name"; cat "$tmp/unknown.log"; exit 1
+fi
+
+# 2. The examples, through CMake and through pkg-config.
 cmake -S examples -B "$tmp/examples" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$tmp/examples" -j"$jobs" >/dev/null
 for e in build_and_trace frame_ahead; do echo "  find_package: $("$tmp/examples/$e" | tail -1)"; done
 echo "  find_package: $(cd "$tmp" && "$tmp/examples/saved_blob" | tail -1)"
-
 export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
 g++ -O2 -o "$tmp/pc_build_and_trace" examples/build_and_trace.cpp $(pkg-config --cflags --libs meshcast)
 g++ -O2 -o "$tmp/pc_frame_ahead" examples/frame_ahead.cpp $(pkg-config --cflags --libs meshcast-host)
+g++ -O2 -o "$tmp/pc_read_off" "$tmp/read_off.cpp" $(pkg-config --cflags --libs meshcast-reader)
 for e in build_and_trace frame_ahead; do echo "  pkg-config: $("$tmp/pc_$e" | tail -1)"; done
+echo "  pkg-config meshcast-reader: $("$tmp/pc_read_off" "$tmp/two.off")"
+unset PKG_CONFIG_PATH
 
-# The subproject with the scalar walkers alone: what is checked here is the
-# subproject's configuration and targets (the installed package above has
-# every instruction set), and one set compiles in a third of the time.
-cmake -S tests/consumer -B "$tmp/consumer" -DMESHCAST_SOURCE="$PWD" -DCMAKE_BUILD_TYPE=Release -DMESHCAST_ISAS=scalar >/dev/null
-cmake --build "$tmp/consumer" -j"$jobs" >/dev/null
-for e in build_and_trace frame_ahead; do echo "  add_subdirectory: $("$tmp/consumer/$e" | tail -1)"; done
+# 3. The library alone, built and installed without root.
+home=$tmp/home
+cmake --no-warn-unused-cli -S . -B "$tmp/libonly" -DCMAKE_BUILD_TYPE=Release -DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF \
+      -DMESHCAST_READER=OFF -DMESHCAST_TOOLS=OFF -DMESHCAST_TESTS=OFF "${disabled[@]}" >/dev/null
+cmake --build "$tmp/libonly" -j"$jobs" > "$tmp/libonly.log" 2>&1 || { cat "$tmp/libonly.log"; exit 1; }
+cmake --install "$tmp/libonly" --prefix "$home/.local" >/dev/null
+scratch "$tmp/alone" "" meshcast::meshcast "$tmp/first.cpp"
+cmake --no-warn-unused-cli -S "$tmp/alone" -B "$tmp/alone/build" -DCMAKE_PREFIX_PATH="$home/.local" "${disabled[@]}" >/dev/null
+cmake --build "$tmp/alone/build" -j"$jobs" >/dev/null
+run_first "$tmp/alone/build" "a library-only build in ~/.local"
+scratch "$tmp/alone_reader" reader meshcast::reader "$tmp/read_off.cpp"
+if cmake -S "$tmp/alone_reader" -B "$tmp/alone_reader/build" -DCMAKE_PREFIX_PATH="$home/.local" \
+     > "$tmp/alone_reader.log" 2>&1 || ! grep -q "MESHCAST_READER=ON" "$tmp/alone_reader.log"; then
+  echo "FAIL: a library-only package did not refuse the reader component by name"; cat "$tmp/alone_reader.log"; exit 1
+fi
+
+# 4. The subproject: configured and generated with every other package
+# disabled (generating fails if a target the examples link is missing).
+# Its compile is step 3's (the same sources, options and walkers).
+cmake -S tests/consumer -B "$tmp/consumer" -DMESHCAST_SOURCE="$PWD" -DCMAKE_BUILD_TYPE=Release -DMESHCAST_ISAS=scalar \
+      > "$tmp/consumer.log" 2>&1 || { echo "FAIL: meshcast as a subproject"; cat "$tmp/consumer.log"; exit 1; }
+echo "  add_subdirectory: configured with only the core's packages; meshcast::meshcast and meshcast::host linked"

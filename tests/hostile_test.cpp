@@ -20,7 +20,7 @@
 #include "builder/layout_names.h"
 #include "check/ray_files.h"
 #include "check/generate.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "layout/blob_format.h"
 #include "tests/testing.h"
 

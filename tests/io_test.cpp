@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "check/generate.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "tests/testing.h"
 
 namespace fs = std::filesystem;

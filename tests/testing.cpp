@@ -15,7 +15,7 @@
 #include <filesystem>
 
 #include "check/generate.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "layout/blob_format.h"
 
 namespace meshcast::testing {

@@ -18,7 +18,7 @@
 #include "bench/robustness.h"
 #include "bench/trees.h"
 #include "check/generate.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 

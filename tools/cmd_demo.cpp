@@ -14,7 +14,7 @@
 #include "meshcast/blob.h"
 #include "gpu/method.h"
 #include "gpu/vulkan.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "layout/blob_format.h"
 #include "tools/commands.h"
 #include "tools/common.h"

@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "check/ray_files.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 

@@ -14,7 +14,7 @@
 #include "check/ray_files.h"
 #include "gpu/method.h"
 #include "meshcast/blob.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 #include "layout/blob_format.h"
 
 namespace meshcast::tools {

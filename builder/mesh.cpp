@@ -52,6 +52,22 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
   if (triangle_stride < 3 * index_bytes)
     throw InputError(name + ": triangle stride " + std::to_string(triangle_stride) + " is shorter than three " +
                      std::to_string(8 * index_bytes) + "-bit indices");
+  // Where a view states its buffers' sizes (the typed constructors do), the
+  // last vertex and triangle must lie inside them: a stride or index type
+  // that does not match the data reads past them otherwise.
+  auto past_end = [](size_t count, size_t stride, size_t element, size_t bytes) {
+    return bytes != 0 && count != 0 && (bytes < element || (count - 1) > (bytes - element) / stride);
+  };
+  if (past_end(view.vertex_count, view.vertex_stride, 12, view.positions_bytes))
+    throw InputError(name + ": the positions hold " + std::to_string(view.positions_bytes / sizeof(float)) +
+                     " floats, not " + std::to_string(view.vertex_count) + " vertices of 3 every " +
+                     std::to_string(view.vertex_stride / sizeof(float)) +
+                     " (the last vertex is cut short: check the stride and where the span starts)");
+  if (past_end(view.triangle_count, triangle_stride, 3 * index_bytes, view.indices_bytes))
+    throw InputError(name + ": the index buffer holds " + std::to_string(view.indices_bytes / index_bytes) + " " +
+                     std::to_string(8 * index_bytes) + "-bit indices, fewer than three for each of " +
+                     std::to_string(view.triangle_count) +
+                     " triangles (check the index type, and that the indices are whole triangles)");
   if (view.vertex_count > 0xFFFFFFFFu)
     throw InputError(name + ": " + std::to_string(view.vertex_count) + " vertices; 32-bit indices reach 2^32");
   Mesh mesh;

@@ -18,10 +18,7 @@ int main() {
       indices.insert(indices.end(), {v, uint16_t(v + 1), uint16_t(v + 4), v, uint16_t(v + 4), uint16_t(v + 3)});
     }
 
-  meshcast::MeshView mesh;
-  mesh.positions = xyz.data(), mesh.vertex_count = xyz.size() / 3;
-  mesh.indices = indices.data(), mesh.triangle_count = indices.size() / 3;
-  mesh.index_type = meshcast::IndexType::Uint16;
+  const meshcast::MeshView mesh(xyz, 3, indices);  // packed x y z; 16-bit indices deduced from the span
   try {
     const std::vector<uint8_t> blob = meshcast::build_blob(mesh, meshcast::BuildOptions{}, "floor");
     const meshcast::BlobView view(blob, "floor");

@@ -12,8 +12,7 @@ int main() {
   // would do the same).
   const std::vector<float> xyz = {-100, -100, 0, 100, -100, 0, 0, 100, 0};
   const std::vector<uint32_t> indices = {0, 1, 2};
-  meshcast::MeshView mesh;
-  mesh.positions = xyz.data(), mesh.vertex_count = 3, mesh.indices = indices.data(), mesh.triangle_count = 1;
+  const meshcast::MeshView mesh(xyz, 3, indices);
 
   try {
     const std::vector<uint8_t> blob = meshcast::build_blob(mesh, {}, "level");

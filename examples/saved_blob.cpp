@@ -12,8 +12,7 @@ int main(int argc, char** argv) {
     {  // the asset build: a unit square of two triangles, saved
       const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
       const std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
-      meshcast::MeshView mesh;
-      mesh.positions = xyz.data(), mesh.vertex_count = 4, mesh.indices = indices.data(), mesh.triangle_count = 2;
+      const meshcast::MeshView mesh(xyz, 3, indices);
       meshcast::BuildOptions options;
       options.layout = meshcast::parse_layout_name("AABBTree/Float3");
       meshcast::save_blob(path, meshcast::build_blob(mesh, options, "square"));

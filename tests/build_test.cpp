@@ -134,10 +134,11 @@ std::vector<std::set<uint32_t>> greedy_batches_by_hand(const std::vector<Box3>& 
   auto before = [&](uint32_t a, uint32_t b) { return c[a][axis] < c[b][axis] || (c[a][axis] == c[b][axis] && a < b); };
   std::vector<bool> used(boxes.size(), false);
   std::vector<std::set<uint32_t>> out;
-  for (size_t left = boxes.size(); left > 0;) {
+  for (;;) {
     uint32_t seed = ~0u;
     for (uint32_t i = 0; i < boxes.size(); ++i)
       if (!used[i] && (seed == ~0u || before(i, seed))) seed = i;
+    if (seed == ~0u) break;  // every box taken
     std::vector<uint32_t> rest;
     for (uint32_t i = 0; i < boxes.size(); ++i)
       if (!used[i] && i != seed) rest.push_back(i);
@@ -149,7 +150,6 @@ std::vector<std::set<uint32_t>> greedy_batches_by_hand(const std::vector<Box3>& 
     rest.resize(std::min<size_t>(rest.size(), batch - 1));
     rest.push_back(seed);
     for (uint32_t i : rest) used[i] = true;
-    left -= rest.size();
     out.emplace_back(rest.begin(), rest.end());
   }
   return out;
@@ -323,6 +323,60 @@ TEST(Build, BadMeshesAreRefusedWithTheirNameAndProblem) {
   BuildOptions big_leaf = parse_layout("QuadTree/Float3");
   big_leaf.leaf_size = 32;
   EXPECT_THROW(build_blob(ok, big_leaf, "grid"), InputError);
+}
+
+// A mesh from typed spans: interleaved vertices (position, normal, uv: 8
+// floats) and 16-bit indices build the same blob as the packed mesh, and a
+// stride or index buffer that does not fit the data is refused by name.
+TEST(Build, TypedMeshViewsDeduceSizesAndRefuseWrongStrides) {
+  const Mesh m = make_grid_plane(4, 3);
+  std::vector<float> interleaved;
+  for (const Vec3& v : m.vertices) interleaved.insert(interleaved.end(), {v.x, v.y, v.z, 0, 0, 1, 0.5f, 0.5f});
+  std::vector<uint16_t> short_indices;
+  std::vector<uint32_t> indices;
+  for (const Triangle& t : m.triangles)
+    for (uint32_t v : t) short_indices.push_back(uint16_t(v)), indices.push_back(v);
+  const std::vector<uint8_t> expected = build_blob(m, {}, "grid");
+  const MeshView interleaved16(interleaved, 8, short_indices);
+  EXPECT_EQ(interleaved16.vertex_count, m.vertices.size());
+  EXPECT_EQ(interleaved16.triangle_count, m.triangles.size());
+  EXPECT_EQ(build_blob(interleaved16, {}, "grid"), expected);
+  // The position third in a vertex: a subspan from the first vertex's x; the
+  // last vertex then ends 5 floats before the buffer does.
+  std::vector<float> normal_first;
+  for (const Vec3& v : m.vertices) normal_first.insert(normal_first.end(), {0, 0, 1, v.x, v.y, v.z, 0.5f, 0.5f});
+  EXPECT_EQ(build_blob(MeshView(std::span<const float>(normal_first).subspan(3), 8, indices), {}, "grid"), expected);
+
+  auto refusal = [](const MeshView& view) {
+    try {
+      build_blob(view, {}, "level.mesh");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("built");
+  };
+  // A stride under 3 floats, a last vertex cut short, indices that are not
+  // whole triangles.
+  const std::string under = refusal(MeshView(interleaved, 2, short_indices));
+  EXPECT_NE(under.find("level.mesh"), std::string::npos) << under;
+  EXPECT_NE(under.find("shorter than a position"), std::string::npos) << under;
+  std::vector<float> cut(interleaved.begin(), interleaved.end() - 6);  // the last vertex's x and y alone
+  const std::string short_vertex = refusal(MeshView(cut, 8, short_indices));
+  EXPECT_NE(short_vertex.find("level.mesh"), std::string::npos) << short_vertex;
+  EXPECT_NE(short_vertex.find("cut short"), std::string::npos) << short_vertex;
+  std::vector<uint16_t> ragged(short_indices.begin(), short_indices.end() - 1);
+  const std::string ragged_indices = refusal(MeshView(interleaved, 8, ragged));
+  EXPECT_NE(ragged_indices.find("whole triangles"), std::string::npos) << ragged_indices;
+  // By hand, with the sizes stated: the default 32-bit index type over a
+  // 16-bit buffer reads past its end and is refused.
+  MeshView by_hand;
+  by_hand.positions = interleaved.data(), by_hand.vertex_count = m.vertices.size(), by_hand.vertex_stride = 32;
+  by_hand.positions_bytes = interleaved.size() * sizeof(float);
+  by_hand.indices = short_indices.data(), by_hand.triangle_count = m.triangles.size();
+  by_hand.indices_bytes = short_indices.size() * sizeof(uint16_t);
+  EXPECT_NE(refusal(by_hand).find("32-bit indices, fewer than three"), std::string::npos) << refusal(by_hand);
+  by_hand.index_type = IndexType::Uint16;
+  EXPECT_EQ(build_blob(by_hand, {}, "grid"), expected);
 }
 
 // Format limits are build errors that name the limit.

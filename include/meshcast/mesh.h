@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,25 @@ constexpr float kMaxCoordinate = 0x1p100f;
 // `triangle_stride` bytes (0: the three indices packed, 6 or 12 bytes). An
 // engine's interleaved vertex buffer and its index buffer serve as they are;
 // build_blob reads them once and keeps nothing.
+//
+// Make it from typed spans where you can: the counts, the stride's unit and
+// the index type then come from the types, and the buffers' sizes are
+// checked (a wrong stride or index type is an error, not a wrong mesh):
+//
+//   // position, normal, uv interleaved: 8 floats a vertex; 16-bit indices
+//   meshcast::MeshView mesh(std::span<const float>(vertices), 8, std::span<const uint16_t>(indices));
+//
+// `positions` starts at the first vertex's x (take a subspan when the
+// position is not first in a vertex) and `stride` counts floats from one
+// vertex's x to the next (3 when packed). Every stride's start in the span
+// is a vertex, and the span must hold the last one's three floats; the
+// indices must be a whole number of triangles. A stride under 3 floats is
+// refused.
+//
+// Filled in by hand (the raw pointers, for buffers that are not floats),
+// the sizes stay 0 (unknown) and only the strides can be checked: set
+// `index_type` to the buffer's own (it defaults to 32-bit), and
+// `vertex_stride` in bytes.
 enum class IndexType : uint8_t { Uint16, Uint32 };
 struct MeshView {
   const void* positions = nullptr;
@@ -77,11 +97,33 @@ struct MeshView {
   size_t triangle_count = 0;
   IndexType index_type = IndexType::Uint32;
   size_t triangle_stride = 0;
+  // The bytes `positions` and `indices` hold, where known (0: unknown):
+  // copy_mesh refuses a view whose last vertex or triangle lies past them.
+  size_t positions_bytes = 0, indices_bytes = 0;
+
+  MeshView() = default;
+  MeshView(std::span<const float> positions, size_t stride, std::span<const uint32_t> indices)
+      : MeshView(positions, stride, indices.data(), indices.size(), IndexType::Uint32) {}
+  MeshView(std::span<const float> positions, size_t stride, std::span<const uint16_t> indices)
+      : MeshView(positions, stride, indices.data(), indices.size(), IndexType::Uint16) {}
+
+ private:
+  MeshView(std::span<const float> p, size_t stride, const void* i, size_t index_count, IndexType type)
+      : positions(p.data()),
+        // A stride of 0 is left for copy_mesh to refuse (shorter than a position).
+        vertex_count(stride ? (p.size() + stride - 1) / stride : 0),
+        vertex_stride(stride * sizeof(float)),
+        indices(i),
+        triangle_count((index_count + 2) / 3),
+        index_type(type),
+        positions_bytes(p.size() * sizeof(float)),
+        indices_bytes(index_count * (type == IndexType::Uint16 ? 2 : 4)) {}
 };
 
 // The view's mesh, copied into a Mesh and checked (check_mesh), named
 // `name` in messages; InputError also for a null array with a count, a
-// stride shorter than its element, or sizes beyond 2^32 vertices.
+// stride shorter than its element, a last vertex or triangle past the bytes
+// a view states, or sizes beyond 2^32 vertices.
 Mesh copy_mesh(const MeshView& view, const std::string& name);
 
 // Checks what every layout relies on: at least one triangle, every index in

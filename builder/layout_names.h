@@ -19,8 +19,11 @@ std::string node_order_refusal(uint32_t tree_format, NodeOrder order);
 
 // BuildOptions for the layout named "AABBTree/Float3" etc. (the layout's
 // own defaults: StacklessLBVH builds by Morton middle split), case-insensitive.
-// Throws InputError listing the valid names for anything else.
+// Throws InputError offering the closest names for anything else.
 BuildOptions parse_layout(const std::string& text);
+// The three layout names nearest `text` ("A, B or C"): a tree or triangle
+// format typed in part ("OctTree") counts as near its whole name.
+std::string closest_layouts(const std::string& text);
 std::string layout_name(uint32_t tree_format, uint32_t triangle_format);
 std::vector<std::string> layout_names();
 

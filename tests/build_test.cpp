@@ -379,6 +379,28 @@ TEST(Build, TypedMeshViewsDeduceSizesAndRefuseWrongStrides) {
   EXPECT_EQ(build_blob(by_hand, {}, "grid"), expected);
 }
 
+// A mistyped layout name is answered with the few nearest names, not the
+// whole list of some 200.
+TEST(LayoutNames, AnUnknownNameOffersTheClosestFew) {
+  auto refusal = [](const std::string& name) {
+    try {
+      parse_layout(name);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("parsed");
+  };
+  const std::string part = refusal("OctTree/Float3");  // the tree's name in part
+  EXPECT_NE(part.find("did you mean OctTreeCompressed/Float3,"), std::string::npos) << part;
+  const std::string typo = refusal("octtreecompressed/clusterbitpacksoa4");
+  EXPECT_NE(typo.find("did you mean OctTreeCompressed/ClusterBitPackSOA8"), std::string::npos) << typo;
+  const std::string half = refusal("ClusterBitPackSOA8");  // a triangle format alone
+  EXPECT_NE(half.find("did you mean AABBTree/ClusterBitPackSOA8"), std::string::npos) << half;
+  const std::string zero = refusal("ZeroByteTree/Float3");  // a tree that takes one triangle format
+  EXPECT_NE(zero.find("ZeroByteTree/Indexed24"), std::string::npos) << zero;
+  for (const std::string& m : {part, typo, half, zero}) EXPECT_LT(m.size(), 300u) << m;
+}
+
 // Format limits are build errors that name the limit.
 TEST(Build, SixteenBitIndicesRefuseMeshesBeyondTheirReach) {
   Mesh big = make_grid_plane(300, 300);  // 90,601 vertices

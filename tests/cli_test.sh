@@ -190,7 +190,7 @@ if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
 fi
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
-check unknown-layout 2 "valid layouts \\(TREE/TRIANGLES\\)" -- "$meshcast" info "$mesh" --layout OctTree/Float3
+check unknown-layout 2 "did you mean OctTreeCompressed/Float3" -- "$meshcast" info "$mesh" --layout OctTree/Float3
 check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
 check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
 check auto-speed 0 "chose OctTreeCompressed" -- "$meshcast" build "$mesh" --layout auto --out "$work/auto.blob"
@@ -205,7 +205,7 @@ check no-triangle-ids 0 "remap: none" -- "$meshcast" info "$mesh" --layout QuadT
 check pairing 0 "of triangles paired" -- "$meshcast" info "$mesh" --layout AABBTree/Float3SOA4 --pairing
 check zerobyte 0 "nodes +0 +0\.00" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Indexed24
 check zerobyte-stats 0 "shuffled; box cache off" -- "$meshcast" info "$mesh" --layout ZeroByteHybrid/Indexed24 --hybrid-leaf 64 --no-box-cache
-check zerobyte-float3 2 "valid layouts" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Float3
+check zerobyte-float3 2 "ZeroByteTree/Indexed24" -- "$meshcast" info "$mesh" --layout ZeroByteTree/Float3
 check zerobyte-trace 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout ZeroByteTree/Indexed24 --rays "$work/r.rays" --out "$work/hz.hits"
 check bench-combos-zerobyte 0 "ZeroByteHybrid/Indexed24 \(leaf 64\)" -- "$meshcast" bench combos "$mesh" --rays 8 --repeat 1 --only ZeroByte,QuadTreeHalfFloat/Indexed8 --out-dir "$work"
 check pairing-bruteforce 2 "keeps its own triangle order" -- "$meshcast" info "$mesh" --layout BruteForce/Float3 --pairing
@@ -312,6 +312,18 @@ check max-error-nan 2 "--max-error nan: a finite number" -- "$meshcast" info "$m
 check blob-leaf 2 "m.blob: is a blob.*--leaf applies only to a mesh" -- "$meshcast" info "$work/m.blob" --leaf 4
 check blob-layout 2 "m.blob: is a blob.*--layout applies only" -- "$meshcast" trace "$work/m.blob" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/x.hits"
 check blob-pairing 2 "m.blob: is a blob.*--pairing" -- "$meshcast" info "$work/m.blob" --pairing
+
+# Long work shows a progress line on stderr when it is a terminal (script(1)
+# gives the command one), never with --json, never into a pipe or file.
+check rays-1m 0 "rays ->" -- "$meshcast" rays "$mesh" --kind long --count 1100000 --seed 3 --out "$work/big.rays"
+check progress-tty 0 "tracing 1100000 rays x 1[ :]" -- script -qec "'$meshcast' trace '$mesh' --rays '$work/big.rays' --out '$work/big.hits' --repeat 1" /dev/null
+check progress-json 0 '^[^t]*\{"input"' -- script -qec "'$meshcast' trace '$mesh' --rays '$work/big.rays' --out '$work/big.hits' --repeat 1 --json" /dev/null
+if "$meshcast" trace "$mesh" --rays "$work/big.rays" --out "$work/big.hits" --repeat 1 2>&1 | grep -q tracing; then
+  echo "FAIL progress-pipe: a progress line went into a pipe"; failures=$((failures + 1))
+else
+  echo "ok   progress-pipe"; passes=$((passes + 1))
+fi
+rm -f "$work/big.rays" "$work/big.hits"
 
 echo "$passes passed, $failures failed"
 exit $((failures > 0))

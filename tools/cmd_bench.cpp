@@ -19,6 +19,7 @@
 #include "bench/trees.h"
 #include "check/generate.h"
 #include "meshcast/read.h"
+#include "tools/progress.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 
@@ -44,7 +45,7 @@ struct BenchArgs {
 // Seed 000 §3.11: every triangle encoding, brute force and in a QuadTree.
 void add_bench_encodings(CLI::App* bench) {
   auto args = std::make_shared<BenchArgs>();
-  CLI::App* cmd = bench->add_subcommand("encodings", "seed 000 3.11: every triangle encoding, brute force and in a QuadTree");
+  CLI::App* cmd = bench->add_subcommand("encodings", "Rouwe 2019, table 3.11: every triangle encoding, brute force and in a QuadTree");
   cmd->add_option("mesh", args->input, "mesh file (default data/bunny00.off)");
   cmd->add_option("--rays", args->rays, "long random rays (the source used 1024)")->check(integer_in(1, 1000000));
   cmd->add_option("--repeat", args->repeat, "passes; the minimum (as the source) and the median are reported")
@@ -58,7 +59,7 @@ void add_bench_encodings(CLI::App* bench) {
     std::vector<bench::EncodingRow> rows = bench::bench_encodings(mesh, args->input, {args->rays, args->repeat, 1});
     double scale = 1024.0 / double(args->rays);  // the source's unit: ms for 1024 rays
     std::printf("\n%s, %zu triangles, %zu long rays, one thread; time = ms for 1024 rays (minimum of %u passes, "
-                "median beside it), as seed 000 3.11 reports it (its column: i7-7700HQ, 69,451-triangle bunny)\n\n",
+                "median beside it), as Rouwe (2019) reports it in table 3.11 (its column: i7-7700HQ, 69,451-triangle bunny)\n\n",
                 args->input.c_str(), mesh.triangles.size(), args->rays, args->repeat);
     std::printf("| encoding | brute force ms (min) | median | bytes/tri | seed ms | seed bytes/tri | QuadTree ms (min) "
                 "| median | bytes/tri in QuadTree | disagreements |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -94,11 +95,11 @@ void add_bench_tables(CLI::App* bench) {
   // plot of time per ray against walked bytes per triangle.
   struct Table { const char* name; const char* what; };
   const Table tables[] = {
-      {"splitters", "seed 000 4.1: every splitter, AABBTree with Float3 and Float3SOA4, leaf 8"},
-      {"leafsize", "seed 000 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning"},
-      {"order", "seed 000 4.3: the four node orders, QuadTree and QuadTreeHalfFloat with Float3"},
-      {"trees", "seed 000 6: every tree format with Float3, Binning, leaf 8"},
-      {"combos", "seed 000 6: every tree with every CPU triangle encoding"}};
+      {"splitters", "Rouwe 2019, 4.1: every splitter, AABBTree with Float3 and Float3SOA4, leaf 8"},
+      {"leafsize", "Rouwe 2019, 4.2: leaf sizes 4, 8, 16, AABBTree/Float3, Binning"},
+      {"order", "Rouwe 2019, 4.3: the four node orders, QuadTree and QuadTreeHalfFloat with Float3"},
+      {"trees", "Rouwe 2019, 6: every tree format with Float3, Binning, leaf 8"},
+      {"combos", "Rouwe 2019, 6: every tree with every CPU triangle encoding"}};
   for (const Table& table : tables) {
     auto targs = std::make_shared<BenchArgs>();
     CLI::App* sub = bench->add_subcommand(table.name, table.what);
@@ -121,7 +122,7 @@ void add_bench_tables(CLI::App* bench) {
       // Microseconds per ray, the unit of the source's "Time 1024 Rays (us)" columns.
       double scale = 1000.0 / double(targs->rays);
       std::printf("\n%s, %zu triangles, %zu long rays, one thread; us per ray (minimum of %u passes, median "
-                  "beside it); seed column: seed 000 (i7-7700HQ, 2019)\n\n",
+                  "beside it); seed column: Rouwe 2019 (i7-7700HQ)\n\n",
                   targs->input.c_str(), mesh.triangles.size(), targs->rays, targs->repeat);
       const char* label = kind == "splitters" ? "splitter" : kind == "leafsize" ? "leaf size" : kind == "order" ? "order" : "tree";
       std::printf("| %s | layout | us/ray (min) | median | seed | build ms | SAH cost | tree bytes (seed) | tree B/tri | "
@@ -170,7 +171,7 @@ void add_bench_tables(CLI::App* bench) {
 void add_bench_gpu(CLI::App* bench) {
   auto gargs = std::make_shared<BenchArgs>();
   auto gdevice = std::make_shared<std::string>();
-  CLI::App* gsub = bench->add_subcommand("gpu", "seed 000 7: the GPU methods on the Vulkan device, the CPU's best beside them");
+  CLI::App* gsub = bench->add_subcommand("gpu", "Rouwe 2019, 7: the GPU methods on the Vulkan device, the CPU's best beside them");
   gsub->add_option("mesh", gargs->input, "mesh file (default data/bunny00.off)");
   gsub->add_option("--rays", gargs->rays, "long random rays (the source used 1024)")->check(integer_in(1, 1000000));
   gsub->add_option("--repeat", gargs->repeat, "passes; the median is reported")->check(integer_in(1, 1000));
@@ -352,7 +353,7 @@ void add_bench_robustness(CLI::App* bench) {
 void add_bench_pairing(CLI::App* bench) {
   auto pargs = std::make_shared<BenchArgs>();
   auto pdata = std::make_shared<std::string>("data");
-  CLI::App* pair = bench->add_subcommand("pairing", "seed 003: triangle pairing, before and after, as the builder's unit");
+  CLI::App* pair = bench->add_subcommand("pairing", "Aman and Fenney's triangle pairing, before and after, as the builder's unit");
   pair->add_option("--data", *pdata, "folder of the public meshes (bunny00, armadillo, refined_elephant, ChineseDragon-10kv)");
   pair->add_option("--rays", pargs->rays, "long random rays")->check(integer_in(1, 1000000));
   pair->add_option("--repeat", pargs->repeat, "passes; the minimum and the median are kept")->check(integer_in(1, 1000));
@@ -434,7 +435,7 @@ void add_bench_offset(CLI::App* bench) {
 }  // namespace
 
 void add_bench(CLI::App& app) {
-  CLI::App* bench = app.add_subcommand("bench", "reproduce the source documents' tables");
+  CLI::App* bench = app.add_subcommand("bench", "measure meshcast: speed, bytes, error, beside Embree where installed");
   bench->require_subcommand(1);
   add_bench_auto(bench);
   add_bench_peers(bench);
@@ -447,6 +448,10 @@ void add_bench(CLI::App& app) {
   add_bench_robustness(bench);
   add_bench_pairing(bench);
   add_bench_offset(bench);
+  // Each bench runs for minutes: a line on a terminal says it is running
+  // (main ends it before printing anything of its own).
+  for (CLI::App* sub : bench->get_subcommands({}))
+    sub->preparse_callback([sub](size_t) { begin_command_progress("meshcast bench " + sub->get_name()); });
 }
 
 }  // namespace meshcast::tools

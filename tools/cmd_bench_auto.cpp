@@ -1,4 +1,4 @@
-// meshcast bench auto [MESHES]: issue 9's table, the automatic layout's
+// meshcast bench auto [MESHES]: the table of the automatic layout's
 // choice under each setting against the best layout of the combos table
 // meeting the same limits, measured in one run.
 #include <cstdio>

@@ -1,4 +1,4 @@
-// `meshcast bench peers` (issue 19): meshcast's layouts beside Embree's
+// `meshcast bench peers`: meshcast's layouts beside Embree's
 // builds on the test meshes, the 2M terrain and the 1M city; Markdown, CSV
 // and a plot of time against bytes, one point per layout and peer.
 #include <cmath>

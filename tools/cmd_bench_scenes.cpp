@@ -1,4 +1,4 @@
-// `meshcast bench scenes` (issue 21): the table of bench/scenes.h, its CSV.
+// `meshcast bench scenes`: the table of bench/scenes.h, its CSV.
 #include <cstdio>
 #include <filesystem>
 

@@ -6,6 +6,7 @@
 
 #include "layout/blob_format.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 #include "tools/common.h"
 
 namespace meshcast::tools {
@@ -22,6 +23,7 @@ void add_info(CLI::App& app) {
   add_layout_options(cmd, args->layout);
   cmd->add_flag("--json", args->json, "print the same as one JSON object");
   cmd->callback([args] {
+    if (args->json) hide_progress();
     Loaded in = load_input(args->input, args->layout, args->json ? stderr : stdout);
     const layout::BlobHeader& h = layout::header_of(in.blob.data());
     SectionBytes s = section_bytes(in.blob);

@@ -13,6 +13,7 @@
 #include "gpu/vulkan.h"
 #include "layout/queries.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 #include "tools/common.h"
 #include "tools/render.h"
 #include "tools/scene_file.h"
@@ -34,6 +35,7 @@ struct TraceArgs {
 // CPU (one thread) or the Vulkan scene method (gpu/scene.h), whose meshes
 // are built in the layout it reads unless --layout names another.
 void trace_scene(TraceArgs a) {
+  if (a.json) hide_progress();
   const Query query = layout::query_named(a.query, "--query");
   const Cull cull = layout::cull_named(a.cull, "--cull");
   if (query == Query::All)
@@ -117,12 +119,13 @@ void add_trace(CLI::App& app) {
                   "seen from the ray's origin")
       ->check(CLI::IsMember({"none", "back", "front"}));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
-  cmd->add_option("--method", args->method, "GPU method (seed 000 7): bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
+  cmd->add_option("--method", args->method, "GPU method: bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
                                             "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
                                             "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4), octtree (OctTreeCompressed/ClusterBitPackSOA8)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args, max_hits] {
+    if (args->json) hide_progress();
     const Query query = layout::query_named(args->query, "--query");
     const Cull cull = layout::cull_named(args->cull, "--cull");
     // Given with a query that keeps one hit a ray, it would be ignored.
@@ -155,17 +158,33 @@ void add_trace(CLI::App& app) {
       if (const std::string why = method->refusal(uint32_t(rays.size())); !why.empty())
         throw InputError("trace " + args->rays + ": " + why + "; cast fewer rays" +
                          (query == Query::All ? " or lower --max-hits" : "") + ", or use --backend cpu");
+      Progress progress("tracing " + std::to_string(rays.size()) + " rays x " + std::to_string(args->repeat) + " on " + device,
+                        rays.size() > kProgressRays);
       for (uint32_t r = 0; r < args->repeat; ++r) {
+        progress.set(double(r) / double(args->repeat));
         gpu::GpuTiming timing;
         skipped = query == Query::All ? method->trace_all_hits(rays, lists, &timing) : method->trace(rays, hits, &timing);
         pass_ms.push_back(timing.wall_ms), device_ms.push_back(timing.device_ms);
       }
     } else {
       BlobView view(in.blob, args->input);
+      Progress progress("tracing " + std::to_string(rays.size()) + " rays x " + std::to_string(args->repeat),
+                        rays.size() > kProgressRays);
+      // Closest and any hits in slices, to say how far a pass is (a slice
+      // of a million rays takes long enough that the cut costs nothing).
+      constexpr size_t kSlice = size_t(1) << 20;
       for (uint32_t r = 0; r < args->repeat; ++r) {
         auto t0 = std::chrono::steady_clock::now();
-        skipped = query == Query::All ? view.trace_all_hits(rays, lists, HitOutputs::None, cull)
-                                      : view.trace(rays, hits, HitOutputs::None, query, cull);
+        if (query == Query::All) {
+          skipped = view.trace_all_hits(rays, lists, HitOutputs::None, cull);
+        } else {
+          skipped = 0;
+          for (size_t at = 0; at < rays.size(); at += kSlice) {
+            const size_t n = std::min(kSlice, rays.size() - at);
+            skipped += view.trace(std::span(rays).subspan(at, n), std::span(hits).subspan(at, n), HitOutputs::None, query, cull);
+            progress.set((double(r) * double(rays.size()) + double(at + n)) / (double(args->repeat) * double(rays.size())));
+          }
+        }
         pass_ms.push_back(ms_since(t0));
       }
     }

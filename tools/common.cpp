@@ -15,6 +15,7 @@
 #include "gpu/method.h"
 #include "meshcast/blob.h"
 #include "meshcast/read.h"
+#include "tools/progress.h"
 #include "layout/blob_format.h"
 
 namespace meshcast::tools {
@@ -35,7 +36,11 @@ Loaded load_mesh_or_blob(const std::string& path, const MeshBuilder& build) {
   out.mesh = read_mesh(path);
   out.load_ms = ms_since(t0);
   auto t1 = std::chrono::steady_clock::now();
-  out.blob = build(*out.mesh, &out.report);
+  {
+    const size_t triangles = out.mesh->triangles.size();
+    Progress progress("building " + path + " (" + std::to_string(triangles) + " triangles)", triangles > kProgressTriangles);
+    out.blob = build(*out.mesh, &out.report);
+  }
   out.build_ms = ms_since(t1);
   return out;
 }
@@ -86,17 +91,17 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
       ->check(integer_in(0, 1u << 20));
   cmd->add_option("--leaf", a.leaf, "largest triangle count of a leaf (default: 16 for OctTreeCompressed, 8 for the others)")
       ->check(integer_in(1, 31));
-  cmd->add_option("--splitter", a.splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (seed 000 4.1)");
+  cmd->add_option("--splitter", a.splitter, "Binning, LongestAxis, Mean, Morton or FixedLeafSize (default Binning: SAH)");
   cmd->add_option("--order", a.order,
-                  "node order (seed 000 4.3): DepthFirst, DepthFirstTrianglesLast, BreadthFirst or "
+                  "node order: DepthFirst, DepthFirstTrianglesLast, BreadthFirst or "
                   "BreadthFirstTrianglesLast; the quad trees take all four");
   cmd->add_option("--lbvh-depth", a.lbvh_depth, "StacklessLBVH depth limit D (0: bit_width(triangles) + 1)")
       ->check(integer_in(0, uint32_t(MC_LBVH_MAX_DEPTH + 1)));
-  cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as seed 001");
-  cmd->add_option("--grouping", a.grouping, "AABBList batches (seed 000 7): ClosestCentroid (the seed's) or Morton");
+  cmd->add_flag("--lbvh-left-first", a.lbvh_left_first, "StacklessLBVH: walk left child first, as the stackless LBVH paper does");
+  cmd->add_option("--grouping", a.grouping, "AABBList batches: ClosestCentroid (greedy, the default) or Morton");
   cmd->add_flag("--no-triangle-ids", a.no_triangle_ids,
                 "leave the remap out: hits name triangles by the blob's slot numbers, not the input's");
-  cmd->add_flag("--pairing", a.pairing, "pair triangles across shared edges first (seed 003); leaves hold whole pairs");
+  cmd->add_flag("--pairing", a.pairing, "pair triangles across shared edges first; leaves hold whole pairs");
   cmd->add_flag("--no-shuffle", a.zbt_no_shuffle, "zero-byte trees: any bound triangles, not 6 each naming its extreme's corner");
   cmd->add_flag("--no-box-cache", a.zbt_no_cache, "zero-byte trees: recompute every box (no per-thread box cache)");
   cmd->add_option("--hybrid-leaf", a.hybrid_leaf, "ZeroByteHybrid: largest leaf, each one zero-byte tree")

@@ -7,6 +7,7 @@
 #include "check/ray_files.h"
 #include "gpu/vulkan.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"meshcast: closest-hit ray casts against static triangle meshes"};
@@ -21,12 +22,14 @@ int main(int argc, char** argv) {
   // Exit codes (README): 2 the input, 3 no Vulkan or no such device, 4 an
   // output not written, 1 anything else.
   auto report = [](const std::exception& e, int code) {
+    meshcast::tools::end_command_progress();
     std::fprintf(stderr, "meshcast: %s\n", e.what());
     return code;
   };
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    meshcast::tools::end_command_progress();
     // --help and --version exit 0; every refused option or value is the input's fault: 2.
     return app.exit(e) == 0 ? 0 : 2;
   } catch (const meshcast::InputError& e) {
@@ -38,6 +41,7 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return report(e, 1);
   }
+  meshcast::tools::end_command_progress();
   // What was printed must have reached stdout (`info --json >/dev/full`).
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
     std::fprintf(stderr, "meshcast: standard output: cannot write (%s)\n", std::strerror(errno));

@@ -1,4 +1,4 @@
-// Scene files (issue 21; README "Files"): a JSON object
+// Scene files (README "Files"): a JSON object
 //   {"meshes": {"NAME": "mesh or blob file", ...},
 //    "instances": [{"mesh": "NAME", "rotation_scale": [9 numbers, row-major],
 //                   "translation": [x, y, z], "mask": 255, "enabled": true}, ...]}

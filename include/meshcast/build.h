@@ -15,8 +15,8 @@
 
 namespace meshcast {
 
-// The tree formats of seed 000 §5, seeds 001 and 004 (ids as stored in a
-// blob's header).
+// The tree formats (ids as stored in a blob's header; docs/design.md
+// describes each).
 enum class TreeFormat : uint32_t {
   AABBTree = 1,
   QuadTree = 2,
@@ -30,10 +30,10 @@ enum class TreeFormat : uint32_t {
   AABBList = 10,
   ZeroByteTree = 11,
   ZeroByteHybrid = 12,
-  OctTreeCompressed = 13,  // 8 children a node, boxes in 8 bits on power-of-two scales (issue 19)
+  OctTreeCompressed = 13,  // 8 children a node, boxes in 8 bits on power-of-two scales
 };
 
-// The triangle formats of seed 000 §3, seeds 003 and 004. The BitPack ones
+// The triangle formats (docs/design.md describes each). The BitPack ones
 // store vertices on a 21-bit grid (moved by at most a stated bound).
 enum class TriangleFormat : uint32_t {
   Float3 = 1,
@@ -54,7 +54,7 @@ enum class TriangleFormat : uint32_t {
   CompressedStrip = 16,
   Indexed24 = 17,
   Float3PairSOA4 = 18,
-  ClusterBitPackSOA8 = 19,  // clusters of up to 16 mesh-grid vertices stored once, 4-bit indices (issue 19)
+  ClusterBitPackSOA8 = 19,  // clusters of up to 16 mesh-grid vertices stored once, 4-bit indices
 };
 
 // A tree format with a triangle format. The default is the recommended
@@ -77,12 +77,13 @@ std::vector<Layout> all_layouts();
 // 8 for the others (the source's).
 uint32_t default_leaf_size(Layout layout);
 
-// The splitters of seed 000 §4.1; SAH binning is the default.
+// The splitters of the binary tree every layout is written from; SAH
+// binning is the default.
 enum class Splitter { Binning, LongestAxis, Mean, Morton, FixedLeafSize };
-// Node orders of seed 000 §4.3; Default is the format's own. Only the quad
+// Node orders in the blob; Default is the format's own. Only the quad
 // trees, whose nodes address every child and block by offset, take all four.
 enum class NodeOrder { Default, DepthFirst, DepthFirstTrianglesLast, BreadthFirst, BreadthFirstTrianglesLast };
-// AABBList batches (seed 000 §7): how triangles are grouped, 256 a batch.
+// AABBList batches: how triangles are grouped, 256 a batch.
 //   ClosestCentroid  the unused triangle with the lowest centre x and the
 //                    255 unused triangles whose centres lie nearest to it
 //   Morton           consecutive runs of the Morton order
@@ -94,19 +95,19 @@ struct BuildOptions {
   // the layout's own (default_leaf_size).
   uint32_t leaf_size = 0;
   Splitter splitter = Splitter::Binning;
-  // StacklessLBVH (seed 001): the depth limit D (leaves at depth D - 1 at
-  // most; 0: bit_width(triangles) + 1, the seed's choice for its meshes),
-  // and whether interior nodes carry seed 002's bits so each ray visits the
-  // nearer child first (false: left first, as the seed).
+  // StacklessLBVH: the depth limit D (leaves at depth D - 1 at most; 0:
+  // bit_width(triangles) + 1), and whether interior nodes carry 8 sorting
+  // bits (one a ray octant) so each ray visits the nearer child first
+  // (false: left first).
   uint32_t lbvh_depth = 0;
   bool lbvh_near_first = true;
   NodeOrder node_order = NodeOrder::Default;
   Grouping grouping = Grouping::ClosestCentroid;
-  // Seed 003: triangles paired across shared edges become the builder's
+  // Triangles paired across shared edges become the builder's
   // primitives, so every leaf holds whole pairs (at most leaf_size
   // triangles a leaf).
   bool pairing = false;
-  // Zero-byte trees (seed 004): interior nodes bounded by 6 triangles whose
+  // Zero-byte trees: interior nodes bounded by 6 triangles whose
   // first corners give the 6 extremes where the mesh allows it; the
   // walkers' per-thread box cache; the hybrid's largest leaf (each leaf one
   // zero-byte tree).

@@ -1,4 +1,4 @@
-// The API a game calls (issue 6): ray batches submitted during one frame
+// The API a game calls: ray batches submitted during one frame
 // and collected in a later one, from the CPU or the GPU, with the latency of
 // each batch measured, and answers right away for the few rays that cannot
 // wait.

@@ -1,4 +1,4 @@
-// Scenes (issue 21): many placed copies of a few blobs, cast against as one
+// Scenes: many placed copies of a few blobs, cast against as one
 // world, far larger than a float reaches.
 //
 //   meshcast::Scene scene;

@@ -55,8 +55,8 @@ struct Scene::Edits {
 
 namespace {
 
-// The inverse of the 3x3 (in double, then rounded to float), its mirroring,
-// and the world box of the mesh's bounds under the transform: centre
+// The inverse of the 3x3 (in double, then rounded to float) and the world
+// box of the mesh's bounds under the transform: centre
 // M c + T and half extents |M| e, in double, padded by 2^-20 of their size
 // (the rounding of the float inverse; what a ray's own rounding adds is the
 // walk's slack, see scene_trace.cpp) and by the double sums' own rounding,
@@ -86,7 +86,6 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
   if (!usable)
     throw UsageError(std::string(who) + ": rotation_scale is not invertible (determinant " + number_text(det) +
                      ") or its inverse has an entry beyond 2^40");
-  p.mirrored = det < 0;
   for (int a = 0; a < 3; ++a) p.translation[a] = t.translation[a];
   const layout::BlobHeader& h = layout::header_of(mesh.bytes.data());
   double c[3], half[3];
@@ -146,7 +145,7 @@ MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
   return MeshId(e.meshes.size() - 1);
 }
 
-InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask) {
+InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask, bool flip_facing) {
   Edits& e = edits("Scene::add_instance");
   if (mesh >= e.meshes.size())
     throw UsageError("Scene::add_instance: mesh " + std::to_string(mesh) + " is unknown (" +
@@ -158,6 +157,7 @@ InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t 
   i.placed.id = uint32_t(e.instances.size());
   i.placed.mesh = mesh;
   i.placed.mask = mask;
+  i.placed.flip_facing = flip_facing;
   WorldBox box;
   place(i.placed, box, transform, *e.meshes[mesh], "Scene::add_instance");
   e.instances.push_back(i);
@@ -181,6 +181,12 @@ void Scene::set_transform(InstanceId instance, const Transform& transform) {
 void Scene::set_mask(InstanceId instance, uint8_t mask) {
   Edits& e = edits("Scene::set_mask");
   e.at(instance, "Scene::set_mask").placed.mask = mask;
+  e.changed = true;
+}
+
+void Scene::set_flip_facing(InstanceId instance, bool flip_facing) {
+  Edits& e = edits("Scene::set_flip_facing");
+  e.at(instance, "Scene::set_flip_facing").placed.flip_facing = flip_facing;
   e.changed = true;
 }
 

@@ -65,10 +65,17 @@ using SceneHitLists = HitRows<SceneHit>;
 
 // Where an instance stands: world = rotation_scale * local + translation.
 // The 3x3 is row-major and may rotate, scale (non-uniformly too) and mirror
-// (a negative determinant; a mirrored instance's corners run the other way
-// in the world, so what is its front face flips with it); it must be
-// invertible. The translation is in double: placements far from the origin
-// keep their precision.
+// (a negative determinant); it must be invertible. The translation is in
+// double: placements far from the origin keep their precision.
+//
+// Facing is the mesh's own, whatever the transform: a triangle's front face
+// is decided in the mesh's frame (the world ray brought into it meets the
+// corners as the mesh winds them), as Vulkan's and DirectX's ray tracing
+// decide it. A mirrored copy of a closed mesh whose outside is its front
+// keeps its outside in front, so Cull::Back from outside still hits it. An
+// instance's flip_facing (Scene::add_instance, set_flip_facing; false by
+// default, like VK_GEOMETRY_INSTANCE_TRIANGLE_FLIP_FACING_BIT_KHR) turns
+// that instance's faces: its front is the mesh's back.
 struct Transform {
   float rotation_scale[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   double translation[3] = {0, 0, 0};
@@ -91,13 +98,17 @@ class Scene {
   MeshId add_mesh(std::vector<uint8_t> blob, const std::string& name);
 
   // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
-  // share a bit with it for the instance to be walked). UsageError for an
-  // unknown mesh, a transform that is not finite or not invertible, a 3x3
-  // or inverse entry beyond 2^40, a translation or world box beyond 2^100
-  // (kMaxCoordinate), or a 2^31st instance.
-  InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF);
+  // share a bit with it for the instance to be walked) and its faces as the
+  // mesh has them, or turned with `flip_facing` (see Transform: Cull::Back
+  // then drops the mesh's front faces). UsageError for an unknown mesh, a
+  // transform that is not finite or not invertible, a 3x3 or inverse entry
+  // beyond 2^40, a translation or world box beyond 2^100 (kMaxCoordinate),
+  // or a 2^31st instance.
+  InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF, bool flip_facing = false);
+  // A new transform keeps the instance's mask and flip_facing.
   void set_transform(InstanceId instance, const Transform& transform);
   void set_mask(InstanceId instance, uint8_t mask);
+  void set_flip_facing(InstanceId instance, bool flip_facing);
   void set_enabled(InstanceId instance, bool enabled);
   // The id is not given again. UsageError for an unknown or removed id.
   void remove_instance(InstanceId instance);
@@ -107,8 +118,9 @@ class Scene {
 
   // The hit of each world ray under `query` (Closest or Any; All has
   // trace_all_hits) against the committed scene, among the instances whose mask shares a bit with
-  // `mask`; `cull` as BlobView::trace, the front face as the instance shows
-  // it in the world; `outputs`: Uv at most (a scene hit has no point).
+  // `mask`; `cull` as BlobView::trace, the front face as the instance's
+  // mesh has it (turned by its flip_facing; a mirroring transform changes
+  // nothing, see Transform); `outputs`: Uv at most (a scene hit has no point).
   // Returns the rays not walkable: a non-finite origin or one beyond 2^100,
   // a direction or t_max BlobView would refuse (answered as misses), or a
   // ray some instance's frame cannot take (its direction scaled past the

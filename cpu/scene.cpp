@@ -17,6 +17,7 @@ namespace meshcast {
 
 struct Scene::Edits {
   std::vector<std::shared_ptr<const SceneMesh>> meshes;
+  size_t owned_bytes = 0;  // the meshes' blobs the scene copied (add_mesh of a vector)
   struct Instance {
     layout::PlacedInstance placed;  // the walk's record, kept up to date
     bool enabled = true, removed = false;
@@ -114,10 +115,11 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
 
 }  // namespace
 
-SceneMesh::SceneMesh(std::vector<uint8_t> blob, std::string mesh_name)
-    : bytes(std::move(blob)),
+SceneMesh::SceneMesh(const BlobView& blob_view, std::shared_ptr<const void> keep, std::string mesh_name)
+    : owner(std::move(keep)),
+      bytes(blob_view.bytes()),
       name(std::move(mesh_name)),
-      view(bytes, name),
+      view(blob_view),
       walk(walker_for(uint32_t(view.layout().tree), uint32_t(view.layout().triangles))) {}
 
 Scene::Scene() : edits_(std::make_unique<Edits>()) {}
@@ -130,20 +132,50 @@ Scene::~Scene() = default;
 Scene::Scene(Scene&&) noexcept = default;
 Scene& Scene::operator=(Scene&&) noexcept = default;
 
-MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
+// Every add_mesh's end: the view (validated) over bytes `owner` keeps
+// alive, or the caller where it is null.
+MeshId Scene::add_validated(const BlobView& view, std::shared_ptr<const void> owner, const std::string& name) {
   Edits& e = edits("Scene::add_mesh");
-  auto mesh = std::make_shared<const SceneMesh>(std::move(blob), name);  // validates
   // The world boxes come from the header's bounds (not every layout's
   // validation reads them): finite, min <= max.
-  const layout::BlobHeader& h = layout::header_of(mesh->bytes.data());
+  const layout::BlobHeader& h = layout::header_of(view.bytes().data());
   for (int a = 0; a < 3; ++a)
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
       throw InputError(name + ": the blob's bounds on axis " + std::to_string(a) + " are not a finite box (" +
                        number_text(h.bounds_min[a]) + " to " + number_text(h.bounds_max[a]) + ")");
-  e.meshes.push_back(std::move(mesh));
+  e.meshes.push_back(std::make_shared<const SceneMesh>(view, std::move(owner), name));
   e.changed = true;
   return MeshId(e.meshes.size() - 1);
 }
+
+MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
+  edits("Scene::add_mesh");  // a moved-from scene refuses before any validation
+  // Moved into the shared copy: its bytes stay where the caller's vector had them.
+  auto copy = std::make_shared<const std::vector<uint8_t>>(std::move(blob));
+  const BlobView view(*copy, name);  // validates
+  const MeshId id = add_validated(view, copy, name);
+  edits_->owned_bytes += copy->capacity();
+  return id;
+}
+
+MeshId Scene::add_mesh(std::shared_ptr<const MappedBlob> file, const std::string& name) {
+  edits("Scene::add_mesh");
+  if (!file) throw UsageError("Scene::add_mesh: " + name + ": the mapped blob is null");
+  const BlobView view(file->bytes(), name);  // validates
+  return add_validated(view, std::move(file), name);
+}
+
+MeshId Scene::add_mesh(const BlobView& blob, const std::string& name) { return add_validated(blob, nullptr, name); }
+
+std::span<const uint8_t> Scene::mesh_blob(MeshId mesh) const {
+  const Edits& e = edits("Scene::mesh_blob");
+  if (mesh >= e.meshes.size())
+    throw UsageError("Scene::mesh_blob: mesh " + std::to_string(mesh) + " is unknown (" +
+                     std::to_string(e.meshes.size()) + " added)");
+  return e.meshes[mesh]->bytes;
+}
+
+size_t Scene::owned_blob_bytes() const { return edits("Scene::owned_blob_bytes").owned_bytes; }
 
 InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask, bool flip_facing) {
   Edits& e = edits("Scene::add_instance");

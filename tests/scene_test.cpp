@@ -273,6 +273,18 @@ std::vector<SceneHit> trace(const Scene& scene, const std::vector<RayD>& rays, Q
   return hits;
 }
 
+// A snapshot's answers: trace_snapshot's, or in the GPU build the Vulkan
+// scene method's.
+std::vector<SceneHit> trace_snapshot_here(const SceneSnapshot& snapshot, const std::vector<RayD>& rays) {
+  std::vector<SceneHit> hits(rays.size());
+#ifdef MESHCAST_TEST_GPU
+  EXPECT_EQ(scene_method(Query::Closest, Cull::None, HitOutputs::None).trace(snapshot, rays, hits), 0u);
+#else
+  EXPECT_EQ(trace_snapshot(snapshot, rays, hits), 0u);
+#endif
+  return hits;
+}
+
 class SceneVsOracle : public ::testing::TestWithParam<std::tuple<std::string, double>> {};
 
 // Every query and culling, masks, on a level of 60 instances over a
@@ -755,6 +767,122 @@ TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
     EXPECT_EQ(again[i].instance, before[i].instance) << "ray " << i;
     EXPECT_EQ(again[i].triangle, before[i].triangle) << "ray " << i;
   }
+}
+
+// A scene over blobs it does not own answers as one over its own copies:
+// a level's blobs saved and mapped (MappedBlob), given shared and as
+// BlobViews, the same hits bit for bit under every query and culling on
+// the CPU and (gpu_scene_test) the Vulkan scene method, which uploads them
+// from the mapping. The bytes are held once: the scene walks the mapped
+// pages themselves and counts no copy of them, the shared mapping lives on
+// in the scene (and in a snapshot outliving the scene) after the caller
+// lets go, and a corrupted file is refused as a corrupted copy is.
+TEST(Scene, ReferencedBlobsAnswerAsCopies) {
+  const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 40, 60, 1e6, 19);
+  std::vector<std::shared_ptr<const MappedBlob>> files;
+  size_t blob_bytes = 0;
+  for (size_t m = 0; m < level.blobs.size(); ++m) {
+    const std::string path = (scratch_dir() / ("scene_mesh_" + std::to_string(m) + ".mcb")).string();
+    save_blob(path, level.blobs[m]);
+    files.push_back(std::make_shared<const MappedBlob>(path));
+    blob_bytes += level.blobs[m].size();
+  }
+  const Scene copied = make_scene(level);
+  Scene shared, viewed;
+  for (size_t m = 0; m < files.size(); ++m) {
+    const std::string name = "level mesh " + std::to_string(m);
+    EXPECT_EQ(shared.add_mesh(std::shared_ptr(files[m]), name), m);
+    EXPECT_EQ(viewed.add_mesh(BlobView(files[m]->bytes(), name), name), m);
+  }
+  for (Scene* s : {&shared, &viewed}) {
+    for (size_t i = 0; i < level.instances.size(); ++i) {
+      const OracleInstance& o = level.instances[i];
+      s->add_instance(o.mesh, o.transform, o.mask, o.flip_facing);
+      if (!level.enabled[i]) s->set_enabled(o.id, false);
+    }
+    s->commit();
+  }
+  // Held once: the scenes walk the mapped pages; only the copy counts bytes.
+  for (size_t m = 0; m < files.size(); ++m) {
+    EXPECT_EQ(shared.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(viewed.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(viewed.mesh_blob(MeshId(m)).size(), level.blobs[m].size()) << m;
+    EXPECT_NE(copied.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+  }
+  EXPECT_GE(copied.owned_blob_bytes(), blob_bytes);
+  {  // A vector moved in is kept where it lies.
+    std::vector<uint8_t> moved_in = level.blobs[0];
+    const uint8_t* at = moved_in.data();
+    Scene owner;
+    EXPECT_EQ(owner.mesh_blob(owner.add_mesh(std::move(moved_in), "moved")).data(), at);
+    EXPECT_EQ(owner.owned_blob_bytes(), level.blobs[0].size());
+  }
+  EXPECT_EQ(shared.owned_blob_bytes(), 0u);
+  EXPECT_EQ(viewed.owned_blob_bytes(), 0u);
+  EXPECT_THROW(viewed.mesh_blob(MeshId(files.size())), UsageError);
+  // The caller lets go of its mappings: the shared scene keeps its own.
+  std::vector<const uint8_t*> mapped_at;
+  for (const auto& f : files) mapped_at.push_back(f->bytes().data());
+  std::vector<std::weak_ptr<const MappedBlob>> watched(files.begin(), files.end());
+  const std::vector<RayD> rays = level_rays(level, quick() ? 400 : 1200, 60, 23);
+  for (const Query q : {Query::Closest, Query::Any})
+    for (const Cull c : {Cull::None, Cull::Back, Cull::Front}) {
+      const std::vector<SceneHit> want = trace(copied, rays, q, c, 0xFF, HitOutputs::Uv);
+      size_t hits = 0;
+      for (const SceneHit& h : want) hits += h.instance != kNoHit;
+      EXPECT_GT(hits, rays.size() / 10) << "query " << int(q) << ", cull " << int(c);
+      for (const Scene* s : {&shared, &viewed}) {
+        const std::vector<SceneHit> got = trace(*s, rays, q, c, 0xFF, HitOutputs::Uv);
+        size_t differ = 0;
+        for (size_t i = 0; i < rays.size(); ++i) differ += std::memcmp(&got[i], &want[i], sizeof(SceneHit)) != 0;
+        EXPECT_EQ(differ, 0u) << (s == &shared ? "shared" : "viewed") << ", query " << int(q) << ", cull " << int(c);
+      }
+    }
+  // Query::All (the CPU's) likewise.
+  SceneHitLists want_rows, got_rows;
+  want_rows.max_hits = got_rows.max_hits = 64;
+  EXPECT_EQ(copied.trace_all_hits(rays, want_rows, HitOutputs::Uv, Cull::Back), 0u);
+  EXPECT_EQ(viewed.trace_all_hits(rays, got_rows, HitOutputs::Uv, Cull::Back), 0u);
+  ASSERT_EQ(got_rows.hits.size(), want_rows.hits.size());
+  EXPECT_EQ(std::memcmp(got_rows.hits.data(), want_rows.hits.data(), want_rows.hits.size() * sizeof(SceneHit)), 0);
+  EXPECT_EQ(got_rows.found, want_rows.found);
+  files.clear();
+  for (const auto& w : watched) EXPECT_FALSE(w.expired()) << "the shared scene let a mapping go";
+  const std::vector<SceneHit> want = trace(copied, rays);
+  {
+    Scene moved = std::move(shared);
+    const std::shared_ptr<const SceneSnapshot> frame = moved.snapshot();
+    moved = Scene();  // the scene is gone; its snapshot keeps the mappings
+    for (const auto& w : watched) EXPECT_FALSE(w.expired()) << "a snapshot let a mapping go";
+    const std::vector<SceneHit> got = trace_snapshot_here(*frame, rays);
+    size_t differ = 0;
+    for (size_t i = 0; i < rays.size(); ++i) differ += std::memcmp(&got[i], &want[i], sizeof(SceneHit)) != 0;
+    EXPECT_EQ(differ, 0u) << "the snapshot of a scene gone";
+  }
+  // A GPU scene method holds the meshes it uploaded until it uploads
+  // others (gpu/scene.h): the copy's, here.
+  trace_snapshot_here(*copied.snapshot(), rays);
+  for (const auto& w : watched) EXPECT_TRUE(w.expired()) << "a mapping outlived every scene and snapshot holding it";
+  // The same validation as a copy's: a flipped byte in the file is refused
+  // with the copy's message.
+  std::vector<uint8_t> corrupted = level.blobs[0];
+  corrupted[corrupted.size() / 2] ^= 0x40;
+  const std::string path = (scratch_dir() / "scene_mesh_corrupted.mcb").string();
+  save_blob(path, corrupted);
+  std::string copy_says, mapped_says;
+  try {
+    Scene().add_mesh(corrupted, "rock");
+  } catch (const InputError& e) {
+    copy_says = e.what();
+  }
+  try {
+    Scene().add_mesh(std::make_shared<const MappedBlob>(path), "rock");
+  } catch (const InputError& e) {
+    mapped_says = e.what();
+  }
+  EXPECT_NE(copy_says, "") << "a corrupted copy was taken";
+  EXPECT_EQ(mapped_says, copy_says);
+  EXPECT_THROW(Scene().add_mesh(std::shared_ptr<const MappedBlob>(), "none"), UsageError);
 }
 
 #ifdef MESHCAST_TEST_GPU

@@ -3,6 +3,8 @@
 //
 //   meshcast::Scene scene;
 //   meshcast::MeshId rock = scene.add_mesh(load_blob("rock.mcb"), "rock.mcb");
+//   auto tree_file = std::make_shared<const meshcast::MappedBlob>("tree.mcb");
+//   meshcast::MeshId tree = scene.add_mesh(tree_file, "tree.mcb");  // mapped, not copied
 //   meshcast::InstanceId a = scene.add_instance(rock, transform);  // any number
 //   scene.commit();                                                // the frame's changes are done
 //   scene.trace(rays, hits);                                       // sees what was committed
@@ -94,8 +96,29 @@ class Scene {
   Scene& operator=(Scene&&) noexcept;
 
   // A blob every instance of it walks, validated once (InputError naming
-  // `name`); the scene keeps the bytes.
+  // `name`: what BlobView checks, and bounds that are a finite box). Three
+  // ways to hand it over, the same validation and walks for each:
+  //
+  // The scene keeps the bytes: a vector moved in is kept where it lies (no
+  // copy), one passed as an lvalue is copied.
   MeshId add_mesh(std::vector<uint8_t> blob, const std::string& name);
+  // A mapped blob file the scene shares: the scene, every snapshot of it and
+  // every caster batch holding one keep the mapping alive; the bytes are
+  // read where they are mapped, never copied (a GPU scene method copies
+  // them to the device). UsageError for a null pointer.
+  MeshId add_mesh(std::shared_ptr<const MappedBlob> file, const std::string& name);
+  // The bytes a BlobView reads (already validated: not checked again),
+  // referenced, neither copied nor owned: they must stay unchanged and
+  // outlive the scene, every snapshot taken from it (a caster's batch holds
+  // one until it is collected) and every trace through them; a GPU scene
+  // method reads them only while a batch is begun, to upload them.
+  MeshId add_mesh(const BlobView& blob, const std::string& name);
+  // The bytes instances of `mesh` walk (the scene's copy, or the caller's
+  // where it shares or references them). UsageError for an unknown mesh.
+  std::span<const uint8_t> mesh_blob(MeshId mesh) const;
+  // The blobs' bytes the scene holds copies of (add_mesh of a vector);
+  // shared and referenced blobs are the caller's memory, not counted.
+  size_t owned_blob_bytes() const;
 
   // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
   // share a bit with it for the instance to be walked) and its faces as the
@@ -152,6 +175,7 @@ class Scene {
  private:
   struct Edits;
   Edits& edits(const char* who) const;  // UsageError naming `who` on a moved-from scene
+  MeshId add_validated(const BlobView& view, std::shared_ptr<const void> owner, const std::string& name);
   std::unique_ptr<Edits> edits_;  // and the committed snapshot, behind a mutex
 };
 

@@ -10,9 +10,17 @@ namespace meshcast {
 
 SceneOracle::SceneOracle(const std::vector<const Mesh*>& meshes, const std::vector<OracleInstance>& instances) {
   for (const OracleInstance& i : instances) {
-    Placed p{i, {}, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    const Mesh& mesh = *meshes.at(i.mesh);
     const float* m = i.transform.rotation_scale;
+    // A mirror (a negative determinant) runs the world corners the other
+    // way round from the mesh's: (M a) x (M b) = det(M) M^-T (a x b), so
+    // the world winding's normal points against the mesh's own. In double
+    // from the float entries, a few roundings: its sign is in doubt only
+    // for a matrix all but singular.
+    const double det = double(m[0]) * (double(m[4]) * m[8] - double(m[5]) * m[7]) -
+                       double(m[1]) * (double(m[3]) * m[8] - double(m[5]) * m[6]) +
+                       double(m[2]) * (double(m[3]) * m[7] - double(m[4]) * m[6]);
+    Placed p{i, {}, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}, (det < 0) != i.flip_facing};
+    const Mesh& mesh = *meshes.at(i.mesh);
     p.corners.reserve(mesh.triangles.size() * 9);
     for (size_t t = 0; t < mesh.triangles.size(); ++t)
       for (int k = 0; k < 3; ++k) {
@@ -49,9 +57,15 @@ void SceneOracle::visit(const RayD& ray, Cull cull, uint8_t mask, const double* 
       tn = std::max(tn, t0 * (1 - 0x1p-50)), tf = std::min(tf, t1 * (1 + 0x1p-50));
     }
     if (!(tn <= tf)) continue;
+    // The culling of the world corners' winding that drops the faces the
+    // mesh's own winding says `cull` drops.
+    const Cull world_cull = !p.world_winding_turned ? cull
+                            : cull == Cull::Back    ? Cull::Front
+                            : cull == Cull::Front   ? Cull::Back
+                                                    : cull;
     for (size_t t = 0; t < p.corners.size() / 9; ++t) {
       const double* c = p.corners.data() + 9 * t;
-      const double hit = oracle_triangle(ray.org, d, ray.tmax, c, c + 3, c + 6, cull);
+      const double hit = oracle_triangle(ray.org, d, ray.tmax, c, c + 3, c + 6, world_cull);
       if (hit != INFINITY) take(hit, p.instance.id, uint32_t(t));
     }
   }

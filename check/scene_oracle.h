@@ -23,14 +23,17 @@ struct OracleInstance {
   uint32_t id, mesh;
   Transform transform;
   uint8_t mask = 0xFF;
+  bool flip_facing = false;  // Scene::add_instance's
 };
 
 class SceneOracle {
  public:
   SceneOracle(const std::vector<const Mesh*>& meshes, const std::vector<OracleInstance>& instances);
   // The closest hit among the instances whose mask shares a bit with
-  // `mask`; the front face as the world sees it (the winding of the
-  // triangle's world corners from the ray's origin).
+  // `mask`; the front face as the mesh has it (Transform's rule): the
+  // winding of the triangle's world corners from the ray's origin, turned
+  // where the instance mirrors (its determinant, in double, negative) and
+  // turned again by its flip_facing.
   SceneOracleHit closest(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Every hit in [0, t_max], in order of t, then instance, then triangle.
   std::vector<SceneOracleHit> all(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
@@ -56,6 +59,7 @@ class SceneOracle {
     OracleInstance instance;
     std::vector<double> corners;  // 9 a triangle, world coordinates
     double min[3], max[3];
+    bool world_winding_turned;  // the world corners' front is the mesh's back
   };
   std::vector<Placed> placed_;
 };

@@ -17,6 +17,7 @@ namespace meshcast {
 
 struct Scene::Edits {
   std::vector<std::shared_ptr<const SceneMesh>> meshes;
+  size_t owned_bytes = 0;  // the meshes' blobs the scene copied (add_mesh of a vector)
   struct Instance {
     layout::PlacedInstance placed;  // the walk's record, kept up to date
     bool enabled = true, removed = false;
@@ -55,8 +56,8 @@ struct Scene::Edits {
 
 namespace {
 
-// The inverse of the 3x3 (in double, then rounded to float), its mirroring,
-// and the world box of the mesh's bounds under the transform: centre
+// The inverse of the 3x3 (in double, then rounded to float) and the world
+// box of the mesh's bounds under the transform: centre
 // M c + T and half extents |M| e, in double, padded by 2^-20 of their size
 // (the rounding of the float inverse; what a ray's own rounding adds is the
 // walk's slack, see scene_trace.cpp) and by the double sums' own rounding,
@@ -86,7 +87,6 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
   if (!usable)
     throw UsageError(std::string(who) + ": rotation_scale is not invertible (determinant " + number_text(det) +
                      ") or its inverse has an entry beyond 2^40");
-  p.mirrored = det < 0;
   for (int a = 0; a < 3; ++a) p.translation[a] = t.translation[a];
   const layout::BlobHeader& h = layout::header_of(mesh.bytes.data());
   double c[3], half[3];
@@ -115,10 +115,11 @@ void place(layout::PlacedInstance& p, WorldBox& box, const Transform& t, const S
 
 }  // namespace
 
-SceneMesh::SceneMesh(std::vector<uint8_t> blob, std::string mesh_name)
-    : bytes(std::move(blob)),
+SceneMesh::SceneMesh(const BlobView& blob_view, std::shared_ptr<const void> keep, std::string mesh_name)
+    : owner(std::move(keep)),
+      bytes(blob_view.bytes()),
       name(std::move(mesh_name)),
-      view(bytes, name),
+      view(blob_view),
       walk(walker_for(uint32_t(view.layout().tree), uint32_t(view.layout().triangles))) {}
 
 Scene::Scene() : edits_(std::make_unique<Edits>()) {}
@@ -131,22 +132,52 @@ Scene::~Scene() = default;
 Scene::Scene(Scene&&) noexcept = default;
 Scene& Scene::operator=(Scene&&) noexcept = default;
 
-MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
+// Every add_mesh's end: the view (validated) over bytes `owner` keeps
+// alive, or the caller where it is null.
+MeshId Scene::add_validated(const BlobView& view, std::shared_ptr<const void> owner, const std::string& name) {
   Edits& e = edits("Scene::add_mesh");
-  auto mesh = std::make_shared<const SceneMesh>(std::move(blob), name);  // validates
   // The world boxes come from the header's bounds (not every layout's
   // validation reads them): finite, min <= max.
-  const layout::BlobHeader& h = layout::header_of(mesh->bytes.data());
+  const layout::BlobHeader& h = layout::header_of(view.bytes().data());
   for (int a = 0; a < 3; ++a)
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
       throw InputError(name + ": the blob's bounds on axis " + std::to_string(a) + " are not a finite box (" +
                        number_text(h.bounds_min[a]) + " to " + number_text(h.bounds_max[a]) + ")");
-  e.meshes.push_back(std::move(mesh));
+  e.meshes.push_back(std::make_shared<const SceneMesh>(view, std::move(owner), name));
   e.changed = true;
   return MeshId(e.meshes.size() - 1);
 }
 
-InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask) {
+MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
+  edits("Scene::add_mesh");  // a moved-from scene refuses before any validation
+  // Moved into the shared copy: its bytes stay where the caller's vector had them.
+  auto copy = std::make_shared<const std::vector<uint8_t>>(std::move(blob));
+  const BlobView view(*copy, name);  // validates
+  const MeshId id = add_validated(view, copy, name);
+  edits_->owned_bytes += copy->capacity();
+  return id;
+}
+
+MeshId Scene::add_mesh(std::shared_ptr<const MappedBlob> file, const std::string& name) {
+  edits("Scene::add_mesh");
+  if (!file) throw UsageError("Scene::add_mesh: " + name + ": the mapped blob is null");
+  const BlobView view(file->bytes(), name);  // validates
+  return add_validated(view, std::move(file), name);
+}
+
+MeshId Scene::add_mesh(const BlobView& blob, const std::string& name) { return add_validated(blob, nullptr, name); }
+
+std::span<const uint8_t> Scene::mesh_blob(MeshId mesh) const {
+  const Edits& e = edits("Scene::mesh_blob");
+  if (mesh >= e.meshes.size())
+    throw UsageError("Scene::mesh_blob: mesh " + std::to_string(mesh) + " is unknown (" +
+                     std::to_string(e.meshes.size()) + " added)");
+  return e.meshes[mesh]->bytes;
+}
+
+size_t Scene::owned_blob_bytes() const { return edits("Scene::owned_blob_bytes").owned_bytes; }
+
+InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask, bool flip_facing) {
   Edits& e = edits("Scene::add_instance");
   if (mesh >= e.meshes.size())
     throw UsageError("Scene::add_instance: mesh " + std::to_string(mesh) + " is unknown (" +
@@ -158,6 +189,7 @@ InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t 
   i.placed.id = uint32_t(e.instances.size());
   i.placed.mesh = mesh;
   i.placed.mask = mask;
+  i.placed.flip_facing = flip_facing;
   WorldBox box;
   place(i.placed, box, transform, *e.meshes[mesh], "Scene::add_instance");
   e.instances.push_back(i);
@@ -181,6 +213,12 @@ void Scene::set_transform(InstanceId instance, const Transform& transform) {
 void Scene::set_mask(InstanceId instance, uint8_t mask) {
   Edits& e = edits("Scene::set_mask");
   e.at(instance, "Scene::set_mask").placed.mask = mask;
+  e.changed = true;
+}
+
+void Scene::set_flip_facing(InstanceId instance, bool flip_facing) {
+  Edits& e = edits("Scene::set_flip_facing");
+  e.at(instance, "Scene::set_flip_facing").placed.flip_facing = flip_facing;
   e.changed = true;
 }
 

@@ -3,6 +3,7 @@
 // Immutable once made: a trace reads it while the next frame is edited.
 #pragma once
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -12,16 +13,21 @@
 
 namespace meshcast {
 
-// A scene's mesh: its blob's bytes, the view over them (validated once),
-// and the walker the view chose, which the scene's walk calls with its own
-// request (cpu/walk.h: its hits keep their slots, looked up afterwards).
+// A scene's mesh: its blob's bytes and what keeps them alive, the view
+// over them (validated once), and the walker the view chose, which the
+// scene's walk calls with its own request (cpu/walk.h: its hits keep their
+// slots, looked up afterwards).
 struct SceneMesh {
-  SceneMesh(std::vector<uint8_t> blob, std::string mesh_name);  // cpu/scene.cpp
+  // `view` validated over bytes that `owner` keeps alive: the scene's copy,
+  // a MappedBlob shared with the caller, or null for bytes the caller
+  // guarantees (Scene::add_mesh of a BlobView). cpu/scene.cpp.
+  SceneMesh(const BlobView& view, std::shared_ptr<const void> owner, std::string mesh_name);
   SceneMesh(const SceneMesh&) = delete;
   SceneMesh& operator=(const SceneMesh&) = delete;
-  const std::vector<uint8_t> bytes;
+  const std::shared_ptr<const void> owner;
+  const std::span<const uint8_t> bytes;  // the view's
   const std::string name;
-  const BlobView view;  // reads `bytes`, declared before it
+  const BlobView view;
   void (*const walk)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
                      const WalkRequest& request);
 };

@@ -90,9 +90,11 @@ Ray to_local(const WorldRay& r, const layout::PlacedInstance& p) {
   return local;
 }
 
-Cull as_instance_sees(Cull cull, bool mirrored) {
-  if (!mirrored || cull == Cull::None) return cull;
-  return cull == Cull::Back ? Cull::Front : Cull::Back;
+// The culling a flip_facing instance's walker takes: its front face is the
+// mesh's back. (A mirroring transform changes nothing: the walk is in the
+// mesh's frame, where the corners run as the mesh has them.)
+Cull turned(Cull cull) {
+  return cull == Cull::Back ? Cull::Front : cull == Cull::Front ? Cull::Back : cull;
 }
 
 bool world_ray_walkable(const RayD& r) {
@@ -124,23 +126,24 @@ void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, Walk
        &context);
 }
 
-// What a trace asks of each instance's walker: for an instance as the
-// world sees it and for a mirrored one (its culling turned). Closest and
+// What a trace asks of each instance's walker: for an instance that faces
+// as its mesh and for a flip_facing one (its culling turned). Closest and
 // any hit keep their slots (looked up by finish_scene_hits); Query::All's
 // rows name the caller's triangles, the instance's row written to `row`
 // (max_hits records), its count to *found.
 struct InstanceRequests {
-  WalkRequest as_seen, mirrored;
+  WalkRequest as_mesh, flipped;
   bool any;
   InstanceRequests(HitOutputs outputs, Query query, Cull cull, uint32_t max_hits = 0, uint32_t* found = nullptr,
                    Hit* row = nullptr)
       : any(query == Query::Any) {
     const uint32_t uv = uint32_t(outputs) & MC_HIT_UV;
-    as_seen.flags = uv | layout::query_bits(query, cull);
-    mirrored.flags = uv | layout::query_bits(query, as_instance_sees(cull, true));
-    as_seen.keep_slots = mirrored.keep_slots = true;
-    for (WalkRequest* r : {&as_seen, &mirrored}) r->max_hits = max_hits, r->found = found, r->lists = row;
+    as_mesh.flags = uv | layout::query_bits(query, cull);
+    flipped.flags = uv | layout::query_bits(query, turned(cull));
+    as_mesh.keep_slots = flipped.keep_slots = true;
+    for (WalkRequest* r : {&as_mesh, &flipped}) r->max_hits = max_hits, r->found = found, r->lists = row;
   }
+  const WalkRequest& of(const layout::PlacedInstance& p) const { return p.flip_facing ? flipped : as_mesh; }
 };
 
 // Closest or any hit of one ray, its triangle a slot of *hit_mesh (left
@@ -156,7 +159,7 @@ bool walk(const SceneSnapshot& s, const RayD& rd, SceneHit& best, const SceneMes
     uint64_t skipped = 0;
     // A local ray the walkers refuse (its direction scaled past their
     // range) is counted, not walked.
-    mesh.walk(mesh.bytes.data(), &local, &h, 1, &skipped, p.mirrored ? requests.mirrored : requests.as_seen);
+    mesh.walk(mesh.bytes.data(), &local, &h, 1, &skipped, requests.of(p));
     if (skipped != 0) complete = false;
     // Equal t: the lower instance id, as the oracle breaks ties.
     if (h.triangle != kNoHit &&
@@ -213,7 +216,7 @@ uint32_t walk_all(const SceneSnapshot& s, const RayD& rd, ListWalk& w, uint32_t&
     uint64_t skipped = 0;
     // A local ray the walkers refuse (its direction scaled past their
     // range) is counted, not walked.
-    mesh.walk(mesh.bytes.data(), &local, nullptr, 1, &skipped, p.mirrored ? w.requests.mirrored : w.requests.as_seen);
+    mesh.walk(mesh.bytes.data(), &local, nullptr, 1, &skipped, w.requests.of(p));
     if (skipped != 0) complete = false;
     const uint32_t own = w.own_found;
     found += own;

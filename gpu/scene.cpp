@@ -105,15 +105,23 @@ std::string SceneMethod::refusal(const SceneSnapshot& s) {
 void SceneMethod::upload_blobs(const SceneSnapshot& s) {
   if (blobs_ && s.meshes == uploaded_) return;
   if (const std::string why = refusal(s); !why.empty()) throw InputError(why);
-  std::vector<uint8_t> all;
   std::vector<uint32_t> base;
+  uint64_t bytes = 0;
   for (const auto& m : s.meshes) {
-    base.push_back(uint32_t(all.size() / 4));
-    all.insert(all.end(), m->bytes.begin(), m->bytes.end());
-    all.resize((all.size() + 3) / 4 * 4);  // the next blob on a word
+    base.push_back(uint32_t(bytes / 4));
+    bytes += (m->bytes.size() + 3) / 4 * 4;  // the next blob on a word
   }
-  auto blobs = std::make_unique<Buffer>(ctx_, std::max<size_t>(all.size(), 16), "scene blobs", 0, Memory::DeviceLocal);
-  if (!all.empty()) blobs->upload(all);
+  auto blobs = std::make_unique<Buffer>(ctx_, std::max<uint64_t>(bytes, 16), "scene blobs", 0, Memory::DeviceLocal);
+  // Each blob read where it lies (the scene's copy, a mapped file, the
+  // caller's bytes) straight into the staging copy: no host copy of them all.
+  blobs->upload(bytes, [&](uint8_t* staging) {
+    for (size_t k = 0; k < s.meshes.size(); ++k) {
+      const std::span<const uint8_t> b = s.meshes[k]->bytes;
+      uint8_t* at = staging + uint64_t(base[k]) * 4;
+      std::memcpy(at, b.data(), b.size());
+      std::memset(at + b.size(), 0, (b.size() + 3) / 4 * 4 - b.size());
+    }
+  });
   blobs_ = std::move(blobs);
   uploaded_ = s.meshes;
   mesh_base_ = std::move(base);

@@ -358,11 +358,15 @@ Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUs
 }
 
 void Buffer::upload(std::span<const uint8_t> bytes) {
-  if (bytes.empty()) return;
-  Buffer staging(ctx_, bytes.size(), "staging copy", VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-  std::memcpy(staging.data(), bytes.data(), bytes.size());
+  upload(bytes.size(), [&](uint8_t* staging) { std::memcpy(staging, bytes.data(), bytes.size()); });
+}
+
+void Buffer::upload(uint64_t bytes, const std::function<void(uint8_t*)>& fill) {
+  if (bytes == 0) return;
+  Buffer staging(ctx_, bytes, "staging copy", VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  fill(static_cast<uint8_t*>(staging.data()));
   ctx_.submit([&](VkCommandBuffer cb) {
-    VkBufferCopy region{0, 0, bytes.size()};
+    VkBufferCopy region{0, 0, bytes};
     ctx_.vk().CmdCopyBuffer(cb, staging.handle(), buffer_, 1, &region);
     // The copy is done before any later submission's shaders read it.
     VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};

@@ -5,6 +5,7 @@
 #pragma once
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -170,6 +171,10 @@ class Buffer {
   // Copies `bytes` (at most size()) to the start of a DeviceLocal buffer
   // through a mapped staging buffer and one transfer; waits for it.
   void upload(std::span<const uint8_t> bytes);
+  // The same for `bytes` that fill() writes into the staging buffer itself:
+  // pieces gathered from several places (the scene's blobs, each where its
+  // owner keeps it) without a host copy of the whole first.
+  void upload(uint64_t bytes, const std::function<void(uint8_t* staging)>& fill);
 
  private:
   void release();

@@ -293,7 +293,7 @@
 #define MC_PLACED_ID_AT 0u
 #define MC_PLACED_MESH_AT 4u
 #define MC_PLACED_MASK_AT 8u
-#define MC_PLACED_MIRRORED_AT 12u
+#define MC_PLACED_FLIP_FACING_AT 12u
 #define MC_PLACED_TO_LOCAL_AT 16u      // 9 floats, row-major
 #define MC_PLACED_TRANSLATION_AT 56u   // 3 doubles
 #define MC_TOP_NODE_BYTES 224u

@@ -16,11 +16,11 @@ namespace meshcast::layout {
 // more; its world box lives with the scene's edits, builds and refits read
 // it there).
 struct PlacedInstance {
-  uint32_t id;        // the caller's InstanceId
-  uint32_t mesh;      // index into the snapshot's meshes
-  uint32_t mask;      // 8 bits: a ray's mask must share one
-  uint32_t mirrored;  // 1 when rotation_scale's determinant is negative: the world sees its faces turned
-  float to_local[9];  // the inverse of rotation_scale, row-major, rounded to float
+  uint32_t id;           // the caller's InstanceId
+  uint32_t mesh;         // index into the snapshot's meshes
+  uint32_t mask;         // 8 bits: a ray's mask must share one
+  uint32_t flip_facing;  // 1 when the caller turned its faces (Scene::add_instance): its front is the mesh's back
+  float to_local[9];     // the inverse of rotation_scale, row-major, rounded to float
   double translation[3];
 };
 
@@ -50,7 +50,7 @@ struct TopLevel {
 
 // The records as layout/formats.h describes them to the shaders.
 static_assert(sizeof(PlacedInstance) == MC_PLACED_BYTES && offsetof(PlacedInstance, mesh) == MC_PLACED_MESH_AT &&
-              offsetof(PlacedInstance, mask) == MC_PLACED_MASK_AT && offsetof(PlacedInstance, mirrored) == MC_PLACED_MIRRORED_AT &&
+              offsetof(PlacedInstance, mask) == MC_PLACED_MASK_AT && offsetof(PlacedInstance, flip_facing) == MC_PLACED_FLIP_FACING_AT &&
               offsetof(PlacedInstance, to_local) == MC_PLACED_TO_LOCAL_AT &&
               offsetof(PlacedInstance, translation) == MC_PLACED_TRANSLATION_AT);
 static_assert(sizeof(TopWideNode) == MC_TOP_NODE_BYTES && offsetof(TopWideNode, hi) == MC_TOP_HI_AT &&

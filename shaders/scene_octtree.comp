@@ -138,7 +138,7 @@ void main() {
           continue;
         }
         blob_base = top_words[TOP_MESH_BASE + top_words[at + MC_PLACED_MESH_AT / 4u]];
-        instance_mirrored = top_words[at + MC_PLACED_MIRRORED_AT / 4u] != 0u;
+        instance_flip_facing = top_words[at + MC_PLACED_FLIP_FACING_AT / 4u] != 0u;
         Closest c = Closest(cut, MC_NO_HIT, 0.0, 0.0, kInfinity, ray);
         walk_octtree(local, c);
         if (c.slot == MC_NO_HIT) continue;

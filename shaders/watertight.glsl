@@ -16,11 +16,11 @@
 // shows (positive: the front face, corners counter-clockwise seen from the
 // origin).
 #ifdef MC_SCENE
-// The scene method walks a mirrored instance with its faces turned: what
-// the world sees as front is the blob's back (cpu/scene_trace.cpp's
-// as_instance_sees).
-bool instance_mirrored = false;
-bool culled(bool positive) { return (kFlags & (positive != instance_mirrored ? MC_CULL_FRONT : MC_CULL_BACK)) != 0u; }
+// The scene method walks a flip_facing instance with its faces turned: its
+// front is the blob's back (cpu/scene_trace.cpp's turned()). A mirroring
+// transform turns nothing: the walk is in the blob's frame.
+bool instance_flip_facing = false;
+bool culled(bool positive) { return (kFlags & (positive != instance_flip_facing ? MC_CULL_FRONT : MC_CULL_BACK)) != 0u; }
 #else
 bool culled(bool positive) { return (kFlags & (positive ? MC_CULL_FRONT : MC_CULL_BACK)) != 0u; }
 #endif

@@ -130,6 +130,24 @@ if ! diff <(od -An -tu4 -v -w12 -j8 "$work/two-cpu.hiti" | awk '{print $1, $2}')
           <(od -An -tu4 -v -w12 -j8 "$work/two-gpu.hiti" | awk '{print $1, $2}') >/dev/null; then
   echo "FAIL trace-scene-vulkan: the Vulkan scene method's hits differ from the CPU's"; failures=$((failures + 1))
 fi
+# flip_facing: false is the default, true turns the instance's faces, so
+# culling the back faces of a flipped instance answers as culling the front
+# faces of a plain one (bit for bit), and not as culling its back faces.
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "flip_facing": false}]}' "$mesh" >"$work/facing.json"
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "flip_facing": true}]}' "$mesh" >"$work/flipped.json"
+for f in one:back:one-back facing:back:facing-back one:front:one-front flipped:back:flipped-back; do
+  IFS=: read -r scene cull out <<<"$f"
+  check "trace-scene-$out" 0 "500 rays" -- "$meshcast" trace "$work/$scene.json" --layout AABBTree/Float3 --cull "$cull" --rays "$work/r.rays" --out "$work/$out.hiti"
+done
+if ! cmp -s "$work/one-back.hiti" "$work/facing-back.hiti"; then
+  echo "FAIL scene-flip-facing-default: \"flip_facing\": false answers otherwise than no key"; failures=$((failures + 1))
+elif ! cmp -s "$work/flipped-back.hiti" "$work/one-front.hiti" || cmp -s "$work/flipped-back.hiti" "$work/one-back.hiti"; then
+  echo "FAIL scene-flip-facing: a flipped instance's back faces are not a plain one's front faces"; failures=$((failures + 1))
+else
+  echo "ok   scene-flip-facing"; passes=$((passes + 1))
+fi
+printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "flip_facing": 1}]}' "$mesh" >"$work/flip_number.json"
+check scene-flip-facing-not-boolean 2 'flip_number.json: instances\[0\].flip_facing is the number 1, not true or false' -- "$meshcast" trace "$work/flip_number.json" --rays "$work/r.rays" --out "$work/x.hiti"
 check render-scene 0 "3 instances of 2 meshes.*scene.png" -- "$meshcast" render "$work/level.json" --png "$work/scene.png" --width 64 --height 48
 printf '{"meshes": {"mesh": "%s"}, "instances": [{"mesh": "mesh", "translation": [1, 2]}]}' "$mesh" >"$work/short.json"
 check scene-short-translation 2 "short.json: instances\[0\].translation is an array of 2, not an array of 3 numbers" -- "$meshcast" trace "$work/short.json" --rays "$work/r.rays" --out "$work/x.hiti"

@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <new>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <thread>
 
@@ -950,6 +951,64 @@ TEST(Host, SceneBatchesOnTheGpuSeeTheFrameTheySubmittedIn) {
   const std::map<Backend, int> refused = scene_frames(Backend::Vulkan, "AABBTree/Float3");
   EXPECT_EQ(refused.at(Backend::Cpu), 24);
   EXPECT_EQ(refused.count(Backend::Vulkan), 0u);
+}
+
+// Scene batches over blobs the scene does not own: a mapped blob file
+// shared with the scene, and the same file referenced through a BlobView.
+// Each batch answers as the scene over a copy, on the CPU and on the GPU
+// (uploaded from the mapping); the shared scene is dropped, and the
+// caller's mapping with it, while its batch is in flight: the batch's
+// snapshot keeps the mapping until it is collected.
+TEST(Host, SceneBatchesReadMappedBlobs) {
+  const std::vector<uint8_t> blob =
+      build_blob(make_sphere(12, 16, 1, {0, 0, 0}), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball");
+  const std::string path = (scratch_dir() / "host_scene_ball.mcb").string();
+  save_blob(path, blob);
+  const MappedBlob referenced(path);
+  auto place = [](Scene& scene, MeshId ball) {
+    for (int i = 0; i < 8; ++i) {
+      Transform t;
+      t.translation[0] = 1e6 + 4.0 * i;
+      if (i % 3 == 0) t.rotation_scale[4] = -1;  // mirrored
+      scene.add_instance(ball, t, 0xFF, i % 4 == 1);
+    }
+    scene.commit();
+  };
+  Scene copied, viewed;
+  place(copied, copied.add_mesh(blob, "ball"));
+  place(viewed, viewed.add_mesh(BlobView(referenced.bytes(), path), path));
+  std::vector<RayD> world(600);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> along(-2, 30), across(-1.2, 1.2);
+  for (RayD& r : world) r = {{1e6 + along(rng), across(rng), 5}, {0, float(across(rng) * 0.1), -1}, INFINITY};
+  for (const Backend b : {Backend::Cpu, Backend::Vulkan}) {
+    if (b == Backend::Vulkan && cpu_only()) continue;
+    for (const Cull cull : {Cull::None, Cull::Back}) {
+      std::vector<SceneHit> want(world.size());
+      copied.trace(world, want, HitOutputs::None, Query::Closest, cull);
+      size_t hits = 0;
+      for (const SceneHit& h : want) hits += h.instance != kNoHit;
+      EXPECT_GT(hits, world.size() / 4);
+      Caster caster(options(b));
+      auto shared = std::make_unique<Scene>();
+      {
+        auto file = std::make_shared<const MappedBlob>(path);
+        place(*shared, shared->add_mesh(file, path));
+        EXPECT_EQ(shared->mesh_blob(0).data(), file->bytes().data());
+      }  // the caller lets go of its mapping: the scene holds it
+      const host::Ticket from_shared = caster.submit(*shared, world, {Query::Closest, cull, 0xFF});
+      shared.reset();  // the scene goes too: the batch's snapshot holds the mapping
+      const host::Ticket from_view = caster.submit(viewed, world, {Query::Closest, cull, 0xFF});
+      for (const host::Ticket& t : {from_shared, from_view}) {
+        std::vector<SceneHit> got(world.size());
+        EXPECT_EQ(caster.wait(t, got).ran_on, b);
+        size_t differ = 0;
+        for (size_t i = 0; i < world.size(); ++i) differ += std::memcmp(&got[i], &want[i], sizeof(SceneHit)) != 0;
+        EXPECT_EQ(differ, 0u) << host::backend_name(b) << ", cull " << int(cull) << (t.id == from_shared.id ? ", shared" : ", viewed");
+      }
+      EXPECT_EQ(caster.validation_messages(), 0u);
+    }
+  }
 }
 
 // A blob's caster on the GPU takes scene batches beside its blob batches,

@@ -85,7 +85,8 @@ Transform random_transform(std::mt19937& rng, double spread, double offset, bool
 // `count` instances of a sphere, a terrain patch and an unwelded sphere
 // (every triangle its own corners), built with `layout`, spread over a cube
 // of 2 `spread` around `offset`: every 3rd mirrored, every 4th scaled
-// unevenly, masks 1, 2, 4 or all, every 7th disabled.
+// unevenly, every 5th with its faces flipped, masks 1, 2, 4 or all, every
+// 7th disabled.
 Level make_level(const std::string& layout, size_t count, double spread, double offset, uint32_t seed) {
   Level level;
   level.offset = offset;
@@ -98,7 +99,7 @@ Level make_level(const std::string& layout, size_t count, double spread, double 
   const uint8_t masks[4] = {1, 2, 4, 0xFF};
   for (uint32_t i = 0; i < count; ++i) {
     const Transform t = random_transform(rng, spread, offset, i % 4 != 0, i % 3 == 0);
-    level.instances.push_back({i, i % 3, t, masks[i % 4]});
+    level.instances.push_back({i, i % 3, t, masks[i % 4], i % 5 == 2});
     level.enabled.push_back(i % 7 != 6);
   }
   return level;
@@ -109,7 +110,7 @@ Scene make_scene(const Level& level) {
   for (size_t m = 0; m < level.blobs.size(); ++m) scene.add_mesh(level.blobs[m], "level mesh " + std::to_string(m));
   for (size_t i = 0; i < level.instances.size(); ++i) {
     const OracleInstance& o = level.instances[i];
-    EXPECT_EQ(scene.add_instance(o.mesh, o.transform, o.mask), o.id);
+    EXPECT_EQ(scene.add_instance(o.mesh, o.transform, o.mask, o.flip_facing), o.id);
     if (!level.enabled[i]) scene.set_enabled(o.id, false);
   }
   scene.commit();
@@ -272,6 +273,18 @@ std::vector<SceneHit> trace(const Scene& scene, const std::vector<RayD>& rays, Q
   return hits;
 }
 
+// A snapshot's answers: trace_snapshot's, or in the GPU build the Vulkan
+// scene method's.
+std::vector<SceneHit> trace_snapshot_here(const SceneSnapshot& snapshot, const std::vector<RayD>& rays) {
+  std::vector<SceneHit> hits(rays.size());
+#ifdef MESHCAST_TEST_GPU
+  EXPECT_EQ(scene_method(Query::Closest, Cull::None, HitOutputs::None).trace(snapshot, rays, hits), 0u);
+#else
+  EXPECT_EQ(trace_snapshot(snapshot, rays, hits), 0u);
+#endif
+  return hits;
+}
+
 class SceneVsOracle : public ::testing::TestWithParam<std::tuple<std::string, double>> {};
 
 // Every query and culling, masks, on a level of 60 instances over a
@@ -365,8 +378,8 @@ INSTANTIATE_TEST_SUITE_P(Layouts, SceneVsOracle,
 
 // A closed sphere 10^7 units away, plain and mirrored, rays from all
 // around it through its inside: every ray hits, under every query and
-// culling of the back faces (the far side's inner face for the mirrored
-// one, whose outside the world sees turned).
+// culling (the near side's outer face where the front is kept, the far
+// side's inner face where the back is: a mirror turns nothing).
 TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
   const Mesh sphere = make_sphere(24, 32, 2.0f, {0, 0, 0});
   for (const std::string& layout : walked_layouts()) {
@@ -395,9 +408,8 @@ TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
       rays[i].tmax = INFINITY;
     }
     // Each ray aims at a point inside its sphere at t = 1: it enters
-    // before and leaves after. The sphere's outside faces the world on the
-    // plain instance; the mirror turns its corners the other way round, so
-    // the world sees its outside as back faces (the oracle's rule).
+    // before and leaves after. The sphere's outside is its front on both
+    // instances: facing is decided in the mesh's frame (Transform).
     for (Query q : {Query::Closest, Query::Any})
       for (Cull c : {Cull::None, Cull::Back, Cull::Front}) {
         const std::vector<SceneHit> hits = trace(scene, rays, q, c);
@@ -405,14 +417,120 @@ TEST(Scene, ClosedSphereFarAwayLeaksNothing) {
         // Past its sphere a ray may go on to the other: any hit may be there.
         for (size_t i = 0; i < count; ++i) {
           leaks += q == Query::Any ? hits[i].instance == kNoHit : hits[i].instance != (i % 2 ? 1u : 0u);
-          const bool mirrored_one = i % 2 == 1;
-          if (q == Query::Closest && c != Cull::None)
-            wrong_side += (c == Cull::Back) != mirrored_one ? !(hits[i].t < 1) : !(hits[i].t > 1);
+          if (q == Query::Closest && c != Cull::None) wrong_side += c == Cull::Back ? !(hits[i].t < 1) : !(hits[i].t > 1);
           if (q == Query::Closest && c == Cull::None) wrong_side += !(hits[i].t < 1);
         }
         EXPECT_EQ(leaks, 0u) << layout << ", query " << int(q) << ", cull " << int(c);
         EXPECT_EQ(wrong_side, 0u) << layout << ", query " << int(q) << ", cull " << int(c);
       }
+  }
+}
+
+// Facing is the mesh's own (Transform): a closed sphere whose outside is
+// its front, scaled unevenly, placed 10^7 units away plain and mirrored
+// (the same rotation and scales, the first column negated: the same
+// surface, its corners running the other way in the world), and both again
+// with flip_facing; rays from outside aimed at a point inside, ending
+// there (an occlusion probe, t_max 1) or going on. Without flip_facing
+// both show their outside as front: Cull::Back keeps the near side (t <
+// 1), so every probe is occluded and nothing leaks through a mirrored
+// prop; Cull::Front keeps the far side's inside (t > 1, a probe sees
+// nothing). With flip_facing the other way round. Every answer also
+// against the oracle, which reads facing off the world corners' winding
+// and the determinant's sign.
+TEST(Scene, MirroredInstancesFaceAsTheirMesh) {
+  const Mesh sphere = make_sphere(24, 32, 2.0f, {0, 0, 0});
+  for (const std::string& layout : walked_layouts()) {
+    Level level;
+    level.meshes.push_back(sphere);
+    level.blobs.push_back(build_blob(sphere, parse_layout(layout), "sphere"));
+    if (moves_vertices(uint32_t(parse_layout(layout).layout.triangles))) level.meshes[0] = stored_mesh(level.blobs[0]);
+    std::mt19937 rng(41);
+    const Transform plain = random_transform(rng, 0, 1e7, false, false);
+    Transform mirrored = plain;
+    for (int row = 0; row < 3; ++row) mirrored.rotation_scale[3 * row] = -mirrored.rotation_scale[3 * row];
+    mirrored.translation[0] += 20;
+    // 0 plain, 1 mirrored, 2 and 3 the same with their faces flipped.
+    for (uint32_t k = 0; k < 4; ++k) {
+      Transform t = k % 2 ? mirrored : plain;
+      t.translation[2] += k / 2 * 20.0;
+      level.instances.push_back({k, 0, t, 0xFF, false});
+      level.enabled.push_back(true);
+    }
+    Scene scene = make_scene(level);
+    // Flipped after the first commit; a new transform keeps the flag.
+    for (uint32_t k : {2u, 3u}) {
+      level.instances[k].flip_facing = true;
+      scene.set_flip_facing(k, true);
+    }
+    scene.set_transform(3, level.instances[3].transform);
+    scene.commit();
+    const SceneOracle oracle = oracle_of(level);
+    std::normal_distribution<double> n(0, 1);
+    std::uniform_real_distribution<double> inside(-0.5, 0.5);
+    const size_t count = quick() ? 800 : 4000;
+    std::vector<RayD> probes(count), through(count);
+    for (size_t i = 0; i < count; ++i) {
+      const Transform& at = level.instances[i % 4].transform;
+      double d[3] = {n(rng), n(rng), n(rng)};
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (int a = 0; a < 3; ++a) {
+        const double target = at.translation[a] + inside(rng);  // the sphere's half axes are 1 at least
+        probes[i].org[a] = target + 9 * d[a] / len;
+        probes[i].dir[a] = float(target - probes[i].org[a]);
+      }
+      probes[i].tmax = 1;
+      through[i] = probes[i];
+      through[i].tmax = INFINITY;
+    }
+    for (const Query q : {Query::Closest, Query::Any})
+      for (const Cull c : {Cull::None, Cull::Back, Cull::Front})
+        for (const std::vector<RayD>* rays : {&probes, &through}) {
+          const bool probe = rays == &probes;
+          const std::vector<SceneHit> hits = trace(scene, *rays, q, c);
+          size_t wrong = 0, ends_inside_hit = 0;
+          std::string first;
+          for (size_t i = 0; i < count; ++i) {
+            const uint32_t own = uint32_t(i % 4);
+            const bool outside_is_front = own < 2;  // flip_facing turns it; the mirror does not
+            const bool near_kept = c == Cull::None || (c == Cull::Back) == outside_is_front;
+            const SceneHit& h = hits[i];
+            bool right;
+            if (probe)  // it ends inside: only its own sphere's near side is on the segment
+              right = near_kept ? h.instance == own && (q == Query::Any || h.t < 1) : h.instance == kNoHit;
+            else if (q == Query::Any)
+              right = h.instance != kNoHit;  // past its sphere it may reach another
+            else
+              right = h.instance == own && (near_kept ? h.t < 1 : h.t > 1);
+            ends_inside_hit += probe && h.instance != kNoHit;
+            if (!right && wrong++ == 0)
+              first = "ray " + std::to_string(i) + " at instance " + std::to_string(own) + ": instance " +
+                      std::to_string(h.instance) + " at t " + std::to_string(h.t);
+          }
+          const std::string what = layout + ", query " + std::to_string(int(q)) + ", cull " + std::to_string(int(c)) +
+                                   (probe ? ", probes ending inside" : ", rays going through");
+          EXPECT_EQ(wrong, 0u) << what << ": " << first;
+          const Judged j = judge(oracle, *rays, hits, c, 0xFF, q == Query::Any);
+          EXPECT_EQ(j.wrong, 0u) << what << " against the oracle: " << j.first_problem;
+          EXPECT_LE(j.ties, count / 100) << what;
+          // Two of the four instances keep their near side under culling.
+          if (probe) {
+            EXPECT_EQ(ends_inside_hit, c == Cull::None ? count : count / 2) << what;
+          }
+        }
+    // Every hit, back faces culled: the near side alone on the plain and
+    // the mirrored sphere, the far side's inside alone on the flipped ones.
+    SceneHitLists lists;
+    lists.max_hits = 16;
+    EXPECT_EQ(scene.trace_all_hits(through, lists, HitOutputs::None, Cull::Back), 0u);
+    size_t wrong_rows = 0;
+    for (size_t i = 0; i < count; ++i) {
+      const std::span<const SceneHit> row = lists.row(i);
+      wrong_rows += row.empty() || row[0].instance != uint32_t(i % 4) || (i % 4 < 2 ? !(row[0].t < 1) : !(row[0].t > 1));
+    }
+    EXPECT_EQ(wrong_rows, 0u) << layout << ", Query::All";
+    const Judged all = judge_all(oracle, through, lists, Cull::Back, 0xFF);
+    EXPECT_EQ(all.wrong, 0u) << layout << ", Query::All against the oracle: " << all.first_problem;
   }
 }
 
@@ -649,6 +767,122 @@ TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
     EXPECT_EQ(again[i].instance, before[i].instance) << "ray " << i;
     EXPECT_EQ(again[i].triangle, before[i].triangle) << "ray " << i;
   }
+}
+
+// A scene over blobs it does not own answers as one over its own copies:
+// a level's blobs saved and mapped (MappedBlob), given shared and as
+// BlobViews, the same hits bit for bit under every query and culling on
+// the CPU and (gpu_scene_test) the Vulkan scene method, which uploads them
+// from the mapping. The bytes are held once: the scene walks the mapped
+// pages themselves and counts no copy of them, the shared mapping lives on
+// in the scene (and in a snapshot outliving the scene) after the caller
+// lets go, and a corrupted file is refused as a corrupted copy is.
+TEST(Scene, ReferencedBlobsAnswerAsCopies) {
+  const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 40, 60, 1e6, 19);
+  std::vector<std::shared_ptr<const MappedBlob>> files;
+  size_t blob_bytes = 0;
+  for (size_t m = 0; m < level.blobs.size(); ++m) {
+    const std::string path = (scratch_dir() / ("scene_mesh_" + std::to_string(m) + ".mcb")).string();
+    save_blob(path, level.blobs[m]);
+    files.push_back(std::make_shared<const MappedBlob>(path));
+    blob_bytes += level.blobs[m].size();
+  }
+  const Scene copied = make_scene(level);
+  Scene shared, viewed;
+  for (size_t m = 0; m < files.size(); ++m) {
+    const std::string name = "level mesh " + std::to_string(m);
+    EXPECT_EQ(shared.add_mesh(std::shared_ptr(files[m]), name), m);
+    EXPECT_EQ(viewed.add_mesh(BlobView(files[m]->bytes(), name), name), m);
+  }
+  for (Scene* s : {&shared, &viewed}) {
+    for (size_t i = 0; i < level.instances.size(); ++i) {
+      const OracleInstance& o = level.instances[i];
+      s->add_instance(o.mesh, o.transform, o.mask, o.flip_facing);
+      if (!level.enabled[i]) s->set_enabled(o.id, false);
+    }
+    s->commit();
+  }
+  // Held once: the scenes walk the mapped pages; only the copy counts bytes.
+  for (size_t m = 0; m < files.size(); ++m) {
+    EXPECT_EQ(shared.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(viewed.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(viewed.mesh_blob(MeshId(m)).size(), level.blobs[m].size()) << m;
+    EXPECT_NE(copied.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+  }
+  EXPECT_GE(copied.owned_blob_bytes(), blob_bytes);
+  {  // A vector moved in is kept where it lies.
+    std::vector<uint8_t> moved_in = level.blobs[0];
+    const uint8_t* at = moved_in.data();
+    Scene owner;
+    EXPECT_EQ(owner.mesh_blob(owner.add_mesh(std::move(moved_in), "moved")).data(), at);
+    EXPECT_EQ(owner.owned_blob_bytes(), level.blobs[0].size());
+  }
+  EXPECT_EQ(shared.owned_blob_bytes(), 0u);
+  EXPECT_EQ(viewed.owned_blob_bytes(), 0u);
+  EXPECT_THROW(viewed.mesh_blob(MeshId(files.size())), UsageError);
+  // The caller lets go of its mappings: the shared scene keeps its own.
+  std::vector<const uint8_t*> mapped_at;
+  for (const auto& f : files) mapped_at.push_back(f->bytes().data());
+  std::vector<std::weak_ptr<const MappedBlob>> watched(files.begin(), files.end());
+  const std::vector<RayD> rays = level_rays(level, quick() ? 400 : 1200, 60, 23);
+  for (const Query q : {Query::Closest, Query::Any})
+    for (const Cull c : {Cull::None, Cull::Back, Cull::Front}) {
+      const std::vector<SceneHit> want = trace(copied, rays, q, c, 0xFF, HitOutputs::Uv);
+      size_t hits = 0;
+      for (const SceneHit& h : want) hits += h.instance != kNoHit;
+      EXPECT_GT(hits, rays.size() / 10) << "query " << int(q) << ", cull " << int(c);
+      for (const Scene* s : {&shared, &viewed}) {
+        const std::vector<SceneHit> got = trace(*s, rays, q, c, 0xFF, HitOutputs::Uv);
+        size_t differ = 0;
+        for (size_t i = 0; i < rays.size(); ++i) differ += std::memcmp(&got[i], &want[i], sizeof(SceneHit)) != 0;
+        EXPECT_EQ(differ, 0u) << (s == &shared ? "shared" : "viewed") << ", query " << int(q) << ", cull " << int(c);
+      }
+    }
+  // Query::All (the CPU's) likewise.
+  SceneHitLists want_rows, got_rows;
+  want_rows.max_hits = got_rows.max_hits = 64;
+  EXPECT_EQ(copied.trace_all_hits(rays, want_rows, HitOutputs::Uv, Cull::Back), 0u);
+  EXPECT_EQ(viewed.trace_all_hits(rays, got_rows, HitOutputs::Uv, Cull::Back), 0u);
+  ASSERT_EQ(got_rows.hits.size(), want_rows.hits.size());
+  EXPECT_EQ(std::memcmp(got_rows.hits.data(), want_rows.hits.data(), want_rows.hits.size() * sizeof(SceneHit)), 0);
+  EXPECT_EQ(got_rows.found, want_rows.found);
+  files.clear();
+  for (const auto& w : watched) EXPECT_FALSE(w.expired()) << "the shared scene let a mapping go";
+  const std::vector<SceneHit> want = trace(copied, rays);
+  {
+    Scene moved = std::move(shared);
+    const std::shared_ptr<const SceneSnapshot> frame = moved.snapshot();
+    moved = Scene();  // the scene is gone; its snapshot keeps the mappings
+    for (const auto& w : watched) EXPECT_FALSE(w.expired()) << "a snapshot let a mapping go";
+    const std::vector<SceneHit> got = trace_snapshot_here(*frame, rays);
+    size_t differ = 0;
+    for (size_t i = 0; i < rays.size(); ++i) differ += std::memcmp(&got[i], &want[i], sizeof(SceneHit)) != 0;
+    EXPECT_EQ(differ, 0u) << "the snapshot of a scene gone";
+  }
+  // A GPU scene method holds the meshes it uploaded until it uploads
+  // others (gpu/scene.h): the copy's, here.
+  trace_snapshot_here(*copied.snapshot(), rays);
+  for (const auto& w : watched) EXPECT_TRUE(w.expired()) << "a mapping outlived every scene and snapshot holding it";
+  // The same validation as a copy's: a flipped byte in the file is refused
+  // with the copy's message.
+  std::vector<uint8_t> corrupted = level.blobs[0];
+  corrupted[corrupted.size() / 2] ^= 0x40;
+  const std::string path = (scratch_dir() / "scene_mesh_corrupted.mcb").string();
+  save_blob(path, corrupted);
+  std::string copy_says, mapped_says;
+  try {
+    Scene().add_mesh(corrupted, "rock");
+  } catch (const InputError& e) {
+    copy_says = e.what();
+  }
+  try {
+    Scene().add_mesh(std::make_shared<const MappedBlob>(path), "rock");
+  } catch (const InputError& e) {
+    mapped_says = e.what();
+  }
+  EXPECT_NE(copy_says, "") << "a corrupted copy was taken";
+  EXPECT_EQ(mapped_says, copy_says);
+  EXPECT_THROW(Scene().add_mesh(std::shared_ptr<const MappedBlob>(), "none"), UsageError);
 }
 
 #ifdef MESHCAST_TEST_GPU

@@ -104,8 +104,10 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
     if (!i.is_object() || !i.contains("mesh") || !i["mesh"].is_string())
       throw InputError(where + " is not an object with a \"mesh\" name");
     for (const auto& [key, value] : i.items())
-      if (key != "mesh" && key != "rotation_scale" && key != "translation" && key != "mask" && key != "enabled")
-        throw InputError(where + ": \"" + shown_text(key) + "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled)");
+      if (key != "mesh" && key != "rotation_scale" && key != "translation" && key != "mask" && key != "enabled" &&
+          key != "flip_facing")
+        throw InputError(where + ": \"" + shown_text(key) +
+                         "\" is not an instance's key (mesh, rotation_scale, translation, mask, enabled, flip_facing)");
     const auto mesh = ids.find(i["mesh"].get<std::string>());
     if (mesh == ids.end()) throw InputError(where + ".mesh: \"" + shown_text(i["mesh"].get<std::string>()) + "\" is not in \"meshes\"");
     Transform t;
@@ -123,10 +125,13 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
         throw InputError(where + ".mask is not an integer in 0..255");
       mask = uint8_t(i["mask"].get<int64_t>());
     }
-    if (i.contains("enabled") && !i["enabled"].is_boolean()) throw InputError(where + ".enabled is not true or false");
+    for (const char* flag : {"enabled", "flip_facing"})
+      if (i.contains(flag) && !i[flag].is_boolean())
+        throw InputError(where + "." + flag + " is " + described(i[flag]) + ", not true or false");
+    const bool flip_facing = i.contains("flip_facing") && i["flip_facing"].get<bool>();
     InstanceId id;
     try {
-      id = out.scene.add_instance(mesh->second, t, mask);
+      id = out.scene.add_instance(mesh->second, t, mask, flip_facing);
     } catch (const UsageError& e) {
       throw InputError(where + ": " + e.what());
     }

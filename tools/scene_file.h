@@ -1,10 +1,12 @@
 // Scene files (README "Files"): a JSON object
 //   {"meshes": {"NAME": "mesh or blob file", ...},
 //    "instances": [{"mesh": "NAME", "rotation_scale": [9 numbers, row-major],
-//                   "translation": [x, y, z], "mask": 255, "enabled": true}, ...]}
+//                   "translation": [x, y, z], "mask": 255, "enabled": true,
+//                   "flip_facing": false}, ...]}
 // where rotation_scale (default the identity), translation (default 0),
-// mask (default 255) and enabled (default true) may be left out, and a
-// mesh's path is taken relative to the scene file's folder.
+// mask (default 255), enabled (default true) and flip_facing (default
+// false: the instance faces as its mesh, Scene::add_instance) may be left
+// out, and a mesh's path is taken relative to the scene file's folder.
 #pragma once
 #include <cstdio>
 #include <string>

@@ -22,6 +22,10 @@
 // thread; Query::All, other layouts, a refused batch and a lost device
 // are the CPU's (BatchRecord::ran_on says which answered). The Automatic
 // backend sends scene batches to the CPU (its crossover is the blob's).
+// The snapshot a batch holds holds the scene's meshes: a MappedBlob the
+// scene shares stays mapped until the batch is collected, even when the
+// scene is gone; bytes the scene only references (Scene::add_mesh of a
+// BlobView) must outlive the batch.
 //
 //   Caster scenes({});                          // no blob: scene batches alone
 //   Ticket f = scenes.submit(scene, world_rays, {Query::Closest, Cull::None, 0xFF});

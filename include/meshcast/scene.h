@@ -3,6 +3,8 @@
 //
 //   meshcast::Scene scene;
 //   meshcast::MeshId rock = scene.add_mesh(load_blob("rock.mcb"), "rock.mcb");
+//   auto tree_file = std::make_shared<const meshcast::MappedBlob>("tree.mcb");
+//   meshcast::MeshId tree = scene.add_mesh(tree_file, "tree.mcb");  // mapped, not copied
 //   meshcast::InstanceId a = scene.add_instance(rock, transform);  // any number
 //   scene.commit();                                                // the frame's changes are done
 //   scene.trace(rays, hits);                                       // sees what was committed
@@ -65,10 +67,17 @@ using SceneHitLists = HitRows<SceneHit>;
 
 // Where an instance stands: world = rotation_scale * local + translation.
 // The 3x3 is row-major and may rotate, scale (non-uniformly too) and mirror
-// (a negative determinant; a mirrored instance's corners run the other way
-// in the world, so what is its front face flips with it); it must be
-// invertible. The translation is in double: placements far from the origin
-// keep their precision.
+// (a negative determinant); it must be invertible. The translation is in
+// double: placements far from the origin keep their precision.
+//
+// Facing is the mesh's own, whatever the transform: a triangle's front face
+// is decided in the mesh's frame (the world ray brought into it meets the
+// corners as the mesh winds them), as Vulkan's and DirectX's ray tracing
+// decide it. A mirrored copy of a closed mesh whose outside is its front
+// keeps its outside in front, so Cull::Back from outside still hits it. An
+// instance's flip_facing (Scene::add_instance, set_flip_facing; false by
+// default, like VK_GEOMETRY_INSTANCE_TRIANGLE_FLIP_FACING_BIT_KHR) turns
+// that instance's faces: its front is the mesh's back.
 struct Transform {
   float rotation_scale[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   double translation[3] = {0, 0, 0};
@@ -87,17 +96,42 @@ class Scene {
   Scene& operator=(Scene&&) noexcept;
 
   // A blob every instance of it walks, validated once (InputError naming
-  // `name`); the scene keeps the bytes.
+  // `name`: what BlobView checks, and bounds that are a finite box). Three
+  // ways to hand it over, the same validation and walks for each:
+  //
+  // The scene keeps the bytes: a vector moved in is kept where it lies (no
+  // copy), one passed as an lvalue is copied.
   MeshId add_mesh(std::vector<uint8_t> blob, const std::string& name);
+  // A mapped blob file the scene shares: the scene, every snapshot of it and
+  // every caster batch holding one keep the mapping alive; the bytes are
+  // read where they are mapped, never copied (a GPU scene method copies
+  // them to the device). UsageError for a null pointer.
+  MeshId add_mesh(std::shared_ptr<const MappedBlob> file, const std::string& name);
+  // The bytes a BlobView reads (already validated: not checked again),
+  // referenced, neither copied nor owned: they must stay unchanged and
+  // outlive the scene, every snapshot taken from it (a caster's batch holds
+  // one until it is collected) and every trace through them; a GPU scene
+  // method reads them only while a batch is begun, to upload them.
+  MeshId add_mesh(const BlobView& blob, const std::string& name);
+  // The bytes instances of `mesh` walk (the scene's copy, or the caller's
+  // where it shares or references them). UsageError for an unknown mesh.
+  std::span<const uint8_t> mesh_blob(MeshId mesh) const;
+  // The blobs' bytes the scene holds copies of (add_mesh of a vector);
+  // shared and referenced blobs are the caller's memory, not counted.
+  size_t owned_blob_bytes() const;
 
   // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
-  // share a bit with it for the instance to be walked). UsageError for an
-  // unknown mesh, a transform that is not finite or not invertible, a 3x3
-  // or inverse entry beyond 2^40, a translation or world box beyond 2^100
-  // (kMaxCoordinate), or a 2^31st instance.
-  InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF);
+  // share a bit with it for the instance to be walked) and its faces as the
+  // mesh has them, or turned with `flip_facing` (see Transform: Cull::Back
+  // then drops the mesh's front faces). UsageError for an unknown mesh, a
+  // transform that is not finite or not invertible, a 3x3 or inverse entry
+  // beyond 2^40, a translation or world box beyond 2^100 (kMaxCoordinate),
+  // or a 2^31st instance.
+  InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF, bool flip_facing = false);
+  // A new transform keeps the instance's mask and flip_facing.
   void set_transform(InstanceId instance, const Transform& transform);
   void set_mask(InstanceId instance, uint8_t mask);
+  void set_flip_facing(InstanceId instance, bool flip_facing);
   void set_enabled(InstanceId instance, bool enabled);
   // The id is not given again. UsageError for an unknown or removed id.
   void remove_instance(InstanceId instance);
@@ -107,8 +141,9 @@ class Scene {
 
   // The hit of each world ray under `query` (Closest or Any; All has
   // trace_all_hits) against the committed scene, among the instances whose mask shares a bit with
-  // `mask`; `cull` as BlobView::trace, the front face as the instance shows
-  // it in the world; `outputs`: Uv at most (a scene hit has no point).
+  // `mask`; `cull` as BlobView::trace, the front face as the instance's
+  // mesh has it (turned by its flip_facing; a mirroring transform changes
+  // nothing, see Transform); `outputs`: Uv at most (a scene hit has no point).
   // Returns the rays not walkable: a non-finite origin or one beyond 2^100,
   // a direction or t_max BlobView would refuse (answered as misses), or a
   // ray some instance's frame cannot take (its direction scaled past the
@@ -140,6 +175,7 @@ class Scene {
  private:
   struct Edits;
   Edits& edits(const char* who) const;  // UsageError naming `who` on a moved-from scene
+  MeshId add_validated(const BlobView& view, std::shared_ptr<const void> owner, const std::string& name);
   std::unique_ptr<Edits> edits_;  // and the committed snapshot, behind a mutex
 };
 

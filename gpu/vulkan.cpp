@@ -51,6 +51,12 @@ bool has_layer(const VulkanFunctions& vk, const char* name) {
 
 }  // namespace
 
+namespace {
+std::atomic<uint64_t> g_instances_created{0}, g_instances_alive{0};  // instances_made()
+}  // namespace
+
+InstanceCount instances_made() { return {g_instances_created.load(), g_instances_alive.load()}; }
+
 void check(VkResult r, const char* what) {
   if (r != VK_SUCCESS)
     throw GpuError(std::string("Vulkan: ") + what + " failed (" + result_name(r) + ")", r == VK_ERROR_DEVICE_LOST);
@@ -89,6 +95,7 @@ Context::Context(const DeviceChoice& choice) {
   if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 1,
                   ici.ppEnabledExtensionNames = &ext;
   check(vk_.CreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
+  ++g_instances_created, ++g_instances_alive;
   // A throw below (no such device, a missing feature) would skip the
   // destructor: release what exists so far, then let it go on.
   try {
@@ -120,7 +127,15 @@ Context::Context(const DeviceChoice& choice) {
       for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
         for (uint32_t i = 0; i < count && pick < 0; ++i)
           if (props[i].deviceType == type) pick = int(i);
-      if (pick < 0) pick = 0;
+      for (uint32_t i = 0; i < count && pick < 0; ++i)
+        if (!choice.hardware_only || props[i].deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) pick = int(i);
+      if (pick < 0) {  // hardware_only, and every device is a CPU-type one
+        std::string list;
+        for (uint32_t i = 0; i < count; ++i) list += (i ? ", " : "") + std::string(props[i].deviceName);
+        throw GpuError("Vulkan: no device but CPU-type (software) ones (" + list +
+                       "), which the automatic choice passes over: the CPU walkers answer faster; name one "
+                       "(CasterOptions::device, $MESHCAST_VK_DEVICE) or ask for Backend::Vulkan to use it");
+      }
     } else if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
       // An index: any number of digits (a long one is no device, not a crash).
       uint64_t index = 0;
@@ -319,7 +334,11 @@ void Context::release() {
   }
   if (!owns_device_) return;
   if (messenger_) vk_.DestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
-  if (instance_ && vk_.DestroyInstance) vk_.DestroyInstance(instance_, nullptr);
+  if (instance_ && vk_.DestroyInstance) {
+    vk_.DestroyInstance(instance_, nullptr);
+    --g_instances_alive;
+  }
+  instance_ = VK_NULL_HANDLE;
 }
 
 VkCommandBuffer Context::allocate_command_buffer() {

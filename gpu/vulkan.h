@@ -31,7 +31,24 @@ struct DeviceChoice {
   std::string device;
   // Validation layers (VK_LAYER_KHRONOS_validation); also turned on by
   // $MESHCAST_VK_VALIDATION=1. Every message they send is counted.
-  bool validation = false;};
+  bool validation = false;
+  // The default choice ("" and no $MESHCAST_VK_DEVICE) passes over
+  // CPU-type devices (VK_PHYSICAL_DEVICE_TYPE_CPU: a software rasterizer
+  // such as lavapipe, running on the cores the CPU walkers use, and far
+  // slower than them on the same rays):
+  // GpuError saying so when no other device is there, the instance then
+  // destroyed at once. A device named (an index, a part of its name) is
+  // taken whatever its type. The Automatic backend's choice.
+  bool hardware_only = false;
+};
+
+// The VkInstances contexts have created in this process, and how many of
+// them still exist (an engine's are never counted): how a test sees that
+// a caster that will not use the GPU starts no Vulkan, or keeps none.
+struct InstanceCount {
+  uint64_t created = 0, alive = 0;
+};
+InstanceCount instances_made();
 
 // An engine's own Vulkan objects, for a context that makes none of its own
 // (it still makes a command pool, fences and its buffers on that device).

@@ -208,7 +208,10 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
           throw;
         }
       } else {
-        gpu_ = std::make_shared<gpu::Context>(gpu::DeviceChoice{options_.device, options_.validation});
+        // Automatic takes no software device by itself: it would measure
+        // for a moment only to find the CPU faster at every size.
+        gpu_ = std::make_shared<gpu::Context>(
+            gpu::DeviceChoice{options_.device, options_.validation, options_.backend == Backend::Automatic});
       }
       // The method that reads the blob's layout, or the one asked for:
       // trying each method in turn would let one that needs a feature the
@@ -309,6 +312,15 @@ Caster::~Caster() {
   method_.reset();
   gpu_.reset();
 }
+
+#if MESHCAST_VULKAN
+VulkanInstances vulkan_instances() {
+  const gpu::InstanceCount n = gpu::instances_made();
+  return {n.created, n.alive};
+}
+#else
+VulkanInstances vulkan_instances() { return {}; }
+#endif
 
 #if MESHCAST_VULKAN
 std::string Caster::device_name() const { return gpu_ ? gpu_->device_name() : "none"; }

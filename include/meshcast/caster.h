@@ -148,6 +148,19 @@ struct VulkanObjects {
   const void* enabled_features = nullptr;  // const VkPhysicalDeviceFeatures2*: the device's, as created
 };
 
+// The Vulkan instances meshcast has made in this process so far, and how
+// many of them still exist (an engine's own are never counted). A caster
+// that will not use the GPU makes none: Backend::Cpu, and a caster of scene
+// batches alone on Automatic. The Automatic backend takes no CPU-type
+// (software) device by itself: where that is all there is, it makes an
+// instance to look, destroys it at once, and measures nothing; the CPU
+// answers and gpu_error() says why. Naming such a device
+// (CasterOptions::device, $MESHCAST_VK_DEVICE), or Backend::Vulkan, takes it.
+struct VulkanInstances {
+  uint64_t created = 0, alive = 0;
+};
+VulkanInstances vulkan_instances();
+
 // The most frames and worker threads a caster takes: each frame holds
 // buffers, and on the GPU a fence and a command buffer, for as long as the
 // caster lives; more than these is a mistake, not a need.
@@ -166,7 +179,11 @@ struct CasterOptions {
   uint32_t frames = 4;          // batches in flight at most (1..kMaxCasterFrames)
   uint32_t threads = 0;         // CPU workers (0: every core), unless `jobs` is given
   JobSystem* jobs = nullptr;    // an engine's job system (not owned) instead of meshcast's pool
-  std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
+  // The Vulkan device: an index or a case-insensitive part of its name,
+  // taken whatever its type; "" for $MESHCAST_VK_DEVICE, else the first
+  // discrete GPU, else the first integrated one, else the first device;
+  // on Automatic the first that is not CPU-type (software), or none.
+  std::string device;
   VulkanObjects engine_vulkan;  // the engine's device instead (its `device` set); `device` and `validation` must be unset
   std::string gpu_method;       // "" : the one that reads the blob's layout
   bool validation = false;      // Vulkan validation layers on meshcast's own instance

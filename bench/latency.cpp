@@ -87,9 +87,12 @@ LatencyResult bench_latency(const Mesh& mesh, const std::string& name, double fr
     result.gpu_error = caster.gpu_error();
     if (caster.gpu_available()) measure(caster, host::Backend::Vulkan, "Vulkan", pool, frame_ms, &result.rows);
   }
-  // What the automatic backend measures for itself at start-up.
+  // What the automatic backend measures for itself at start-up, on the
+  // device of the table above, named: by itself it passes over a software
+  // device (lavapipe), and would measure nothing there.
   host::CasterOptions automatic = all;
-  automatic.backend = host::Backend::Automatic, automatic.device = device;
+  automatic.backend = host::Backend::Automatic;
+  automatic.device = device.empty() && result.gpu_error.empty() ? result.device : device;
   host::Caster caster(blob, name, automatic);
   caster.wait_for_crossover();
   result.crossover = caster.crossover();

@@ -29,6 +29,11 @@ const char* result_name(VkResult r) {
   }
 }
 
+// "1.2": a Vulkan version as errors name it.
+std::string version_text(uint32_t version) {
+  return std::to_string(VK_API_VERSION_MAJOR(version)) + "." + std::to_string(VK_API_VERSION_MINOR(version));
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -45,6 +50,12 @@ bool has_layer(const VulkanFunctions& vk, const char* name) {
 }
 
 }  // namespace
+
+namespace {
+std::atomic<uint64_t> g_instances_created{0}, g_instances_alive{0};  // instances_made()
+}  // namespace
+
+InstanceCount instances_made() { return {g_instances_created.load(), g_instances_alive.load()}; }
 
 void check(VkResult r, const char* what) {
   if (r != VK_SUCCESS)
@@ -68,8 +79,7 @@ Context::Context(const DeviceChoice& choice) {
   uint32_t version = VK_API_VERSION_1_0;
   if (vk_.EnumerateInstanceVersion) vk_.EnumerateInstanceVersion(&version);
   if (version < VK_API_VERSION_1_2)
-    throw GpuError("Vulkan: the loader offers Vulkan 1." + std::to_string(VK_API_VERSION_MINOR(version)) +
-                   "; meshcast needs 1.2");
+    throw GpuError("Vulkan: the loader offers Vulkan " + version_text(version) + "; meshcast needs 1.2");
   const char* env_validation = std::getenv("MESHCAST_VK_VALIDATION");
   bool validation = choice.validation || (env_validation && std::string(env_validation) == "1");
   if (validation && !has_layer(vk_, "VK_LAYER_KHRONOS_validation"))
@@ -85,6 +95,7 @@ Context::Context(const DeviceChoice& choice) {
   if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 1,
                   ici.ppEnabledExtensionNames = &ext;
   check(vk_.CreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
+  ++g_instances_created, ++g_instances_alive;
   // A throw below (no such device, a missing feature) would skip the
   // destructor: release what exists so far, then let it go on.
   try {
@@ -116,7 +127,15 @@ Context::Context(const DeviceChoice& choice) {
       for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
         for (uint32_t i = 0; i < count && pick < 0; ++i)
           if (props[i].deviceType == type) pick = int(i);
-      if (pick < 0) pick = 0;
+      for (uint32_t i = 0; i < count && pick < 0; ++i)
+        if (!choice.hardware_only || props[i].deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) pick = int(i);
+      if (pick < 0) {  // hardware_only, and every device is a CPU-type one
+        std::string list;
+        for (uint32_t i = 0; i < count; ++i) list += (i ? ", " : "") + std::string(props[i].deviceName);
+        throw GpuError("Vulkan: no device but CPU-type (software) ones (" + list +
+                       "), which the automatic choice passes over: the CPU walkers answer faster; name one "
+                       "(CasterOptions::device, $MESHCAST_VK_DEVICE) or ask for Backend::Vulkan to use it");
+      }
     } else if (std::all_of(wanted.begin(), wanted.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
       // An index: any number of digits (a long one is no device, not a crash).
       uint64_t index = 0;
@@ -177,9 +196,56 @@ Context::Context(const DeviceChoice& choice) {
   }
 }
 
+namespace {
+
+// The features meshcast reads, as an engine states it created its device
+// with them (ExternalDevice::enabled_features) or as a device offers them.
+struct Features {
+  bool int64 = false, float64 = false, int64_atomics = false;
+};
+
+// What the engine's VkPhysicalDeviceFeatures2 chain enables; UsageError for
+// a root that is not one, or a chain that does not end (a loop).
+Features enabled_in(const VkPhysicalDeviceFeatures2& root) {
+  if (root.sType != VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2)
+    throw UsageError("Vulkan: the engine's enabled_features has sType " + std::to_string(int(root.sType)) +
+                     ", not VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2 (the VkPhysicalDeviceFeatures2 given to vkCreateDevice)");
+  Features f{root.features.shaderInt64 == VK_TRUE, root.features.shaderFloat64 == VK_TRUE, false};
+  constexpr int kMostLinks = 256;  // far beyond any real chain: more is a loop
+  int links = 0;
+  for (auto* s = static_cast<const VkBaseInStructure*>(root.pNext); s; s = s->pNext) {
+    if (++links > kMostLinks)
+      throw UsageError("Vulkan: the engine's enabled_features chain has over " + std::to_string(kMostLinks) +
+                       " structures (a pNext loop?)");
+    if (s->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES)
+      f.int64_atomics |= reinterpret_cast<const VkPhysicalDeviceVulkan12Features*>(s)->shaderBufferInt64Atomics == VK_TRUE;
+    else if (s->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_INT64_FEATURES)
+      f.int64_atomics |= reinterpret_cast<const VkPhysicalDeviceShaderAtomicInt64Features*>(s)->shaderBufferInt64Atomics == VK_TRUE;
+  }
+  return f;
+}
+
+}  // namespace
+
 Context::Context(const ExternalDevice& external) : owns_device_(false) {
-  if (!external.instance || !external.physical_device || !external.device || !external.queue)
-    throw GpuError("Vulkan: an engine's device needs its instance, physical device, device and queue (one was null)");
+  // What Vulkan cannot be asked is checked first, before any call that an
+  // instance of an older version would not have.
+  for (auto [handle, what] : {std::pair<const void*, const char*>{external.instance, "instance"},
+                              {external.physical_device, "physical_device"},
+                              {external.device, "device"},
+                              {external.queue, "queue"}})
+    if (!handle) throw UsageError(std::string("Vulkan: the engine's ") + what + " is null (an engine's device needs its instance, physical device, device and queue)");
+  if (external.instance_api_version == 0)
+    throw UsageError("Vulkan: the engine's instance_api_version is 0 (not stated): give the VkApplicationInfo::apiVersion "
+                     "its instance was created with (Vulkan cannot be asked); meshcast needs 1.2 or later");
+  if (external.instance_api_version < VK_API_VERSION_1_2)
+    throw UsageError("Vulkan: the engine's instance was created for Vulkan " + version_text(external.instance_api_version) +
+                     " (instance_api_version); meshcast needs an instance of Vulkan 1.2 or later (its shaders are "
+                     "SPIR-V for Vulkan 1.2): create it with VkApplicationInfo::apiVersion VK_API_VERSION_1_2");
+  if (!external.enabled_features)
+    throw UsageError("Vulkan: the engine's enabled_features is null (not stated): give the VkPhysicalDeviceFeatures2 "
+                     "chain its device was created with (Vulkan cannot be asked which features a device enabled)");
+  const Features enabled = enabled_in(*external.enabled_features);
   const PFN_vkGetInstanceProcAddr get =
       external.get_instance_proc_addr ? external.get_instance_proc_addr : loader_get_instance_proc_addr();
   if (!get) throw GpuError("Vulkan: no vkGetInstanceProcAddr given and no Vulkan loader found");
@@ -195,31 +261,42 @@ Context::Context(const ExternalDevice& external) : owns_device_(false) {
     VkPhysicalDeviceProperties props;
     vk_.GetPhysicalDeviceProperties(physical_, &props);
     name_ = props.deviceName;
-    // The shaders and the feature query need Vulkan 1.2 of the loader and of
-    // the device (the engine's instance must have asked for 1.2 as well).
     uint32_t loader_version = VK_API_VERSION_1_0;
     if (vk_.EnumerateInstanceVersion) vk_.EnumerateInstanceVersion(&loader_version);
     if (loader_version < VK_API_VERSION_1_2)
-      throw GpuError("Vulkan: the loader offers Vulkan 1." + std::to_string(VK_API_VERSION_MINOR(loader_version)) +
-                     ", meshcast needs 1.2");
+      throw GpuError("Vulkan: the loader offers Vulkan " + version_text(loader_version) + ", meshcast needs 1.2");
     if (props.apiVersion < VK_API_VERSION_1_2)
-      throw GpuError("Vulkan: the engine's device " + name_ + " offers Vulkan 1." +
-                     std::to_string(VK_API_VERSION_MINOR(props.apiVersion)) + ", meshcast needs 1.2");
+      throw UsageError("Vulkan: the engine's device " + name_ + " offers Vulkan " + version_text(props.apiVersion) +
+                       ", meshcast needs 1.2 or later");
     uint32_t families = 0;
     vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
     std::vector<VkQueueFamilyProperties> qf(families);
     vk_.GetPhysicalDeviceQueueFamilyProperties(physical_, &families, qf.data());
     if (family_ >= families || !(qf[family_].queueFlags & VK_QUEUE_COMPUTE_BIT))
-      throw GpuError("Vulkan: queue family " + std::to_string(family_) + " of " + name_ + " (of " +
-                     std::to_string(families) + ") offers no compute");
-    // Which features the engine enabled Vulkan cannot say; what the device
-    // offers bounds it (the device must have enabled them: ExternalDevice).
+      throw UsageError("Vulkan: the engine's queue_family " + std::to_string(family_) + " of " + name_ + " (of " +
+                       std::to_string(families) + " families) offers no compute, which every GPU method dispatches");
+    // What the device offers bounds what the engine may have enabled: a
+    // statement beyond it is a mistake (vkCreateDevice would have failed).
     VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
     vk_.GetPhysicalDeviceFeatures2(physical_, &f2);
-    if (!f2.features.shaderInt64 || !f2.features.shaderFloat64)
-      throw GpuError("Vulkan: " + name_ + " lacks shaderInt64 or shaderFloat64, which every GPU method uses");
-    set_up_device(f12.shaderBufferInt64Atomics == VK_TRUE);
+    const Features offered{f2.features.shaderInt64 == VK_TRUE, f2.features.shaderFloat64 == VK_TRUE,
+                           f12.shaderBufferInt64Atomics == VK_TRUE};
+    const std::tuple<bool Features::*, const char*> named[] = {
+        {&Features::int64, "shaderInt64"}, {&Features::float64, "shaderFloat64"}, {&Features::int64_atomics, "shaderBufferInt64Atomics"}};
+    for (const auto& [feature, what] : named)
+      if ((enabled.*feature) && !(offered.*feature))
+        throw UsageError("Vulkan: the engine's enabled_features enables " + std::string(what) + ", which " + name_ +
+                         " does not offer (its device cannot have been created with it)");
+    // What every method needs: 64-bit integers (remap words, keys) and
+    // doubles (the watertight test's rare redo, the exact BitPack decode).
+    std::string missing;
+    for (const auto& [feature, what] : named)
+      if (feature != &Features::int64_atomics && !(enabled.*feature)) missing += (missing.empty() ? "" : " and ") + std::string(what);
+    if (!missing.empty())
+      throw UsageError("Vulkan: the engine's device " + name_ + " was created without " + missing +
+                       " (enabled_features), which every GPU method uses: enable it in VkPhysicalDeviceFeatures");
+    set_up_device(enabled.int64_atomics);
   } catch (...) {
     release();
     throw;
@@ -257,7 +334,11 @@ void Context::release() {
   }
   if (!owns_device_) return;
   if (messenger_) vk_.DestroyDebugUtilsMessengerEXT(instance_, messenger_, nullptr);
-  if (instance_ && vk_.DestroyInstance) vk_.DestroyInstance(instance_, nullptr);
+  if (instance_ && vk_.DestroyInstance) {
+    vk_.DestroyInstance(instance_, nullptr);
+    --g_instances_alive;
+  }
+  instance_ = VK_NULL_HANDLE;
 }
 
 VkCommandBuffer Context::allocate_command_buffer() {
@@ -298,8 +379,12 @@ void Context::end_and_wait(VkCommandBuffer cb) {
 
 void Context::require_int64_atomics(const std::string& method) const {
   if (!int64_atomics_)
-    throw GpuError("Vulkan: " + name_ + " lacks shaderBufferInt64Atomics, which the " + method +
-                   " method's 64-bit atomic minimum needs");
+    throw GpuError("Vulkan: " +
+                   (owns_device_ ? name_ + " lacks shaderBufferInt64Atomics"
+                                 : "the engine's device " + name_ +
+                                       " was created without shaderBufferInt64Atomics (enabled_features: "
+                                       "VkPhysicalDeviceVulkan12Features)") +
+                   ", which the " + method + " method's 64-bit atomic minimum needs");
 }
 
 bool Context::has_memory_type(uint32_t bits, VkMemoryPropertyFlags wanted) const {

@@ -21,7 +21,9 @@
 namespace meshcast::gpu {
 
 // GpuError (meshcast/errors.h): the CPU path never needs the GPU.
+// UsageError: an engine's objects that lack what meshcast needs.
 using meshcast::GpuError;
+using meshcast::UsageError;
 
 struct DeviceChoice {
   // "" : $MESHCAST_VK_DEVICE, else the first discrete GPU, else the first
@@ -31,17 +33,40 @@ struct DeviceChoice {
   // Validation layers (VK_LAYER_KHRONOS_validation); also turned on by
   // $MESHCAST_VK_VALIDATION=1. Every message they send is counted.
   bool validation = false;
+  // The default choice ("" and no $MESHCAST_VK_DEVICE) passes over
+  // CPU-type devices (VK_PHYSICAL_DEVICE_TYPE_CPU: a software rasterizer
+  // such as lavapipe, running on the cores the CPU walkers use, and far
+  // slower than them on the same rays):
+  // GpuError saying so when no other device is there, the instance then
+  // destroyed at once. A device named (an index, a part of its name) is
+  // taken whatever its type. The Automatic backend's choice.
+  bool hardware_only = false;
 };
+
+// The VkInstances contexts have created in this process, and how many of
+// them still exist (an engine's are never counted): how a test sees that
+// a caster that will not use the GPU starts no Vulkan, or keeps none.
+struct InstanceCount {
+  uint64_t created = 0, alive = 0;
+};
+InstanceCount instances_made();
 
 // An engine's own Vulkan objects, for a context that makes none of its own
 // (it still makes a command pool, fences and its buffers on that device).
-// The device must have been created with shaderInt64 and shaderFloat64
-// enabled (and shaderBufferInt64Atomics for the bruteforce and aabblist
-// methods); the queue belongs to `queue_family`, which must offer compute,
-// and Vulkan's rule holds that no two threads submit to one queue at once:
-// give meshcast a queue the engine does not submit to from another thread
-// (a Caster's: none the engine submits to at all, see VulkanObjects).
-// The engine's objects must outlive the context, which never destroys them.
+// What meshcast needs of them (meshcast/caster.h, VulkanObjects, says it to
+// the engine): an instance created for Vulkan 1.2 or later and a device
+// offering 1.2 (the shaders are SPIR-V for Vulkan 1.2), shaderInt64 and
+// shaderFloat64 enabled on the device (shaderBufferInt64Atomics too for the
+// bruteforce and aabblist methods), no extension, and a queue of
+// `queue_family`, which offers compute. Vulkan cannot tell which version an
+// instance was created for, nor which features a device was created with:
+// the engine states both (instance_api_version, enabled_features) and the
+// context checks them, and what the physical device offers, before it
+// calls anything of Vulkan 1.1 or later. Vulkan's rule holds that no two
+// threads submit to one queue at once: give meshcast a queue the engine
+// does not submit to from another thread (a Caster's: none the engine
+// submits to at all, see VulkanObjects). The engine's objects must outlive
+// the context, which never destroys them.
 struct ExternalDevice {
   VkInstance instance = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device = VK_NULL_HANDLE;
@@ -49,6 +74,13 @@ struct ExternalDevice {
   VkQueue queue = VK_NULL_HANDLE;
   uint32_t queue_family = 0;
   PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;  // null: the loader's
+  // VkApplicationInfo::apiVersion of the instance (0: not stated, refused).
+  uint32_t instance_api_version = 0;
+  // The features the device was created with: the VkPhysicalDeviceFeatures2
+  // the engine chained to VkDeviceCreateInfo, its pNext chain read for
+  // VkPhysicalDeviceVulkan12Features or VkPhysicalDeviceShaderAtomicInt64Features
+  // (null: not stated, refused). Read by the constructor alone.
+  const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
 };
 
 class Buffer;
@@ -56,6 +88,9 @@ class Buffer;
 class Context {
  public:
   explicit Context(const DeviceChoice& choice = {});
+  // UsageError naming what the engine's objects lack (a version, a
+  // feature, a compute queue) or left unstated; GpuError for a Vulkan call
+  // that failed.
   explicit Context(const ExternalDevice& external);
   ~Context();
   Context(const Context&) = delete;
@@ -72,7 +107,8 @@ class Context {
   }
   double timestamp_period_ns() const { return timestamp_ns_; }
   bool has_timestamps() const { return timestamps_; }
-  // GpuError naming `method` when the device lacks 64-bit buffer atomics.
+  // GpuError naming `method` when the device lacks 64-bit buffer atomics
+  // (an engine's device: was not created with them).
   void require_int64_atomics(const std::string& method) const;
 
   // The blob's device-local copy, uploaded once and shared by every method

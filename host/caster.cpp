@@ -115,6 +115,14 @@ void check_options(const CasterOptions& o) {
            " has bits other than HitOutputs::Uv (1) and HitOutputs::Point (2)");
   if (o.jobs && o.jobs->threads() == 0)
     refuse("jobs: its threads() is 0; a job system runs at least one job at a time");
+  // The engine made its instance (its layers are the ones that validate)
+  // and chose its device: asking meshcast for either is a contradiction,
+  // which would otherwise pass unnoticed.
+  if (o.engine_vulkan.device && o.validation)
+    refuse("validation is set together with engine_vulkan: the engine's instance has the layers it was created with; "
+           "enable VK_LAYER_KHRONOS_validation on it instead");
+  if (o.engine_vulkan.device && !o.device.empty())
+    refuse("device '" + o.device + "' is set together with engine_vulkan, whose device is the one used");
 }
 
 }  // namespace
@@ -180,6 +188,7 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
     (void)blob, (void)name;
     gpu_error_ = "meshcast was built without its Vulkan backend (MESHCAST_VULKAN=OFF): the CPU answers";
 #else
+    bool refused_at_the_door = false;
     try {
       const VulkanObjects& engine = options_.engine_vulkan;
       if (engine.device) {
@@ -190,29 +199,37 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
         external.queue = static_cast<VkQueue>(engine.queue);
         external.queue_family = engine.queue_family;
         external.get_instance_proc_addr = reinterpret_cast<PFN_vkGetInstanceProcAddr>(engine.get_instance_proc_addr);
-        gpu_ = std::make_shared<gpu::Context>(external);
-      } else {
-        gpu_ = std::make_shared<gpu::Context>(gpu::DeviceChoice{options_.device, options_.validation});
-      }
-      std::vector<std::string> names = options_.gpu_method.empty() ? gpu::method_names()
-                                                                     : std::vector<std::string>{options_.gpu_method};
-      if (!view_) names.clear();  // scene batches alone: the context is all they need
-      for (const std::string& m : names) {
+        external.instance_api_version = engine.instance_api_version;
+        external.enabled_features = static_cast<const VkPhysicalDeviceFeatures2*>(engine.enabled_features);
         try {
-          method_ = gpu::make_method(*gpu_, m, blob, name, uint32_t(slots_.size()), uint32_t(options_.hit_outputs));
-          method_name_ = m;
-          break;
-        } catch (const InputError&) {
-          if (!options_.gpu_method.empty()) throw;
+          gpu_ = std::make_shared<gpu::Context>(external);
+        } catch (const UsageError&) {  // the engine's objects lack what meshcast needs
+          refused_at_the_door = true;
+          throw;
         }
+      } else {
+        // Automatic takes no software device by itself: it would measure
+        // for a moment only to find the CPU faster at every size.
+        gpu_ = std::make_shared<gpu::Context>(
+            gpu::DeviceChoice{options_.device, options_.validation, options_.backend == Backend::Automatic});
       }
-      if (!method_ && view_)
+      // The method that reads the blob's layout, or the one asked for:
+      // trying each method in turn would let one that needs a feature the
+      // device lacks (64-bit atomics) refuse the device for a blob that
+      // only another method reads.
+      const std::string m = options_.gpu_method.empty() && view_ ? gpu::method_reading(blob) : options_.gpu_method;
+      if (view_ && m.empty())
         throw GpuError("no GPU method reads " + std::string(layout::tree_format_name(layout::header_of(blob.data()).tree_format)) +
                             "/" + std::string(layout::triangle_format_name(layout::header_of(blob.data()).triangle_format)));
+      if (view_) {  // scene batches alone: the context is all they need
+        method_ = gpu::make_method(*gpu_, m, blob, name, uint32_t(slots_.size()), uint32_t(options_.hit_outputs));
+        method_name_ = m;
+      }
       completion_ = std::thread([this] { gpu_completions(); });
     } catch (const std::exception& e) {  // GpuError, or InputError for a method that does not read the layout
       method_.reset();
       gpu_.reset();
+      if (refused_at_the_door) throw;  // nothing was started: the caster is not made
       gpu_error_ = e.what();
     }
 #endif
@@ -295,6 +312,15 @@ Caster::~Caster() {
   method_.reset();
   gpu_.reset();
 }
+
+#if MESHCAST_VULKAN
+VulkanInstances vulkan_instances() {
+  const gpu::InstanceCount n = gpu::instances_made();
+  return {n.created, n.alive};
+}
+#else
+VulkanInstances vulkan_instances() { return {}; }
+#endif
 
 #if MESHCAST_VULKAN
 std::string Caster::device_name() const { return gpu_ ? gpu_->device_name() : "none"; }

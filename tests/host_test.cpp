@@ -17,6 +17,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <new>
+#include <optional>
+#include <string>
+#include <system_error>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -55,6 +58,17 @@ bool cpu_only() { return !MESHCAST_VULKAN || std::getenv("MESHCAST_HOST_CPU_ONLY
 CasterOptions options(Backend b, uint32_t frames = 4) {
   CasterOptions o;
   o.backend = b, o.frames = frames, o.validation = true;
+  return o;
+}
+
+// The Automatic backend passes over a software device (lavapipe, all a
+// machine without a GPU has) unless one is named: its tests of the GPU side
+// name the device $MESHCAST_VK_DEVICE names, else the first one, which it
+// then takes whatever its type.
+CasterOptions automatic_on_a_device() {
+  CasterOptions o = options(Backend::Automatic);
+  const char* env = std::getenv("MESHCAST_VK_DEVICE");
+  o.device = env && *env ? env : "0";
   return o;
 }
 
@@ -437,6 +451,110 @@ TEST(Host, AMissingDeviceIsReportedAndTheCpuAnswers) {
   expect_same(hits, sync_cpu(caster, rays), "after a missing device");
 }
 
+// An environment variable set (value) or unset (null) for a scope, and put
+// back as it was after it.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* was = std::getenv(name)) was_ = was;
+    if (value) ::setenv(name, value, 1);
+    else ::unsetenv(name);
+  }
+  ~ScopedEnv() {
+    if (was_) ::setenv(name_, was_->c_str(), 1);
+    else ::unsetenv(name_);
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> was_;
+};
+
+// Mesa's lavapipe driver manifest in the loader's usual folders; "" for none.
+std::string lavapipe_manifest() {
+  for (const char* dir : {"/usr/share/vulkan/icd.d", "/usr/local/share/vulkan/icd.d", "/etc/vulkan/icd.d"}) {
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+      if (entry.path().filename().string().starts_with("lvp_icd")) return entry.path().string();
+  }
+  return "";
+}
+
+// A machine whose only Vulkan device is a software one (the loader shown
+// lavapipe's driver alone): the Automatic backend makes an instance to
+// look, destroys it at once, measures nothing, and leaves the CPU
+// answering, saying why. Named, or on Backend::Vulkan, the device is taken.
+TEST(Host, AutomaticPassesOverASoftwareDeviceAndSaysWhy) {
+  if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
+  const std::string manifest = lavapipe_manifest();
+  if (manifest.empty()) GTEST_SKIP() << "no lavapipe driver manifest (mesa-vulkan-drivers)";
+  // VK_DRIVER_FILES for newer loaders, VK_ICD_FILENAMES for older ones.
+  const ScopedEnv drivers("VK_DRIVER_FILES", manifest.c_str()), icds("VK_ICD_FILENAMES", manifest.c_str()),
+      unnamed("MESHCAST_VK_DEVICE", nullptr);
+  const Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
+  const host::VulkanInstances before = host::vulkan_instances();
+  {
+    Caster caster(blob, "sphere", options(Backend::Automatic));
+    const host::VulkanInstances looked = host::vulkan_instances();
+    EXPECT_EQ(looked.created, before.created + 1);  // made to see the devices
+    EXPECT_EQ(looked.alive, before.alive);           // and gone at once
+    EXPECT_FALSE(caster.gpu_available());
+    EXPECT_TRUE(caster.crossover_known());  // nothing to measure
+    EXPECT_EQ(caster.crossover(), ~0u);
+    EXPECT_NE(caster.gpu_error().find("no device but CPU-type (software) ones (llvmpipe"), std::string::npos)
+        << caster.gpu_error();
+    const std::string why = caster.why(1u << 20);
+    EXPECT_EQ(why.rfind("1048576 rays: CPU, the GPU is unavailable (", 0), 0u) << why;
+    EXPECT_NE(why.find("the automatic choice passes over"), std::string::npos) << why;
+    const std::vector<Ray> rays = make_rays(m, RayKind::Long, 500, 3);
+    std::vector<Hit> hits(rays.size());
+    EXPECT_EQ(caster.wait(caster.submit(rays), hits).ran_on, Backend::Cpu);
+    expect_same(hits, sync_cpu(caster, rays), "the Automatic backend beside a software device");
+  }
+  for (const CasterOptions& o : {options(Backend::Vulkan), automatic_on_a_device()}) {
+    Caster caster(blob, "sphere", o);
+    EXPECT_TRUE(caster.gpu_available()) << host::backend_name(o.backend) << ": " << caster.gpu_error();
+    EXPECT_NE(caster.device_name().find("llvmpipe"), std::string::npos) << caster.device_name();
+  }
+}
+
+// A caster that will never use the GPU makes no Vulkan instance at all:
+// Backend::Cpu, for blob and scene batches, and a caster of scene batches
+// alone on Automatic (which sends them to the CPU).
+TEST(Host, CastersThatNeverUseTheGpuMakeNoVulkanInstance) {
+  const Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "sphere");
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 300, 4);
+  Scene scene;
+  scene.add_instance(scene.add_mesh(blob, "sphere"), Transform{});
+  scene.commit();
+  std::vector<RayD> world;
+  for (const Ray& r : rays) world.push_back({{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax});
+  const host::VulkanInstances before = host::vulkan_instances();
+  {
+    Caster cpu(blob, "sphere", options(Backend::Cpu));
+    std::vector<Hit> hits(rays.size());
+    EXPECT_EQ(cpu.wait(cpu.submit(rays), hits).ran_on, Backend::Cpu);
+    std::vector<SceneHit> scene_hits(world.size());
+    EXPECT_EQ(cpu.wait(cpu.submit(scene, world), scene_hits).ran_on, Backend::Cpu);
+    EXPECT_FALSE(cpu.gpu_available());
+    EXPECT_EQ(cpu.device_name(), "none");
+  }
+  {
+    Caster scenes(options(Backend::Automatic));
+    std::vector<SceneHit> scene_hits(world.size());
+    EXPECT_EQ(scenes.wait(scenes.submit(scene, world), scene_hits).ran_on, Backend::Cpu);
+    EXPECT_FALSE(scenes.gpu_available());
+    EXPECT_EQ(scenes.gpu_error(), "");
+  }
+  const host::VulkanInstances after = host::vulkan_instances();
+  EXPECT_EQ(after.created, before.created);
+  EXPECT_EQ(after.alive, before.alive);
+}
+
 // A Vulkan caster on a small sphere whose GPU submissions go through
 // `fault(n)` first (n counts from 1): the fault-injection tests' setup.
 struct FaultySphere {
@@ -607,7 +725,7 @@ TEST(Host, AutomaticChoiceMeasuresSavesAndLoadsTheCrossover) {
   std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
   const std::string profile = (std::filesystem::temp_directory_path() / "meshcast_host_test.profile").string();
   std::filesystem::remove(profile);
-  CasterOptions o = options(Backend::Automatic);
+  CasterOptions o = automatic_on_a_device();
   o.profile = profile;
   uint32_t crossover;
   {
@@ -727,7 +845,7 @@ TEST(Host, AutomaticChoiceOnProfilesItCannotUse) {
   if (cpu_only()) GTEST_SKIP() << "Vulkan kept out of this run";
   const Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
   const std::vector<uint8_t> blob = build_blob(m, parse_layout("QuadTreeHalfFloat/Indexed8BitPackSOA4"), "sphere");
-  CasterOptions o = options(Backend::Automatic);
+  CasterOptions o = automatic_on_a_device();
   o.profile = make_file("notes.txt", "my own notes\n");
   {
     Caster caster(blob, "sphere", o);
@@ -1037,7 +1155,7 @@ TEST(Host, BlobAndSceneBatchesShareTheGpu) {
   std::vector<SceneHit> want(world.size());
   scene.trace(world, want, HitOutputs::Uv);
   for (Backend b : {Backend::Vulkan, Backend::Automatic}) {
-    CasterOptions o = options(b);
+    CasterOptions o = b == Backend::Automatic ? automatic_on_a_device() : options(b);
     o.hit_outputs = HitOutputs::Uv;
     Caster caster(blob, "terrain", o);
     ASSERT_TRUE(caster.gpu_available()) << caster.gpu_error();
@@ -1220,7 +1338,7 @@ TEST(Host, AnEnginesJobSystemThatThrowsOnTheCastersThreads) {
     row.expect_answered(got, "after the job system threw");
     EXPECT_TRUE(caster.gpu_available());
   }
-  CasterOptions a = options(Backend::Automatic);
+  CasterOptions a = automatic_on_a_device();
   a.jobs = &jobs;
   jobs.fail = true;
   Caster automatic(row.blob, "ball", a);

@@ -115,14 +115,32 @@ struct Percentiles {
 // An engine's own Vulkan objects, for a Vulkan backend that makes no instance
 // or device of its own: the handles as the engine holds them (VkInstance,
 // VkPhysicalDevice, VkDevice, VkQueue, PFN_vkGetInstanceProcAddr), cast to
-// void* so this header needs no Vulkan. The device must have shaderInt64 and
-// shaderFloat64 enabled (and shaderBufferInt64Atomics for the bruteforce and
-// aabblist methods), `queue` must be of `queue_family`, which offers compute,
-// and must not be submitted to by the engine at all while the caster lives
-// (the caster submits from threads of its own too: the Automatic backend's
-// measurement, and scene batches); everything must outlive the caster,
-// which destroys none of it.
-// get_instance_proc_addr: null for the loader's.
+// void* so this header needs no Vulkan. What meshcast needs of them:
+//   - an instance created with VkApplicationInfo::apiVersion 1.2 or later,
+//     stated in instance_api_version (Vulkan cannot be asked for it), and a
+//     physical device whose VkPhysicalDeviceProperties::apiVersion is 1.2 or
+//     later: the shaders are SPIR-V for Vulkan 1.2;
+//   - a device created with shaderInt64 and shaderFloat64 (every method),
+//     and shaderBufferInt64Atomics (VkPhysicalDeviceVulkan12Features or
+//     VkPhysicalDeviceShaderAtomicInt64Features) for the bruteforce and
+//     aabblist methods alone, stated in enabled_features: the
+//     VkPhysicalDeviceFeatures2 the engine chained to VkDeviceCreateInfo
+//     (read while the caster is made; Vulkan cannot be asked which features
+//     a device enabled);
+//   - no instance or device extension, and no layer;
+//   - `queue` of `queue_family`, a family that offers compute (timestamps,
+//     where it has them, give BatchRecord::device_ms), on which the engine
+//     submits nothing at all while the caster lives (the caster submits
+//     from threads of its own too: the Automatic backend's measurement, and
+//     scene batches); and host-visible coherent memory for storage buffers.
+// The caster checks them as it is made, and throws UsageError naming the
+// version or feature that is missing or not stated, rather than leaving
+// the GPU: an engine that hands its device over wants it used. A device
+// without shaderBufferInt64Atomics is taken, and a blob whose layout only
+// the bruteforce or aabblist method reads leaves the CPU answering, with
+// gpu_error() naming the feature and the method. Everything must outlive
+// the caster, which destroys none of it. get_instance_proc_addr: null for
+// the loader's.
 struct VulkanObjects {
   void* instance = nullptr;
   void* physical_device = nullptr;
@@ -130,7 +148,22 @@ struct VulkanObjects {
   void* queue = nullptr;
   uint32_t queue_family = 0;
   void* get_instance_proc_addr = nullptr;
+  uint32_t instance_api_version = 0;      // VkApplicationInfo::apiVersion of `instance` (VK_API_VERSION_1_2 or later)
+  const void* enabled_features = nullptr;  // const VkPhysicalDeviceFeatures2*: the device's, as created
 };
+
+// The Vulkan instances meshcast has made in this process so far, and how
+// many of them still exist (an engine's own are never counted). A caster
+// that will not use the GPU makes none: Backend::Cpu, and a caster of scene
+// batches alone on Automatic. The Automatic backend takes no CPU-type
+// (software) device by itself: where that is all there is, it makes an
+// instance to look, destroys it at once, and measures nothing; the CPU
+// answers and gpu_error() says why. Naming such a device
+// (CasterOptions::device, $MESHCAST_VK_DEVICE), or Backend::Vulkan, takes it.
+struct VulkanInstances {
+  uint64_t created = 0, alive = 0;
+};
+VulkanInstances vulkan_instances();
 
 // The most frames and worker threads a caster takes: each frame holds
 // buffers, and on the GPU a fence and a command buffer, for as long as the
@@ -142,16 +175,22 @@ constexpr uint32_t kMaxCasterThreads = 1024;
 // range) rather than bending it: a backend outside the enum, frames outside
 // 1..kMaxCasterFrames, threads beyond kMaxCasterThreads, hit_outputs with
 // bits other than HitOutputs::Uv and HitOutputs::Point, a job system whose
-// threads() is 0.
+// threads() is 0, `validation` or `device` together with an engine's device
+// (the engine made its instance and chose its device: its own layers
+// validate meshcast's calls on it).
 struct CasterOptions {
   Backend backend = Backend::Automatic;
   uint32_t frames = 4;          // batches in flight at most (1..kMaxCasterFrames)
   uint32_t threads = 0;         // CPU workers (0: every core), unless `jobs` is given
   JobSystem* jobs = nullptr;    // an engine's job system (not owned) instead of meshcast's pool
-  std::string device;           // Vulkan device (gpu::DeviceChoice), "" for the default
-  VulkanObjects engine_vulkan;  // the engine's device instead (its `device` set): `device` unused
+  // The Vulkan device: an index or a case-insensitive part of its name,
+  // taken whatever its type; "" for $MESHCAST_VK_DEVICE, else the first
+  // discrete GPU, else the first integrated one, else the first device;
+  // on Automatic the first that is not CPU-type (software), or none.
+  std::string device;
+  VulkanObjects engine_vulkan;  // the engine's device instead (its `device` set); `device` and `validation` must be unset
   std::string gpu_method;       // "" : the one that reads the blob's layout
-  bool validation = false;      // Vulkan validation layers
+  bool validation = false;      // Vulkan validation layers on meshcast's own instance
   HitOutputs hit_outputs = HitOutputs::None;  // what each hit carries besides t and the triangle, either backend
   // A file with a saved crossover (the Automatic backend): read when it
   // holds one for this device and blob, else measured and written to it.
@@ -174,7 +213,8 @@ class Caster {
   // bytes 4-byte aligned); the caster reads the caller's bytes, which must
   // outlive it. UsageError for an option out of range (CasterOptions).
   // With Backend::Vulkan or Automatic, a device that is missing or fails
-  // leaves the caster on the CPU, and gpu_error() says why.
+  // leaves the caster on the CPU, and gpu_error() says why; an engine's
+  // device that lacks what VulkanObjects lists is UsageError naming it.
   Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options = {});
   // A caster of scene batches alone: no blob; the CPU's workers, or with
   // Backend::Vulkan the GPU as above (a missing device leaves the CPU and

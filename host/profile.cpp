@@ -23,7 +23,13 @@ constexpr std::string_view kAnyVersion = "meshcast-profile ";
 constexpr size_t kMaxProfileBytes = 4096;
 
 // A line of the file as an error quotes it (message_text.h).
-std::string quoted(std::string_view line) { return "'" + shown_text(line, 40) + "'"; }
+// Built by appending: gcc 12 warns falsely (-Wrestrict) on "'" + a temporary.
+std::string quoted(std::string_view line) {
+  std::string out = "'";
+  out += shown_text(line, 40);
+  out += '\'';
+  return out;
+}
 
 }  // namespace
 

@@ -32,7 +32,7 @@ class SceneOracle {
   // `mask`; the front face as the world sees it (the winding of the
   // triangle's world corners from the ray's origin).
   SceneOracleHit closest(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
-  // Every hit in [0, t_max], in order of t, then instance, then triangle.
+  // Every hit in [t_min, t_max], in order of t, then instance, then triangle.
   std::vector<SceneOracleHit> all(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Whether the triangle of instance `instance` (an index into the
   // instances given) meets the ray in double at distance t, to within

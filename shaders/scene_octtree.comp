@@ -8,8 +8,8 @@
 // divisions of the ray's set-up rounded once, div_exact).
 //
 // Bindings: 0 every mesh's blob, one after another (the top buffer's
-// table gives each one's first word); 1 the world rays as RAYD records
-// (3 doubles, 3 floats, t_max: 10 words); 5 the top level; 6 the answers,
+// table gives each one's first word); 1 the world rays as RayD records
+// (3 doubles, 3 floats, t_max, t_min, padding: 12 words); 5 the top level; 6 the answers,
 // 6 words a ray: t, instance, triangle, u, v and whether some part of the
 // ray could not be walked (the CPU's count of such rays). 2 to 4 are the
 // blob methods' (unused here).
@@ -40,7 +40,7 @@ layout(std430, set = 0, binding = 5) readonly buffer Top { uint top_words[]; };
 #define SCENE_HIT_WORDS 6u
 layout(std430, set = 0, binding = 6) writeonly buffer SceneHits { uint scene_hits[]; };
 
-#define RAYD_WORDS 10u
+#define RAYD_WORDS 12u
 
 double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_words[word + 1u])); }
 

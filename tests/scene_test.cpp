@@ -158,7 +158,10 @@ struct RayRules {
   const double len;
   double slack(double t) const { return 1e-5 * (t * len + 4); }
   bool same_t(double t, double oracle_t) const { return std::fabs(t - oracle_t) * len <= slack(oracle_t); }
-  bool near_end(double t) const { return t * len <= slack(t) || std::fabs(t - r.tmax) * len <= slack(t); }
+  // At t_min (the origin when it is 0) or t_max, where rounding decides
+  // whether a hit is on the segment.
+  bool at_start(double t) const { return std::fabs(t - r.tmin) * len <= slack(t); }
+  bool near_end(double t) const { return at_start(t) || std::fabs(t - r.tmax) * len <= slack(t); }
   // The hit's triangle meets the ray at its t.
   bool meets(const SceneHit& h) const {
     return oracle.distance_to(oracle.index_of(h.instance), h.triangle, r, h.t) <= slack(h.t);
@@ -214,7 +217,10 @@ Judged judge(const SceneOracle& oracle, const std::vector<RayD>& rays, const std
         continue;
       }
       const bool same = h.instance == o.instance && h.triangle == o.triangle;
-      if (!rules.same_t(h.t, o.t)) j.fail(where + "t " + std::to_string(h.t) + " against " + std::to_string(o.t));
+      // One of them at t_min > 0, where rounding decides whether it is on
+      // the segment: the other is the next hit along.
+      if (!same && rays[i].tmin > 0 && (rules.at_start(h.t) || rules.at_start(o.t)) && rules.meets(h)) ++j.ties;
+      else if (!rules.same_t(h.t, o.t)) j.fail(where + "t " + std::to_string(h.t) + " against " + std::to_string(o.t));
       else if (!same && !rules.meets(h)) j.fail(where + named(h.instance, h.triangle) + " against " + named(o.instance, o.triangle));
       else if (!same) ++j.ties;
     } else if (h.instance == kNoHit) {
@@ -300,6 +306,39 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
     EXPECT_LE(j.ties, rays.size() / 100) << what;
     EXPECT_GT(j.hits, rays.size() / (c.mask == 0xFF ? 5 : 10)) << what << ": too few hits to show anything";
   }
+  // t_min, the rule of a blob's walk (meshcast/scene.h): each ray from a
+  // fraction of its closest hit's t on (half of it, 1.001 and 1.02 times
+  // it: a world unit or so past the hit, inside the instance, in turn by
+  // threes, as the finite t_max go by ones; a ray that misses from half
+  // its t_max, or 1), so some keep their first hit and some find the next
+  // one along (the instance's far side); closest, any and every hit.
+  std::vector<RayD> offset_rays = rays;
+  size_t skipped_first = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    RayD& r = offset_rays[i];
+    const SceneOracleHit o = oracle.closest(rays[i]);
+    const size_t turn = i / 3 % 3;
+    if (o.instance == kNoHit) r.tmin = std::isfinite(r.tmax) ? r.tmax * 0.5f : 1.0f;
+    else r.tmin = std::min(r.tmax, float(o.t * (turn == 0 ? 0.5 : turn == 1 ? 1.001 : 1.02)));
+    const SceneOracleHit next = oracle.closest(r);
+    skipped_first += o.instance != kNoHit && next.instance != kNoHit && (next.instance != o.instance || next.triangle != o.triangle);
+  }
+  EXPECT_GT(skipped_first, rays.size() / 50) << layout << " at " << offset << ", t_min: too few rays find a next hit";
+  for (const Query q : {Query::Closest, Query::Any}) {
+    std::vector<SceneHit> offset_hits(offset_rays.size());
+    EXPECT_EQ(scene.trace(offset_rays, offset_hits, HitOutputs::None, q), 0u);
+    const Judged j = judge(oracle, offset_rays, offset_hits, Cull::None, 0xFF, q == Query::Any);
+    const std::string what = layout + " at " + std::to_string(offset) + ", t_min, query " + std::to_string(int(q));
+    EXPECT_EQ(j.wrong, 0u) << what << ": " << j.first_problem;
+    EXPECT_LE(j.ties, rays.size() / 100) << what;
+    EXPECT_GT(j.hits, rays.size() / 10) << what << ": too few hits to show anything";
+  }
+  SceneHitLists offset_lists;
+  offset_lists.max_hits = 256;
+  EXPECT_EQ(scene.trace_all_hits(offset_rays, offset_lists), 0u);
+  const Judged offset_all = judge_all(oracle, offset_rays, offset_lists, Cull::None, 0xFF);
+  EXPECT_EQ(offset_all.wrong, 0u) << layout << " at " << offset << ", t_min, Query::All: " << offset_all.first_problem;
+  EXPECT_LE(offset_all.ties, offset_all.hits / 100 + 2) << layout << " at " << offset << ", t_min, Query::All";
   // Every hit, front faces culled and mask 3, rows long enough for all.
   SceneHitLists lists;
   lists.max_hits = 256;
@@ -818,9 +857,12 @@ TEST(Scene, RefusesBadInput) {
   scene.commit();
   // The refused transform left the instance where it was.
   std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}, {{NAN, 0, 5}, {0, 0, -1}, INFINITY},
-                            {{0, 0, 1e31}, {0, 0, -1}, INFINITY}, {{0, 0, 5}, {0, 0, 0}, INFINITY}};
+                            {{0, 0, 1e31}, {0, 0, -1}, INFINITY}, {{0, 0, 5}, {0, 0, 0}, INFINITY},
+                            {{0, 0, 5}, {0, 0, -1}, INFINITY, NAN}, {{0, 0, 5}, {0, 0, -1}, 4.0f, 4.5f}};
   std::vector<SceneHit> hits(rays.size());
-  EXPECT_EQ(scene.trace(rays, hits), 3u);  // the NaN origin, the far origin, the zero direction
+  // The NaN origin, the far origin, the zero direction, the NaN t_min and
+  // t_min past t_max.
+  EXPECT_EQ(scene.trace(rays, hits), 5u);
   EXPECT_EQ(hits[0].instance, id);
   EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
   for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(hits[i].instance, kNoHit);
@@ -831,7 +873,7 @@ TEST(Scene, RefusesBadInput) {
   lists.max_hits = 0;
   EXPECT_THROW(scene.trace_all_hits(rays, lists), UsageError);
   lists.max_hits = 2;
-  EXPECT_EQ(scene.trace_all_hits(rays, lists), 3u);
+  EXPECT_EQ(scene.trace_all_hits(rays, lists), 5u);
   EXPECT_GE(lists.found[0], 2u);  // through both poles: every triangle around each, once
   EXPECT_EQ(lists.row(0)[0].instance, id);
   EXPECT_FLOAT_EQ(lists.row(0)[0].t, 4.0f);
@@ -850,7 +892,7 @@ TEST(Scene, RefusesBadInput) {
     EXPECT_THROW(s->trace_all_hits(rays, lists, HitOutputs::None, Cull(9)), UsageError);
   }
   // The rays no scene walks are counted whatever the scene holds.
-  EXPECT_EQ(empty.trace(rays, hits), 3u);
+  EXPECT_EQ(empty.trace(rays, hits), 5u);
   // A 3x3 entry beyond 2^40; a world box beyond 2^100 (a sphere 10^18
   // across scaled by 2^40, 2^99 from the origin).
   Transform huge;

@@ -325,9 +325,7 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
   }
   EXPECT_GT(skipped_first, rays.size() / 50) << layout << " at " << offset << ", t_min: too few rays find a next hit";
   for (const Query q : {Query::Closest, Query::Any}) {
-    std::vector<SceneHit> offset_hits(offset_rays.size());
-    EXPECT_EQ(scene.trace(offset_rays, offset_hits, HitOutputs::None, q), 0u);
-    const Judged j = judge(oracle, offset_rays, offset_hits, Cull::None, 0xFF, q == Query::Any);
+    const Judged j = judge(oracle, offset_rays, trace(scene, offset_rays, q), Cull::None, 0xFF, q == Query::Any);
     const std::string what = layout + " at " + std::to_string(offset) + ", t_min, query " + std::to_string(int(q));
     EXPECT_EQ(j.wrong, 0u) << what << ": " << j.first_problem;
     EXPECT_LE(j.ties, rays.size() / 100) << what;
@@ -697,6 +695,7 @@ TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
 // triangles meet the ray at the same t (the GPU's walk may take the other
 // one: gpu_test's rule for the blob methods). Query::Any may take another
 // hit where two boxes are entered at the same distance: the same rays hit.
+// The same again with a t_min, and the t_min the CPU refuses counted.
 TEST(SceneOnTheGpu, AnswersAsTheCpu) {
   for (const double offset : {0.0, 1e7}) {
     const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 60, 100, offset, 7);
@@ -722,7 +721,43 @@ TEST(SceneOnTheGpu, AnswersAsTheCpu) {
                                 << ", query " << int(query);
           EXPECT_GT(hits, rays.size() / 10);
         }
+    // t_min: from half, 1.25 and 2 times each ray's closest hit t (the
+    // CPU's), the GPU's hits the CPU's bit for bit.
+    std::vector<SceneHit> first(rays.size());
+    ASSERT_EQ(scene.trace(rays, first), 0u);
+    std::vector<RayD> offset_rays = rays;
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (first[i].instance != kNoHit)
+        offset_rays[i].tmin = std::min(rays[i].tmax, first[i].t * (i % 3 == 0 ? 0.5f : i % 3 == 1 ? 1.25f : 2.0f));
+    for (const Query query : {Query::Closest, Query::Any}) {
+      const std::vector<SceneHit> gpu = trace(scene, offset_rays, query, Cull::None, 0xFF, HitOutputs::Uv);
+      std::vector<SceneHit> cpu(rays.size());
+      ASSERT_EQ(scene.trace(offset_rays, cpu, HitOutputs::Uv, query), 0u);
+      size_t differ = 0, moved = 0;
+      for (size_t i = 0; i < rays.size(); ++i) {
+        moved += cpu[i].instance != first[i].instance || cpu[i].triangle != first[i].triangle;
+        if (query == Query::Any) {
+          differ += (gpu[i].instance == kNoHit) != (cpu[i].instance == kNoHit) ||
+                    (gpu[i].instance != kNoHit && !(gpu[i].t >= offset_rays[i].tmin && gpu[i].t <= offset_rays[i].tmax));
+          continue;
+        }
+        const bool tie = gpu[i].triangle != cpu[i].triangle && gpu[i].instance == cpu[i].instance;
+        differ += tie ? std::memcmp(&gpu[i].t, &cpu[i].t, 4) != 0 : std::memcmp(&gpu[i], &cpu[i], sizeof(SceneHit)) != 0;
+      }
+      EXPECT_EQ(differ, 0u) << "offset " << offset << ", t_min, query " << int(query);
+      if (query == Query::Closest) {
+        EXPECT_GT(moved, rays.size() / 20) << "offset " << offset << ": t_min changed too few hits";
+      }
+    }
   }
+  // t_min refused as the CPU refuses it: NaN, negative, past t_max.
+  const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 4, 10, 0, 7);
+  const Scene scene = make_scene(level);
+  std::vector<RayD> bad = level_rays(level, 4, 10, 3);
+  bad[1].tmin = NAN, bad[2].tmin = -1.0f, bad[3].tmin = 2.0f, bad[3].tmax = 1.0f;
+  std::vector<SceneHit> hits(bad.size());
+  EXPECT_EQ(scene_method(Query::Closest, Cull::None, HitOutputs::None).trace(*scene.snapshot(), bad, hits), 3u);
+  for (size_t i = 1; i < bad.size(); ++i) EXPECT_EQ(hits[i].instance, kNoHit) << i;
   EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
 }
 

@@ -17,7 +17,7 @@ class Peer {
   virtual std::string name() const = 0;
   virtual double build_ms() const = 0;
   virtual uint64_t bytes() const = 0;  // memory the peer reports for its scene
-  // One thread, t in [0, t_max], hits in the caller's indices: the closest
+  // One thread, t in [t_min, t_max], hits in the caller's indices: the closest
   // hit, or with Query::Any the peer's occlusion query (Embree's
   // rtcOccluded1, which names no triangle: an occluded ray's hit is t 0,
   // triangle 0).

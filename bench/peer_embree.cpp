@@ -103,7 +103,7 @@ class Embree final : public Peer {
         RTCRay ray{};
         ray.org_x = r.org[0], ray.org_y = r.org[1], ray.org_z = r.org[2];
         ray.dir_x = r.dir[0], ray.dir_y = r.dir[1], ray.dir_z = r.dir[2];
-        ray.tnear = 0.0f, ray.tfar = r.tmax, ray.mask = ~0u;
+        ray.tnear = r.tmin, ray.tfar = r.tmax, ray.mask = ~0u;
         rtcOccluded1(scene_, &context, &ray);
         hits[i] = ray.tfar < 0 ? Hit{0.0f, 0} : Hit{};  // occluded: tfar is set to -inf
       }
@@ -114,7 +114,7 @@ class Embree final : public Peer {
       RTCRayHit rh{};
       rh.ray.org_x = r.org[0], rh.ray.org_y = r.org[1], rh.ray.org_z = r.org[2];
       rh.ray.dir_x = r.dir[0], rh.ray.dir_y = r.dir[1], rh.ray.dir_z = r.dir[2];
-      rh.ray.tnear = 0.0f, rh.ray.tfar = r.tmax, rh.ray.mask = ~0u;
+      rh.ray.tnear = r.tmin, rh.ray.tfar = r.tmax, rh.ray.mask = ~0u;
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(scene_, &context, &rh);
       hits[i] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? Hit{} : Hit{rh.ray.tfar, rh.hit.primID, rh.hit.u, rh.hit.v};
@@ -199,7 +199,7 @@ class EmbreeScene final : public ScenePeer {
       RTCRayHit rh{};
       rh.ray.org_x = float(r.org[0]), rh.ray.org_y = float(r.org[1]), rh.ray.org_z = float(r.org[2]);
       rh.ray.dir_x = r.dir[0], rh.ray.dir_y = r.dir[1], rh.ray.dir_z = r.dir[2];
-      rh.ray.tnear = 0.0f, rh.ray.tfar = r.tmax, rh.ray.mask = ~0u;
+      rh.ray.tnear = r.tmin, rh.ray.tfar = r.tmax, rh.ray.mask = ~0u;
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(top_, &context, &rh);

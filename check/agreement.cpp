@@ -105,8 +105,8 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
     }
     if (h.triangle == MC_NO_HIT || o.triangle == MC_NO_HIT) {
       // Hit/miss may differ only where the hit lies within rounding of the
-      // ends of the segment [0, t_max]: an origin on the surface, or a
-      // surface at t_max.
+      // ends of the segment [t_min, t_max]: a surface at t_min (an origin
+      // on the surface when t_min is 0), or a surface at t_max.
       const Ray& r = rays[i];
       auto at = [&](double t, double p[3]) {
         for (int k = 0; k < 3; ++k) p[k] = double(r.org[k]) + t * double(r.dir[k]);
@@ -115,8 +115,8 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
       double p[3];
       if (h.triangle != MC_NO_HIT) {
         const Vec3 ta = mesh.corner(h.triangle, 0), tb = mesh.corner(h.triangle, 1), tc = mesh.corner(h.triangle, 2);
-        at(0.0, p);
-        boundary = h.t * len <= tolerance && point_triangle_distance(p, ta, tb, tc) <= tolerance;
+        at(r.tmin, p);
+        boundary = std::fabs(h.t - r.tmin) * len <= tolerance && point_triangle_distance(p, ta, tb, tc) <= tolerance;
         if (!boundary && std::isfinite(r.tmax)) {
           at(r.tmax, p);
           boundary = std::fabs(h.t - r.tmax) <= t_tolerance && point_triangle_distance(p, ta, tb, tc) <= tolerance;
@@ -137,7 +137,8 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
           boundary = boundary || edge_distance(p, ta, tb, tc) <= tolerance;
         }
       } else {
-        boundary = o.t * len <= tolerance || (std::isfinite(r.tmax) && std::fabs(o.t - r.tmax) <= t_tolerance);
+        boundary = std::fabs(o.t - r.tmin) * len <= tolerance ||
+                   (std::isfinite(r.tmax) && std::fabs(o.t - r.tmax) <= t_tolerance);
         if (!boundary) {
           // A miss where the oracle's hit lies within float rounding of its
           // triangle's edge: a ray grazing a silhouette, where the surface
@@ -160,6 +161,13 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
         ++a.wrong;
         note(i, "hit/miss differs");
       }
+      continue;
+    }
+    if (h.triangle != o.triangle && rays[i].tmin > 0 &&
+        (std::fabs(double(h.t) - rays[i].tmin) * len <= tolerance || std::fabs(o.t - rays[i].tmin) * len <= tolerance)) {
+      // One of the two lies at t_min, where rounding decides whether it is
+      // on the segment: the other answer is then the next hit along.
+      ++a.ties;
       continue;
     }
     if (h.triangle != o.triangle) {

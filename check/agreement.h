@@ -29,9 +29,12 @@ double edge_distance(const double p[3], const double a[3], const double b[3], co
 // rounding decides, a difference is counted as a tie instead:
 //  - another triangle at the same t that touches the oracle's hit point
 //    (a shared edge or vertex, coincident triangles);
-//  - a walker hit against an oracle miss at the ends of the segment (origin
-//    on the surface, surface at t_max), on the hit triangle's edge, or for a
-//    ray lying in the triangle's plane;
+//  - a walker hit against an oracle miss at the ends of the segment (a
+//    surface at t_min, i.e. the origin on the surface when t_min is 0, or
+//    at t_max), on the hit triangle's edge, or for a ray lying in the
+//    triangle's plane;
+//  - with t_min above 0, different triangles where either lies at t_min
+//    (rounding decides whether it is on the segment);
 //  - a walker miss against an oracle hit at the ends of the segment, or
 //    within a few float ulps of the hit triangle's edge (a grazed silhouette).
 // A walker miss in the middle of a triangle is always wrong; leaks through

@@ -12,10 +12,10 @@ double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3&
   const double o[3] = {ray.org[0], ray.org[1], ray.org[2]},
                d[3] = {walked_direction(ray.dir[0]), walked_direction(ray.dir[1]), walked_direction(ray.dir[2])};
   const double da[3] = {a[0], a[1], a[2]}, db[3] = {b[0], b[1], b[2]}, dc[3] = {c[0], c[1], c[2]};
-  return oracle_triangle(o, d, ray.tmax, da, db, dc, cull);
+  return oracle_triangle(o, d, ray.tmin, ray.tmax, da, db, dc, cull);
 }
 
-double oracle_triangle(const double org[3], const double dir[3], double tmax, const double a[3], const double b[3],
+double oracle_triangle(const double org[3], const double dir[3], double tmin, double tmax, const double a[3], const double b[3],
                        const double c[3], Cull cull) {
   const double* d = dir;
   int kz = std::fabs(d[0]) > std::fabs(d[1]) ? (std::fabs(d[0]) > std::fabs(d[2]) ? 0 : 2)
@@ -35,8 +35,9 @@ double oracle_triangle(const double org[3], const double dir[3], double tmax, co
   if ((cull == Cull::Back && det < 0) || (cull == Cull::Front && det > 0)) return INFINITY;
   double T = (U * az + V * bz + W * cz) * sz;
   double t = T / det;
-  // A t past the largest float is no hit: no walker could report it.
-  if (!(t >= 0) || t > tmax || t > double(FLT_MAX)) return INFINITY;
+  // A t past the largest float is no hit: no walker could report it. Both
+  // ends of the segment are included, as the walkers include them.
+  if (!(t >= 0) || t < tmin || t > tmax || t > double(FLT_MAX)) return INFINITY;
   return t;
 }
 

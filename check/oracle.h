@@ -1,5 +1,5 @@
 // The double-precision oracle every layout is checked against: the closest
-// hit over the unmodified input mesh, two-sided, t in [0, t_max], no epsilon
+// hit over the unmodified input mesh, two-sided, t in [t_min, t_max], no epsilon
 // that drops small or thin triangles, ties broken by the lowest triangle
 // index. The triangle test is the watertight one (Woop et al. 2013) carried
 // out entirely in double, so shared edges and vertices never leak.
@@ -22,7 +22,7 @@ struct OracleHit {
 double oracle_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, Cull cull = Cull::None);
 // The same test on double coordinates (a ray's origin and corners far from
 // the origin, scenes): the ray's walkability is the caller's to check.
-double oracle_triangle(const double org[3], const double dir[3], double tmax, const double a[3], const double b[3],
+double oracle_triangle(const double org[3], const double dir[3], double tmin, double tmax, const double a[3], const double b[3],
                        const double c[3], Cull cull = Cull::None);
 
 // Every triangle, in input order.
@@ -36,7 +36,7 @@ class OracleTree {
  public:
   explicit OracleTree(const Mesh& mesh);
   OracleHit closest(const Ray& ray, Cull cull = Cull::None) const;
-  // Query::All's answer: every triangle the ray hits in [0, t_max], in
+  // Query::All's answer: every triangle the ray hits in [t_min, t_max], in
   // order of t, then triangle.
   std::vector<OracleHit> all(const Ray& ray, Cull cull = Cull::None) const;
 

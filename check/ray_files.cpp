@@ -58,8 +58,8 @@ std::vector<Record> read_records(const std::string& path, const char magic[4]) {
   return out;
 }
 
-// Each item written as to_record(item); at most kMaxRayCount (a ray file
-// and its hits file hold one record a ray).
+// Each item written as to_record(item, its index); at most kMaxRayCount (a
+// ray file and its hits file hold one record a ray).
 template <class Record, class Item, class ToRecord>
 void write_records(const std::string& path, const char magic[4], const std::vector<Item>& items, ToRecord to_record) {
   if (items.size() > kMaxRayCount)
@@ -69,10 +69,35 @@ void write_records(const std::string& path, const char magic[4], const std::vect
   const uint32_t n = uint32_t(items.size());
   std::memcpy(b.data(), magic, 4), std::memcpy(b.data() + 4, &n, 4);
   for (size_t i = 0; i < items.size(); ++i) {
-    const Record r = to_record(items[i]);
+    const Record r = to_record(items[i], i);
     std::memcpy(b.data() + 8 + i * sizeof(Record), &r, sizeof(Record));
   }
   write_file(path, b.data(), b.size());
+}
+
+// The ray records of RAYS and RAYD files: a Ray's and a RayD's fields up to
+// tmax. The files have no t_min: a ray read has t_min 0 (a caller that
+// wants another sets it, as `meshcast trace --t-min` does), and a ray with
+// another t_min is refused by the writers rather than written without it.
+// These four functions are the one place a ray and its record meet.
+struct RayRecord {
+  float org[3], dir[3], tmax;
+};
+struct RayDRecord {
+  double org[3];
+  float dir[3], tmax;
+};
+
+Ray ray_of(const RayRecord& r) { return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax}; }
+RayD ray_of(const RayDRecord& r) { return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax}; }
+
+// `path`'s record of ray `i`; UsageError for a t_min the file cannot hold.
+template <class Record, class R>
+Record record_of(const std::string& path, const R& r, size_t i) {
+  if (r.tmin != 0)
+    throw UsageError(path + ": ray " + std::to_string(i) + " has t_min " + std::to_string(r.tmin) +
+                     ", which a rays file does not hold (its rays start at t_min 0)");
+  return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax};
 }
 
 struct HitRecord {
@@ -87,13 +112,19 @@ struct SceneHitRecord {
 
 }  // namespace
 
-static_assert(sizeof(Ray) == 28 && sizeof(RayD) == 40 && sizeof(HitRecord) == 8 && sizeof(SceneHitRecord) == 12,
+static_assert(sizeof(RayRecord) == 28 && sizeof(RayDRecord) == 40 && sizeof(HitRecord) == 8 &&
+                  sizeof(SceneHitRecord) == 12,
               "the records of README's file formats");
 
-std::vector<Ray> read_rays(const std::string& path) { return read_records<Ray>(path, "RAYS"); }
+std::vector<Ray> read_rays(const std::string& path) {
+  const std::vector<RayRecord> records = read_records<RayRecord>(path, "RAYS");
+  std::vector<Ray> rays(records.size());
+  for (size_t i = 0; i < records.size(); ++i) rays[i] = ray_of(records[i]);
+  return rays;
+}
 
 void write_rays(const std::string& path, const std::vector<Ray>& rays) {
-  write_records<Ray>(path, "RAYS", rays, [](const Ray& r) { return r; });
+  write_records<RayRecord>(path, "RAYS", rays, [&](const Ray& r, size_t i) { return record_of<RayRecord>(path, r, i); });
 }
 
 void write_rays(const std::string& path, size_t count, const std::function<void(std::span<Ray>)>& make) {
@@ -105,14 +136,17 @@ void write_rays(const std::string& path, size_t count, const std::function<void(
   std::memcpy(header + 4, &n, 4);
   constexpr size_t kChunk = size_t(1) << 16;  // 1.75 MiB of records at a time
   std::vector<Ray> chunk;
+  std::vector<RayRecord> records;
   size_t written = 0;
   bool header_written = false;
   write_file_pieces(path, [&]() -> Bytes {
     if (!header_written) return header_written = true, Bytes{header, sizeof header};
-    chunk.resize(std::min(kChunk, count - written));
+    chunk.assign(std::min(kChunk, count - written), Ray{});
     make(chunk);
+    records.resize(chunk.size());
+    for (size_t i = 0; i < chunk.size(); ++i) records[i] = record_of<RayRecord>(path, chunk[i], written + i);
     written += chunk.size();
-    return {chunk.data(), chunk.size() * sizeof(Ray)};
+    return {records.data(), records.size() * sizeof(RayRecord)};
   });
 }
 
@@ -123,7 +157,7 @@ std::vector<Hit> read_hits(const std::string& path) {
 }
 
 void write_hits(const std::string& path, const std::vector<Hit>& hits) {
-  write_records<HitRecord>(path, "HITS", hits, [](const Hit& h) { return HitRecord{h.t, h.triangle}; });
+  write_records<HitRecord>(path, "HITS", hits, [](const Hit& h, size_t) { return HitRecord{h.t, h.triangle}; });
 }
 
 namespace {
@@ -221,10 +255,16 @@ void write_hit_lists(const std::string& path, const HitLists& lists) {
   write_file(path, {{head, 12}, {lists.found.data(), 4 * n}, {records.data(), records.size() * sizeof(HitRecord)}});
 }
 
-std::vector<RayD> read_scene_rays(const std::string& path) { return read_records<RayD>(path, "RAYD"); }
+std::vector<RayD> read_scene_rays(const std::string& path) {
+  const std::vector<RayDRecord> records = read_records<RayDRecord>(path, "RAYD");
+  std::vector<RayD> rays(records.size());
+  for (size_t i = 0; i < records.size(); ++i) rays[i] = ray_of(records[i]);
+  return rays;
+}
 
 void write_scene_rays(const std::string& path, const std::vector<RayD>& rays) {
-  write_records<RayD>(path, "RAYD", rays, [](const RayD& r) { return r; });
+  write_records<RayDRecord>(path, "RAYD", rays,
+                            [&](const RayD& r, size_t i) { return record_of<RayDRecord>(path, r, i); });
 }
 
 std::vector<SceneHit> read_scene_hits(const std::string& path) {
@@ -235,7 +275,7 @@ std::vector<SceneHit> read_scene_hits(const std::string& path) {
 
 void write_scene_hits(const std::string& path, const std::vector<SceneHit>& hits) {
   write_records<SceneHitRecord>(path, "HITI", hits,
-                                [](const SceneHit& h) { return SceneHitRecord{h.t, h.instance, h.triangle}; });
+                                [](const SceneHit& h, size_t) { return SceneHitRecord{h.t, h.instance, h.triangle}; });
 }
 
 bool is_scene_rays_file(const std::string& path) {

@@ -12,7 +12,8 @@
 //         direction, float32 t_max (40 bytes)
 //   scene hits: "HITI", uint32 count, per ray float32 t (inf: miss),
 //         uint32 instance, uint32 triangle (a miss: 0xFFFFFFFF twice)
-// All little-endian.
+// All little-endian. Neither rays file holds a t_min: rays read have t_min
+// 0, and the writers refuse a ray with another (UsageError naming it).
 #pragma once
 #include <functional>
 #include <span>

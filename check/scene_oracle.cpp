@@ -39,6 +39,9 @@ SceneOracle::SceneOracle(const std::vector<const Mesh*>& meshes, const std::vect
 
 template <class Take>
 void SceneOracle::visit(const RayD& ray, Cull cull, uint8_t mask, const double* cut, Take&& take) const {
+  // A segment the walkers refuse (a NaN or negative end, t_min past t_max)
+  // is a miss here too.
+  if (!(ray.tmax >= 0 && ray.tmin >= 0 && ray.tmin <= ray.tmax)) return;
   // The direction as the walkers read it (a denormal component as 0).
   const double d[3] = {walked_direction(ray.dir[0]), walked_direction(ray.dir[1]), walked_direction(ray.dir[2])};
   for (const Placed& p : placed_) {
@@ -65,7 +68,7 @@ void SceneOracle::visit(const RayD& ray, Cull cull, uint8_t mask, const double* 
                                                     : cull;
     for (size_t t = 0; t < p.corners.size() / 9; ++t) {
       const double* c = p.corners.data() + 9 * t;
-      const double hit = oracle_triangle(ray.org, d, ray.tmax, c, c + 3, c + 6, world_cull);
+      const double hit = oracle_triangle(ray.org, d, ray.tmin, ray.tmax, c, c + 3, c + 6, world_cull);
       if (hit != INFINITY) take(hit, p.instance.id, uint32_t(t));
     }
   }

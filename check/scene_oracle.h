@@ -35,7 +35,7 @@ class SceneOracle {
   // where the instance mirrors (its determinant, in double, negative) and
   // turned again by its flip_facing.
   SceneOracleHit closest(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
-  // Every hit in [0, t_max], in order of t, then instance, then triangle.
+  // Every hit in [t_min, t_max], in order of t, then instance, then triangle.
   std::vector<SceneOracleHit> all(const RayD& ray, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Whether the triangle of instance `instance` (an index into the
   // instances given) meets the ray in double at distance t, to within

@@ -10,8 +10,9 @@
 //    a lane whose determinant or T overflowed or fell below kSettleTiny
 //    (coordinates near the +-2^100 limit, tiny meshes, tiny or huge
 //    directions): float cannot settle it, double always can.
-// Both are two-sided and accept t in [0, t_max]; a hit whose t exceeds the
-// largest float is a miss (the hit record carries t as a float).
+// Both are two-sided and accept t in [t_min, t_max] (the float t they
+// compute, both ends included); a hit whose t exceeds the largest float is
+// a miss (the hit record carries t as a float).
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -60,7 +61,7 @@ inline float cull_sign(uint32_t flags) {
 // `cull`: cull_sign() of the query.
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
-                            float cull, float closest, LaneHit* out);
+                            float cull, float tmin, float closest, LaneHit* out);
 
 // Which test the walkers run: the watertight one unless a benchmark asks
 // for the plain one (process-wide; set it before tracing, not during).
@@ -86,8 +87,13 @@ struct RayPre {
   float sx, sy, sz;
   uint32_t outputs;  // MC_HIT_* asked for: the triangle tests skip u, v unless asked
   float cull;        // cull_sign() of the query's MC_CULL_* bits
+  // The nearest t a triangle test accepts. The box tests keep entering at
+  // 0: a box the ray enters before tmin may still hold hits past it, and
+  // the conservative test needs no second bound to stay conservative.
+  float tmin;
 
-  explicit RayPre(const Ray& r, uint32_t hit_outputs = 0) : outputs(hit_outputs), cull(cull_sign(hit_outputs)) {
+  explicit RayPre(const Ray& r, uint32_t hit_outputs = 0)
+      : outputs(hit_outputs), cull(cull_sign(hit_outputs)), tmin(r.tmin) {
     for (int a = 0; a < 3; ++a) {
       org[a] = r.org[a];
       dir[a] = walked_direction(r.dir[a]);
@@ -179,15 +185,15 @@ inline auto float_settles(const F4& det, const F4& T) {
 // three corners, then their unscaled z) stored, each lane redone by
 // watertight_lane_double against limit(); take(lane, hit) for each hit.
 template <class F4, class Limit, class Take>
-[[gnu::noinline, gnu::cold]] void settle_in_double(int redo, const F4 (&p)[9], float sz, float cull, Limit&& limit,
-                                                   Take&& take) {
+[[gnu::noinline, gnu::cold]] void settle_in_double(int redo, const F4 (&p)[9], float sz, float cull, float tmin,
+                                                   Limit&& limit, Take&& take) {
   float l[9][F4::kLanes];
   for (int k = 0; k < 9; ++k) p[k].store(l[k]);
   for (int m = redo; m; m &= m - 1) {
     int i = __builtin_ctz(m);
     LaneHit h;
     if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i], sz,
-                               cull, limit(), &h))
+                               cull, tmin, limit(), &h))
       take(i, h);
   }
 }
@@ -221,7 +227,7 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
   // sign an odd permutation (kx, ky swapped: dir[kz] < 0) flips.
   const float cull = r.dir[r.axis[2]] < 0 ? -r.cull : r.cull;
   M4 accept = valid & (det != zero) & (det * F4::splat(cull) >= zero) & (u >= zero) & (w >= zero) & (u + w <= one) &
-              (t >= zero) & (t <= F4::splat(closest));
+              (t >= zero) & (t >= F4::splat(r.tmin)) & (t <= F4::splat(closest));
   LaneHit best;
   float tl[kW], ul[kW], wl[kW];
   t.store(tl), u.store(ul), w.store(wl);
@@ -273,8 +279,10 @@ template <class F4, class M4>
   M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
   // A culled face fails here; det is finite and not 0 on every lane that
   // float settles, so cull 0 keeps them all.
+  // t >= tmin beside Ts >= 0: an underflowed t of -0 passes tmin = 0 as
+  // before, while Ts < 0 stays a miss.
   M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (det * F4::splat(r.cull) >= zero) &
-                                     (t <= F4::splat(std::min(closest, FLT_MAX))));
+                                     (t >= F4::splat(r.tmin)) & (t <= F4::splat(std::min(closest, FLT_MAX))));
 
   LaneHit best;
   int acc = simd::bits(accept);
@@ -303,7 +311,7 @@ template <class F4, class M4>
   }
   // Rare: an edge function of 0, or det or T out of float's reach.
   if (int lanes = simd::bits(redo))
-    settle_in_double(lanes, {ax, ay, bx, by, cx, cy, az, bz, cz}, r.sz, r.cull,
+    settle_in_double(lanes, {ax, ay, bx, by, cx, cy, az, bz, cz}, r.sz, r.cull, r.tmin,
                      [&] { return best.lane >= 0 && !every ? best.t : closest; },
                      [&](int i, const LaneHit& h) {
                        if (every) every->add(i, h);
@@ -360,7 +368,7 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     F4 t = Ts / dets;
     M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
     M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (det * F4::splat(r.cull) >= zero) &
-                                       (t <= F4::splat(std::min(closest, FLT_MAX))));
+                                       (t >= F4::splat(r.tmin)) & (t <= F4::splat(std::min(closest, FLT_MAX))));
     float tl[kW], Ul[kW], Vl[kW], Wl[kW];
     t.store(tl), U.store(Ul), V.store(Vl), W.store(Wl);
     for (int m = simd::bits(accept); m; m &= m - 1) {
@@ -377,7 +385,7 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     const int* k = corner[tri];
     if (int lanes = simd::bits(redo))
       settle_in_double(lanes, {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]], z[k[0]], z[k[1]], z[k[2]]}, r.sz,
-                       r.cull, [&] { return best.lane >= 0 && !every ? best.t : closest; },
+                       r.cull, r.tmin, [&] { return best.lane >= 0 && !every ? best.t : closest; },
                        [&](int i, const LaneHit& h) {
                          if (every) every[tri].add(i, h);
                          if (best.lane < 0 || h.t < best.t) best = {i, tri == 1, h.t, h.u, h.v};

@@ -81,6 +81,7 @@ Ray to_local(const WorldRay& r, const layout::PlacedInstance& p) {
   float rel[3];
   for (int a = 0; a < 3; ++a) rel[a] = float(r.ray.org[a] - p.translation[a]);
   Ray local;
+  local.tmin = r.ray.tmin;  // t is the same number in both frames
   const float* dir = r.dir;
   for (int i = 0; i < 3; ++i) {
     const float* row = p.to_local + 3 * i;
@@ -98,7 +99,7 @@ Cull turned(Cull cull) {
 }
 
 bool world_ray_walkable(const RayD& r) {
-  Ray probe{{0, 0, 0}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax};
+  Ray probe{{0, 0, 0}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax, r.tmin};
   for (int a = 0; a < 3; ++a)
     if (!(std::fabs(r.org[a]) <= double(kMaxCoordinate))) return false;
   return ray_is_walkable(probe);
@@ -106,8 +107,9 @@ bool world_ray_walkable(const RayD& r) {
 
 // The chosen instruction set's top-level walk (cpu/walk_top.h) for one
 // ray, each instance it reaches handed to visit(instance, its local ray
-// with t_max the cut), which returns the cut from then on, or a negative
-// number to end the walk.
+// with t_max the cut and the world ray's t_min), which returns the cut from
+// then on, or a negative number to end the walk. The cut never falls below
+// t_min (it is t_max or a hit's t), so every local ray keeps t_min <= t_max.
 template <class Visit>
 void walk_top(const layout::TopLevel& top, const WorldRay& r, uint8_t mask, WalkTopFn walk, Visit&& visit) {
   struct Context {

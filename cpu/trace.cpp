@@ -138,14 +138,15 @@ bool ray_is_walkable(const Ray& r) {
     if (!(std::fabs(r.org[a]) <= kMaxCoordinate) || !(std::fabs(r.dir[a]) <= kMaxDirection)) return false;
   const float m = std::max({std::fabs(r.dir[0]), std::fabs(r.dir[1]), std::fabs(r.dir[2])});
   if (!(m >= 0x1p-126f)) return false;
-  return !std::isnan(r.tmax) && r.tmax >= 0;
+  // Comparisons false on NaN: a NaN tmax or tmin is refused with them.
+  return r.tmax >= 0 && r.tmin >= 0 && r.tmin <= r.tmax;
 }
 
 void set_triangle_test(TriangleTest t) { triangle_test_choice.store(t, std::memory_order_relaxed); }
 
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
-                            float cull, float closest, LaneHit* out) {
+                            float cull, float tmin, float closest, LaneHit* out) {
   double U = double(cx) * by - double(cy) * bx;
   double V = double(ax) * cy - double(ay) * cx;
   double W = double(bx) * ay - double(by) * ax;
@@ -155,9 +156,10 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
   double T = (U * az + V * bz + W * cz) * double(sz);
   if (det < 0) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0) return false;
-  // Compared in double: a t past the largest float is no hit.
+  // Compared in double: a t past the largest float is no hit. Both ends
+  // are floats, so the float t reported lies between them too.
   const double t = T / det;
-  if (!(t <= double(std::min(closest, FLT_MAX)))) return false;
+  if (!(t >= double(tmin) && t <= double(std::min(closest, FLT_MAX)))) return false;
   out->t = float(t), out->u = float(V / det), out->v = float(W / det);
   return true;
 }

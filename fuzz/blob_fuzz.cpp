@@ -23,6 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::vector<Ray> rays = fuzz::rays_through_box(h.bounds_min, h.bounds_max);
     std::vector<Hit> hits(rays.size());
     view.trace(rays, hits);
+    if (!fuzz::hits_on_segments(rays, hits)) __builtin_trap();
     // A hit names a triangle of the mesh, or without a remap a slot number.
     const uint32_t names = layout::has_remap(h) ? h.triangle_count : h.remap_slots;
     for (const Hit& hit : hits)

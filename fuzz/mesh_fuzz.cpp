@@ -62,6 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::vector<Ray> rays = fuzz::rays_through_box(lo, hi);
     std::vector<Hit> hits(rays.size());
     view.trace(rays, hits);
+    if (!fuzz::hits_on_segments(rays, hits)) __builtin_trap();
   } catch (const InputError&) {
   }
   return 0;

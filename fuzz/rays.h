@@ -1,7 +1,8 @@
 // Rays both fuzz targets cast at whatever they built or were given: a grid
 // across each face of a box toward the opposite face, the box's diagonals,
-// grazing rays along its faces, and rays no walker may walk (NaN, zero
-// direction, negative t_max). Deterministic: a crash replays from its input.
+// grazing rays along its faces, diagonals with a t_min, and rays no walker
+// may walk (NaN, zero direction, negative t_max, NaN, negative or inverted
+// t_min). Deterministic: a crash replays from its input.
 #pragma once
 #include <cmath>
 #include <vector>
@@ -42,10 +43,30 @@ inline std::vector<Ray> rays_through_box(const float lo_in[3], const float hi_in
     rays.push_back(r);
   }
   rays.push_back({{lo[0], lo[1], lo[2]}, {1, 0, 0}, INFINITY});  // along an edge of the box
+  // The box's diagonals again, starting half way: t_min skips what lies
+  // before it, and t_min = t_max keeps one point.
+  const size_t diagonals = rays.size() - 9;
+  for (int corner = 0; corner < 8; corner += 3) {
+    Ray r = rays[diagonals + size_t(corner)];
+    r.tmin = 0.5f;
+    if (corner == 6) r.tmax = 0.5f;
+    rays.push_back(r);
+  }
   rays.push_back({{NAN, lo[1], lo[2]}, {1, 0, 0}, INFINITY});
   rays.push_back({{lo[0], lo[1], lo[2]}, {0, 0, 0}, INFINITY});
   rays.push_back({{lo[0], lo[1], lo[2]}, {1, 1, 1}, -1.0f});
+  rays.push_back({{lo[0], lo[1], lo[2]}, {1, 1, 1}, INFINITY, NAN});
+  rays.push_back({{lo[0], lo[1], lo[2]}, {1, 1, 1}, 1.0f, 2.0f});  // t_min past t_max
+  rays.push_back({{lo[0], lo[1], lo[2]}, {1, 1, 1}, 1.0f, -1.0f});
   return rays;
+}
+
+// Whether every hit lies on its ray's segment, t_min <= t <= t_max (a
+// walker reporting one outside it is a bug whatever the blob holds).
+inline bool hits_on_segments(const std::vector<Ray>& rays, const std::vector<Hit>& hits) {
+  for (size_t i = 0; i < rays.size(); ++i)
+    if (hits[i].triangle != MC_NO_HIT && !(hits[i].t >= rays[i].tmin && hits[i].t <= rays[i].tmax)) return false;
+  return true;
 }
 
 }  // namespace meshcast::fuzz

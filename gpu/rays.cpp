@@ -19,6 +19,7 @@ uint64_t pack_rays(std::span<const Ray> rays, uint32_t* out) {
     w[10] = uint32_t(p.axis[0]) | uint32_t(p.axis[1]) << 2 | uint32_t(p.axis[2]) << 4;
     w[11] = 1;
     std::memcpy(w + 12, p.inv, 12);
+    std::memcpy(w + 15, &rays[i].tmin, 4);
   }
   return skipped;
 }

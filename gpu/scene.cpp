@@ -1,5 +1,6 @@
 #include "gpu/scene.h"
 
+#include <cstddef>
 #include <cstring>
 #include <stdexcept>
 
@@ -160,8 +161,10 @@ void SceneMethod::begin(const SceneSnapshot& s, std::span<const RayD> rays, uint
   std::memcpy(top + kTopMeshBase, mesh_base_.data(), mesh_base_.size() * 4);
   std::memcpy(top + placed_at, t.placed.data(), t.placed.size() * sizeof(layout::PlacedInstance));
   std::memcpy(top + wide_at, t.wide.data(), t.wide.size() * sizeof(layout::TopWideNode));
-  // The rays as RAYD records, the answers 6 words a ray.
-  static_assert(sizeof(RayD) == 40, "a RAYD record");
+  // The rays as RayD records (12 words: RAYD_WORDS of the shader), the
+  // answers 6 words a ray.
+  static_assert(sizeof(RayD) == 48 && offsetof(RayD, tmax) == 36 && offsetof(RayD, tmin) == 40,
+                "the scene shader's RAYD_WORDS and its t_max and t_min words");
   const uint32_t n = uint32_t(rays.size());
   fit(rays_, ctx_, uint64_t(n) * sizeof(RayD), "scene ray buffer");
   fit(hits_, ctx_, uint64_t(n) * kSceneHitWords * 4, "scene hit buffer");

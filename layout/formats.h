@@ -16,7 +16,7 @@
 #define MC_HIT_UV 1u     // barycentrics u, v of the hit in its triangle
 #define MC_HIT_POINT 2u  // the hit point: org + t * dir, in float
 // The query a trace answers, in the same word as the outputs (issue 20):
-// without a query bit the closest hit; MC_QUERY_ANY any hit in [0, t_max],
+// without a query bit the closest hit; MC_QUERY_ANY any hit in [t_min, t_max],
 // the walk ending at the first triangle it takes; MC_QUERY_ALL every hit
 // along the segment. Face culling rides there too: MC_CULL_BACK keeps the
 // triangles whose corners run counter-clockwise seen from the ray's origin

@@ -1,6 +1,8 @@
 // Method 2 of seed 000 §7, AABBList, pass 1: one thread a (ray, batch),
 // the conservative box test of the CPU walker against the ray's whole
-// [0, tmax]; an entered box appends the pair.
+// [0, tmax] (from 0 whatever its tmin: the triangle test applies tmin, and
+// a box entered before tmin may hold hits past it); an entered box appends
+// the pair.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require

@@ -3,7 +3,7 @@
 // correctly rounded arithmetic, so the shear the GPU applies is the CPU's
 // bit for bit, and the box test's reciprocals likewise. 16 words a ray:
 //   org xyz, dir xyz, tmax, sx, sy, sz, axes (kx | ky << 2 | kz << 4),
-//   walkable (0: answered as a miss, as the CPU does), inv xyz, 0
+//   walkable (0: answered as a miss, as the CPU does), inv xyz, tmin
 #ifndef MESHCAST_RAY_GLSL
 #define MESHCAST_RAY_GLSL
 
@@ -19,7 +19,7 @@ layout(constant_id = 1) const uint kMaxHits = 1u;
 
 struct GpuRay {
   vec3 org, dir, inv;
-  float tmax, sx, sy, sz;
+  float tmin, tmax, sx, sy, sz;
   uint kx, ky, kz;
   bool walkable;
 };
@@ -48,6 +48,7 @@ GpuRay load_ray(uint i) {
   r.kx = axes & 3u, r.ky = (axes >> 2) & 3u, r.kz = (axes >> 4) & 3u;
   r.walkable = ray_words[b + 11u] != 0u;
   r.inv = vec3(uintBitsToFloat(ray_words[b + 12u]), uintBitsToFloat(ray_words[b + 13u]), uintBitsToFloat(ray_words[b + 14u]));
+  r.tmin = uintBitsToFloat(ray_words[b + 15u]);
   return r;
 }
 

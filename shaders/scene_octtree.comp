@@ -8,8 +8,8 @@
 // divisions of the ray's set-up rounded once, div_exact).
 //
 // Bindings: 0 every mesh's blob, one after another (the top buffer's
-// table gives each one's first word); 1 the world rays as RAYD records
-// (3 doubles, 3 floats, t_max: 10 words); 5 the top level; 6 the answers,
+// table gives each one's first word); 1 the world rays as RayD records
+// (3 doubles, 3 floats, t_max, t_min, padding: 12 words); 5 the top level; 6 the answers,
 // 6 words a ray: t, instance, triangle, u, v and whether some part of the
 // ray could not be walked (the CPU's count of such rays). 2 to 4 are the
 // blob methods' (unused here).
@@ -40,7 +40,7 @@ layout(std430, set = 0, binding = 5) readonly buffer Top { uint top_words[]; };
 #define SCENE_HIT_WORDS 6u
 layout(std430, set = 0, binding = 6) writeonly buffer SceneHits { uint scene_hits[]; };
 
-#define RAYD_WORDS 10u
+#define RAYD_WORDS 12u
 
 double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_words[word + 1u])); }
 
@@ -48,19 +48,20 @@ double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_wor
 #define TOP_STACK_SIZE (7u * MC_TOP_MAX_DEPTH + 8u)
 
 // ray_is_walkable of cpu/trace.cpp: an origin within 2^100, a direction
-// within 2^126 and not below 2^-126 on every axis, t_max not NaN nor < 0.
-bool directions_walkable(vec3 dir, float tmax) {
+// within 2^126 and not below 2^-126 on every axis, t_max and t_min not NaN
+// nor < 0, t_min not past t_max (the comparisons fail on NaN).
+bool directions_walkable(vec3 dir, float tmin, float tmax) {
   const float biggest = max(max(abs(dir.x), abs(dir.y)), abs(dir.z));
   return all(lessThanEqual(abs(dir), vec3(uintBitsToFloat(0x7E800000u)))) && biggest >= uintBitsToFloat(0x00800000u) &&
-         !isnan(tmax) && tmax >= 0.0;
+         !isnan(tmax) && !isnan(tmin) && tmax >= 0.0 && tmin >= 0.0 && tmin <= tmax;
 }
 
 // RayPre of cpu/intersect.h for a ray made here (gpu/rays.cpp makes the
 // blob methods' on the host): 1/d, the dominant axis, the shear.
-GpuRay prepared(vec3 org, vec3 given_dir, float tmax) {
+GpuRay prepared(vec3 org, vec3 given_dir, float tmin, float tmax) {
   GpuRay r;
   const vec3 dir = walked_direction(given_dir);
-  r.org = org, r.dir = dir, r.tmax = tmax;
+  r.org = org, r.dir = dir, r.tmin = tmin, r.tmax = tmax;
   for (int a = 0; a < 3; ++a) r.inv[a] = div_exact(1.0, dir[a]);
   const float ax = abs(dir.x), ay = abs(dir.y), az = abs(dir.z);
   const uint kz = ax > ay ? (ax > az ? 0u : 2u) : (ay > az ? 1u : 2u);
@@ -73,7 +74,7 @@ GpuRay prepared(vec3 org, vec3 given_dir, float tmax) {
   r.sy = div_exact(dir[ky], dir[kz]);
   r.sz = div_exact(1.0, dir[kz]);
   r.kx = kx, r.ky = ky, r.kz = kz;
-  r.walkable = all(lessThanEqual(abs(org), vec3(uintBitsToFloat(0x71800000u)))) && directions_walkable(dir, tmax);
+  r.walkable = all(lessThanEqual(abs(org), vec3(uintBitsToFloat(0x71800000u)))) && directions_walkable(dir, tmin, tmax);
   return r;
 }
 
@@ -86,11 +87,11 @@ void main() {
   const vec3 given_dir = vec3(uintBitsToFloat(ray_words[w + 6u]), uintBitsToFloat(ray_words[w + 7u]),
                               uintBitsToFloat(ray_words[w + 8u]));
   const vec3 dir = walked_direction(given_dir);  // as WorldRay of cpu/scene_trace.cpp
-  const float tmax = uintBitsToFloat(ray_words[w + 9u]);
+  const float tmax = uintBitsToFloat(ray_words[w + 9u]), tmin = uintBitsToFloat(ray_words[w + 10u]);
   float best_t = kInfinity, best_u = 0.0, best_v = 0.0;
   uint best_instance = MC_NO_HIT, best_triangle = MC_NO_HIT, incomplete = 0u;
   const double max_coordinate = 1267650600228229401496703205376.0lf;  // 2^100
-  const bool walkable = all(lessThanEqual(abs(org), dvec3(max_coordinate))) && directions_walkable(dir, tmax);
+  const bool walkable = all(lessThanEqual(abs(org), dvec3(max_coordinate))) && directions_walkable(dir, tmin, tmax);
   if (!walkable) incomplete = 1u;
   if (walkable && top_words[TOP_NODES] > 0u) {
     // The world ray as the top level's float boxes read it (TopRay of
@@ -132,7 +133,9 @@ void main() {
           precise float d = m0 * dir[0] + m1 * dir[1] + m2 * dir[2];
           local_org[i] = o, local_dir[i] = d;
         }
-        const GpuRay local = prepared(local_org, local_dir, cut);
+        // The world ray's t_min: t is the same number in both frames, and
+        // the cut (t_max or a hit's t) never falls below it.
+        const GpuRay local = prepared(local_org, local_dir, tmin, cut);
         if (!local.walkable) {  // its direction scaled past the walkers' range: not walked, counted
           incomplete = 1u;
           continue;

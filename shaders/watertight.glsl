@@ -6,7 +6,7 @@
 // beyond the divisors Vulkan bounds a division's error for) is redone in double,
 // as on the CPU. Two-sided unless the batch culls (kFlags' MC_CULL_*: det > 0
 // is the front face, as cpu/intersect.h's cull_sign); accepts t in
-// [0, closest]; a t past the largest float is no hit.
+// [r.tmin, closest], both ends included; a t past the largest float is no hit.
 #ifndef MESHCAST_WATERTIGHT_GLSL
 #define MESHCAST_WATERTIGHT_GLSL
 
@@ -30,7 +30,7 @@ bool culled(bool positive) { return (kFlags & (positive ? MC_CULL_FRONT : MC_CUL
 
 // Corners in ray space: sheared x, y, and z not yet scaled by sz.
 bool watertight_double(float ax, float ay, float bx, float by, float cx, float cy, float az, float bz, float cz,
-                       float sz, float closest, out float t, out float u, out float v) {
+                       float sz, float tmin, float closest, out float t, out float u, out float v) {
   precise double U = double(cx) * double(by) - double(cy) * double(bx);
   precise double V = double(ax) * double(cy) - double(ay) * double(cx);
   precise double W = double(bx) * double(ay) - double(by) * double(ax);
@@ -41,7 +41,7 @@ bool watertight_double(float ax, float ay, float bx, float by, float cx, float c
   if (det < 0.0lf) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0.0lf) return false;
   precise double td = T / det;
-  if (!(td <= double(min(closest, kFloatMax)))) return false;
+  if (!(td >= double(tmin) && td <= double(min(closest, kFloatMax)))) return false;
   t = float(td);
   u = float(V / det), v = float(W / det);
   return true;
@@ -58,18 +58,18 @@ bool watertight(GpuRay r, vec3 a, vec3 b, vec3 c, float closest, out float t, ou
   precise float U = cx * by - cy * bx;
   precise float V = ax * cy - ay * cx;
   precise float W = bx * ay - by * ax;
-  if (U == 0.0 || V == 0.0 || W == 0.0) return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
+  if (U == 0.0 || V == 0.0 || W == 0.0) return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, r.tmin, closest, t, u, v);
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   precise float det = U + V + W;
   precise float T = U * (r.sz * az) + V * (r.sz * bz) + W * (r.sz * cz);
   const float dets = abs(det), Tabs = abs(T);
   if (!(dets >= kSettleTiny && dets < kSettleHuge && Tabs >= kSettleTiny && Tabs < kInfinity))
-    return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, closest, t, u, v);
+    return watertight_double(ax, ay, bx, by, cx, cy, az, bz, cz, r.sz, r.tmin, closest, t, u, v);
   if (culled(det > 0.0)) return false;
   const float Ts = det < 0.0 ? -T : T;
   if (!(Ts >= 0.0)) return false;
   t = Ts / dets;
-  if (!(t <= min(closest, kFloatMax))) return false;
+  if (!(t >= r.tmin && t <= min(closest, kFloatMax))) return false;
   u = V / det, v = W / det;
   return true;
 }

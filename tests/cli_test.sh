@@ -120,6 +120,31 @@ if ! diff <(od -An -tu4 -v -w8 -j8 "$work/one.hits" | awk '{print $1, ($2 == 429
           <(od -An -tu4 -v -w12 -j8 "$work/one.hiti" | awk '{print $1, ($2 == 4294967295 ? "miss" : $2), $3}') >/dev/null; then
   echo "FAIL trace-scene-one: the scene's hits differ from the mesh's"; failures=$((failures + 1))
 fi
+# --t-min T on every ray read, T the median first-hit t: a ray whose first
+# hit lies past T keeps it (t and triangle bit for bit), one whose first
+# hit lies before T finds a later one or misses, and no hit lies before T
+# (within od's printed digits: 1e-4 of T either way); the scene of that
+# one instance answers as the mesh. A negative or NaN T is refused.
+tmin=$(od -An -tf4 -v -w8 -j8 "$work/one.hits" | awk '$1 != "inf" {print $1}' | sort -g | awk '{t[NR] = $1} END {print t[int((NR + 1) / 2)]}')
+check trace-t-min 0 "\"t_min\":[0-9]" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --t-min "$tmin" --rays "$work/r.rays" --out "$work/tmin.hits" --json
+if ! paste <(od -An -tf4 -tu4 -v -w8 -j8 "$work/one.hits" | paste - - ) <(od -An -tf4 -tu4 -v -w8 -j8 "$work/tmin.hits" | paste - - ) |
+     awk -v T="$tmin" '
+       # Per ray: t, triangle (as floats), t bits, triangle; before, then with --t-min.
+       { t0 = $1; b0 = $3; tri0 = $4; t1 = $5; b1 = $7; tri1 = $8
+         if (tri1 != 4294967295 && t1 < T * 0.9999) bad++
+         if (tri0 == 4294967295) next
+         if (t0 > T * 1.0001 && (b1 != b0 || tri1 != tri0)) bad++
+         if (t0 < T * 0.9999) { moved++; if (tri1 != 4294967295 && t1 <= t0) bad++ } }
+       END { exit !(bad == 0 && moved > 0) }'; then
+  echo "FAIL trace-t-min: hits before --t-min, or first hits past it changed, or no ray skipped its first hit"; failures=$((failures + 1))
+fi
+check trace-scene-t-min 0 "500 rays" -- "$meshcast" trace "$work/one.json" --layout AABBTree/Float3 --t-min "$tmin" --rays "$work/r.rays" --out "$work/tmin.hiti"
+if ! diff <(od -An -tu4 -v -w8 -j8 "$work/tmin.hits" | awk '{print $1, ($2 == 4294967295 ? "miss" : 0), $2}') \
+          <(od -An -tu4 -v -w12 -j8 "$work/tmin.hiti" | awk '{print $1, ($2 == 4294967295 ? "miss" : $2), $3}') >/dev/null; then
+  echo "FAIL trace-scene-t-min: the scene's hits with --t-min differ from the mesh's"; failures=$((failures + 1))
+fi
+check trace-t-min-negative 2 "--t-min -0.5: a finite number at least 0" -- "$meshcast" trace "$mesh" --t-min -0.5 --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-t-min-nan 2 "--t-min nan: a finite number at least 0" -- "$meshcast" trace "$mesh" --t-min nan --rays "$work/r.rays" --out "$work/hx.hits"
 # The Vulkan scene method (lavapipe in CI) on the same scene, culled: the
 # CPU's t bits and instances (the triangle may be the other one of an edge
 # both meet at the same t, as gpu_test allows).

@@ -133,7 +133,8 @@ TEST_P(GpuMethods, MatchTheCpuAndTheOracle) {
 // The queries besides the closest hit (issue 20), each a method made for
 // it (specialization constants): closest and any hit with a face culled,
 // and every hit (culled on long rays), on every method against the oracle
-// with the same culling, and every hit's rows equal to the CPU's. 500
+// with the same culling, and every hit's rows equal to the CPU's; the
+// three again with a t_min (check_t_min_queries), the closest hits the CPU's. 500
 // rays of each kind (the brute force 150) on bunny00 (the stiff suite
 // probes the sphere and the grid).
 TEST_P(GpuMethods, QueriesMatchTheOracle) {
@@ -165,6 +166,8 @@ TEST_P(GpuMethods, QueriesMatchTheOracle) {
           }};
       const QueryAnswers answers = check_queries(vulkan, reference, kind, rays, tolerance, 64, what);
       expect_same_as_cpu(answers.culled, trace_all(view, rays, Query::Closest, answers.cull), what + ", culled");
+      const TMinAnswers offset = check_t_min_queries(vulkan, reference, kind, rays, tolerance, 64, what);
+      expect_same_as_cpu(offset.closest, trace_all(view, offset.rays), what + ", t_min");
       const HitLists& lists = answers.all;
       const HitLists cpu = trace_lists(view, rays, 64, answers.all_cull);
       for (size_t i = 0; i < rays.size(); ++i) {

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -314,6 +315,20 @@ TEST(Hostile, SceneRayAndHitFilesRoundTripAndRefuseBadHeaders) {
   }
   const std::vector<uint8_t> raw = read_file(rays_path);
   EXPECT_EQ(raw.size(), 8u + 2 * 40);
+  // The files hold no t_min: rays read start at 0, and a ray with another
+  // is refused rather than written without it (RAYS alike).
+  for (const RayD& r : rays_back) EXPECT_EQ(r.tmin, 0.0f);
+  RayD offset = rays[1];
+  offset.tmin = 0.25f;
+  expect_throws<UsageError>([&] { write_scene_rays(rays_path, {rays[0], offset}); },
+                            {"level.rayd", "ray 1 has t_min 0.25", "does not hold"});
+  const std::string float_path = (scratch_dir() / "level.rays").string();
+  write_rays(float_path, {{{1, 2, 3}, {0, 0, -1}, 9.0f}});
+  EXPECT_EQ(read_file(float_path).size(), 8u + 28);
+  EXPECT_EQ(read_rays(float_path).at(0).tmin, 0.0f);
+  expect_throws<UsageError>([&] { write_rays(float_path, {{{1, 2, 3}, {0, 0, -1}, 9.0f, 1.5f}}); },
+                            {"level.rays", "ray 0 has t_min 1.5", "does not hold"});
+  EXPECT_EQ(read_rays(float_path).size(), 1u);  // the refused write left the file as it was
   const std::string cut = make_file("cut.rayd", std::string(raw.begin(), raw.end() - 1));
   expect_throws<InputError>([&] { read_scene_rays(cut); }, {"cut.rayd", "header says 2 records"});
   const std::string plain = make_file("plain.rayd", "RAYS" + std::string(raw.begin() + 4, raw.end()));
@@ -379,9 +394,13 @@ TEST(Hostile, RaysFilesAreMadeAChunkAtATime) {
     std::vector<Ray> rays(kCount);
     RaySource source(tetrahedron, kind, 9);
     for (size_t at = 0; at < kCount; at += 4096) source.fill(std::span(rays).subspan(at, std::min<size_t>(4096, kCount - at)));
+    // Over each ray's record, its 7 floats before t_min (what the hashes
+    // were taken over when a Ray was those 7 floats).
     uint64_t h = 0xcbf29ce484222325ull;
-    const auto* bytes = reinterpret_cast<const unsigned char*>(rays.data());
-    for (size_t i = 0; i < kCount * sizeof(Ray); ++i) h = (h ^ bytes[i]) * 0x100000001b3ull;
+    for (const Ray& r : rays) {
+      const auto* bytes = reinterpret_cast<const unsigned char*>(&r);
+      for (size_t i = 0; i < offsetof(Ray, tmin); ++i) h = (h ^ bytes[i]) * 0x100000001b3ull;
+    }
     EXPECT_EQ(h, hash) << int(kind);
   }
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "check/oracle.h"
+#include "check/scene_oracle.h"
 #include "check/generate.h"
 #include "tests/testing.h"
 
@@ -34,6 +35,44 @@ TEST(Oracle, TMaxIsInclusiveAndOriginOnSurfaceHitsAtZero) {
   EXPECT_EQ(oracle_brute_force(m, short_).triangle, MC_NO_HIT);
   Ray on{{0.25f, 0.25f, 0.0f}, {0, 0, -1}, 0.0f};
   EXPECT_DOUBLE_EQ(oracle_brute_force(m, on).t, 0.0);
+}
+
+// t_min, included as t_max is: a hit needs t_min <= t <= t_max. Past t_min
+// the next triangle along is the answer (brute force and tree alike, and
+// every hit's set starts there); a NaN, negative or inverted t_min is a
+// ray the walkers refuse, a miss.
+TEST(Oracle, TMinIsInclusiveAndSkipsWhatLiesBefore) {
+  Mesh m = one_triangle();
+  m.vertices.push_back({0, 0, -1}), m.vertices.push_back({1, 0, -1}), m.vertices.push_back({0, 1, -1});
+  m.triangles.push_back({3, 4, 5});  // the same triangle 1 below
+  const OracleTree tree(m);
+  auto closest = [&](float tmin, float tmax) {
+    const Ray r{{0.25f, 0.25f, 2.0f}, {0, 0, -1}, tmax, tmin};
+    const OracleHit brute = oracle_brute_force(m, r), walked = tree.closest(r);
+    EXPECT_EQ(brute.triangle, walked.triangle) << tmin;
+    EXPECT_EQ(brute.t, walked.t) << tmin;
+    return brute;
+  };
+  EXPECT_EQ(closest(2.0f, INFINITY).triangle, 0u);  // exactly at t_min: hit
+  EXPECT_EQ(closest(2.0f, INFINITY).t, 2.0);
+  EXPECT_EQ(closest(2.001f, INFINITY).triangle, 1u);  // past the first: the next
+  EXPECT_EQ(closest(2.001f, INFINITY).t, 3.0);
+  EXPECT_EQ(closest(3.0f, 3.0f).triangle, 1u);  // t_min = t_max = the hit's t
+  EXPECT_EQ(closest(2.5f, 2.9f).triangle, MC_NO_HIT);
+  EXPECT_EQ(closest(3.001f, INFINITY).triangle, MC_NO_HIT);
+  for (float bad : {NAN, -0.5f, 5.0f})  // 5: past t_max 4
+    EXPECT_EQ(closest(bad, 4.0f).triangle, MC_NO_HIT) << bad;
+  const std::vector<OracleHit> all = tree.all({{0.25f, 0.25f, 2.0f}, {0, 0, -1}, INFINITY, 2.5f});
+  ASSERT_EQ(all.size(), 1u);
+  EXPECT_EQ(all[0].triangle, 1u);
+  // The scene oracle, origins in double, by the same rule.
+  const SceneOracle scene({&m}, {OracleInstance{7, 0, Transform{}}});
+  const RayD far_down{{0.25, 0.25, 2.0}, {0, 0, -1}, INFINITY, 2.001f};
+  EXPECT_EQ(scene.closest(far_down).triangle, 1u);
+  EXPECT_EQ(scene.closest(far_down).t, 3.0);
+  EXPECT_EQ(scene.all(far_down).size(), 1u);
+  EXPECT_EQ(scene.closest({{0.25, 0.25, 2.0}, {0, 0, -1}, 1.0f, 2.0f}).instance, kNoHit);  // t_min past t_max
+  EXPECT_EQ(scene.closest({{0.25, 0.25, 2.0}, {0, 0, -1}, INFINITY, NAN}).instance, kNoHit);
 }
 
 TEST(Oracle, SharedEdgeAndVertexNeverLeak) {

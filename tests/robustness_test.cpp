@@ -519,6 +519,8 @@ TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
       {{0x1p101f, 1, 1}, {-1, 0, -1}, inf},  // origin beyond +-2^100
       {{1, 1, 1}, {0, 0, -0x1p127f}, inf},   // a component beyond 2^126
       {{1, 1, 1}, {0x1p-127f, 0, 0}, inf},   // every component below FLT_MIN
+      // t_min refused as t_max is: NaN, negative, and past t_max.
+      {{1, 1, 1}, {0, 0, -1}, inf, nan}, {{1, 1, 1}, {0, 0, -1}, inf, -1.0f}, {{1, 1, 1}, {0, 0, -1}, 1.0f, 1.5f},
   };
   uint64_t skipped = 0;
   std::vector<Hit> hits = trace(blob, rays, &skipped);
@@ -529,7 +531,7 @@ TEST_P(Robustness, UnwalkableRaysAreCountedMisses) {
   }
 }
 
-TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
+TEST_P(Robustness, TMinTMaxZeroInfinityAndOriginsOnTheSurface) {
   Mesh g = make_grid_plane(4, 4);
   std::vector<Ray> rays = {
       {{1.3f, 1.6f, 0.0f}, {0, 0, -1}, 0.0f},     // on the surface, t_max 0: hit at 0
@@ -539,13 +541,26 @@ TEST_P(Robustness, TMaxZeroInfinityAndOriginsOnTheSurface) {
       {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, 0.999f},   // just short: miss
       {{1.3f, 1.6f, 1e30f}, {0, 0, -1}, INFINITY},
       {{2.0f, 2.0f, 0.0f}, {0, 0, 1}, INFINITY},  // on a vertex, leaving
+      // t_min, included as t_max is.
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, INFINITY, 1.0f},    // exactly t_min: hit
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, INFINITY, 1.001f},  // just past: miss
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, 1.0f, 1.0f},        // t_min = t_max at the surface: hit
+      {{1.3f, 1.6f, 0.0f}, {0, 0, -1}, INFINITY, 1e-6f},   // on the surface, t_min past 0: miss
+      {{1.3f, 1.6f, 1.0f}, {0, 0, -1}, INFINITY, -0.0f},   // -0 is 0
   };
   expect_answers(g, rays, "t_max");
-  std::vector<Hit> hits = trace(build(g, "grid"), rays);
+  uint64_t skipped = 0;
+  std::vector<Hit> hits = trace(build(g, "grid"), rays, &skipped);
+  EXPECT_EQ(skipped, 0u);
   EXPECT_EQ(hits[0].t, 0.0f);
   EXPECT_EQ(hits[2].triangle, MC_NO_HIT);
   EXPECT_NE(hits[3].triangle, MC_NO_HIT);
   EXPECT_EQ(hits[4].triangle, MC_NO_HIT);
+  EXPECT_EQ(hits[7].t, 1.0f);
+  EXPECT_EQ(hits[8].triangle, MC_NO_HIT);
+  EXPECT_EQ(hits[9].t, 1.0f);
+  EXPECT_EQ(hits[10].triangle, MC_NO_HIT);
+  EXPECT_EQ(hits[11].t, 1.0f);
 }
 
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) {

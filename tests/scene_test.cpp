@@ -159,7 +159,10 @@ struct RayRules {
   const double len;
   double slack(double t) const { return 1e-5 * (t * len + 4); }
   bool same_t(double t, double oracle_t) const { return std::fabs(t - oracle_t) * len <= slack(oracle_t); }
-  bool near_end(double t) const { return t * len <= slack(t) || std::fabs(t - r.tmax) * len <= slack(t); }
+  // At t_min (the origin when it is 0) or t_max, where rounding decides
+  // whether a hit is on the segment.
+  bool at_start(double t) const { return std::fabs(t - r.tmin) * len <= slack(t); }
+  bool near_end(double t) const { return at_start(t) || std::fabs(t - r.tmax) * len <= slack(t); }
   // The hit's triangle meets the ray at its t.
   bool meets(const SceneHit& h) const {
     return oracle.distance_to(oracle.index_of(h.instance), h.triangle, r, h.t) <= slack(h.t);
@@ -215,7 +218,10 @@ Judged judge(const SceneOracle& oracle, const std::vector<RayD>& rays, const std
         continue;
       }
       const bool same = h.instance == o.instance && h.triangle == o.triangle;
-      if (!rules.same_t(h.t, o.t)) j.fail(where + "t " + std::to_string(h.t) + " against " + std::to_string(o.t));
+      // One of them at t_min > 0, where rounding decides whether it is on
+      // the segment: the other is the next hit along.
+      if (!same && rays[i].tmin > 0 && (rules.at_start(h.t) || rules.at_start(o.t)) && rules.meets(h)) ++j.ties;
+      else if (!rules.same_t(h.t, o.t)) j.fail(where + "t " + std::to_string(h.t) + " against " + std::to_string(o.t));
       else if (!same && !rules.meets(h)) j.fail(where + named(h.instance, h.triangle) + " against " + named(o.instance, o.triangle));
       else if (!same) ++j.ties;
     } else if (h.instance == kNoHit) {
@@ -313,6 +319,37 @@ TEST_P(SceneVsOracle, GeneratedLevel) {
     EXPECT_LE(j.ties, rays.size() / 100) << what;
     EXPECT_GT(j.hits, rays.size() / (c.mask == 0xFF ? 5 : 10)) << what << ": too few hits to show anything";
   }
+  // t_min, the rule of a blob's walk (meshcast/scene.h): each ray from a
+  // fraction of its closest hit's t on (half of it, 1.001 and 1.02 times
+  // it: a world unit or so past the hit, inside the instance, in turn by
+  // threes, as the finite t_max go by ones; a ray that misses from half
+  // its t_max, or 1), so some keep their first hit and some find the next
+  // one along (the instance's far side); closest, any and every hit.
+  std::vector<RayD> offset_rays = rays;
+  size_t skipped_first = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    RayD& r = offset_rays[i];
+    const SceneOracleHit o = oracle.closest(rays[i]);
+    const size_t turn = i / 3 % 3;
+    if (o.instance == kNoHit) r.tmin = std::isfinite(r.tmax) ? r.tmax * 0.5f : 1.0f;
+    else r.tmin = std::min(r.tmax, float(o.t * (turn == 0 ? 0.5 : turn == 1 ? 1.001 : 1.02)));
+    const SceneOracleHit next = oracle.closest(r);
+    skipped_first += o.instance != kNoHit && next.instance != kNoHit && (next.instance != o.instance || next.triangle != o.triangle);
+  }
+  EXPECT_GT(skipped_first, rays.size() / 50) << layout << " at " << offset << ", t_min: too few rays find a next hit";
+  for (const Query q : {Query::Closest, Query::Any}) {
+    const Judged j = judge(oracle, offset_rays, trace(scene, offset_rays, q), Cull::None, 0xFF, q == Query::Any);
+    const std::string what = layout + " at " + std::to_string(offset) + ", t_min, query " + std::to_string(int(q));
+    EXPECT_EQ(j.wrong, 0u) << what << ": " << j.first_problem;
+    EXPECT_LE(j.ties, rays.size() / 100) << what;
+    EXPECT_GT(j.hits, rays.size() / 10) << what << ": too few hits to show anything";
+  }
+  SceneHitLists offset_lists;
+  offset_lists.max_hits = 256;
+  EXPECT_EQ(scene.trace_all_hits(offset_rays, offset_lists), 0u);
+  const Judged offset_all = judge_all(oracle, offset_rays, offset_lists, Cull::None, 0xFF);
+  EXPECT_EQ(offset_all.wrong, 0u) << layout << " at " << offset << ", t_min, Query::All: " << offset_all.first_problem;
+  EXPECT_LE(offset_all.ties, offset_all.hits / 100 + 2) << layout << " at " << offset << ", t_min, Query::All";
   // Every hit, front faces culled and mask 3, rows long enough for all.
   SceneHitLists lists;
   lists.max_hits = 256;
@@ -892,6 +929,7 @@ TEST(Scene, ReferencedBlobsAnswerAsCopies) {
 // triangles meet the ray at the same t (the GPU's walk may take the other
 // one: gpu_test's rule for the blob methods). Query::Any may take another
 // hit where two boxes are entered at the same distance: the same rays hit.
+// The same again with a t_min, and the t_min the CPU refuses counted.
 TEST(SceneOnTheGpu, AnswersAsTheCpu) {
   for (const double offset : {0.0, 1e7}) {
     const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 60, 100, offset, 7);
@@ -917,7 +955,43 @@ TEST(SceneOnTheGpu, AnswersAsTheCpu) {
                                 << ", query " << int(query);
           EXPECT_GT(hits, rays.size() / 10);
         }
+    // t_min: from half, 1.25 and 2 times each ray's closest hit t (the
+    // CPU's), the GPU's hits the CPU's bit for bit.
+    std::vector<SceneHit> first(rays.size());
+    ASSERT_EQ(scene.trace(rays, first), 0u);
+    std::vector<RayD> offset_rays = rays;
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (first[i].instance != kNoHit)
+        offset_rays[i].tmin = std::min(rays[i].tmax, first[i].t * (i % 3 == 0 ? 0.5f : i % 3 == 1 ? 1.25f : 2.0f));
+    for (const Query query : {Query::Closest, Query::Any}) {
+      const std::vector<SceneHit> gpu = trace(scene, offset_rays, query, Cull::None, 0xFF, HitOutputs::Uv);
+      std::vector<SceneHit> cpu(rays.size());
+      ASSERT_EQ(scene.trace(offset_rays, cpu, HitOutputs::Uv, query), 0u);
+      size_t differ = 0, moved = 0;
+      for (size_t i = 0; i < rays.size(); ++i) {
+        moved += cpu[i].instance != first[i].instance || cpu[i].triangle != first[i].triangle;
+        if (query == Query::Any) {
+          differ += (gpu[i].instance == kNoHit) != (cpu[i].instance == kNoHit) ||
+                    (gpu[i].instance != kNoHit && !(gpu[i].t >= offset_rays[i].tmin && gpu[i].t <= offset_rays[i].tmax));
+          continue;
+        }
+        const bool tie = gpu[i].triangle != cpu[i].triangle && gpu[i].instance == cpu[i].instance;
+        differ += tie ? std::memcmp(&gpu[i].t, &cpu[i].t, 4) != 0 : std::memcmp(&gpu[i], &cpu[i], sizeof(SceneHit)) != 0;
+      }
+      EXPECT_EQ(differ, 0u) << "offset " << offset << ", t_min, query " << int(query);
+      if (query == Query::Closest) {
+        EXPECT_GT(moved, rays.size() / 20) << "offset " << offset << ": t_min changed too few hits";
+      }
+    }
   }
+  // t_min refused as the CPU refuses it: NaN, negative, past t_max.
+  const Level level = make_level("OctTreeCompressed/ClusterBitPackSOA8", 4, 10, 0, 7);
+  const Scene scene = make_scene(level);
+  std::vector<RayD> bad = level_rays(level, 4, 10, 3);
+  bad[1].tmin = NAN, bad[2].tmin = -1.0f, bad[3].tmin = 2.0f, bad[3].tmax = 1.0f;
+  std::vector<SceneHit> hits(bad.size());
+  EXPECT_EQ(scene_method(Query::Closest, Cull::None, HitOutputs::None).trace(*scene.snapshot(), bad, hits), 3u);
+  for (size_t i = 1; i < bad.size(); ++i) EXPECT_EQ(hits[i].instance, kNoHit) << i;
   EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
 }
 
@@ -1052,9 +1126,12 @@ TEST(Scene, RefusesBadInput) {
   scene.commit();
   // The refused transform left the instance where it was.
   std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}, {{NAN, 0, 5}, {0, 0, -1}, INFINITY},
-                            {{0, 0, 1e31}, {0, 0, -1}, INFINITY}, {{0, 0, 5}, {0, 0, 0}, INFINITY}};
+                            {{0, 0, 1e31}, {0, 0, -1}, INFINITY}, {{0, 0, 5}, {0, 0, 0}, INFINITY},
+                            {{0, 0, 5}, {0, 0, -1}, INFINITY, NAN}, {{0, 0, 5}, {0, 0, -1}, 4.0f, 4.5f}};
   std::vector<SceneHit> hits(rays.size());
-  EXPECT_EQ(scene.trace(rays, hits), 3u);  // the NaN origin, the far origin, the zero direction
+  // The NaN origin, the far origin, the zero direction, the NaN t_min and
+  // t_min past t_max.
+  EXPECT_EQ(scene.trace(rays, hits), 5u);
   EXPECT_EQ(hits[0].instance, id);
   EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
   for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(hits[i].instance, kNoHit);
@@ -1065,7 +1142,7 @@ TEST(Scene, RefusesBadInput) {
   lists.max_hits = 0;
   EXPECT_THROW(scene.trace_all_hits(rays, lists), UsageError);
   lists.max_hits = 2;
-  EXPECT_EQ(scene.trace_all_hits(rays, lists), 3u);
+  EXPECT_EQ(scene.trace_all_hits(rays, lists), 5u);
   EXPECT_GE(lists.found[0], 2u);  // through both poles: every triangle around each, once
   EXPECT_EQ(lists.row(0)[0].instance, id);
   EXPECT_FLOAT_EQ(lists.row(0)[0].t, 4.0f);
@@ -1084,7 +1161,7 @@ TEST(Scene, RefusesBadInput) {
     EXPECT_THROW(s->trace_all_hits(rays, lists, HitOutputs::None, Cull(9)), UsageError);
   }
   // The rays no scene walks are counted whatever the scene holds.
-  EXPECT_EQ(empty.trace(rays, hits), 3u);
+  EXPECT_EQ(empty.trace(rays, hits), 5u);
   // A 3x3 entry beyond 2^40; a world box beyond 2^100 (a sphere 10^18
   // across scaled by 2^40, 2^99 from the origin).
   Transform huge;

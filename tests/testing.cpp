@@ -1,5 +1,6 @@
 #include "tests/testing.h"
 
+#include <bit>
 #include <cmath>
 #include <random>
 
@@ -129,10 +130,30 @@ const OracleTree& oracle_tree(const NamedMesh& m) {
 }
 }  // namespace
 
+namespace {
+// What tells a ray set from the same set with t_min (with_t_min) in the
+// caches below: a hash of its t_min values, 0 when all are 0.
+uint64_t t_min_print(const std::vector<Ray>& rays) {
+  uint64_t h = 0;
+  for (const Ray& r : rays) h = (h ^ std::bit_cast<uint32_t>(r.tmin)) * 0x100000001b3ull;
+  return h;
+}
+}  // namespace
+
+std::vector<Ray> with_t_min(const std::vector<Ray>& rays, const std::vector<OracleHit>& closest) {
+  std::vector<Ray> out(rays);
+  for (size_t i = 0; i < out.size(); ++i) {
+    Ray& r = out[i];
+    if (closest[i].triangle == MC_NO_HIT) r.tmin = std::isfinite(r.tmax) ? r.tmax * 0.5f : 1.0f;
+    else r.tmin = std::min(r.tmax, float(closest[i].t * (i % 3 == 0 ? 0.5 : i % 3 == 1 ? 1.25 : 2.0)));
+  }
+  return out;
+}
+
 const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, const std::vector<Ray>& rays,
                                              Cull cull) {
-  static std::map<std::tuple<std::string, int, size_t, int>, std::vector<OracleHit>> cache;
-  auto key = std::make_tuple(m.name, int(kind), rays.size(), int(cull));
+  static std::map<std::tuple<std::string, int, size_t, int, uint64_t>, std::vector<OracleHit>> cache;
+  auto key = std::make_tuple(m.name, int(kind), rays.size(), int(cull), t_min_print(rays));
   if (!cache.count(key)) {
     std::vector<OracleHit> answers(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) answers[i] = oracle_tree(m).closest(rays[i], cull);
@@ -143,8 +164,8 @@ const std::vector<OracleHit>& oracle_answers(const NamedMesh& m, RayKind kind, c
 
 const std::vector<std::vector<OracleHit>>& oracle_all_answers(const NamedMesh& m, RayKind kind,
                                                               const std::vector<Ray>& rays, Cull cull) {
-  static std::map<std::tuple<std::string, int, size_t, int>, std::vector<std::vector<OracleHit>>> cache;
-  auto key = std::make_tuple(m.name, int(kind), rays.size(), int(cull));
+  static std::map<std::tuple<std::string, int, size_t, int, uint64_t>, std::vector<std::vector<OracleHit>>> cache;
+  auto key = std::make_tuple(m.name, int(kind), rays.size(), int(cull), t_min_print(rays));
   if (!cache.count(key)) {
     std::vector<std::vector<OracleHit>> answers(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) answers[i] = oracle_tree(m).all(rays[i], cull);
@@ -213,6 +234,40 @@ QueryAnswers check_queries(const QueryTracer& trace, const NamedMesh& reference,
                                   tolerance);
   EXPECT_EQ(c.wrong + c.t_errors, 0u) << what << ", Query::All: " << c.first_problem;
   EXPECT_GT(c.rays, rays.size() / 20) << what << ", Query::All: too few hits to show anything";
+  return out;
+}
+
+TMinAnswers check_t_min_queries(const QueryTracer& trace, const NamedMesh& reference, RayKind kind,
+                                const std::vector<Ray>& rays, double tolerance, uint32_t max_hits,
+                                const std::string& what) {
+  TMinAnswers out;
+  const std::vector<OracleHit>& plain_oracle = oracle_answers(reference, kind, rays);
+  out.rays = with_t_min(rays, plain_oracle);
+  const std::vector<Ray>& offset_rays = out.rays;
+  const std::vector<OracleHit>& offset_oracle = oracle_answers(reference, kind, offset_rays);
+  out.closest = trace.hits(offset_rays, Query::Closest, Cull::None);
+  const Agreement d = compare(*reference.mesh, offset_rays, out.closest, offset_oracle, tolerance);
+  EXPECT_EQ(d.wrong + d.t_errors, 0u) << what << ", t_min: " << d.first_problem;
+  // Where the first hits lie past the origin (not so for rays cast from a
+  // plane they lie on), some must keep them and some skip them.
+  size_t kept_first = 0, skipped_first = 0, past_origin = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (plain_oracle[i].triangle == MC_NO_HIT || !(plain_oracle[i].t > 0)) continue;
+    ++past_origin;
+    if (offset_rays[i].tmin < plain_oracle[i].t) kept_first += out.closest[i].triangle == plain_oracle[i].triangle;
+    else skipped_first += out.closest[i].triangle != plain_oracle[i].triangle;
+  }
+  if (past_origin > rays.size() / 10) {
+    EXPECT_GT(kept_first, past_origin / 10) << what << ", t_min: too few rays keep their first hit";
+    EXPECT_GT(skipped_first, past_origin / 10) << what << ", t_min: too few rays skip their first hit";
+  }
+  const Agreement e = compare_any(*reference.mesh, offset_rays, trace.hits(offset_rays, Query::Any, Cull::None),
+                                  offset_oracle, tolerance);
+  EXPECT_EQ(e.wrong + e.t_errors, 0u) << what << ", Query::Any, t_min: " << e.first_problem;
+  const Cull all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
+  const Agreement f = compare_all(*reference.mesh, offset_rays, trace.rows(offset_rays, max_hits, all_cull),
+                                  oracle_all_answers(reference, kind, offset_rays, all_cull), tolerance);
+  EXPECT_EQ(f.wrong + f.t_errors, 0u) << what << ", Query::All, t_min: " << f.first_problem;
   return out;
 }
 

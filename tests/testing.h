@@ -71,6 +71,12 @@ std::vector<Hit> trace_all(const BlobView& view, const std::vector<Ray>& rays, Q
 // Query::All on every ray, rows of `max_hits`.
 HitLists trace_lists(const BlobView& view, const std::vector<Ray>& rays, uint32_t max_hits, Cull cull = Cull::None);
 
+// The rays again with a t_min each, from the oracle's closest hit t of each
+// (`closest`, on those rays): half of it (the same first hit), 1.25 and 2
+// times it (past the first hit: the next one along, or a miss), in turn;
+// a ray that misses gets half its t_max, or 1 where that is infinite.
+std::vector<Ray> with_t_min(const std::vector<Ray>& rays, const std::vector<OracleHit>& closest);
+
 // What check_queries traces: hits for a query and culling, or rows of
 // `max_hits` for Query::All (a CPU blob view, a Vulkan method).
 struct QueryTracer {
@@ -91,6 +97,17 @@ struct QueryAnswers {
 // A failure names `what`.
 QueryAnswers check_queries(const QueryTracer& trace, const NamedMesh& reference, RayKind kind,
                            const std::vector<Ray>& rays, double tolerance, uint32_t max_hits, const std::string& what);
+// The three queries on with_t_min(rays) against the oracle on the same
+// rays: the closest and any hit unculled, every hit in rows of `max_hits`
+// (front faces culled on long rays, as check_queries); some rays keep
+// their first hit and some skip it. Returns the rays and their closest hits.
+struct TMinAnswers {
+  std::vector<Ray> rays;
+  std::vector<Hit> closest;
+};
+TMinAnswers check_t_min_queries(const QueryTracer& trace, const NamedMesh& reference, RayKind kind,
+                                const std::vector<Ray>& rays, double tolerance, uint32_t max_hits,
+                                const std::string& what);
 
 // `planes` unit squares (two triangles each) stacked at z = 0, 1, ...,
 // and `count` rays straight down from above them, each through every plane

@@ -23,13 +23,15 @@ class WalkerVsOracle : public ::testing::TestWithParam<std::string> {};
 // long rays, the front faces on probe and radial rays, which start inside
 // closed meshes and see back faces there), and every hit, culled on long
 // rays. Each against the oracle over `reference` with the same culling.
-// The queries (testing's check_queries) on a tenth of the rays.
+// The queries (testing's check_queries) on a tenth of the rays, and again
+// with a t_min (check_t_min_queries).
 void check_queries(const BlobView& blob, const NamedMesh& reference, RayKind kind,
                    const std::vector<Ray>& rays, double tolerance, const std::string& what) {
   const std::vector<Ray> part(rays.begin(), rays.begin() + std::ptrdiff_t(rays.size() / 10));
   const QueryTracer cpu{[&](const std::vector<Ray>& r, Query q, Cull c) { return trace_all(blob, r, q, c); },
                         [&](const std::vector<Ray>& r, uint32_t max_hits, Cull c) { return trace_lists(blob, r, max_hits, c); }};
   testing::check_queries(cpu, reference, kind, part, tolerance, 256, what);
+  testing::check_t_min_queries(cpu, reference, kind, part, tolerance, 256, what);
 }
 
 // Every node's box, as the walker decodes it (half floats, 7-bit codes,
@@ -450,6 +452,127 @@ TEST(EveryHit, RowsAtTheLimitHoldTheHitsFoundAlone) {
         EXPECT_EQ(few.row(i)[k].t, every.row(i)[k].t) << name << ", ray " << i << ", record " << k;
       }
     }
+  }
+}
+}  // namespace
+}  // namespace meshcast::testing
+
+// t_min on every layout, with answers known without the oracle: rays
+// straight down through 12 stacked planes (a hit each at t = 13 - z) with
+// t_min half way between two planes find the plane just past it first,
+// and Query::All's rows hold the planes from there on alone; any hit lies
+// in [t_min, t_max]. The rows against the oracle's sets too.
+namespace meshcast::testing {
+namespace {
+TEST(TMin, HitsBeforeItAreSkippedOnEveryQuery) {
+  constexpr int kPlanes = 12;
+  const Mesh planes = stacked_planes(kPlanes);
+  std::vector<Ray> rays = rays_down_through(kPlanes, 240);
+  for (size_t i = 0; i < rays.size(); ++i) rays[i].tmin = float(i % (kPlanes + 1)) + 1.5f;  // 1.5 .. 13.5
+  for (const std::string& name : covering_layouts(layout_names())) {
+    const std::vector<uint8_t> blob = build_blob(planes, parse_layout(name), "planes");
+    const layout::BlobHeader& h = layout::header_of(blob.data());
+    const Mesh stored = moves_vertices(h.triangle_format) || !layout::has_remap(h) ? stored_mesh(blob) : planes;
+    const BlobView view(blob, name);
+    const std::vector<Hit> closest = trace_all(view, rays), any = trace_all(view, rays, Query::Any);
+    const HitLists rows = trace_lists(view, rays, kPlanes);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      // The planes at t = 2 .. 13; the first at or past t_min is at ceil(t_min).
+      const int first_t = int(std::ceil(rays[i].tmin));
+      const std::string what = name + ", ray " + std::to_string(i) + ", t_min " + std::to_string(rays[i].tmin);
+      if (first_t > kPlanes + 1) {
+        EXPECT_EQ(closest[i].triangle, MC_NO_HIT) << what;
+        EXPECT_EQ(any[i].triangle, MC_NO_HIT) << what;
+      } else {
+        EXPECT_NEAR(closest[i].t, first_t, 1e-5) << what;
+        if (closest[i].triangle != MC_NO_HIT) {  // on the plane z = 13 - t (as stored: quantized formats move it a little)
+          EXPECT_NEAR(stored.corner(closest[i].triangle, 0).z, float(kPlanes + 1 - first_t), 1e-4) << what;
+        }
+        EXPECT_NE(any[i].triangle, MC_NO_HIT) << what;
+        EXPECT_TRUE(any[i].t >= rays[i].tmin && any[i].t <= rays[i].tmax) << what << ": any hit at " << any[i].t;
+      }
+      EXPECT_EQ(rows.found[i], uint32_t(std::max(0, kPlanes + 2 - first_t))) << what;
+    }
+    expect_nearest_rows(stored, rays, rows, name + ", t_min");
+  }
+}
+
+// A secondary ray from a hit point (meshcast/ray.h's rule, t_min = 2^-16
+// m / |d . n|), on every layout, around a convex sphere at the origin and
+// 10^4 units out. Primary rays from outside hit the sphere; from each hit
+// point, the reflected ray leaves the convex surface and hits nothing in
+// exact arithmetic: with the rule's t_min every one misses, while with
+// t_min 0 the rounded hit point makes some meet their own triangle again
+// (what a shadow ray without t_min did). The ray going on through the
+// surface never names its own triangle and, at the origin, gets the
+// oracle's far-side hit.
+TEST(TMin, SecondaryRaysFromHitPointsMissTheirOwnTriangle) {
+  struct Place {
+    const char* name;
+    Vec3 centre;
+  };
+  for (const Place& place : {Place{"at the origin", {0.5f, -0.25f, 1.0f}}, Place{"10^4 out", {1e4f, -2e4f, 5e3f}}}) {
+    const Mesh sphere = make_sphere(24, 48, 2.0f, place.centre);
+    const double c[3] = {place.centre.x, place.centre.y, place.centre.z};
+    std::mt19937 rng(17);
+    std::normal_distribution<double> normal;
+    std::vector<Ray> primary(quick() ? 150 : 400);
+    for (Ray& r : primary) {
+      double u[3] = {normal(rng), normal(rng), normal(rng)};
+      const double len = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      for (int a = 0; a < 3; ++a) {
+        r.org[a] = float(c[a] + 10 * u[a] / len);
+        r.dir[a] = float(c[a] + 0.6 * normal(rng) - r.org[a]);  // at a point well inside the sphere
+      }
+      r.tmax = INFINITY;
+    }
+    size_t self_hits_without = 0;
+    for (const std::string& name : covering_layouts(layout_names())) {
+      const std::vector<uint8_t> blob = build_blob(sphere, parse_layout(name), "sphere");
+      const Mesh stored = stored_mesh(blob);  // what the walk meets, numbered as its hits
+      const BlobView view(blob, name);
+      std::vector<Hit> hits(primary.size());
+      view.trace(primary, hits, HitOutputs::Point);
+      std::vector<Ray> reflected, through;
+      std::vector<uint32_t> own;
+      for (size_t i = 0; i < primary.size(); ++i) {
+        if (hits[i].triangle == MC_NO_HIT) continue;
+        const Ray& r = primary[i];
+        const Vec3 a = stored.corner(hits[i].triangle, 0), b = stored.corner(hits[i].triangle, 1),
+                   d = stored.corner(hits[i].triangle, 2);
+        const double e1[3] = {double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z};
+        const double e2[3] = {double(d.x) - a.x, double(d.y) - a.y, double(d.z) - a.z};
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const double n_len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (double& x : n) x /= n_len;
+        const double dn = r.dir[0] * n[0] + r.dir[1] * n[1] + r.dir[2] * n[2];
+        const double d_len = std::sqrt(double(r.dir[0]) * r.dir[0] + double(r.dir[1]) * r.dir[1] + double(r.dir[2]) * r.dir[2]);
+        if (std::fabs(dn) < 1e-3 * d_len) continue;  // grazing: the reflection's sign along n is rounding's
+        double m = 0;
+        for (int k = 0; k < 3; ++k) m = std::max({m, std::fabs(double(hits[i].point[k])), std::fabs(double(r.org[k]))});
+        const float t_min = float(0x1p-16 * m / std::fabs(dn));  // |d' . n| = |d . n| for the reflection too
+        Ray out{{hits[i].point[0], hits[i].point[1], hits[i].point[2]}, {}, INFINITY, t_min};
+        for (int k = 0; k < 3; ++k) out.dir[k] = float(r.dir[k] - 2 * dn * n[k]);
+        reflected.push_back(out);
+        for (int k = 0; k < 3; ++k) out.dir[k] = r.dir[k];
+        through.push_back(out);
+        own.push_back(hits[i].triangle);
+      }
+      ASSERT_GT(reflected.size(), primary.size() / 2) << name << " " << place.name;
+      const std::vector<Hit> off = trace_all(view, reflected), go_on = trace_all(view, through);
+      std::vector<Ray> at_zero = reflected;
+      for (Ray& r : at_zero) r.tmin = 0;
+      const std::vector<Hit> from_zero = trace_all(view, at_zero);
+      for (size_t i = 0; i < reflected.size(); ++i) {
+        EXPECT_EQ(off[i].triangle, MC_NO_HIT) << name << " " << place.name << ", reflected ray " << i << " hit "
+                                              << off[i].triangle << " (its own: " << own[i] << ") at t " << off[i].t
+                                              << ", t_min " << reflected[i].tmin;
+        EXPECT_NE(go_on[i].triangle, own[i]) << name << " " << place.name << ", ray " << i << " going on";
+        self_hits_without += from_zero[i].triangle == own[i];
+      }
+      if (place.centre.x < 1) expect_oracle(stored, blob, through, go_on, name + " " + place.name + ", going on");
+    }
+    EXPECT_GT(self_hits_without, 0u) << place.name << ": with t_min 0 no ray met its own triangle; the test shows nothing";
   }
 }
 }  // namespace

@@ -1,8 +1,9 @@
 // meshcast trace MESH|BLOB --rays R.rays --out H.hits [--query closest|any|all]
-// [--max-hits N] [--cull none|back|front]: one thread, the whole batch cast
+// [--max-hits N] [--cull none|back|front] [--t-min T]: one thread, the whole batch cast
 // --repeat times, the median pass reported per ray. --query all writes HITC
 // (compact rows: the file's size follows the hits found).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iterator>
 
@@ -29,7 +30,16 @@ struct TraceArgs {
   bool json = false;
   std::string backend = "cpu", method = "bruteforce", device, query = "closest", cull = "none";
   uint32_t max_hits = 16;
+  float t_min = 0;
 };
+
+// --t-min on every ray read (the rays files hold no t_min of their own). A
+// ray whose t_max is below it is refused by the walk, as any ray with
+// t_min past t_max: a counted miss.
+template <class R>
+void apply_t_min(std::vector<R>& rays, float t_min) {
+  for (R& r : rays) r.tmin = t_min;
+}
 
 // trace on a scene file: RAYD or RAYS rays in, a HITI file out; on the
 // CPU (one thread) or the Vulkan scene method (gpu/scene.h), whose meshes
@@ -48,8 +58,9 @@ void trace_scene(TraceArgs a) {
   // Double origins (RAYD) or float ones (RAYS: Scene's float-ray trace on
   // the CPU; the GPU method reads RAYD records, so they are widened).
   const bool double_origins = is_scene_rays_file(a.rays);
-  const std::vector<Ray> rays_f = double_origins ? std::vector<Ray>{} : read_rays(a.rays);
+  std::vector<Ray> rays_f = double_origins ? std::vector<Ray>{} : read_rays(a.rays);
   std::vector<RayD> rays_d = double_origins ? read_scene_rays(a.rays) : std::vector<RayD>{};
+  apply_t_min(rays_f, a.t_min), apply_t_min(rays_d, a.t_min);
   if (vulkan && !double_origins)
     std::transform(rays_f.begin(), rays_f.end(), std::back_inserter(rays_d), widened);
   const size_t ray_count = double_origins ? rays_d.size() : rays_f.size();
@@ -82,7 +93,7 @@ void trace_scene(TraceArgs a) {
   if (a.json) {
     print_json({{"input", a.input}, {"meshes", file.mesh_names.size()}, {"instances", file.instances},
                 {"blob_bytes", file.blob_bytes}, {"load_ms", load_ms}, {"device", device}, {"query", a.query},
-                {"cull", a.cull}, {"rays", ray_count}, {"hits", hit_count}, {"invalid_rays", skipped},
+                {"cull", a.cull}, {"t_min", a.t_min}, {"rays", ray_count}, {"hits", hit_count}, {"invalid_rays", skipped},
                 {"repeat", a.repeat}, {"ns_per_ray", ns}});
     return;
   }
@@ -118,6 +129,9 @@ void add_trace(CLI::App& app) {
                   "none (two-sided), back or front: the face culled; the front face's corners run counter-clockwise "
                   "seen from the ray's origin")
       ->check(CLI::IsMember({"none", "back", "front"}));
+  cmd->add_option("--t-min", args->t_min,
+                  "the nearest t a hit may have, on every ray read (a hit needs t-min <= t <= t_max; default 0): "
+                  "secondary rays from a surface skip it. A ray whose t_max is below it is an invalid ray (a miss)");
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--method", args->method, "GPU method: bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
                                             "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
@@ -131,6 +145,11 @@ void add_trace(CLI::App& app) {
     // Given with a query that keeps one hit a ray, it would be ignored.
     if (max_hits->count() > 0 && query != Query::All)
       throw InputError("trace: --max-hits is for --query all (every hit); --query " + args->query + " keeps one hit a ray");
+    if (!(args->t_min >= 0) || std::isinf(args->t_min)) {
+      char shown[32];
+      std::snprintf(shown, sizeof shown, "%g", double(args->t_min));
+      throw InputError(std::string("trace: --t-min ") + shown + ": a finite number at least 0 (the nearest t a hit may have)");
+    }
     if (is_scene_file(args->input)) {
       trace_scene(*args);
       return;
@@ -141,6 +160,7 @@ void add_trace(CLI::App& app) {
     Loaded in = load_input(args->input, args->layout);
     if (vulkan_auto) args->method = gpu::method_reading(in.blob);
     std::vector<Ray> rays = read_rays(args->rays);
+    apply_t_min(rays, args->t_min);
     std::vector<Hit> hits(rays.size());
     HitLists lists;
     lists.max_hits = args->max_hits;
@@ -203,7 +223,7 @@ void add_trace(CLI::App& app) {
     double device_ns = rays.empty() || device_ms.empty() ? 0 : median(device_ms) * 1e6 / double(rays.size());
     if (args->json) {
       print_json({{"input", args->input}, {"layout", layout}, {"device", device}, {"query", args->query},
-                  {"cull", args->cull}, {"every_hit", every_hit}, {"load_ms", in.load_ms},
+                  {"cull", args->cull}, {"t_min", args->t_min}, {"every_hit", every_hit}, {"load_ms", in.load_ms},
                   {"build_ms", in.build_ms}, {"rays", rays.size()}, {"hits", hit_count}, {"invalid_rays", skipped},
                   {"repeat", args->repeat}, {"ns_per_ray", ns}, {"device_ns_per_ray", device_ns}});
     } else {
@@ -212,6 +232,7 @@ void add_trace(CLI::App& app) {
       std::printf("%zu rays, %zu hits, %llu invalid rays answered as misses\n", rays.size(), hit_count,
                   (unsigned long long)skipped);
       std::printf("query %s, cull %s", args->query.c_str(), args->cull.c_str());
+      if (args->t_min != 0) std::printf(", t_min %g", double(args->t_min));
       if (query == Query::All) std::printf(": %zu hits in all, rows of %u", every_hit, args->max_hits);
       std::printf("\n");
       std::printf("device: %s\n", device.c_str());

@@ -1,6 +1,6 @@
 // Rays and the hits they get: the records every walker, shader and file
-// (RAYS, HITS, HITN) shares. A ray is o + t d for t in [0, tmax]; d need not
-// be normalized and t is in units of d. Triangles are two-sided (unless a
+// (RAYS, HITS, HITN) shares. A ray is o + t d for t in [tmin, tmax]; d need
+// not be normalized and t is in units of d. Triangles are two-sided (unless a
 // query culls, see Cull) and the test is watertight: a ray through a shared
 // edge or vertex hits one of its triangles.
 #pragma once
@@ -17,12 +17,38 @@
 
 namespace meshcast {
 
+// A hit needs tmin <= t <= tmax, both ends included, compared on the
+// float t the hit reports, by every walker, query and Vulkan method alike.
+// tmin comes last so that every initialisation written before it existed,
+// Ray{{ox, oy, oz}, {dx, dy, dz}, tmax}, keeps its meaning (tmin 0), as
+// does a Ray declared and then filled field by field. 32 bytes: two
+// 16-byte loads (origin and dir x; dir y, z, tmax, tmin). A RAYS file's
+// record is the first 7 floats (tmin is read as 0).
+//
+// A secondary ray (a shadow or a reflection) from a hit: the hit point
+// p = org + t dir (HitOutputs::Point) is rounded, so it lies off the hit
+// triangle's plane by some h, and a ray from p along d meets that plane
+// again at t' = h / |dot(d, n)| (n the unit normal; t' in units of d), on
+// either side: with tmin 0 about half of such rays hit their own triangle.
+// h comes from roundings of numbers no larger than m, the largest
+// coordinate of p and of the primary origin: the primary t (a few ulps,
+// times |t dir| <= 2m), org + t dir (half an ulp of m an axis) and the
+// secondary test's corners taken relative to p (a few ulps of m); each is
+// k 2^-24 m for a small k. Hence
+//   tmin = 0x1p-16f * m / |dot(d, n)|
+// (d of any length), 256 ulps of m: a margin of tens over their sum (the
+// tests measure self-hits at most 2% of it, every layout, a mesh at the
+// origin and 10^4 units out). It is relative, as rounding is: 1.5e-5 for a
+// hit 1 unit from the origin, 0.15 for one 10^4 out. A d grazing the
+// surface (small |dot(d, n)|) gets a long tmin and may pass geometry that
+// close: no offset avoids both.
 struct Ray {
   float org[3];
   float dir[3];
   float tmax;
+  float tmin = 0;
 };
-static_assert(sizeof(Ray) == 28, "Ray is the 7 floats of a rays-file record");
+static_assert(sizeof(Ray) == 32, "Ray is two 16-byte words (a rays-file record is its first 7 floats)");
 
 // How every walker, shader and the oracle read a direction component: one
 // below FLT_MIN in magnitude (a denormal) as 0, its sign kept. Its
@@ -50,7 +76,7 @@ enum class HitOutputs : uint32_t { None = 0, Uv = 1, Point = 2 };
 constexpr HitOutputs operator|(HitOutputs a, HitOutputs b) { return HitOutputs(uint32_t(a) | uint32_t(b)); }
 constexpr bool has(HitOutputs set, HitOutputs flag) { return (uint32_t(set) & uint32_t(flag)) != 0; }
 
-// The question a trace answers: the closest hit along [0, tmax] (the
+// The question a trace answers: the closest hit along [tmin, tmax] (the
 // default), or any hit there ("is anything in the way?": line of sight,
 // shadow and audio probes), where the walk ends at the first triangle it
 // takes and the hit names that triangle and its t, not the nearest.
@@ -129,8 +155,10 @@ constexpr float kMaxDirection = 0x1p126f;
 // range of meshes), direction components within +-2^126 (so every
 // reciprocal the tests use is a normal float: a GPU may flush denormals to
 // 0) and not all below FLT_MIN (such a direction counts as zero), tmax not
-// NaN and not negative (infinity allowed). Any other ray is answered as a
-// miss and counted.
+// NaN and not negative (infinity allowed), tmin not NaN, not negative and
+// not above tmax (tmin = tmax is the one point; infinity for both is
+// walkable and hits nothing). Any other ray is answered as a miss and
+// counted.
 bool ray_is_walkable(const Ray& r);  // defined once in the library (cpu/trace.cpp)
 
 }  // namespace meshcast

@@ -38,17 +38,23 @@
 namespace meshcast {
 
 // A ray whose origin is in double precision: worlds kilometres across keep
-// their millimetres. The same record as a RAYD file's (40 bytes).
+// their millimetres. A hit needs tmin <= t <= tmax, as Ray's (tmin last for
+// the same reason). For a secondary ray, meshcast/ray.h's rule with m taken
+// in the hit instance's frame, where the walk rounds: the largest of the
+// hit point's coordinates less the instance's translation and of |t dir|
+// (the primary t is a float). 48 bytes (4 of padding after tmin); a RAYD
+// file keeps the first 40 (no tmin: read as 0).
 struct RayD {
   double org[3];
   float dir[3];
   float tmax;
+  float tmin = 0;
 };
-static_assert(sizeof(RayD) == 40, "RayD is the record of a RAYD file");
+static_assert(sizeof(RayD) == 48, "RayD: the 40 bytes of a RAYD file record, tmin and padding");
 
 // A float ray as a RayD: its origin taken as doubles.
 inline RayD widened(const Ray& r) {
-  return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax};
+  return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax, r.tmin};
 }
 
 // A hit in a scene: the instance and the triangle of its mesh (the index in

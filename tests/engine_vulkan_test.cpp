@@ -274,7 +274,7 @@ TEST(EngineVulkan, ValidationOrADeviceWithAnEnginesDeviceIsRefused) {
   std::string why = refusal(options);
   EXPECT_NE(why.find("CasterOptions::validation is set together with engine_vulkan"), std::string::npos) << why;
   options = on(engine);
-  options.device = "0";
+  options.device = std::string("0");  // not a literal: gcc 12 warns falsely (-Wrestrict) on that assignment
   why = refusal(options);
   EXPECT_NE(why.find("CasterOptions::device '0' is set together with engine_vulkan"), std::string::npos) << why;
   engine.work();

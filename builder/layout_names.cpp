@@ -66,8 +66,8 @@ BuildOptions parse_layout(const std::string& text) {
       if (l.tree == TreeFormat::StacklessLBVH) o.splitter = Splitter::Morton;
       return o;
     }
-  throw InputError("unknown layout '" + text + "'; did you mean " + closest_layouts(text) + "? (TREE/TRIANGLES, " +
-                   std::to_string(all_layouts().size()) + " layouts; docs/design.md lists the formats)");
+  throw InputError("unknown layout '" + text + "'; did you mean " + closest_layouts(text) + "? (TREE/TRIANGLES; `meshcast layouts` lists all " +
+                   std::to_string(all_layouts().size()) + ")");
 }
 
 namespace {

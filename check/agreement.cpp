@@ -166,8 +166,20 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
     if (h.triangle != o.triangle && rays[i].tmin > 0 &&
         (std::fabs(double(h.t) - rays[i].tmin) * len <= tolerance || std::fabs(o.t - rays[i].tmin) * len <= tolerance)) {
       // One of the two lies at t_min, where rounding decides whether it is
-      // on the segment: the other answer is then the next hit along.
-      ++a.ties;
+      // on the segment: the other answer is then the next hit along. The
+      // walker's triangle must still lie on the ray at its t, and where the
+      // oracle's hit is the one at t_min the walker's comes no nearer.
+      double p[3];
+      for (int k = 0; k < 3; ++k) p[k] = double(rays[i].org[k]) + double(h.t) * double(rays[i].dir[k]);
+      const double gap = point_triangle_distance(p, mesh.corner(h.triangle, 0), mesh.corner(h.triangle, 1),
+                                                 mesh.corner(h.triangle, 2));
+      const bool oracle_at_t_min = std::fabs(o.t - rays[i].tmin) * len <= tolerance;
+      if (gap <= tolerance && (!oracle_at_t_min || double(h.t) >= o.t - t_tolerance)) {
+        ++a.ties;
+      } else {
+        ++a.wrong;
+        note(i, "different triangle beside t_min");
+      }
       continue;
     }
     if (h.triangle != o.triangle) {

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "layout/message_text.h"
+
 namespace meshcast {
 
 namespace {
@@ -95,7 +97,7 @@ RayD ray_of(const RayDRecord& r) { return {{r.org[0], r.org[1], r.org[2]}, {r.di
 template <class Record, class R>
 Record record_of(const std::string& path, const R& r, size_t i) {
   if (r.tmin != 0)
-    throw UsageError(path + ": ray " + std::to_string(i) + " has t_min " + std::to_string(r.tmin) +
+    throw UsageError(path + ": ray " + std::to_string(i) + " has t_min " + number_text(r.tmin) +
                      ", which a rays file does not hold (its rays start at t_min 0)");
   return {{r.org[0], r.org[1], r.org[2]}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax};
 }

@@ -81,9 +81,26 @@ CPP
 printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n' > "$tmp/two.off"
 scratch "$tmp/reader" reader meshcast::reader "$tmp/read_off.cpp"
 if cmake -S "$tmp/reader" -B "$tmp/reader/off" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON \
-     > "$tmp/reader.log" 2>&1; then
-  echo "FAIL: the reader component configured without Assimp"; exit 1
+     > "$tmp/reader.log" 2>&1 || ! grep -q "needs Assimp" "$tmp/reader.log"; then
+  echo "FAIL: the reader component was not refused for want of Assimp"; cat "$tmp/reader.log"; exit 1
 fi
+# Asked for as optional, a reader without Assimp leaves the core found.
+mkdir -p "$tmp/optional"
+cp "$tmp/first.cpp" "$tmp/optional/"
+cat > "$tmp/optional/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.25)
+project(optional LANGUAGES CXX)
+find_package(meshcast REQUIRED OPTIONAL_COMPONENTS reader)
+if(meshcast_reader_FOUND)
+  message(FATAL_ERROR "the reader was found with Assimp disabled")
+endif()
+add_executable(first first.cpp)
+target_link_libraries(first PRIVATE meshcast::meshcast)
+CMAKE
+cmake --no-warn-unused-cli -S "$tmp/optional" -B "$tmp/optional/build" -DCMAKE_PREFIX_PATH="$prefix" \
+      -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON > "$tmp/optional.log" 2>&1 ||
+  { echo "FAIL: an optional reader without Assimp took the package down"; cat "$tmp/optional.log"; exit 1; }
+echo "  find_package OPTIONAL_COMPONENTS reader without Assimp: the core found, the reader not"
 cmake -S "$tmp/reader" -B "$tmp/reader/build" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
 cmake --build "$tmp/reader/build" -j"$jobs" >/dev/null
 echo "  find_package COMPONENTS reader: $("$tmp/reader/build/read_off" "$tmp/two.off")"

@@ -233,7 +233,8 @@ if ! cmp -s <(od -An -tu4 -w8 -j8 "$work/h.hits" | awk '{print $2}') \
 fi
 check splitter 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout aabbtreepns/float3soa8 --splitter morton --rays "$work/r.rays" --out "$work/h3.hits"
 check unknown-splitter 2 "valid splitters" -- "$meshcast" info "$mesh" --splitter octree
-check unknown-layout 2 "did you mean OctTreeCompressed/Float3" -- "$meshcast" info "$mesh" --layout OctTree/Float3
+check layouts 0 "OctTreeCompressed/ClusterBitPackSOA8" -- "$meshcast" layouts
+check unknown-layout 2 "did you mean OctTreeCompressed/Float3.*meshcast layouts. lists all" -- "$meshcast" info "$mesh" --layout OctTree/Float3
 check grouping 0 "ns/ray" -- "$meshcast" trace "$mesh" --layout AABBList/Indexed16SOA4 --grouping morton --rays "$work/r.rays" --out "$work/h5.hits"
 check trace-aabblist-vulkan 0 "device: " -- "$meshcast" trace "$mesh" --layout AABBList/BitPackSOA128 --backend vulkan --method aabblist --rays "$work/r.rays" --out "$work/h6.hits" --repeat 1
 check auto-speed 0 "chose OctTreeCompressed" -- "$meshcast" build "$mesh" --layout auto --out "$work/auto.blob"

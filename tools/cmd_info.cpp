@@ -82,4 +82,12 @@ void add_info(CLI::App& app) {
   });
 }
 
+// meshcast layouts: every TREE/TRIANGLES name --layout takes, a line each.
+void add_layouts(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand("layouts", "list every layout --layout takes (TREE/TRIANGLES), a line each");
+  cmd->callback([] {
+    for (const std::string& name : layout_names()) std::printf("%s\n", name.c_str());
+  });
+}
+
 }  // namespace meshcast::tools

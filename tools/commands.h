@@ -12,6 +12,7 @@ namespace meshcast::tools {
 void add_trace(CLI::App& app);
 void add_build(CLI::App& app);
 void add_info(CLI::App& app);
+void add_layouts(CLI::App& app);
 void add_rays(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_bench(CLI::App& app);

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   meshcast::tools::add_trace(app);
   meshcast::tools::add_build(app);
   meshcast::tools::add_info(app);
+  meshcast::tools::add_layouts(app);
   meshcast::tools::add_rays(app);
   meshcast::tools::add_demo(app);
   meshcast::tools::add_bench(app);

@@ -22,7 +22,10 @@ Progress::Progress(std::string what, bool shown) : what_(std::move(what)) {
   if (!shown || g_hidden || !isatty(STDERR_FILENO)) return;
   ticker_ = std::thread([this] {
     std::unique_lock<std::mutex> lock(mutex_);
-    while (!wake_.wait_for(lock, kTick, [this] { return done_; })) show();
+    // Said at once, then every tick: work that asked for a line gets one
+    // however fast the machine.
+    do show();
+    while (!wake_.wait_for(lock, kTick, [this] { return done_; }));
   });
 }
 

@@ -24,8 +24,10 @@
 // backend sends scene batches to the CPU (its crossover is the blob's).
 // The snapshot a batch holds holds the scene's meshes: a MappedBlob the
 // scene shares stays mapped until the batch is collected, even when the
-// scene is gone; bytes the scene only references (Scene::add_mesh of a
-// BlobView) must outlive the batch.
+// scene is gone, and with Backend::Vulkan until the caster's GPU has taken
+// another scene's meshes or the caster is destroyed (the device keeps the
+// meshes it last uploaded); bytes the scene only references
+// (Scene::add_mesh of a BlobView) must outlive the batch.
 //
 //   Caster scenes({});                          // no blob: scene batches alone
 //   Ticket f = scenes.submit(scene, world_rays, {Query::Closest, Cull::None, 0xFF});

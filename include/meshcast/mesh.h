@@ -110,11 +110,13 @@ struct MeshView {
  private:
   MeshView(std::span<const float> p, size_t stride, const void* i, size_t index_count, IndexType type)
       : positions(p.data()),
-        // A stride of 0 is left for copy_mesh to refuse (shorter than a position).
-        vertex_count(stride ? (p.size() + stride - 1) / stride : 0),
-        vertex_stride(stride * sizeof(float)),
+        // Every stride's start in the span. A stride of 0 is left for
+        // copy_mesh to refuse (shorter than a position); one past any
+        // buffer's size stays past it rather than wrapping.
+        vertex_count(stride ? p.size() / stride + (p.size() % stride != 0) : 0),
+        vertex_stride(stride > SIZE_MAX / sizeof(float) ? SIZE_MAX : stride * sizeof(float)),
         indices(i),
-        triangle_count((index_count + 2) / 3),
+        triangle_count(index_count / 3 + (index_count % 3 != 0)),
         index_type(type),
         positions_bytes(p.size() * sizeof(float)),
         indices_bytes(index_count * (type == IndexType::Uint16 ? 2 : 4)) {}

@@ -122,8 +122,9 @@ class Scene {
   // The bytes instances of `mesh` walk (the scene's copy, or the caller's
   // where it shares or references them). UsageError for an unknown mesh.
   std::span<const uint8_t> mesh_blob(MeshId mesh) const;
-  // The blobs' bytes the scene holds copies of (add_mesh of a vector);
-  // shared and referenced blobs are the caller's memory, not counted.
+  // The memory the scene holds for blob copies (add_mesh of a vector: each
+  // vector's capacity, spare bytes included); shared and referenced
+  // blobs are the caller's memory, not counted.
   size_t owned_blob_bytes() const;
 
   // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
@@ -151,7 +152,7 @@ class Scene {
   // mesh has it (turned by its flip_facing; a mirroring transform changes
   // nothing, see Transform); `outputs`: Uv at most (a scene hit has no point).
   // Returns the rays not walkable: a non-finite origin or one beyond 2^100,
-  // a direction or t_max BlobView would refuse (answered as misses), or a
+  // a direction, t_max or t_min BlobView would refuse (answered as misses), or a
   // ray some instance's frame cannot take (its direction scaled past the
   // walkers' range: that instance is not walked, the others are). UsageError
   // when hits is shorter than rays, for Query::All or HitOutputs::Point.

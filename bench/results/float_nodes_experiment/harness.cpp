@@ -9,7 +9,7 @@
 #include "check/generate.h"
 #include "builder/layout_names.h"
 #include "builder/ray_sets.h"
-#include "io/read_mesh.h"
+#include "meshcast/read.h"
 using namespace meshcast;
 int main(int argc, char** argv) {
   std::string in = argv[1];

@@ -1,0 +1,153 @@
+"""meshcast: ray casts against static triangle meshes, numpy in and out.
+
+Two ways in:
+
+* meshcast's own: ``build(vertices, triangles)`` (or ``load(path)``, memory-
+  mapped) gives a :class:`Blob`, the mesh's whole ray-cast structure in one
+  buffer of about 14 bytes a triangle; ``blob.cast(origins, directions)``
+  answers the closest hit, any hit or every hit of each ray, with face
+  culling, on every core or on the GPU (``backend="vulkan"``). A
+  :class:`Scene` places blobs as instances (3x3 rotation-scale, float64
+  translation) and casts float32 or float64 rays against them as one world.
+* Open3D's: :class:`RaycastingScene` takes the names, shapes, dtypes and
+  sentinels of ``open3d.t.geometry.RaycastingScene``.
+
+Rays: a hit needs ``t_min <= t <= t_max``, ``t`` in units of the direction
+(which need not be normalized). Triangles are two-sided unless a cast culls
+(the front face's corners run counter-clockwise seen from the ray's origin),
+and the triangle test is watertight: a ray through a shared edge or vertex
+hits exactly one of its triangles. A ray with a NaN or infinite component, a
+zero direction or ``t_min > t_max`` is refused with ``ValueError`` naming it.
+
+Arrays: float32 or float64 (other real types are converted once); C-
+contiguous arrays are read where they lie. Every cast releases the GIL and
+splits the batch over meshcast's own threads (``nthreads``: 0 for every
+core). Bad input raises ``ValueError``, files ``OSError``.
+"""
+
+import os as _os
+
+import numpy as _np
+
+from . import _meshcast
+from ._meshcast import (NO_HIT, Blob, Scene, __version__, features, layouts,  # noqa: F401
+                        walker_isa)
+
+__all__ = ["Blob", "Scene", "RaycastingScene", "build", "load", "read_mesh", "layouts", "features",
+           "walker_isa", "NO_HIT", "__version__"]
+
+
+def build(vertices, triangles, layout="auto", max_bytes=0, leaf_size=0, threads=0, name="mesh"):
+    """Builds a mesh's :class:`Blob`.
+
+    vertices: (V, 3) float32 or float64 (stored as float32: a mesh far from
+    the origin is best built about its own centre and placed with a Scene
+    instance's float64 translation, as RaycastingScene does by itself).
+    triangles: (T, 3) int32, uint32 or int64 vertex indices.
+    layout: "auto" (chosen for the mesh, fastest first, within max_bytes) or
+    a name of :func:`layouts`, e.g. "OctTreeCompressed/ClusterBitPackSOA8",
+    the recommended one. max_bytes: the blob's size at most (0: no limit).
+    leaf_size: a named layout's largest leaf (0: its own). threads: the
+    build's threads (0: every core); the bytes are the same on any number.
+    """
+    return _meshcast._build(vertices, triangles, layout, float(max_bytes), leaf_size, threads, name)
+
+
+def load(path):
+    """A blob file, memory-mapped read-only and validated (``Blob.mapped``)."""
+    path = _os.fspath(path)
+    with open(path, "rb"):  # the system's own error for a missing or unreadable file
+        pass
+    return _meshcast._load(path)
+
+
+def from_bytes(data, name="bytes"):
+    """A blob from its bytes (``Blob.to_bytes()``, a file read whole), validated."""
+    return _meshcast._from_bytes(bytes(data), name)
+
+
+def read_mesh(path):
+    """A mesh file (OFF, OBJ, PLY, STL) as (vertices float32 (V, 3),
+    triangles uint32 (T, 3)), the file's vertex and triangle order kept."""
+    if not features["reader"]:
+        raise RuntimeError("meshcast.read_mesh: this meshcast was built without its mesh reader (Assimp)")
+    path = _os.fspath(path)
+    with open(path, "rb"):
+        pass
+    return _meshcast._read_mesh(path)
+
+
+class Tensor(_np.ndarray):
+    """A numpy array that also answers ``.numpy()``, as Open3D's tensors do,
+    so code written for Open3D's RaycastingScene runs unchanged."""
+
+    def numpy(self):
+        return self.view(_np.ndarray)
+
+
+def _tensors(answer):
+    if isinstance(answer, dict):
+        return {key: value.view(Tensor) for key, value in answer.items()}
+    return answer.view(Tensor)
+
+
+def _array(value):
+    # Open3D's tensors (and anything else exposing .numpy()) as numpy arrays.
+    numpy = getattr(value, "numpy", None)
+    return numpy() if callable(numpy) and not isinstance(value, _np.ndarray) else value
+
+
+class RaycastingScene:
+    """Open3D's ``open3d.t.geometry.RaycastingScene``, on meshcast.
+
+    Port with a rename: the methods, argument names, result keys, dtypes and
+    sentinels are Open3D's (``t_hit`` inf and ``INVALID_ID`` on a miss). Rays
+    are (..., 6) arrays, [ox, oy, oz, dx, dy, dz], float32 or float64: float64
+    origins keep their precision, and each geometry is stored about its own
+    float64 centre, so scenes far from the origin answer as at the origin.
+    """
+
+    INVALID_ID = _meshcast.INVALID_ID
+
+    def __init__(self, nthreads=0):
+        self._scene = _meshcast._RaycastingScene(nthreads)
+        self._nthreads = nthreads
+
+    def _threads(self, nthreads):
+        return nthreads if nthreads else self._nthreads
+
+    def add_triangles(self, vertex_positions, triangle_indices=None):
+        """Adds a mesh: (V, 3) vertices and (T, 3) triangles, or an object
+        with ``.vertex.positions`` and ``.triangle.indices`` (Open3D's
+        ``t.geometry.TriangleMesh``). Returns its geometry id (0, 1, ...)."""
+        if triangle_indices is None:
+            mesh = vertex_positions
+            vertex_positions, triangle_indices = mesh.vertex.positions, mesh.triangle.indices
+        return self._scene.add_triangles(_array(vertex_positions), _array(triangle_indices))
+
+    def cast_rays(self, rays, nthreads=0):
+        """The closest hit of each ray: t_hit, geometry_ids, primitive_ids,
+        primitive_uvs (barycentrics of corners 1 and 2), primitive_normals
+        (the unit normal (b - a) x (c - a))."""
+        return _tensors(self._scene.cast_rays(_array(rays), self._threads(nthreads)))
+
+    def test_occlusions(self, rays, tnear=0.0, tfar=float("inf"), nthreads=0):
+        """Whether anything lies on each ray between tnear and tfar (bool)."""
+        return _tensors(self._scene.test_occlusions(_array(rays), tnear, tfar, self._threads(nthreads)))
+
+    def count_intersections(self, rays, nthreads=0):
+        """How many triangles each ray crosses for t >= 0 (int32)."""
+        return _tensors(self._scene.count_intersections(_array(rays), self._threads(nthreads)))
+
+    def list_intersections(self, rays, nthreads=0):
+        """Every hit of every ray, Open3D 0.18's layout: ray i's hits are
+        [ray_splits[i], ray_splits[i + 1]) of ray_ids, geometry_ids,
+        primitive_ids, primitive_uvs and t_hit, nearest first (at most 4096
+        a ray are listed; count_intersections counts them all)."""
+        return _tensors(self._scene.list_intersections(_array(rays), self._threads(nthreads)))
+
+    @property
+    def nbytes(self):
+        """The memory the scene's structures hold: every geometry's blob, its
+        normals and the top level."""
+        return self._scene.nbytes

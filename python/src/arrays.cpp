@@ -1,0 +1,297 @@
+#include "python/src/arrays.h"
+
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace meshcast::python {
+
+namespace {
+
+std::string shape_text(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) s += (d ? ", " : "") + std::to_string(a.shape(d));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+bool is_double(const py::array& a) { return a.dtype().itemsize() == 8; }
+
+double read_real(const uint8_t* p, bool is_double_value) {
+  if (is_double_value) {
+    double d;
+    std::memcpy(&d, p, 8);
+    return d;
+  }
+  float f;
+  std::memcpy(&f, p, 4);
+  return f;
+}
+
+std::string triple(const double v[3]) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "(" << v[0] << ", " << v[1] << ", " << v[2] << ")";
+  return s.str();
+}
+
+}  // namespace
+
+py::array real_array(const py::handle& input, const char* what) {
+  py::module_ np = py::module_::import("numpy");
+  py::array a = np.attr("asarray")(input);
+  const char kind = a.dtype().kind();
+  if (kind == 'f' && (a.dtype().itemsize() == 4 || a.dtype().itemsize() == 8)) {
+    if (!(a.flags() & py::array::c_style)) a = np.attr("ascontiguousarray")(a);
+    return a;
+  }
+  if (kind == 'f' || kind == 'i' || kind == 'u') {
+    // float16 and integers: float32 is exact for float16 and what the
+    // library computes in; float128 keeps what float64 can.
+    const char* to = (kind == 'f' && a.dtype().itemsize() > 8) ? "float64" : "float32";
+    return np.attr("ascontiguousarray")(a, py::arg("dtype") = to);
+  }
+  throw py::value_error(std::string(what) + ": dtype " + py::str(a.dtype()).cast<std::string>() +
+                        " is not a real number type (float32 or float64 expected)");
+}
+
+Ray RayArrays::ray(size_t i) const {
+  Ray r;
+  const uint8_t* o = org + i * org_stride;
+  const uint8_t* d = dir + i * dir_stride;
+  const size_t os = org_double ? 8 : 4, ds = dir_double ? 8 : 4;
+  for (int k = 0; k < 3; ++k) {
+    r.org[k] = float(read_real(o + k * os, org_double));
+    r.dir[k] = float(read_real(d + k * ds, dir_double));
+  }
+  r.tmax = tmax(i);
+  r.tmin = tmin(i);
+  return r;
+}
+
+RayD RayArrays::ray_d(size_t i) const {
+  RayD r;
+  const uint8_t* o = org + i * org_stride;
+  const uint8_t* d = dir + i * dir_stride;
+  const size_t os = org_double ? 8 : 4, ds = dir_double ? 8 : 4;
+  for (int k = 0; k < 3; ++k) {
+    r.org[k] = read_real(o + k * os, org_double);
+    r.dir[k] = float(read_real(d + k * ds, dir_double));
+  }
+  r.tmax = tmax(i);
+  r.tmin = tmin(i);
+  return r;
+}
+
+RayArrays rays_from_six(const py::handle& input) {
+  RayArrays r;
+  py::array a = real_array(input, "rays");
+  if (a.ndim() < 1 || a.shape(a.ndim() - 1) != 6)
+    throw py::value_error("rays: shape " + shape_text(a) + " is not (..., 6): each ray is ox, oy, oz, dx, dy, dz");
+  r.shape.assign(a.shape(), a.shape() + a.ndim() - 1);
+  r.count = size_t(a.size() / 6);
+  r.origins = r.directions = a;
+  r.org = static_cast<const uint8_t*>(a.data());
+  r.dir = r.org + 3 * a.itemsize();
+  r.org_stride = r.dir_stride = 6 * a.itemsize();
+  r.org_double = r.dir_double = is_double(a);
+  return r;
+}
+
+RayArrays rays_from_pair(const py::handle& origins, const py::handle& directions) {
+  RayArrays r;
+  py::array o = real_array(origins, "origins"), d = real_array(directions, "directions");
+  if (d.ndim() < 1 || d.shape(d.ndim() - 1) != 3)
+    throw py::value_error("directions: shape " + shape_text(d) + " is not (..., 3)");
+  if (o.ndim() < 1 || o.shape(o.ndim() - 1) != 3)
+    throw py::value_error("origins: shape " + shape_text(o) + " is not (..., 3)");
+  const bool shared_origin = o.ndim() == 1;
+  if (!shared_origin) {
+    bool same = o.ndim() == d.ndim();
+    for (py::ssize_t k = 0; same && k < o.ndim(); ++k) same = o.shape(k) == d.shape(k);
+    if (!same)
+      throw py::value_error("origins " + shape_text(o) + " and directions " + shape_text(d) +
+                            ": the same shape expected (or one origin, shape (3,), for every ray)");
+  }
+  r.shape.assign(d.shape(), d.shape() + d.ndim() - 1);
+  r.count = size_t(d.size() / 3);
+  r.origins = o;
+  r.directions = d;
+  r.org = static_cast<const uint8_t*>(o.data());
+  r.dir = static_cast<const uint8_t*>(d.data());
+  r.org_stride = shared_origin ? 0 : 3 * o.itemsize();
+  r.dir_stride = 3 * d.itemsize();
+  r.org_double = is_double(o);
+  r.dir_double = is_double(d);
+  return r;
+}
+
+namespace {
+
+// One end of the segment: a number, or an array of the rays' shape.
+void set_end(RayArrays& rays, const py::handle& value, const char* name, py::array& keep, float& scalar,
+             const float*& values) {
+  if (value.is_none()) return;
+  py::array a = real_array(value, name);
+  if (a.ndim() == 0) {
+    scalar = float(read_real(static_cast<const uint8_t*>(a.data()), is_double(a)));
+    return;
+  }
+  bool same = size_t(a.ndim()) == rays.shape.size();
+  for (size_t k = 0; same && k < rays.shape.size(); ++k) same = a.shape(py::ssize_t(k)) == rays.shape[k];
+  if (!same) {
+    std::string rays_shape = "(";
+    for (size_t k = 0; k < rays.shape.size(); ++k) rays_shape += (k ? ", " : "") + std::to_string(rays.shape[k]);
+    rays_shape += rays.shape.size() == 1 ? ",)" : ")";
+    throw py::value_error(std::string(name) + ": shape " + shape_text(a) + " is neither a number nor the rays' " +
+                          rays_shape);
+  }
+  keep = py::module_::import("numpy").attr("ascontiguousarray")(a, py::arg("dtype") = "float32");
+  values = static_cast<const float*>(keep.data());
+}
+
+}  // namespace
+
+void set_segment(RayArrays& rays, const py::handle& t_min, const py::handle& t_max) {
+  set_end(rays, t_min, "t_min", rays.t_min, rays.t_min_scalar, rays.t_min_values);
+  set_end(rays, t_max, "t_max", rays.t_max, rays.t_max_scalar, rays.t_max_values);
+}
+
+std::string refusal(const RayArrays& rays, size_t i) {
+  const RayD r = rays.ray_d(i);
+  double o[3], d[3];
+  for (int k = 0; k < 3; ++k) {
+    o[k] = r.org[k];
+    d[k] = read_real(rays.dir + i * rays.dir_stride + k * (rays.dir_double ? 8 : 4), rays.dir_double);
+  }
+  std::string at = "rays[" + std::to_string(i) + "]: ";
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(o[k])) return at + "origin " + triple(o) + " is not finite";
+  for (int k = 0; k < 3; ++k)
+    if (std::fabs(o[k]) > kMaxCoordinate) return at + "origin " + triple(o) + " lies beyond 2^100 on an axis";
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(d[k]) || !std::isfinite(r.dir[k]))
+      return at + "direction " + triple(d) + " is not finite (in float)";
+  for (int k = 0; k < 3; ++k)
+    if (std::fabs(r.dir[k]) > kMaxDirection) return at + "direction " + triple(d) + " has a component beyond 2^126";
+  if (std::fabs(r.dir[0]) < FLT_MIN && std::fabs(r.dir[1]) < FLT_MIN && std::fabs(r.dir[2]) < FLT_MIN)
+    return at + "direction " + triple(d) + " is zero (every component below FLT_MIN)";
+  if (std::isnan(r.tmax) || r.tmax < 0) return at + "t_max " + std::to_string(r.tmax) + " is NaN or negative";
+  if (std::isnan(r.tmin) || r.tmin < 0) return at + "t_min " + std::to_string(r.tmin) + " is NaN or negative";
+  if (r.tmin > r.tmax)
+    return at + "t_min " + std::to_string(r.tmin) + " is above t_max " + std::to_string(r.tmax);
+  return "";
+}
+
+void raise_for_refused(const RayArrays& rays, uint64_t refused) {
+  if (refused == 0) return;
+  for (size_t i = 0; i < rays.count; ++i) {
+    std::string why = refusal(rays, i);
+    if (!why.empty())
+      throw py::value_error(why + " (" + std::to_string(refused) + " of " + std::to_string(rays.count) +
+                            " rays refused)");
+  }
+}
+
+void vertex_box(const py::handle& vertices, double lo[3], double hi[3]) {
+  py::array v = real_array(vertices, "vertices");
+  if (v.ndim() != 2 || v.shape(1) != 3) throw py::value_error("vertices: shape " + shape_text(v) + " is not (V, 3)");
+  const uint8_t* p = static_cast<const uint8_t*>(v.data());
+  const bool dbl = is_double(v);
+  const size_t size = dbl ? 8 : 4;
+  for (int k = 0; k < 3; ++k) lo[k] = INFINITY, hi[k] = -INFINITY;
+  for (py::ssize_t i = 0; i < v.shape(0); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double x = read_real(p + (size_t(i) * 3 + k) * size, dbl);
+      lo[k] = std::fmin(lo[k], x);  // fmin: a NaN is left for check_mesh to name
+      hi[k] = std::fmax(hi[k], x);
+    }
+}
+
+Mesh mesh_from_arrays(const py::handle& vertices, const py::handle& triangles, const double centre[3]) {
+  py::array v = real_array(vertices, "vertices");
+  if (v.ndim() != 2 || v.shape(1) != 3) throw py::value_error("vertices: shape " + shape_text(v) + " is not (V, 3)");
+  py::module_ np = py::module_::import("numpy");
+  py::array t = np.attr("asarray")(triangles);
+  const char kind = t.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::value_error("triangles: dtype " + py::str(t.dtype()).cast<std::string>() +
+                          " is not an integer type (int32, uint32 or int64 expected)");
+  if (t.ndim() != 2 || t.shape(1) != 3)
+    throw py::value_error("triangles: shape " + shape_text(t) + " is not (T, 3)");
+  const size_t vertex_count = size_t(v.shape(0));
+  // uint64 would wrap negatives; int64 holds every int32, uint32 and int64.
+  py::array_t<int64_t> indices = np.attr("ascontiguousarray")(
+      kind == 'u' && t.dtype().itemsize() == 8 ? np.attr("minimum")(t, uint64_t(INT64_MAX)) : t,
+      py::arg("dtype") = "int64");
+  Mesh mesh;
+  mesh.triangles.resize(size_t(t.shape(0)));
+  const int64_t* in = indices.data();
+  for (size_t i = 0; i < mesh.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const int64_t index = in[i * 3 + k];
+      if (index < 0 || uint64_t(index) >= vertex_count)
+        throw py::value_error("triangles[" + std::to_string(i) + ", " + std::to_string(k) + "] = " +
+                              std::to_string(index) + ": a vertex index must lie in [0, " +
+                              std::to_string(vertex_count) + ")");
+      mesh.triangles[i][k] = uint32_t(index);
+    }
+  const uint8_t* p = static_cast<const uint8_t*>(v.data());
+  const bool dbl = is_double(v);
+  const size_t size = dbl ? 8 : 4;
+  mesh.vertices.resize(vertex_count);
+  for (size_t i = 0; i < vertex_count; ++i)
+    for (int k = 0; k < 3; ++k) mesh.vertices[i][k] = float(read_real(p + (i * 3 + k) * size, dbl) - centre[k]);
+  return mesh;
+}
+
+template <class T>
+py::array_t<T> answer_array(const py::object& out, const char* key, const std::vector<py::ssize_t>& shape) {
+  if (!out.is_none()) {
+    py::dict given = out.cast<py::dict>();
+    if (given.contains(key)) {
+      py::object o = given[key];
+      const std::string name = std::string("out[\"") + key + "\"]";
+      if (!py::isinstance<py::array>(o)) throw py::value_error(name + " is not a numpy array");
+      py::array a = o.cast<py::array>();
+      if (!a.dtype().is(py::dtype::of<T>()))
+        throw py::value_error(name + ": dtype " + py::str(a.dtype()).cast<std::string>() + " where " +
+                              py::str(py::dtype::of<T>()).cast<std::string>() + " is written");
+      bool same = size_t(a.ndim()) == shape.size();
+      for (size_t k = 0; same && k < shape.size(); ++k) same = a.shape(py::ssize_t(k)) == shape[k];
+      if (!same) {
+        std::string want = "(";
+        for (size_t k = 0; k < shape.size(); ++k) want += (k ? ", " : "") + std::to_string(shape[k]);
+        want += shape.size() == 1 ? ",)" : ")";
+        throw py::value_error(name + ": shape " + shape_text(a) + " where the answer's is " + want);
+      }
+      if (!(a.flags() & py::array::c_style)) throw py::value_error(name + " is not C-contiguous");
+      if (!a.writeable()) throw py::value_error(name + " is read-only");
+      return py::reinterpret_borrow<py::array_t<T>>(o);
+    }
+  }
+  return py::array_t<T>(shape);
+}
+
+template py::array_t<float> answer_array<float>(const py::object&, const char*, const std::vector<py::ssize_t>&);
+template py::array_t<uint32_t> answer_array<uint32_t>(const py::object&, const char*,
+                                                      const std::vector<py::ssize_t>&);
+template py::array_t<int32_t> answer_array<int32_t>(const py::object&, const char*, const std::vector<py::ssize_t>&);
+template py::array_t<bool> answer_array<bool>(const py::object&, const char*, const std::vector<py::ssize_t>&);
+template py::array_t<int64_t> answer_array<int64_t>(const py::object&, const char*, const std::vector<py::ssize_t>&);
+
+Query parse_query(const std::string& name) {
+  if (name == "closest") return Query::Closest;
+  if (name == "any") return Query::Any;
+  if (name == "all") return Query::All;
+  throw py::value_error("query \"" + name + "\": closest, any or all");
+}
+
+Cull parse_cull(const std::string& name) {
+  if (name == "none") return Cull::None;
+  if (name == "back") return Cull::Back;
+  if (name == "front") return Cull::Front;
+  throw py::value_error("cull \"" + name + "\": none, back or front");
+}
+
+}  // namespace meshcast::python

@@ -1,0 +1,90 @@
+// numpy arrays in and out: the shapes and dtypes the package takes, read
+// where they lie when they are C-contiguous and of a dtype the walk reads
+// (float32 or float64), converted once otherwise; and the arrays it answers
+// into, new or the caller's `out=`.
+#pragma once
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "meshcast/mesh.h"
+#include "meshcast/ray.h"
+#include "meshcast/scene.h"
+
+namespace meshcast::python {
+
+namespace py = pybind11;
+
+// A real-valued array as float32 or float64, C-contiguous: float32 and
+// float64 arrays kept (copied once when not contiguous), integers and
+// float16 converted to float32. ValueError naming `what` for complex,
+// boolean, object and string arrays.
+py::array real_array(const py::handle& input, const char* what);
+
+// Rays as the caller gave them: origins and directions (...,3) each, or
+// one (...,6) array whose first three columns are the origin. The leading
+// shape is the rays' shape: the answers take it.
+struct RayArrays {
+  std::vector<py::ssize_t> shape;  // the leading shape
+  size_t count = 0;
+  py::array origins, directions;   // C-contiguous float32 or float64 (one array twice for (...,6))
+  const uint8_t* org = nullptr;    // the first ray's origin x and direction x
+  const uint8_t* dir = nullptr;
+  // Bytes from one ray's origin (direction) to the next's: 0 for one
+  // origin (3,) that every direction shares (a sensor's rays).
+  size_t org_stride = 0, dir_stride = 0;
+  bool org_double = false, dir_double = false;
+  // t_min and t_max: a scalar each, or an array of the rays' shape (float32).
+  py::array t_min, t_max;
+  float t_min_scalar = 0, t_max_scalar = INFINITY;
+  const float* t_min_values = nullptr;
+  const float* t_max_values = nullptr;
+
+  float tmin(size_t i) const { return t_min_values ? t_min_values[i] : t_min_scalar; }
+  float tmax(size_t i) const { return t_max_values ? t_max_values[i] : t_max_scalar; }
+  // Ray i, its origin rounded to float (a blob's own frame is float).
+  Ray ray(size_t i) const;
+  // Ray i with its origin as the caller gave it (float32 widened exactly).
+  RayD ray_d(size_t i) const;
+};
+
+// origins may also be one point (3,) that every ray starts from.
+RayArrays rays_from_pair(const py::handle& origins, const py::handle& directions);
+RayArrays rays_from_six(const py::handle& rays);
+// t_min and t_max: None for the default, a number, or an array of the
+// rays' shape (ValueError otherwise, naming the argument).
+void set_segment(RayArrays& rays, const py::handle& t_min, const py::handle& t_max);
+
+// Why a ray is refused (ValueError: "rays[12]: ..."), checked in the order
+// a reader would look, or "" for a ray the walkers take. What they refuse
+// is what ray_is_walkable refuses (meshcast/ray.h); the scene's rays check
+// their origins in double, whatever their type.
+std::string refusal(const RayArrays& rays, size_t i);
+// After a batch that counted `refused` rays not walkable: ValueError for
+// the first ray that has a refusal(); nothing when none has (a scene counts
+// a ray some instance's frame cannot take, which it answers through the
+// others).
+void raise_for_refused(const RayArrays& rays, uint64_t refused);
+
+// A mesh from (V,3) vertices and (T,3) triangles: indices int32, uint32 or
+// int64 (any integer dtype is read), each checked against the vertex count;
+// vertices float32 or float64. The vertices are taken less `centre` (in
+// double) and rounded to float.
+Mesh mesh_from_arrays(const py::handle& vertices, const py::handle& triangles, const double centre[3]);
+// The vertices' box in double (for a centre), ValueError for a wrong shape.
+void vertex_box(const py::handle& vertices, double lo[3], double hi[3]);
+
+// An answer array: the caller's out[key] when `out` has it (checked: a
+// writable C-contiguous array of that dtype and shape, ValueError naming
+// the key otherwise), else a new one.
+template <class T>
+py::array_t<T> answer_array(const py::object& out, const char* key, const std::vector<py::ssize_t>& shape);
+
+// "closest", "any", "all"; "none", "back", "front": ValueError otherwise.
+Query parse_query(const std::string& name);
+Cull parse_cull(const std::string& name);
+
+}  // namespace meshcast::python

@@ -1,0 +1,281 @@
+#include "python/src/blob_api.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "builder/auto_layout.h"
+#include "meshcast/build.h"
+#include "python/src/arrays.h"
+#include "python/src/cast.h"
+#if MESHCAST_READER
+#include "meshcast/read.h"
+#endif
+
+namespace meshcast::python {
+
+PyBlob::PyBlob(std::vector<uint8_t> bytes, std::string name) : owned_(std::move(bytes)), name_(std::move(name)) {
+  view_.emplace(owned_, name_);
+}
+
+PyBlob::PyBlob(std::shared_ptr<const MappedBlob> file, std::string name)
+    : mapped_(std::move(file)), name_(std::move(name)) {
+  view_.emplace(mapped_->bytes(), name_);
+}
+
+host::Caster& PyBlob::vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& lock) {
+  lock = std::unique_lock<std::mutex>(vulkan_mutex_);
+  std::unique_ptr<host::Caster>& caster = casters_[uint32_t(outputs)];
+  if (!caster) {
+    host::CasterOptions options;
+    options.backend = host::Backend::Vulkan;
+    options.frames = 1;  // one batch at a time, under the lock
+    options.hit_outputs = outputs;
+    caster = std::make_unique<host::Caster>(view_->bytes(), name_, options);
+  }
+  if (!caster->gpu_available()) throw GpuError("backend \"vulkan\": " + caster->gpu_error());
+  return *caster;
+}
+
+namespace {
+
+// The answers of a closest or any hit cast, in the rays' shape.
+struct HitArrays {
+  py::array_t<float> t;
+  py::array_t<uint32_t> triangle;
+  py::array_t<float> uv;
+  float* t_out = nullptr;
+  uint32_t* triangle_out = nullptr;
+  float* uv_out = nullptr;
+  void write(size_t i, const Hit& h) const {
+    t_out[i] = h.t;
+    triangle_out[i] = h.triangle;
+    if (uv_out) uv_out[2 * i] = h.u, uv_out[2 * i + 1] = h.v;
+  }
+};
+
+void check_out_keys(const py::object& out, std::initializer_list<const char*> keys) {
+  if (out.is_none()) return;
+  if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
+  for (auto item : out.cast<py::dict>()) {
+    const std::string key = py::str(item.first);
+    bool known = false;
+    for (const char* k : keys) known |= key == k;
+    if (!known) throw py::value_error("out[\"" + key + "\"]: the answer has no such array");
+  }
+}
+
+py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::handle& directions,
+                   const py::handle& t_min, const py::handle& t_max, const std::string& query_name,
+                   const std::string& cull_name, long long max_hits, bool uv, const py::object& out,
+                   const std::string& backend, uint32_t nthreads) {
+  const Query query = parse_query(query_name);
+  const Cull cull = parse_cull(cull_name);
+  if (backend != "cpu" && backend != "vulkan") throw py::value_error("backend \"" + backend + "\": cpu or vulkan");
+  const uint32_t kept = checked_max_hits(max_hits);
+  RayArrays rays = rays_from_pair(origins, directions);
+  set_segment(rays, t_min, t_max);
+  const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
+  const uint32_t threads = thread_count(nthreads);
+  const BlobTarget target{blob.view()};
+  py::dict answer;
+
+  if (query == Query::All) {
+    if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
+    AllHits<BlobTarget> all;
+    {
+      py::gil_scoped_release release;
+      if (backend == "vulkan") {
+        std::vector<Ray> packed(rays.count);
+        for (size_t i = 0; i < rays.count; ++i) packed[i] = rays.ray(i);
+        std::unique_lock<std::mutex> lock;
+        host::Caster& caster = const_cast<PyBlob&>(blob).vulkan(outputs, lock);
+        all.parts.resize(1);
+        all.parts[0].max_hits = kept;
+        const host::Ticket ticket = caster.submit(packed, {Query::All, cull, kept});
+        caster.wait(ticket, all.parts[0]);
+        for (const Ray& r : packed) all.refused += !ray_is_walkable(r);
+      } else {
+        all = cast_all(target, rays, cull, outputs, kept, threads);
+      }
+    }
+    raise_for_refused(rays, all.refused);
+    const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(all.hits());
+    py::array_t<uint32_t> found({n}), triangle({h});
+    py::array_t<int64_t> offsets({n + 1});
+    py::array_t<float> t({h});
+    py::array_t<float> uvs;
+    if (uv) uvs = py::array_t<float>({h, py::ssize_t(2)});
+    uint32_t* found_out = found.mutable_data();
+    int64_t* offsets_out = offsets.mutable_data();
+    float* t_out = t.mutable_data();
+    uint32_t* triangle_out = triangle.mutable_data();
+    float* uv_out = uv ? uvs.mutable_data() : nullptr;
+    {
+      py::gil_scoped_release release;
+      all.gather([&](size_t i, uint32_t f, size_t offset) { found_out[i] = f, offsets_out[i] = int64_t(offset); },
+                 [&](size_t j, const Hit& hit) {
+                   t_out[j] = hit.t;
+                   triangle_out[j] = hit.triangle;
+                   if (uv_out) uv_out[2 * j] = hit.u, uv_out[2 * j + 1] = hit.v;
+                 });
+      offsets_out[rays.count] = int64_t(all.hits());
+    }
+    answer["found"] = found;
+    answer["offsets"] = offsets;
+    answer["t"] = t;
+    answer["triangle"] = triangle;
+    if (uv) answer["uv"] = uvs;
+    return answer;
+  }
+
+  check_out_keys(out, {"t", "triangle", "uv"});
+  HitArrays a;
+  a.t = answer_array<float>(out, "t", rays.shape);
+  a.triangle = answer_array<uint32_t>(out, "triangle", rays.shape);
+  a.t_out = a.t.mutable_data();
+  a.triangle_out = a.triangle.mutable_data();
+  if (uv) {
+    std::vector<py::ssize_t> shape = rays.shape;
+    shape.push_back(2);
+    a.uv = answer_array<float>(out, "uv", shape);
+    a.uv_out = a.uv.mutable_data();
+  }
+  uint64_t refused = 0;
+  {
+    py::gil_scoped_release release;
+    if (backend == "vulkan") {
+      std::vector<Ray> packed(rays.count);
+      for (size_t i = 0; i < rays.count; ++i) packed[i] = rays.ray(i);
+      std::vector<Hit> hits(rays.count);
+      std::unique_lock<std::mutex> lock;
+      host::Caster& caster = const_cast<PyBlob&>(blob).vulkan(outputs, lock);
+      const host::Ticket ticket = caster.submit(packed, {query, cull, kept});
+      caster.wait(ticket, hits);
+      for (size_t i = 0; i < rays.count; ++i) {
+        a.write(i, hits[i]);
+        refused += !ray_is_walkable(packed[i]);
+      }
+    } else {
+      refused = cast_hits(target, rays, query, cull, outputs, threads,
+                          [&a](size_t i, const Hit& h) { a.write(i, h); });
+    }
+  }
+  raise_for_refused(rays, refused);
+  answer["t"] = a.t;
+  answer["triangle"] = a.triangle;
+  if (uv) answer["uv"] = a.uv;
+  return answer;
+}
+
+std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,
+                              double max_bytes, uint32_t leaf_size, uint32_t threads, const std::string& name) {
+  const double no_centre[3] = {0, 0, 0};
+  const Mesh mesh = mesh_from_arrays(vertices, triangles, no_centre);
+  if (!(max_bytes >= 0)) throw py::value_error("max_bytes: " + std::to_string(max_bytes) + " is negative");
+  std::vector<uint8_t> bytes;
+  {
+    py::gil_scoped_release release;
+    if (layout == "auto") {
+      AutoLimits limits;
+      limits.max_bytes_per_triangle = max_bytes / double(std::max<size_t>(1, mesh.triangle_count()));
+      limits.build_threads = threads;
+      if (leaf_size) throw InputError(name + ": leaf_size is the automatic layout's to choose (name a layout to set it)");
+      bytes = choose_layout(mesh, limits, name).blob;
+    } else {
+      BuildOptions options;
+      options.layout = parse_layout_name(layout);
+      options.leaf_size = leaf_size;
+      options.threads = threads;
+      bytes = build_blob(mesh, options, name);
+      if (max_bytes > 0 && double(bytes.size()) > max_bytes)
+        throw InputError(name + ": the " + layout + " blob is " + std::to_string(bytes.size()) +
+                         " bytes, above max_bytes " + std::to_string(uint64_t(max_bytes)) +
+                         " (layout=\"auto\" chooses a layout within it)");
+    }
+  }
+  return std::make_shared<PyBlob>(std::move(bytes), name);
+}
+
+}  // namespace
+
+uint32_t checked_max_hits(long long max_hits) {
+  if (max_hits < 1 || max_hits > kMaxHitsLimit)
+    throw py::value_error("max_hits " + std::to_string(max_hits) + ": from 1 to " + std::to_string(kMaxHitsLimit));
+  return uint32_t(max_hits);
+}
+
+void register_blob(py::module_& m) {
+  py::class_<PyBlob, std::shared_ptr<PyBlob>>(m, "Blob", R"(A mesh's ray-cast structure: one byte buffer, validated once.
+
+Made by meshcast.build() or meshcast.load() (memory-mapped). Any number of
+Python threads may cast through one Blob at once.)")
+      .def_property_readonly("layout", [](const PyBlob& b) { return layout_name(b.view().layout()); },
+                             "The layout: tree format / triangle format.")
+      .def_property_readonly("triangle_count", [](const PyBlob& b) { return b.view().triangle_count(); })
+      .def_property_readonly("nbytes", [](const PyBlob& b) { return b.view().bytes().size(); },
+                             "The blob's bytes: all the memory the structure takes (the mesh included).")
+      .def_property_readonly("mapped", &PyBlob::mapped, "Whether the bytes are a file's, mapped read-only.")
+      .def_property_readonly("name", &PyBlob::name)
+      .def(
+          "save", [](const PyBlob& b, const std::string& path) { save_blob(path, b.view().bytes()); },
+          py::arg("path"), "Writes the blob to a file (replaced whole, or left as it was).")
+      .def(
+          "to_bytes",
+          [](const PyBlob& b) {
+            const auto bytes = b.view().bytes();
+            return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+          },
+          "The blob's bytes, copied.")
+      .def("cast", &cast_blob, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
+           py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",
+           py::arg("max_hits") = 16, py::arg("uv") = false, py::arg("out") = py::none(), py::arg("backend") = "cpu",
+           py::arg("nthreads") = 0, "See the package's documentation (help(meshcast)).")
+      .def("__repr__", [](const PyBlob& b) {
+        return "<meshcast.Blob " + b.name() + ": " + layout_name(b.view().layout()) + ", " +
+               std::to_string(b.view().triangle_count()) + " triangles, " + std::to_string(b.view().bytes().size()) +
+               " bytes" + (b.mapped() ? ", mapped" : "") + ">";
+      });
+
+  m.def("_build", &build, py::arg("vertices"), py::arg("triangles"), py::arg("layout") = "auto",
+        py::arg("max_bytes") = 0.0, py::arg("leaf_size") = 0, py::arg("threads") = 0, py::arg("name") = "mesh");
+  m.def(
+      "_load",
+      [](const std::string& path) {
+        auto file = std::make_shared<const MappedBlob>(path);
+        return std::make_shared<PyBlob>(file, path);
+      },
+      py::arg("path"));
+  m.def(
+      "_from_bytes",
+      [](const py::bytes& data, const std::string& name) {
+        const std::string_view s = data;
+        return std::make_shared<PyBlob>(std::vector<uint8_t>(s.begin(), s.end()), name);
+      },
+      py::arg("data"), py::arg("name") = "bytes");
+  m.def("layouts", [] {
+    std::vector<std::string> names;
+    for (const Layout& l : all_layouts()) names.push_back(layout_name(l));
+    return names;
+  }, "Every layout meshcast.build takes by name.");
+#if MESHCAST_READER
+  m.def(
+      "_read_mesh",
+      [](const std::string& path) {
+        Mesh mesh;
+        {
+          py::gil_scoped_release release;
+          mesh = read_mesh(path);
+        }
+        py::array_t<float> v({py::ssize_t(mesh.vertices.size()), py::ssize_t(3)});
+        py::array_t<uint32_t> t({py::ssize_t(mesh.triangles.size()), py::ssize_t(3)});
+        std::memcpy(v.mutable_data(), mesh.vertices.data(), mesh.vertices.size() * sizeof(Vec3));
+        std::memcpy(t.mutable_data(), mesh.triangles.data(), mesh.triangles.size() * sizeof(Triangle));
+        return py::make_tuple(v, t);
+      },
+      py::arg("path"));
+#endif
+}
+
+}  // namespace meshcast::python

@@ -1,0 +1,45 @@
+// meshcast.Blob: a built or loaded blob, validated once, cast against on
+// the library's threads or, with backend="vulkan", by the host layer's
+// Vulkan caster; and meshcast.build, meshcast.load, meshcast.read_mesh.
+#pragma once
+#include <pybind11/pybind11.h>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "meshcast/blob.h"
+#include "meshcast/caster.h"
+
+namespace meshcast::python {
+
+namespace py = pybind11;
+
+class PyBlob {
+ public:
+  PyBlob(std::vector<uint8_t> bytes, std::string name);            // built here
+  PyBlob(std::shared_ptr<const MappedBlob> file, std::string name);  // mapped from a file
+  const BlobView& view() const { return *view_; }
+  const std::string& name() const { return name_; }
+  bool mapped() const { return mapped_ != nullptr; }
+  const std::shared_ptr<const MappedBlob>& mapped_file() const { return mapped_; }
+  // The Vulkan caster for answers carrying `outputs`, made on first use;
+  // RuntimeError when it has no GPU (its reason). Batches through it are
+  // one at a time (the lock held from submit to wait).
+  host::Caster& vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& lock);
+
+ private:
+  std::vector<uint8_t> owned_;
+  std::shared_ptr<const MappedBlob> mapped_;
+  std::string name_;
+  std::optional<BlobView> view_;
+  std::mutex vulkan_mutex_;
+  std::map<uint32_t, std::unique_ptr<host::Caster>> casters_;
+};
+
+void register_blob(py::module_& m);
+
+}  // namespace meshcast::python

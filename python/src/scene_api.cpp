@@ -1,0 +1,199 @@
+// meshcast.Scene: instances of blobs, placed with a 3x3 rotation-scale and a
+// float64 translation, edited and committed, cast against with float32 or
+// float64 rays (the origins kept in double: meshcast/scene.h).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <vector>
+
+#include "meshcast/scene.h"
+#include "python/src/arrays.h"
+#include "python/src/blob_api.h"
+#include "python/src/cast.h"
+
+namespace meshcast::python {
+
+namespace {
+
+class PyScene {
+ public:
+  MeshId add_mesh(const std::shared_ptr<PyBlob>& blob) {
+    // A mapped file is shared with the scene; bytes built here are
+    // referenced, and the Blob kept alive beside the scene.
+    const MeshId id = blob->mapped() ? scene.add_mesh(blob->mapped_file(), blob->name())
+                                     : scene.add_mesh(blob->view(), blob->name());
+    blobs.push_back(blob);
+    return id;
+  }
+  Scene scene;
+  std::vector<std::shared_ptr<PyBlob>> blobs;
+};
+
+Transform transform_from(const py::handle& rotation_scale, const py::handle& translation) {
+  Transform t;
+  if (!rotation_scale.is_none()) {
+    py::array m = real_array(rotation_scale, "rotation_scale");
+    if (m.ndim() != 2 || m.shape(0) != 3 || m.shape(1) != 3)
+      throw py::value_error("rotation_scale: a (3, 3) matrix expected");
+    py::array_t<float> f = py::module_::import("numpy").attr("ascontiguousarray")(m, py::arg("dtype") = "float32");
+    for (int k = 0; k < 9; ++k) t.rotation_scale[k] = f.data()[k];
+  }
+  if (!translation.is_none()) {
+    py::array v = real_array(translation, "translation");
+    if (v.ndim() != 1 || v.shape(0) != 3) throw py::value_error("translation: a (3,) vector expected");
+    py::array_t<double> d = py::module_::import("numpy").attr("ascontiguousarray")(v, py::arg("dtype") = "float64");
+    for (int k = 0; k < 3; ++k) t.translation[k] = d.data()[k];
+  }
+  return t;
+}
+
+uint8_t checked_mask(long long mask) {
+  if (mask < 0 || mask > 255) throw py::value_error("mask " + std::to_string(mask) + ": from 0 to 255 (8 bits)");
+  return uint8_t(mask);
+}
+
+py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& directions, const py::handle& t_min,
+                    const py::handle& t_max, const std::string& query_name, const std::string& cull_name,
+                    long long mask, long long max_hits, bool uv, const py::object& out, uint32_t nthreads) {
+  const Query query = parse_query(query_name);
+  const Cull cull = parse_cull(cull_name);
+  const uint32_t kept = checked_max_hits(max_hits);
+  RayArrays rays = rays_from_pair(origins, directions);
+  set_segment(rays, t_min, t_max);
+  const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
+  const uint32_t threads = thread_count(nthreads);
+  const SceneTarget target{s.scene, checked_mask(mask)};
+  py::dict answer;
+
+  if (query == Query::All) {
+    if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
+    AllHits<SceneTarget> all;
+    {
+      py::gil_scoped_release release;
+      all = cast_all(target, rays, cull, outputs, kept, threads);
+    }
+    raise_for_refused(rays, all.refused);
+    const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(all.hits());
+    py::array_t<uint32_t> found({n}), instance({h}), triangle({h});
+    py::array_t<int64_t> offsets({n + 1});
+    py::array_t<float> t({h});
+    py::array_t<float> uvs;
+    if (uv) uvs = py::array_t<float>({h, py::ssize_t(2)});
+    uint32_t* found_out = found.mutable_data();
+    int64_t* offsets_out = offsets.mutable_data();
+    float* t_out = t.mutable_data();
+    uint32_t* instance_out = instance.mutable_data();
+    uint32_t* triangle_out = triangle.mutable_data();
+    float* uv_out = uv ? uvs.mutable_data() : nullptr;
+    {
+      py::gil_scoped_release release;
+      all.gather([&](size_t i, uint32_t f, size_t offset) { found_out[i] = f, offsets_out[i] = int64_t(offset); },
+                 [&](size_t j, const SceneHit& hit) {
+                   t_out[j] = hit.t;
+                   instance_out[j] = hit.instance;
+                   triangle_out[j] = hit.triangle;
+                   if (uv_out) uv_out[2 * j] = hit.u, uv_out[2 * j + 1] = hit.v;
+                 });
+      offsets_out[rays.count] = int64_t(all.hits());
+    }
+    answer["found"] = found;
+    answer["offsets"] = offsets;
+    answer["t"] = t;
+    answer["instance"] = instance;
+    answer["triangle"] = triangle;
+    if (uv) answer["uv"] = uvs;
+    return answer;
+  }
+
+  if (!out.is_none()) {
+    if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
+    for (auto item : out.cast<py::dict>()) {
+      const std::string key = py::str(item.first);
+      if (key != "t" && key != "instance" && key != "triangle" && key != "uv")
+        throw py::value_error("out[\"" + key + "\"]: the answer has no such array");
+    }
+  }
+  py::array_t<float> t = answer_array<float>(out, "t", rays.shape);
+  py::array_t<uint32_t> instance = answer_array<uint32_t>(out, "instance", rays.shape);
+  py::array_t<uint32_t> triangle = answer_array<uint32_t>(out, "triangle", rays.shape);
+  py::array_t<float> uvs;
+  if (uv) {
+    std::vector<py::ssize_t> shape = rays.shape;
+    shape.push_back(2);
+    uvs = answer_array<float>(out, "uv", shape);
+  }
+  float* t_out = t.mutable_data();
+  uint32_t* instance_out = instance.mutable_data();
+  uint32_t* triangle_out = triangle.mutable_data();
+  float* uv_out = uv ? uvs.mutable_data() : nullptr;
+  uint64_t refused = 0;
+  {
+    py::gil_scoped_release release;
+    refused = cast_hits(target, rays, query, cull, outputs, threads, [&](size_t i, const SceneHit& h) {
+      t_out[i] = h.t;
+      instance_out[i] = h.instance;
+      triangle_out[i] = h.triangle;
+      if (uv_out) uv_out[2 * i] = h.u, uv_out[2 * i + 1] = h.v;
+    });
+  }
+  raise_for_refused(rays, refused);
+  answer["t"] = t;
+  answer["instance"] = instance;
+  answer["triangle"] = triangle;
+  if (uv) answer["uv"] = uvs;
+  return answer;
+}
+
+}  // namespace
+
+void register_scene(py::module_& m) {
+  py::class_<PyScene>(m, "Scene", R"(Instances of blobs, cast against as one world.
+
+world = rotation_scale @ local + translation; the translation is float64, so
+worlds far larger than a float reaches keep their precision. Edits are seen
+by casts after commit(). One thread edits and commits; any number cast.)")
+      .def(py::init<>())
+      .def("add_mesh", &PyScene::add_mesh, py::arg("blob"), "Adds a Blob (kept alive by the scene); returns its mesh id.")
+      .def(
+          "add_instance",
+          [](PyScene& s, MeshId mesh, const py::handle& rotation_scale, const py::handle& translation, long long mask,
+             bool flip_facing) {
+            return s.scene.add_instance(mesh, transform_from(rotation_scale, translation), checked_mask(mask),
+                                        flip_facing);
+          },
+          py::arg("mesh"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none(),
+          py::arg("mask") = 0xFF, py::arg("flip_facing") = false,
+          "A placed copy of a mesh; returns its instance id (0, 1, ... in order).")
+      .def(
+          "set_transform",
+          [](PyScene& s, InstanceId i, const py::handle& rotation_scale, const py::handle& translation) {
+            s.scene.set_transform(i, transform_from(rotation_scale, translation));
+          },
+          py::arg("instance"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none())
+      .def(
+          "set_mask", [](PyScene& s, InstanceId i, long long mask) { s.scene.set_mask(i, checked_mask(mask)); },
+          py::arg("instance"), py::arg("mask"))
+      .def(
+          "set_flip_facing", [](PyScene& s, InstanceId i, bool flip) { s.scene.set_flip_facing(i, flip); },
+          py::arg("instance"), py::arg("flip_facing"))
+      .def(
+          "set_enabled", [](PyScene& s, InstanceId i, bool enabled) { s.scene.set_enabled(i, enabled); },
+          py::arg("instance"), py::arg("enabled"))
+      .def(
+          "remove_instance", [](PyScene& s, InstanceId i) { s.scene.remove_instance(i); }, py::arg("instance"))
+      .def(
+          "commit",
+          [](PyScene& s) {
+            py::gil_scoped_release release;
+            s.scene.commit();
+          },
+          "The edits so far are done: casts from now on see them.")
+      .def_property_readonly("instance_count", [](const PyScene& s) { return s.scene.instance_count(); })
+      .def("cast", &cast_scene, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
+           py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",
+           py::arg("mask") = 0xFF, py::arg("max_hits") = 16, py::arg("uv") = false, py::arg("out") = py::none(),
+           py::arg("nthreads") = 0, "See the package's documentation (help(meshcast)).");
+}
+
+}  // namespace meshcast::python

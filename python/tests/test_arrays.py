@@ -180,3 +180,21 @@ def test_vertex_dtypes_same_blob(soup, tmp_path):
     b32 = meshcast.build(v, f, layout="AABBTree/Float3")
     b64 = meshcast.build(v.astype(np.float64), f, layout="AABBTree/Float3")
     assert_same(b32.cast(o, d), b64.cast(o, d))
+
+
+def test_inputs_copied_not_kept(soup):
+    """build and add_triangles read the arrays during the call: changing
+    them afterwards changes nothing."""
+    v, f, o, d, b = soup
+    ref = b.cast(o, d)
+    v2, f2 = v.copy(), f.copy()
+    b2 = meshcast.build(v2, f2)
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v2, f2)
+    ref_rc = rc.cast_rays(rays6(o, d))
+    v2[:] = 0
+    f2[:] = 0
+    assert_same(ref, b2.cast(o, d))
+    got = rc.cast_rays(rays6(o, d))
+    for k in ("t_hit", "primitive_ids"):
+        np.testing.assert_array_equal(np.asarray(got[k]), np.asarray(ref_rc[k]), err_msg=k)

@@ -28,7 +28,12 @@ def containing(point, vertices, triangles):
     """The closed triangles holding an exact point (Fractions throughout)."""
     p = [Fraction(float(x)) for x in point]
     out = set()
-    for k, tri in enumerate(triangles):
+    # Only triangles whose box holds the point can hold it (a float test,
+    # exact: comparisons of exact values).
+    corners = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    near = np.all((corners.min(axis=1) <= point) & (point <= corners.max(axis=1)), axis=1)
+    for k in np.nonzero(near)[0]:
+        tri = triangles[k]
         a, b, c = ([Fraction(float(x)) for x in vertices[i]] for i in tri)
         e1 = [b[i] - a[i] for i in range(3)]
         e2 = [c[i] - a[i] for i in range(3)]
@@ -44,7 +49,7 @@ def containing(point, vertices, triangles):
 
         s = [edge(a, b), edge(b, c), edge(c, a)]
         if all(x >= 0 for x in s) or all(x <= 0 for x in s):
-            out.add(k)
+            out.add(int(k))
     return out
 
 
@@ -211,3 +216,32 @@ def test_closed_cube_culling_through_edges(layout):
         r = b.cast(o, d, cull=cull)
         assert np.all(r["triangle"] != NO_HIT), f"cull={cull}: a ray leaked"
         np.testing.assert_allclose(r["t"], t, atol=tol, err_msg=f"cull={cull}")
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+@pytest.mark.parametrize("shape", ["cube", "octahedron"])
+def test_closed_mesh_two_hits_through_edges(shape, layout):
+    """From outside through edges and vertices of a closed convex mesh: query
+    "all" finds exactly 2 hits, in and out (one a crossing)."""
+    v, f = shapes.cube() if shape == "cube" else shapes.octahedron()
+    o, d, _ = closed_rays(CUBE_PAIRS if shape == "cube" else OCTAHEDRON_PAIRS)
+    found = meshcast.build(v, f, layout=layout).cast(o, d, query="all")["found"]
+    bad = np.nonzero(found != 2)[0]
+    if len(bad):
+        pytest.fail(f"{shape}: found {found.tolist()}, expected 2 on every ray; first: {describe(bad[0], o, d)}")
+
+
+@pytest.mark.parametrize("shape", ["cube", "octahedron"])
+def test_count_intersections_parity(shape):
+    """RaycastingScene.count_intersections is what inside/outside tests count:
+    through edges and vertices, 2 from outside and 1 from inside (from the
+    midpoint of each outside ray's chord)."""
+    v, f = shapes.cube() if shape == "cube" else shapes.octahedron()
+    o, d, _ = closed_rays(CUBE_PAIRS if shape == "cube" else OCTAHEDRON_PAIRS)
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    outside = np.asarray(rc.count_intersections(np.concatenate([o, d], axis=1)))
+    inside_o = (o.astype(np.float64) + 1.5 * d).astype(np.float32)  # halfway between t 1 and 2: exact
+    inside = np.asarray(rc.count_intersections(np.concatenate([inside_o, d], axis=1)))
+    if np.any(outside != 2) or np.any(inside != 1):
+        pytest.fail(f"{shape}: from outside {outside.tolist()} (expected 2), from inside {inside.tolist()} (expected 1)")

@@ -67,6 +67,9 @@ def test_nan_rays(grid, where):
     o2, d2 = o.copy(), d.copy()
     (o2 if where == "origins" else d2)[1, 2] = np.nan
     refused(where[:-1], b.cast, o2, d2)
+    o3, d3 = o.copy(), d.copy()
+    (o3 if where == "origins" else d3)[2, 0] = -np.inf  # the package's documentation: infinite too
+    refused(where[:-1], b.cast, o3, d3)
     for dtype in (np.float32, np.float64):
         refused(where[:-1] + "|ray|nan", b.cast, o2.astype(dtype), d2.astype(dtype), query="all")
     s = meshcast.Scene()

@@ -187,6 +187,9 @@ def test_raycasting_cast_rays():
     rc = raycasting_case()
     world, o, d = rc["world"], rc["o"], rc["d"]
     r = rc["scene"].cast_rays(rays6(o, d))
+    for key in ("t_hit", "geometry_ids", "primitive_ids", "primitive_uvs", "primitive_normals"):
+        plain = r[key].numpy()  # as Open3D's tensors answer
+        assert type(plain) is np.ndarray, f"{key}.numpy() is a {type(plain)}"
     t, geo, prim = as_array(r["t_hit"]), as_array(r["geometry_ids"]), as_array(r["primitive_ids"])
     uvs, nrm = as_array(r["primitive_uvs"]), as_array(r["primitive_normals"])
     assert t.dtype == np.float32 and geo.dtype == np.uint32 and prim.dtype == np.uint32

@@ -36,6 +36,7 @@ def footprint(cx, cy, hx, hy):
 def test_translation(cube_blob):
     s = meshcast.Scene()
     m = s.add_mesh(cube_blob)
+    assert m == 0 and s.add_mesh(cube_blob) == 1
     assert s.add_instance(m, translation=(10.0, -4.0, 1.0)) == 0
     assert s.add_instance(m, translation=(-6.0, 3.0, -2.0)) == 1
     assert s.instance_count == 2
@@ -202,3 +203,23 @@ def test_scene_uv_and_triangle(cube_blob):
         u, w = r["uv"][k].astype(np.float64)
         p = (1 - u - w) * a + u * b + w * c
         np.testing.assert_allclose(p, [x, y, 1.0], atol=1e-6)
+
+
+def test_scene_keeps_its_blobs(tmp_path):
+    """A scene keeps the blobs it was given: the Python objects dropped and a
+    loaded blob's file removed, it still casts."""
+    import gc
+    import os
+    v, f = shapes.cube()
+    path = tmp_path / "cube.mcb"
+    meshcast.build(v, f, layout=FLOAT3_LAYOUT).save(str(path))
+    s = meshcast.Scene()
+    s.add_instance(s.add_mesh(meshcast.load(str(path))), translation=(0.0, 0.0, 0.0))
+    s.add_instance(s.add_mesh(meshcast.build(v, f, layout=FLOAT3_LAYOUT)), translation=(0.0, 0.0, -4.0))
+    s.commit()
+    gc.collect()
+    os.remove(path)
+    o, d = down_rays(footprint(0, 0, 1, 1))
+    r = s.cast(o, d, query="all")
+    np.testing.assert_array_equal(r["found"], 4)
+    np.testing.assert_array_equal(r["t"].reshape(-1, 4), np.tile([4, 6, 8, 10], (9, 1)))

@@ -30,7 +30,7 @@ RAY_COUNT = {"sphere": 2000, "soup": 2000, "grid": 2000, "bunny": 160}
 
 
 def layout_delta(layout, vertices):
-    return 0.0 if layout == FLOAT3_LAYOUT else LOSSY_DELTA * oracle.mesh_diagonal(vertices)
+    return 0.0 if layout.endswith("/Float3") else LOSSY_DELTA * oracle.mesh_diagonal(vertices)
 
 
 @functools.lru_cache(maxsize=None)

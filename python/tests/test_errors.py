@@ -231,3 +231,48 @@ def test_scene_bad_ids(grid):
         s.add_instance(m, rotation_scale=np.zeros((3, 3)))  # not invertible
     with pytest.raises(ValueError):
         s.add_instance(m, rotation_scale=np.eye(2))
+
+
+def test_negative_counts(grid):
+    """Negative thread counts and leaf sizes are bad input (ValueError naming
+    them), not a type error."""
+    v, f, o, d, b = grid
+    s = meshcast.Scene()
+    s.add_instance(s.add_mesh(b))
+    s.commit()
+    calls = {
+        "Blob.cast(nthreads=-1)": (r"thread", lambda: b.cast(o, d, nthreads=-1)),
+        "Scene.cast(nthreads=-1)": (r"thread", lambda: s.cast(o, d, nthreads=-1)),
+        "build(threads=-1)": (r"thread", lambda: meshcast.build(v, f, threads=-1)),
+        "build(leaf_size=-1)": (r"leaf", lambda: meshcast.build(v, f, layout="AABBTree/Float3", leaf_size=-1)),
+        "RaycastingScene(nthreads=-1)": (r"thread", lambda: meshcast.RaycastingScene(nthreads=-1)),
+        "Blob.cast(query='all', max_hits=-1)": (r"max_hits", lambda: b.cast(o, d, query="all", max_hits=-1)),
+    }
+    wrong = []
+    for what, (pattern, call) in calls.items():
+        try:
+            call()
+            wrong.append(f"{what}: accepted")
+        except ValueError as e:
+            if not re.search(pattern, str(e), re.I):
+                wrong.append(f"{what}: ValueError {str(e)!r} does not name {pattern!r}")
+        except Exception as e:
+            wrong.append(f"{what}: {type(e).__name__} ({str(e).splitlines()[0]})")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_out_of_range_options(grid):
+    v, f, o, d, b = grid
+    refused(r"leaf", meshcast.build, v, f, layout="AABBTree/Float3", leaf_size=1000)
+    refused(r"max_bytes", meshcast.build, v, f, max_bytes=-5)
+    s = meshcast.Scene()
+    m = s.add_mesh(b)
+    refused(r"mask", s.add_instance, m, mask=256)
+    refused(r"translation", s.add_instance, m, translation=(np.nan, 0.0, 0.0))
+    refused(r"rotation", s.add_instance, m, rotation_scale=np.full((3, 3), np.inf))
+    s.add_instance(m)
+    s.commit()
+    refused(r"mask", s.cast, o, d, mask=256)
+    for edit in (lambda: s.remove_instance(5), lambda: s.set_enabled(5, True), lambda: s.set_flip_facing(5, True),
+                 lambda: s.set_transform(5, translation=(1.0, 2.0, 3.0))):
+        refused(r"instance", edit)

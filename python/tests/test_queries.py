@@ -51,6 +51,23 @@ def test_blob_all(name, layout, cull, max_hits):
               f"{name} {layout} all cull={cull} max_hits={max_hits}", c.origins, c.directions)
 
 
+@pytest.mark.parametrize("layout", [name for name in meshcast.layouts() if name.endswith("/Float3")])
+def test_every_tree_family(layout):
+    """Each tree family (the float32 corners kept exactly) on the soup: the
+    three queries, culling back faces."""
+    c = case("soup")
+    b = meshcast.build(c.vertices, c.triangles, layout=layout)
+    assert b.layout == layout
+    truth = c.truth(layout, "back")
+    kw = dict(t_min=c.t_min, t_max=c.t_max, cull="back")
+    r = b.cast(c.origins, c.directions, **kw)
+    check_closest(truth, r["t"], r["triangle"], f"soup {layout} closest", c.origins, c.directions)
+    r = b.cast(c.origins, c.directions, query="any", **kw)
+    check_any(truth, r["t"], r["triangle"], f"soup {layout} any", c.origins, c.directions)
+    r = b.cast(c.origins, c.directions, query="all", max_hits=3, **kw)
+    check_all(truth, r["found"], r["offsets"], r["t"], r["triangle"], 3, f"soup {layout} all", c.origins, c.directions)
+
+
 @pytest.mark.parametrize("layout", [DEFAULT_LAYOUT, FLOAT3_LAYOUT])
 def test_blob_scalar_t_range_and_leading_shape(layout):
     """Scalar t_min/t_max, and rays of leading shape (40, 50): answers of that shape."""

@@ -32,21 +32,36 @@ def problem():
     return v, f, o, d
 
 
+@pytest.mark.parametrize("cull", ["none", "back", "front"])
 @pytest.mark.parametrize("layout", [DEFAULT_LAYOUT, FLOAT3_LAYOUT])
-@pytest.mark.parametrize("query", ["closest", "any"])
-def test_vulkan_equals_cpu(problem, layout, query):
+@pytest.mark.parametrize("query", ["closest", "any", "all"])
+def test_vulkan_equals_cpu(problem, layout, query, cull):
     v, f, o, d = problem
     b = meshcast.build(v, f, layout=layout)
-    t_max = np.where(np.arange(len(o)) % 3 == 0, 2.0, np.inf).astype(np.float32)
-    cpu = b.cast(o, d, t_max=t_max, query=query)
-    gpu = vulkan_cast(b, o, d, t_max=t_max, query=query)
-    assert gpu["t"].dtype == np.float32 and gpu["triangle"].dtype == np.uint32
+    n = len(o)
+    t_max = np.where(np.arange(n) % 3 == 0, 2.0, np.inf).astype(np.float32)
+    t_min = np.where(np.arange(n) % 4 == 1, 0.25, 0.0).astype(np.float32)
+    kw = dict(t_min=t_min, t_max=t_max, query=query, cull=cull)
+    cpu = b.cast(o, d, **kw)
+    gpu = vulkan_cast(b, o, d, **kw)
+    assert set(gpu) == set(cpu)
+    for key in cpu:
+        assert gpu[key].dtype == cpu[key].dtype and gpu[key].shape == cpu[key].shape, key
     if query == "closest":
         np.testing.assert_array_equal(gpu["triangle"], cpu["triangle"])
         np.testing.assert_allclose(gpu["t"], cpu["t"], rtol=1e-6)
-    else:
-        # Any hit: hit or miss agree (which triangle is the walk's).
+    elif query == "any":
+        # Hit or miss agree; which triangle is the walk's (any one on the ray).
         np.testing.assert_array_equal(gpu["triangle"] == meshcast.NO_HIT, cpu["triangle"] == meshcast.NO_HIT)
+    else:
+        np.testing.assert_array_equal(gpu["found"], cpu["found"])
+        np.testing.assert_array_equal(gpu["offsets"], cpu["offsets"])
+        np.testing.assert_allclose(gpu["t"], cpu["t"], rtol=1e-6)
+        ray = np.repeat(np.arange(n), np.diff(cpu["offsets"]))
+        # The same triangles a ray (the order of equal t's is free).
+        key_cpu = np.lexsort((cpu["triangle"], ray))
+        key_gpu = np.lexsort((gpu["triangle"], ray))
+        np.testing.assert_array_equal(gpu["triangle"][key_gpu], cpu["triangle"][key_cpu])
 
 
 def test_vulkan_out_and_uv(problem):

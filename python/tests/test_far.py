@@ -96,3 +96,23 @@ def test_scene_instance_far_translation():
     lossy = far.cast(shifted(o).astype(np.float32), d)
     exact = far.cast(shifted(o), d)
     assert np.mean(lossy["triangle"] != exact["triangle"]) > 0.3
+
+
+def test_raycasting_scene_two_far_geometries():
+    """Two geometries far apart, each about its own centre: rays at each
+    answer as the geometry alone at the origin does."""
+    v, f, o, d = problem()
+    t2 = np.array([-2e7, 1e7, 3e7])  # multiples of 128 too
+    near = meshcast.RaycastingScene()
+    near.add_triangles(v.astype(np.float64), f)
+    far = meshcast.RaycastingScene()
+    assert far.add_triangles(shifted(v), f) == 0
+    assert far.add_triangles(v.astype(np.float64) + t2, f) == 1
+    ref = near.cast_rays(rays6(o, d, np.float64))
+    for shift, geometry in ((T, 0), (t2, 1)):
+        r = far.cast_rays(np.concatenate([o.astype(np.float64) + shift, d.astype(np.float64)], axis=1))
+        prim = as_array(r["primitive_ids"])
+        np.testing.assert_array_equal(prim, as_array(ref["primitive_ids"]))
+        hit = prim != NO_HIT
+        np.testing.assert_array_equal(as_array(r["geometry_ids"])[hit], geometry)
+        np.testing.assert_allclose(as_array(r["t_hit"])[hit], as_array(ref["t_hit"])[hit], rtol=1e-6, atol=0)

@@ -77,6 +77,10 @@ def test_blob_scalar_t_range_and_leading_shape(layout):
     assert r["t"].shape == (40, 50) and r["triangle"].shape == (40, 50)
     truth = c.truth(layout, t_min=0.1, t_max=2.5)
     check_closest(truth, r["t"], r["triangle"], f"sphere {layout} scalar t range", c.origins, c.directions)
+    # Per-ray t ranges of the rays' leading shape.
+    r2 = blob("sphere", layout).cast(o, d, t_min=c.t_min[:2000].reshape(40, 50), t_max=c.t_max[:2000].reshape(40, 50))
+    assert r2["t"].shape == (40, 50)
+    check_closest(c.truth(layout), r2["t"], r2["triangle"], f"sphere {layout} t range (40, 50)", c.origins, c.directions)
     a = blob("sphere", layout).cast(o, d, t_min=0.1, t_max=2.5, query="all")
     assert a["found"].shape == (2000,) and a["offsets"].shape == (2001,)
     check_all(truth, a["found"], a["offsets"], a["t"], a["triangle"], 16, f"sphere {layout} all, leading shape",

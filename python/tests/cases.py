@@ -26,7 +26,7 @@ LOSSY_DELTA = 4e-6
 MIN_CLEAN = 0.85
 
 MESH_NAMES = ["sphere", "soup", "grid", "bunny"]
-RAY_COUNT = {"sphere": 2000, "soup": 2000, "grid": 2000, "bunny": 160}
+RAY_COUNT = {"sphere": 2000, "soup": 2000, "grid": 2000, "bunny": 256}
 
 
 def layout_delta(layout, vertices):

@@ -45,10 +45,16 @@ def test_translation(cube_blob):
     r = s.cast(o, d)
     np.testing.assert_array_equal(r["instance"], [0] * 9 + [1] * 9 + [NO_HIT])
     np.testing.assert_array_equal(r["t"], [5 - 2] * 9 + [5 - (-2 + 1)] * 9 + [np.inf])
-    a = s.cast(o, d, query="all")
+    a = s.cast(o, d, query="all", uv=True)
+    assert a["uv"].shape == (36, 2)
     np.testing.assert_array_equal(a["found"], [2] * 18 + [0])
     np.testing.assert_array_equal(a["t"], [3, 5] * 9 + [6, 8] * 9)
     np.testing.assert_array_equal(a["instance"], [0] * 18 + [1] * 18)
+    # max_hits 1: every hit counted, the nearest kept.
+    one = s.cast(o, d, query="all", max_hits=1)
+    np.testing.assert_array_equal(one["found"], [2] * 18 + [0])
+    np.testing.assert_array_equal(one["offsets"], list(range(19)) + [18])
+    np.testing.assert_array_equal(one["t"], [3] * 9 + [6] * 9)
 
 
 def test_rotation_scale_mirror_nonuniform(cube_blob):

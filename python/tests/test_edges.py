@@ -1,0 +1,247 @@
+"""Rays exactly through shared edges and vertices: nothing leaks.
+
+Every coordinate here is a small dyadic number, so the rays, the corners and
+the points where the rays cross the surface are exact in float32, and which
+closed triangles hold a crossing point is decided exactly (fractions).
+
+What must hold on every layout: one crossing of the surface is one distinct
+t (never zero crossings: no leak; never two), a closest or any query never
+misses, and every triangle reported holds the crossing point. How many of the
+triangles around an edge or a vertex a query "all" reports is checked on its
+own (test_one_hit_per_crossing): the watertight test (Woop et al.) promises
+no leak, and reports a triangle whose edge function comes out exactly zero,
+so a ray through an edge may be counted by both triangles."""
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import shapes
+from cases import DEFAULT_LAYOUT, FLOAT3_LAYOUT, NO_HIT, describe
+import meshcast
+
+LAYOUTS = [DEFAULT_LAYOUT, FLOAT3_LAYOUT]
+
+
+def containing(point, vertices, triangles):
+    """The closed triangles holding an exact point (Fractions throughout)."""
+    p = [Fraction(float(x)) for x in point]
+    out = set()
+    # Only triangles whose box holds the point can hold it (a float test,
+    # exact: comparisons of exact values).
+    corners = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles, dtype=np.int64)]
+    near = np.all((corners.min(axis=1) <= point) & (point <= corners.max(axis=1)), axis=1)
+    for k in np.nonzero(near)[0]:
+        tri = triangles[k]
+        a, b, c = ([Fraction(float(x)) for x in vertices[i]] for i in tri)
+        e1 = [b[i] - a[i] for i in range(3)]
+        e2 = [c[i] - a[i] for i in range(3)]
+        n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+        if sum(n[i] * (p[i] - a[i]) for i in range(3)) != 0:
+            continue  # off the plane
+        # Project along the normal's largest axis; signs of the three edge functions.
+        ax = max(range(3), key=lambda i: abs(n[i]))
+        i, j = [k2 for k2 in range(3) if k2 != ax]
+
+        def edge(u, v):
+            return (v[i] - u[i]) * (p[j] - u[j]) - (v[j] - u[j]) * (p[i] - u[i])
+
+        s = [edge(a, b), edge(b, c), edge(c, a)]
+        if all(x >= 0 for x in s) or all(x <= 0 for x in s):
+            out.add(int(k))
+    return out
+
+
+def crossings(ts, tol):
+    """Distinct crossings among sorted hit distances (hits within tol are one)."""
+    ts = np.sort(np.asarray(ts, dtype=np.float64))
+    return 0 if len(ts) == 0 else 1 + int(np.sum(np.diff(ts) > tol))
+
+
+def grid_rays():
+    """Rays through the 8x8 integer grid's interior vertices and edges (the
+    three edge directions: x, y and the cells' diagonals), straight down, straight
+    up and oblique; each crosses z = 0 at t = 2 at a known point."""
+    points = []
+    for x in range(1, 8):
+        for y in range(1, 8):
+            points.append((x, y))  # vertex
+            points.append((x + 0.5, y))  # edge along x
+            points.append((x, y + 0.5))  # edge along y
+            points.append((x + 0.25, y + 0.25))  # a cell's diagonal
+            points.append((x - 0.375, y - 0.375))
+    origins, directions, hits = [], [], []
+    for px, py in points:
+        for d in ((0.0, 0.0, -1.0), (0.0, 0.0, 1.0), (0.5, -0.25, -1.0), (-0.125, 0.75, 1.0)):
+            d = np.array(d)
+            p = np.array([px, py, 0.0])
+            origins.append(p - 2 * d)
+            directions.append(d)
+            hits.append(p)
+    return (np.array(origins, dtype=np.float32), np.array(directions, dtype=np.float32), np.array(hits))
+
+
+def check_exact_crossings(v, f, layout, origins, directions, hit_points, t_hits, what):
+    """hit_points[i]: the exact crossing points of ray i (at t_hits[i])."""
+    b = meshcast.build(v, f, layout=layout)
+    tol = 1e-6 if layout == FLOAT3_LAYOUT else 1e-4
+    incident = [[containing(p, v, f) for p in pts] for pts in hit_points]
+    for sets in incident:
+        assert all(sets), "a test point is not on the surface"
+    closest = b.cast(origins, directions)
+    anyq = b.cast(origins, directions, query="any")
+    allq = b.cast(origins, directions, query="all", max_hits=64)
+    problems = []
+    for i in range(len(origins)):
+        near = min(range(len(t_hits[i])), key=lambda k: t_hits[i][k])
+        if closest["triangle"][i] == NO_HIT:
+            problems.append(f"ray {i} {origins[i].tolist()} -> {directions[i].tolist()}: closest leaked")
+        elif closest["triangle"][i] not in incident[i][near] or abs(closest["t"][i] - t_hits[i][near]) > tol:
+            problems.append(f"ray {i}: closest triangle {closest['triangle'][i]} at t {closest['t'][i]}, "
+                            f"expected one of {sorted(incident[i][near])} at t {t_hits[i][near]}")
+        if anyq["triangle"][i] == NO_HIT:
+            problems.append(f"ray {i} {origins[i].tolist()} -> {directions[i].tolist()}: any leaked")
+        s = slice(allq["offsets"][i], allq["offsets"][i + 1])
+        ts, tris = allq["t"][s], allq["triangle"][s].tolist()
+        found = int(allq["found"][i])
+        if crossings(ts, tol) != len(t_hits[i]) or found != len(tris):
+            problems.append(f"ray {i} {origins[i].tolist()} -> {directions[i].tolist()}: all found {found}, "
+                            f"t {ts.tolist()}, expected {len(t_hits[i])} crossing(s) at t {list(t_hits[i])}")
+            continue
+        if len(set(tris)) != len(tris):
+            problems.append(f"ray {i}: a triangle reported twice: {tris}")
+        for th, sets in zip(t_hits[i], incident[i]):
+            at = [tri for tri, t in zip(tris, ts) if abs(t - th) <= tol]
+            if not at or not set(at) <= sets:
+                problems.append(f"ray {i}: at t {th} triangles {at}, expected a subset of {sorted(sets)}")
+    assert not problems, f"{what} {layout}: {len(problems)} problems:\n  " + "\n  ".join(problems[:10])
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_grid_edges_and_vertices(layout):
+    v, f = shapes.grid(8, 8)
+    o, d, p = grid_rays()
+    check_exact_crossings(v, f, layout, o, d, [[x] for x in p], [[2.0]] * len(o), "grid")
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_one_hit_per_crossing(layout):
+    """Query "all" through a shared edge or vertex of the flat grid: the ray
+    crosses the surface once, so found is 1 (the package's documentation:
+    "a ray through a shared edge or vertex hits exactly one of its
+    triangles")."""
+    v, f = shapes.grid(8, 8)
+    o, d, p = grid_rays()
+    r = meshcast.build(v, f, layout=layout).cast(o, d, query="all")
+    bad = np.nonzero(r["found"] != 1)[0]
+    kinds = {}
+    for i in bad:
+        kinds.setdefault((tuple(float(x) for x in p[i][:2] % 1)), []).append(int(r["found"][i]))
+    if len(bad):
+        pytest.fail(f"{len(bad)} of {len(o)} rays counted more than one hit at one crossing; by the crossing "
+                    f"point's place in its cell (x mod 1, y mod 1): found "
+                    + ", ".join(f"{k}: {sorted(set(v))}" for k, v in kinds.items()) + f"; first: {describe(bad[0], o, d)}")
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_grid_culling_through_edges(layout):
+    """Grid normals are +z: a ray going down sees front faces. Through an edge
+    or a vertex, cull="back" keeps the hit at t 2 and cull="front" drops it."""
+    v, f = shapes.grid(8, 8)
+    o, d, _ = grid_rays()
+    b = meshcast.build(v, f, layout=layout)
+    down = d[:, 2] < 0
+    for cull, kept in (("back", down), ("front", ~down)):
+        for query in ("closest", "any"):
+            r = b.cast(o, d, query=query, cull=cull)
+            hit = r["triangle"] != NO_HIT
+            np.testing.assert_array_equal(hit, kept, err_msg=f"cull={cull} query={query}")
+            np.testing.assert_allclose(r["t"][kept], 2.0, rtol=1e-6 if layout == FLOAT3_LAYOUT else 1e-4)
+
+
+def closed_rays(pairs):
+    """A ray through each pair of surface points: origin one step before the
+    first, so the crossings are at t 1 and 2."""
+    p_in = np.array([p for p, _ in pairs], dtype=np.float64)
+    p_out = np.array([q for _, q in pairs], dtype=np.float64)
+    d = p_out - p_in
+    return (p_in - d).astype(np.float32), d.astype(np.float32), [[a, b] for a, b in zip(p_in, p_out)]
+
+
+CUBE_PAIRS = [
+    ((1, 1, 0.25), (-1, -1, -0.5)),  # edge to the opposite edge
+    ((1, 1, 0.25), (-1, 0.375, 0.5)),  # edge to a face
+    ((1, -1, 0.5), (-0.25, 1, -0.75)),
+    ((1, 1, 1), (-1, -1, -1)),  # vertex to vertex (the diagonal)
+    ((1, 1, 1), (-1, 0.25, -0.5)),  # vertex to a face
+    ((-1, 1, -1), (1, -0.5, 1)),  # vertex to an edge
+    ((0.5, 0.5, 1), (-1, -0.5, -0.5)),  # a face diagonal to a face diagonal
+    ((1, 0.0, 0.0), (0.25, 1, 0.25)),
+]
+
+OCTAHEDRON_PAIRS = [
+    ((1, 1, 0), (-1, -1, 0)),  # edge midpoints, opposite edges
+    ((1, 1, 0), (-0.5, 0, 1.5)),  # edge to edge
+    ((2, 0, 0), (-2, 0, 0)),  # vertex to vertex
+    ((0, 2, 0), (-0.5, -0.5, -1)),  # vertex to a face
+    ((0, 0, -2), (0.5, 0.5, 1)),  # vertex to a face
+    ((1, 0, 1), (0, -1, -1)),  # edge to edge
+]
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+@pytest.mark.parametrize("shape", ["cube", "octahedron"])
+def test_closed_mesh_edges_and_vertices(shape, layout):
+    """From outside through edges and vertices of a closed convex mesh: two
+    crossings (in and out), nothing leaked, nothing counted at another t."""
+    v, f = shapes.cube() if shape == "cube" else shapes.octahedron()
+    pairs = CUBE_PAIRS if shape == "cube" else OCTAHEDRON_PAIRS
+    o, d, pts = closed_rays(pairs)
+    # Both directions along each line.
+    o2, d2, pts2 = closed_rays([(q, p) for p, q in pairs])
+    o, d, pts = np.concatenate([o, o2]), np.concatenate([d, d2]), pts + pts2
+    check_exact_crossings(v, f, layout, o, d, pts, [[1.0, 2.0]] * len(o), shape)
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_closed_cube_culling_through_edges(layout):
+    """Outward faces: entering, the ray meets front faces, leaving back faces.
+    cull="back" keeps the entry (t 1), cull="front" the exit (t 2)."""
+    v, f = shapes.cube()
+    o, d, _ = closed_rays(CUBE_PAIRS)
+    b = meshcast.build(v, f, layout=layout)
+    tol = 1e-6 if layout == FLOAT3_LAYOUT else 1e-4
+    for cull, t in (("back", 1.0), ("front", 2.0)):
+        r = b.cast(o, d, cull=cull)
+        assert np.all(r["triangle"] != NO_HIT), f"cull={cull}: a ray leaked"
+        np.testing.assert_allclose(r["t"], t, atol=tol, err_msg=f"cull={cull}")
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+@pytest.mark.parametrize("shape", ["cube", "octahedron"])
+def test_closed_mesh_two_hits_through_edges(shape, layout):
+    """From outside through edges and vertices of a closed convex mesh: query
+    "all" finds exactly 2 hits, in and out (one a crossing)."""
+    v, f = shapes.cube() if shape == "cube" else shapes.octahedron()
+    o, d, _ = closed_rays(CUBE_PAIRS if shape == "cube" else OCTAHEDRON_PAIRS)
+    found = meshcast.build(v, f, layout=layout).cast(o, d, query="all")["found"]
+    bad = np.nonzero(found != 2)[0]
+    if len(bad):
+        pytest.fail(f"{shape}: found {found.tolist()}, expected 2 on every ray; first: {describe(bad[0], o, d)}")
+
+
+@pytest.mark.parametrize("shape", ["cube", "octahedron"])
+def test_count_intersections_parity(shape):
+    """RaycastingScene.count_intersections is what inside/outside tests count:
+    through edges and vertices, 2 from outside and 1 from inside (from the
+    midpoint of each outside ray's chord)."""
+    v, f = shapes.cube() if shape == "cube" else shapes.octahedron()
+    o, d, _ = closed_rays(CUBE_PAIRS if shape == "cube" else OCTAHEDRON_PAIRS)
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    outside = np.asarray(rc.count_intersections(np.concatenate([o, d], axis=1)))
+    inside_o = (o.astype(np.float64) + 1.5 * d).astype(np.float32)  # halfway between t 1 and 2: exact
+    inside = np.asarray(rc.count_intersections(np.concatenate([inside_o, d], axis=1)))
+    if np.any(outside != 2) or np.any(inside != 1):
+        pytest.fail(f"{shape}: from outside {outside.tolist()} (expected 2), from inside {inside.tolist()} (expected 1)")

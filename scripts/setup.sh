@@ -10,6 +10,9 @@ PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgte
           mesa-vulkan-drivers vulkan-validationlayers      # lavapipe (a Vulkan device on the CPU), the layers the tests run
           libembree-dev gnuplot-nox  # Embree: a peer measured beside meshcast; gnuplot: bench plots
           python3)                   # the CLI test parses every --json output with Python's json module
+# The Python package (built into build/python, tested with pytest; its
+# README install lines make a venv): pybind11, numpy, pytest, venv.
+PACKAGES+=(pybind11-dev python3-dev python3-numpy python3-pytest python3-venv)
 source scripts/packages.sh
 install_missing "${PACKAGES[@]}"
 
@@ -30,5 +33,7 @@ for m in bunny00 armadillo refined_elephant ChineseDragon-10kv; do
 done
 
 jobs=$(nproc)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+# Debian's interpreter, the one its numpy and pytest belong to (python3 on
+# PATH may be another).
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHCAST_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build -j"$jobs"

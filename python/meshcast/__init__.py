@@ -16,8 +16,13 @@ Rays: a hit needs ``t_min <= t <= t_max``, ``t`` in units of the direction
 (which need not be normalized). Triangles are two-sided unless a cast culls
 (the front face's corners run counter-clockwise seen from the ray's origin),
 and the triangle test is watertight: a ray through a shared edge or vertex
-hits exactly one of its triangles. A ray with a NaN or infinite component, a
-zero direction or ``t_min > t_max`` is refused with ``ValueError`` naming it.
+never slips between its triangles. The closest or any hit there is one of
+them; ``query="all"`` lists every triangle holding the point, each once,
+while RaycastingScene's count_intersections and list_intersections count
+such a crossing once (once for each facing among the triangles there: a ray
+touching a closed mesh's silhouette edge counts in and out). A ray with a
+NaN or infinite component, a zero direction or ``t_min > t_max`` is refused
+with ``ValueError`` naming it.
 
 Arrays: float32 or float64 (other real types are converted once); C-
 contiguous arrays are read where they lie. Every cast releases the GIL and
@@ -136,7 +141,9 @@ class RaycastingScene:
         return _tensors(self._scene.test_occlusions(_array(rays), tnear, tfar, self._threads(nthreads)))
 
     def count_intersections(self, rays, nthreads=0):
-        """How many triangles each ray crosses for t >= 0 (int32)."""
+        """How many times each ray crosses the meshes for t >= 0 (int32): a
+        crossing through a shared edge or vertex counts once, so the parity
+        tells inside from outside of a closed mesh."""
         return _tensors(self._scene.count_intersections(_array(rays), self._threads(nthreads)))
 
     def list_intersections(self, rays, nthreads=0):

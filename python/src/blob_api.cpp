@@ -69,7 +69,7 @@ void check_out_keys(const py::object& out, std::initializer_list<const char*> ke
 py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::handle& directions,
                    const py::handle& t_min, const py::handle& t_max, const std::string& query_name,
                    const std::string& cull_name, long long max_hits, bool uv, const py::object& out,
-                   const std::string& backend, uint32_t nthreads) {
+                   const std::string& backend, long long nthreads) {
   const Query query = parse_query(query_name);
   const Cull cull = parse_cull(cull_name);
   if (backend != "cpu" && backend != "vulkan") throw py::value_error("backend \"" + backend + "\": cpu or vulkan");
@@ -170,7 +170,10 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
 }
 
 std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,
-                              double max_bytes, uint32_t leaf_size, uint32_t threads, const std::string& name) {
+                              double max_bytes, long long leaf_size, long long threads, const std::string& name) {
+  if (leaf_size < 0 || leaf_size > 31)
+    throw py::value_error("leaf_size " + std::to_string(leaf_size) + ": from 1 to 31 (0: the layout's own)");
+  const uint32_t build_threads = threads == 0 ? 0 : thread_count(threads, "threads");
   const double no_centre[3] = {0, 0, 0};
   const Mesh mesh = mesh_from_arrays(vertices, triangles, no_centre);
   if (!(max_bytes >= 0)) throw py::value_error("max_bytes: " + std::to_string(max_bytes) + " is negative");
@@ -180,14 +183,14 @@ std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& tria
     if (layout == "auto") {
       AutoLimits limits;
       limits.max_bytes_per_triangle = max_bytes / double(std::max<size_t>(1, mesh.triangle_count()));
-      limits.build_threads = threads;
+      limits.build_threads = build_threads;
       if (leaf_size) throw InputError(name + ": leaf_size is the automatic layout's to choose (name a layout to set it)");
       bytes = choose_layout(mesh, limits, name).blob;
     } else {
       BuildOptions options;
       options.layout = parse_layout_name(layout);
-      options.leaf_size = leaf_size;
-      options.threads = threads;
+      options.leaf_size = uint32_t(leaf_size);
+      options.threads = build_threads;
       bytes = build_blob(mesh, options, name);
       if (max_bytes > 0 && double(bytes.size()) > max_bytes)
         throw InputError(name + ": the " + layout + " blob is " + std::to_string(bytes.size()) +

@@ -81,6 +81,13 @@ struct AllHits {
     for (const auto& p : parts) total += p.hits.size();
     return total;
   }
+  // Calls row(i, found, hits) for every ray i, its kept hits in order.
+  template <class Row>
+  void for_each_row(const Row& row) const {
+    size_t i = 0;
+    for (const auto& p : parts)
+      for (size_t r = 0; r < p.rays(); ++r, ++i) row(i, p.found[r], p.row(r));
+  }
   // Calls ray(i, found, offset) for every ray i (its row starts at
   // `offset` of the gathered hits) and hit(j, record) for every kept hit j.
   template <class Ray, class Hit>

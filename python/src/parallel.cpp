@@ -7,14 +7,17 @@
 #include <memory>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "host/jobs.h"
 
 namespace meshcast::python {
 
-uint32_t thread_count(uint32_t requested) {
-  return requested ? requested : std::max(1u, std::thread::hardware_concurrency());
+uint32_t thread_count(long long requested, const char* what) {
+  if (requested < 0 || requested > 1024)
+    throw std::invalid_argument(std::string(what) + " " + std::to_string(requested) + ": from 0 (every core) to 1024");
+  return requested ? uint32_t(requested) : std::max(1u, std::thread::hardware_concurrency());
 }
 
 namespace {

@@ -8,8 +8,9 @@
 
 namespace meshcast::python {
 
-// The threads a call may use: `requested`, or every core for 0.
-uint32_t thread_count(uint32_t requested);
+// The threads a call may use: `requested`, or every core for 0;
+// std::invalid_argument (Python's ValueError) outside 0..1024.
+uint32_t thread_count(long long requested, const char* what = "nthreads");
 
 // How a batch of `count` rays is cut for `threads` threads: enough chunks
 // that the threads finish together (rays differ in cost by tens of times:

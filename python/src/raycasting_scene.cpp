@@ -7,7 +7,9 @@
 #include <pybind11/pybind11.h>
 
 #include <cmath>
+#include <algorithm>
 #include <memory>
+#include <span>
 #include <mutex>
 #include <vector>
 
@@ -38,6 +40,71 @@ void storage_centre(const double lo[3], const double hi[3], double centre[3]) {
   }
 }
 
+// primitive_normals, stored in 4 bytes a triangle: the unit normal mapped
+// onto the octahedron |x| + |y| + |z| = 1, its lower half folded over the
+// upper, and the square's two coordinates kept in 16 bits each. Decoded,
+// a normal is off its double-precision direction by at most about 6e-5
+// radians (python/tests measure it); 12 bytes of float32 would nearly
+// double the scene's memory (the blob is about 14 bytes a triangle).
+// -32768 (never a coordinate's code) marks a degenerate triangle's: no normal.
+struct PackedNormal {
+  int16_t x = INT16_MIN, y = INT16_MIN;
+};
+static_assert(sizeof(PackedNormal) == 4);
+PackedNormal pack_normal(const double n[3]) {
+  const double l1 = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+  if (!(l1 > 0) || !std::isfinite(l1)) return {};
+  double x = n[0] / l1, y = n[1] / l1;
+  if (n[2] < 0) {
+    const double fx = (1 - std::fabs(y)) * (x >= 0 ? 1 : -1), fy = (1 - std::fabs(x)) * (y >= 0 ? 1 : -1);
+    x = fx, y = fy;
+  }
+  return {int16_t(std::lround(x * 32767)), int16_t(std::lround(y * 32767))};
+}
+void unpack_normal(const PackedNormal& p, float out[3]) {
+  if (p.x == INT16_MIN) {
+    out[0] = out[1] = out[2] = 0;
+    return;
+  }
+  double x = p.x / 32767.0, y = p.y / 32767.0;
+  const double z = 1 - std::fabs(x) - std::fabs(y);
+  if (z < 0) {
+    const double fx = (1 - std::fabs(y)) * (x >= 0 ? 1 : -1), fy = (1 - std::fabs(x)) * (y >= 0 ? 1 : -1);
+    x = fx, y = fy;
+  }
+  const double length = std::sqrt(x * x + y * y + z * z);
+  out[0] = float(x / length), out[1] = float(y / length), out[2] = float(z / length);
+}
+
+// Where a ray crosses a mesh exactly on an edge or a vertex, the watertight
+// test reports every triangle there (its edge function is exactly 0 for
+// each), each at its own t, equal but for rounding. Open3D's users count
+// crossings (inside/outside tests by parity, the surfaces a LiDAR return
+// passed): hits within 2^-20 of each other's t make one crossing for each
+// facing among them. Through an edge or vertex into a closed mesh the
+// triangles all face the ray alike: one crossing. A ray that only touches
+// the mesh there (a silhouette edge) meets a front face and a back face:
+// two, in and out, and the parity stays right.
+template <class Keep>
+void crossings(std::span<const SceneHit> row, const float dir[3],
+               const std::vector<std::vector<PackedNormal>>& normals, const Keep& keep) {
+  for (size_t g = 0; g < row.size();) {
+    const float t0 = row[g].t;
+    const float tol = std::ldexp(std::fabs(t0), -20);
+    bool front = false, back = false;
+    size_t end = g;
+    for (; end < row.size() && row[end].t - t0 <= tol; ++end) {
+      float n[3];
+      unpack_normal(normals[row[end].instance][row[end].triangle], n);
+      const bool faces_back = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0;
+      bool& seen = faces_back ? back : front;
+      if (!seen) keep(row[end]);
+      seen = true;
+    }
+    g = end;
+  }
+}
+
 class RaycastingScene {
  public:
   uint32_t add_triangles(const py::handle& vertices, const py::handle& triangles) {
@@ -46,7 +113,7 @@ class RaycastingScene {
     storage_centre(lo, hi, centre);
     const std::string name = "geometry " + std::to_string(normals_.size());
     Mesh mesh = mesh_from_arrays(vertices, triangles, centre);
-    std::vector<float> normals(mesh.triangle_count() * 3);
+    std::vector<PackedNormal> normals(mesh.triangle_count());
     std::vector<uint8_t> blob;
     {
       py::gil_scoped_release release;
@@ -60,8 +127,7 @@ class RaycastingScene {
         }
         const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                              e1[0] * e2[1] - e1[1] * e2[0]};
-        const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        for (int k = 0; k < 3; ++k) normals[3 * i + k] = length > 0 ? float(n[k] / length) : 0.0f;
+        normals[i] = pack_normal(n);
       }
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -74,7 +140,7 @@ class RaycastingScene {
     return id;
   }
 
-  py::dict cast_rays(const py::handle& rays_in, uint32_t nthreads) {
+  py::dict cast_rays(const py::handle& rays_in, long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
     std::vector<py::ssize_t> shape2 = rays.shape, shape3 = rays.shape;
     shape2.push_back(2);
@@ -97,9 +163,8 @@ class RaycastingScene {
                             p_out[i] = h.triangle;
                             uv_out[2 * i] = h.u;
                             uv_out[2 * i + 1] = h.v;
-                            const float* n = h.instance != kNoHit ? &normals_[h.instance][3 * size_t(h.triangle)]
-                                                                  : kNoNormal;
-                            for (int k = 0; k < 3; ++k) n_out[3 * i + k] = n[k];
+                            unpack_normal(h.instance != kNoHit ? normals_[h.instance][h.triangle] : PackedNormal{},
+                                          n_out + 3 * i);
                           });
     }
     raise_for_refused(rays, refused);
@@ -113,7 +178,7 @@ class RaycastingScene {
   }
 
   py::array test_occlusions(const py::handle& rays_in, const py::handle& tnear, const py::handle& tfar,
-                            uint32_t nthreads) {
+                            long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
     set_segment(rays, tnear, tfar);
     py::array_t<bool> occluded(rays.shape);
@@ -129,24 +194,29 @@ class RaycastingScene {
     return occluded;
   }
 
-  py::array count_intersections(const py::handle& rays_in, uint32_t nthreads) {
+  py::array count_intersections(const py::handle& rays_in, long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
     AllHits<SceneTarget> all;
     {
       py::gil_scoped_release release;
       commit();
-      // One hit kept a ray: the walk counts them all (HitRows::found).
-      all = cast_all(SceneTarget{scene_}, rays, Cull::None, HitOutputs::None, 1, thread_count(nthreads));
+      all = cast_all(SceneTarget{scene_}, rays, Cull::None, HitOutputs::None, kMaxHitsLimit, thread_count(nthreads));
     }
     raise_for_refused(rays, all.refused);
     py::array_t<int32_t> counts(rays.shape);
     int32_t* out = counts.mutable_data();
-    all.gather([out](size_t i, uint32_t found, size_t) { out[i] = int32_t(std::min<uint32_t>(found, INT32_MAX)); },
-               [](size_t, const SceneHit&) {});
+    {
+      py::gil_scoped_release release;
+      all.for_each_row([&](size_t i, uint32_t found, std::span<const SceneHit> row) {
+        uint64_t n = found - row.size();  // beyond the kept hits: each counted
+        crossings(row, rays.ray(i).dir, normals_, [&n](const SceneHit&) { ++n; });
+        out[i] = int32_t(std::min<uint64_t>(n, INT32_MAX));
+      });
+    }
     return counts;
   }
 
-  py::dict list_intersections(const py::handle& rays_in, uint32_t nthreads) {
+  py::dict list_intersections(const py::handle& rays_in, long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
     AllHits<SceneTarget> all;
     {
@@ -155,7 +225,21 @@ class RaycastingScene {
       all = cast_all(SceneTarget{scene_}, rays, Cull::None, HitOutputs::Uv, kMaxHitsLimit, thread_count(nthreads));
     }
     raise_for_refused(rays, all.refused);
-    const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(all.hits());
+    // The crossings of each ray, then the arrays of their total.
+    std::vector<SceneHit> listed;
+    std::vector<uint32_t> splits_of(rays.count + 1, 0);
+    uint64_t dropped = 0;
+    {
+      py::gil_scoped_release release;
+      listed.reserve(all.hits());
+      all.for_each_row([&](size_t i, uint32_t found, std::span<const SceneHit> row) {
+        splits_of[i] = uint32_t(listed.size());
+        dropped += found - row.size();
+        crossings(row, rays.ray(i).dir, normals_, [&listed](const SceneHit& h) { listed.push_back(h); });
+      });
+      splits_of[rays.count] = uint32_t(listed.size());
+    }
+    const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(listed.size());
     py::array_t<uint32_t> splits({n + 1}), ray_ids({h}), geometry({h}), primitive({h});
     py::array_t<float> uvs({h, py::ssize_t(2)}), t({h});
     uint32_t* s_out = splits.mutable_data();
@@ -164,24 +248,19 @@ class RaycastingScene {
     uint32_t* p_out = primitive.mutable_data();
     float* uv_out = uvs.mutable_data();
     float* t_out = t.mutable_data();
-    uint64_t dropped = 0;
     {
       py::gil_scoped_release release;
-      all.gather(
-          [&](size_t i, uint32_t found, size_t offset) {
-            s_out[i] = uint32_t(offset);
-            if (found > kMaxHitsLimit) dropped += found - kMaxHitsLimit;
-          },
-          [&](size_t j, const SceneHit& hit) {
-            g_out[j] = hit.instance;
-            p_out[j] = hit.triangle;
-            uv_out[2 * j] = hit.u;
-            uv_out[2 * j + 1] = hit.v;
-            t_out[j] = hit.t;
-          });
-      s_out[rays.count] = uint32_t(all.hits());
+      std::copy(splits_of.begin(), splits_of.end(), s_out);
       for (size_t i = 0; i < rays.count; ++i)
-        for (uint32_t j = s_out[i]; j < s_out[i + 1]; ++j) r_out[j] = uint32_t(i);
+        for (uint32_t j = s_out[i]; j < s_out[i + 1]; ++j) {
+          const SceneHit& hit = listed[j];
+          r_out[j] = uint32_t(i);
+          g_out[j] = hit.instance;
+          p_out[j] = hit.triangle;
+          uv_out[2 * j] = hit.u;
+          uv_out[2 * j + 1] = hit.v;
+          t_out[j] = hit.t;
+        }
     }
     if (dropped)
       PyErr_WarnEx(PyExc_RuntimeWarning,
@@ -203,7 +282,7 @@ class RaycastingScene {
   // top level over the instances.
   size_t nbytes() const {
     size_t bytes = scene_.owned_blob_bytes() + scene_.top_level_bytes();
-    for (const auto& n : normals_) bytes += n.capacity() * sizeof(float);
+    for (const auto& n : normals_) bytes += n.capacity() * sizeof(PackedNormal);
     return bytes;
   }
 
@@ -214,10 +293,9 @@ class RaycastingScene {
     if (changed_) scene_.commit();
     changed_ = false;
   }
-  static constexpr float kNoNormal[3] = {0, 0, 0};
   std::mutex mutex_;
   Scene scene_;
-  std::vector<std::vector<float>> normals_;  // a unit normal a triangle, a geometry's in its order
+  std::vector<std::vector<PackedNormal>> normals_;  // a triangle's, a geometry's in its order
   bool changed_ = false;
 };
 
@@ -225,7 +303,11 @@ class RaycastingScene {
 
 void register_raycasting_scene(py::module_& m) {
   py::class_<RaycastingScene>(m, "_RaycastingScene")
-      .def(py::init([](uint32_t) { return std::make_unique<RaycastingScene>(); }), py::arg("nthreads") = 0)
+      .def(py::init([](long long nthreads) {
+             thread_count(nthreads);  // checked: Open3D takes it here
+             return std::make_unique<RaycastingScene>();
+           }),
+           py::arg("nthreads") = 0)
       .def("add_triangles", &RaycastingScene::add_triangles, py::arg("vertex_positions"), py::arg("triangle_indices"))
       .def("cast_rays", &RaycastingScene::cast_rays, py::arg("rays"), py::arg("nthreads") = 0)
       .def("test_occlusions", &RaycastingScene::test_occlusions, py::arg("rays"), py::arg("tnear") = 0.0,

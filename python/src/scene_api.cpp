@@ -28,10 +28,11 @@ class PyScene {
   }
   Scene scene;
   std::vector<std::shared_ptr<PyBlob>> blobs;
+  std::vector<Transform> placed;  // each instance's, for set_transform's parts left as they were
 };
 
-Transform transform_from(const py::handle& rotation_scale, const py::handle& translation) {
-  Transform t;
+// The transform with the parts given (None: `t`'s kept).
+Transform transform_from(const py::handle& rotation_scale, const py::handle& translation, Transform t = {}) {
   if (!rotation_scale.is_none()) {
     py::array m = real_array(rotation_scale, "rotation_scale");
     if (m.ndim() != 2 || m.shape(0) != 3 || m.shape(1) != 3)
@@ -55,7 +56,7 @@ uint8_t checked_mask(long long mask) {
 
 py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& directions, const py::handle& t_min,
                     const py::handle& t_max, const std::string& query_name, const std::string& cull_name,
-                    long long mask, long long max_hits, bool uv, const py::object& out, uint32_t nthreads) {
+                    long long mask, long long max_hits, bool uv, const py::object& out, long long nthreads) {
   const Query query = parse_query(query_name);
   const Cull cull = parse_cull(cull_name);
   const uint32_t kept = checked_max_hits(max_hits);
@@ -159,8 +160,11 @@ by casts after commit(). One thread edits and commits; any number cast.)")
           "add_instance",
           [](PyScene& s, MeshId mesh, const py::handle& rotation_scale, const py::handle& translation, long long mask,
              bool flip_facing) {
-            return s.scene.add_instance(mesh, transform_from(rotation_scale, translation), checked_mask(mask),
-                                        flip_facing);
+            const Transform t = transform_from(rotation_scale, translation);
+            const InstanceId id = s.scene.add_instance(mesh, t, checked_mask(mask), flip_facing);
+            s.placed.resize(size_t(id) + 1);
+            s.placed[id] = t;
+            return id;
           },
           py::arg("mesh"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none(),
           py::arg("mask") = 0xFF, py::arg("flip_facing") = false,
@@ -168,9 +172,15 @@ by casts after commit(). One thread edits and commits; any number cast.)")
       .def(
           "set_transform",
           [](PyScene& s, InstanceId i, const py::handle& rotation_scale, const py::handle& translation) {
-            s.scene.set_transform(i, transform_from(rotation_scale, translation));
+            if (i >= s.placed.size()) {
+              s.scene.set_transform(i, Transform{});  // the library's error, naming the instance
+            }
+            const Transform t = transform_from(rotation_scale, translation, s.placed[i]);
+            s.scene.set_transform(i, t);
+            s.placed[i] = t;
           },
-          py::arg("instance"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none())
+          py::arg("instance"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none(),
+          "A new rotation_scale, translation or both; a part not given is kept.")
       .def(
           "set_mask", [](PyScene& s, InstanceId i, long long mask) { s.scene.set_mask(i, checked_mask(mask)); },
           py::arg("instance"), py::arg("mask"))

@@ -8,9 +8,11 @@ What must hold on every layout: one crossing of the surface is one distinct
 t (never zero crossings: no leak; never two), a closest or any query never
 misses, and every triangle reported holds the crossing point. How many of the
 triangles around an edge or a vertex a query "all" reports is checked on its
-own (test_one_hit_per_crossing): the watertight test (Woop et al.) promises
-no leak, and reports a triangle whose edge function comes out exactly zero,
-so a ray through an edge may be counted by both triangles."""
+own: the watertight test (Woop et al.) promises no leak, and reports every
+triangle whose edge function comes out exactly zero, so a ray through an
+edge meets both its triangles (Blob.cast, query "all"); RaycastingScene's
+count_intersections and list_intersections count the crossing once
+(test_one_hit_per_crossing)."""
 
 from fractions import Fraction
 
@@ -125,23 +127,29 @@ def test_grid_edges_and_vertices(layout):
     check_exact_crossings(v, f, layout, o, d, [[x] for x in p], [[2.0]] * len(o), "grid")
 
 
-@pytest.mark.parametrize("layout", LAYOUTS)
-def test_one_hit_per_crossing(layout):
-    """Query "all" through a shared edge or vertex of the flat grid: the ray
-    crosses the surface once, so found is 1 (the package's documentation:
-    "a ray through a shared edge or vertex hits exactly one of its
-    triangles")."""
+def test_one_hit_per_crossing():
+    """RaycastingScene counts and lists crossings: through a shared edge or
+    vertex of the flat grid the ray crosses the surface once, so
+    count_intersections is 1 and list_intersections lists one hit (Blob.cast
+    with query "all" reports every triangle holding the point instead:
+    test_grid_edges_and_vertices)."""
     v, f = shapes.grid(8, 8)
     o, d, p = grid_rays()
-    r = meshcast.build(v, f, layout=layout).cast(o, d, query="all")
-    bad = np.nonzero(r["found"] != 1)[0]
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    rays = np.concatenate([o, d], axis=1)
+    counts = np.asarray(rc.count_intersections(rays))
+    listed = rc.list_intersections(rays)
+    per_ray = np.diff(np.asarray(listed["ray_splits"]))
+    bad = np.nonzero((counts != 1) | (per_ray != 1))[0]
     kinds = {}
     for i in bad:
-        kinds.setdefault((tuple(float(x) for x in p[i][:2] % 1)), []).append(int(r["found"][i]))
+        kinds.setdefault((tuple(float(x) for x in p[i][:2] % 1)), []).append((int(counts[i]), int(per_ray[i])))
     if len(bad):
-        pytest.fail(f"{len(bad)} of {len(o)} rays counted more than one hit at one crossing; by the crossing "
-                    f"point's place in its cell (x mod 1, y mod 1): found "
+        pytest.fail(f"{len(bad)} of {len(o)} rays did not count one crossing; by the crossing "
+                    f"point's place in its cell (x mod 1, y mod 1): (count, listed) "
                     + ", ".join(f"{k}: {sorted(set(v))}" for k, v in kinds.items()) + f"; first: {describe(bad[0], o, d)}")
+    np.testing.assert_allclose(np.asarray(listed["t_hit"]), 2.0, atol=1e-6)
 
 
 @pytest.mark.parametrize("layout", LAYOUTS)
@@ -218,17 +226,18 @@ def test_closed_cube_culling_through_edges(layout):
         np.testing.assert_allclose(r["t"], t, atol=tol, err_msg=f"cull={cull}")
 
 
-@pytest.mark.parametrize("layout", LAYOUTS)
 @pytest.mark.parametrize("shape", ["cube", "octahedron"])
-def test_closed_mesh_two_hits_through_edges(shape, layout):
-    """From outside through edges and vertices of a closed convex mesh: query
-    "all" finds exactly 2 hits, in and out (one a crossing)."""
+def test_closed_mesh_two_hits_through_edges(shape):
+    """From outside through edges and vertices of a closed convex mesh:
+    list_intersections lists exactly 2 hits, in and out (one a crossing)."""
     v, f = shapes.cube() if shape == "cube" else shapes.octahedron()
     o, d, _ = closed_rays(CUBE_PAIRS if shape == "cube" else OCTAHEDRON_PAIRS)
-    found = meshcast.build(v, f, layout=layout).cast(o, d, query="all")["found"]
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    found = np.diff(np.asarray(rc.list_intersections(np.concatenate([o, d], axis=1))["ray_splits"]))
     bad = np.nonzero(found != 2)[0]
     if len(bad):
-        pytest.fail(f"{shape}: found {found.tolist()}, expected 2 on every ray; first: {describe(bad[0], o, d)}")
+        pytest.fail(f"{shape}: listed {found.tolist()}, expected 2 on every ray; first: {describe(bad[0], o, d)}")
 
 
 @pytest.mark.parametrize("shape", ["cube", "octahedron"])

@@ -14,7 +14,10 @@
 #     root would, and the README's program built against it; the reader
 #     component is refused there, naming the option that builds it;
 #  4. tests/consumer: meshcast through add_subdirectory with every package
-#     but the core's disabled (configuring fails if it reaches for one).
+#     but the core's disabled (configuring fails if it reaches for one);
+#  5. the Python package: imported from where step 1's cmake --install put
+#     it; the README's install lines (a venv, pip install ./python) and its
+#     Python example run in that venv.
 # The library-only build compiles the scalar walkers alone: what it checks
 # is configuration, installation and targets (the installed package of
 # step 1 has every instruction set), at a third of the time.
@@ -110,6 +113,16 @@ if cmake -S "$tmp/unknown" -B "$tmp/unknown/build" -DCMAKE_PREFIX_PATH="$prefix"
   echo "FAIL: an unknown component was not refused by name"; cat "$tmp/unknown.log"; exit 1
 fi
 
+# The Python package, as cmake --install put it: PREFIX/lib/python3.X/site-packages.
+pyver=$(/usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+PYTHONPATH="$prefix/lib/python$pyver/site-packages" /usr/bin/python3 -c '
+import meshcast, numpy as np
+blob = meshcast.build(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32), np.array([[0, 1, 2]]))
+hit = blob.cast(np.array([0.25, 0.25, 1.0]), np.array([[0, 0, -1.0]]))
+assert hit["triangle"][0] == 0 and hit["t"][0] == 1, hit' ||
+  { echo "FAIL: the Python package installed by cmake --install"; exit 1; }
+echo "  cmake --install: the Python package imported from PREFIX/lib/python$pyver/site-packages, a ray cast"
+
 # 2. The examples, through CMake and through pkg-config.
 cmake -S examples -B "$tmp/examples" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$tmp/examples" -j"$jobs" >/dev/null
@@ -125,8 +138,15 @@ unset PKG_CONFIG_PATH
 
 # 3. The library alone, built and installed without root.
 home=$tmp/home
-cmake --no-warn-unused-cli -S . -B "$tmp/libonly" -DCMAKE_BUILD_TYPE=Release -DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF \
-      -DMESHCAST_READER=OFF -DMESHCAST_TOOLS=OFF -DMESHCAST_TESTS=OFF "${disabled[@]}" >/dev/null
+# With the Python package: step 5 builds it again through pip with these
+# options (and the reader), and where ccache is installed most of its
+# compiles are this step's.
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+libonly_options=(-DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF -DMESHCAST_READER=OFF "${launcher[@]}")
+cmake --no-warn-unused-cli -S . -B "$tmp/libonly" -DCMAKE_BUILD_TYPE=Release "${libonly_options[@]}" \
+      -DMESHCAST_TOOLS=OFF -DMESHCAST_TESTS=OFF -DMESHCAST_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 \
+      "${disabled[@]}" >/dev/null
 cmake --build "$tmp/libonly" -j"$jobs" > "$tmp/libonly.log" 2>&1 || { cat "$tmp/libonly.log"; exit 1; }
 cmake --install "$tmp/libonly" --prefix "$home/.local" >/dev/null
 scratch "$tmp/alone" "" meshcast::meshcast "$tmp/first.cpp"
@@ -145,3 +165,23 @@ fi
 cmake -S tests/consumer -B "$tmp/consumer" -DMESHCAST_SOURCE="$PWD" -DCMAKE_BUILD_TYPE=Release -DMESHCAST_ISAS=scalar \
       > "$tmp/consumer.log" 2>&1 || { echo "FAIL: meshcast as a subproject"; cat "$tmp/consumer.log"; exit 1; }
 echo "  add_subdirectory: configured with only the core's packages; meshcast::meshcast and meshcast::host linked"
+
+# 5. Python: the README's install lines as written (a venv that sees
+# Debian's numpy, pip without build isolation, offline), step 3's scalar
+# walkers and no Vulkan passed through MESHCAST_CMAKE_ARGS (the reader is
+# built: Assimp is installed); then the README's Python example run in the
+# venv on bunny00, its PNG checked.
+awk '/<!-- python install begins/ {on = 1; next} /<!-- python install ends/ {on = 0} on && !/^```/' README.md > "$tmp/install.sh"
+awk '/<!-- python example begins/ {on = 1; next} /<!-- python example ends/ {on = 0} on && !/^```/' README.md > "$tmp/scan.py"
+[[ $(wc -l < "$tmp/install.sh") -ge 3 && $(wc -l < "$tmp/scan.py") -ge 10 ]] ||
+  { echo "FAIL: no Python install lines or example between the README's markers"; exit 1; }
+root=$PWD
+MESHCAST_CMAKE_ARGS="-DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF ${launcher[*]}" bash -e "$tmp/install.sh" > "$tmp/pip.log" 2>&1 ||
+  { echo "FAIL: the README's Python install lines"; tail -40 "$tmp/pip.log"; exit 1; }
+echo "  pip install ./python into a venv: $(tail -1 "$tmp/pip.log")"
+mkdir -p "$tmp/scan" && ln -s "$PWD/data" "$tmp/scan/data"
+(cd "$tmp/scan" && "$root/.venv/bin/python" "$tmp/scan.py" > out.txt 2>&1) ||
+  { echo "FAIL: the README's Python example"; cat "$tmp/scan/out.txt"; exit 1; }
+[[ $(head -c 8 "$tmp/scan/scan.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] ||
+  { echo "FAIL: the README's Python example wrote no PNG"; exit 1; }
+echo "  the README's Python example: $(tail -1 "$tmp/scan/out.txt")"

@@ -13,6 +13,8 @@ PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgte
 # The Python package (built into build/python, tested with pytest; its
 # README install lines make a venv): pybind11, numpy, pytest, venv.
 PACKAGES+=(pybind11-dev python3-dev python3-numpy python3-pytest python3-venv)
+# ccache: the package test builds the library twice (cmake, then pip) with the same compiles.
+PACKAGES+=(ccache)
 source scripts/packages.sh
 install_missing "${PACKAGES[@]}"
 

@@ -20,6 +20,12 @@ jobs=$(nproc)
 # shards each, so the two cores finish together.
 cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test scene_test
             hostile_test oracle_test io_test)
+# Under AddressSanitizer: the suites that read hostile input, walk, build
+# on threads, place instances and allocate per frame. The layouts' own
+# suites (layout_test, pairing_test, auto_test) and the oracle's run in
+# Release alone: their encoders are the builds the suites below make, and
+# the fuzz targets' ASan builds read and walk every layout again.
+asan_suites=(walker_test robustness_test limits_test build_test zerobyte_test scene_test hostile_test io_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
 walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
@@ -66,7 +72,10 @@ fi
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
-stage "AddressSanitizer + UBSan ($widest walkers), the test counters compiled in, without the Vulkan backend: every CPU test suite and the CPU host layer"
+stage "Python: the package (build/python) against its own double-precision brute force (pytest)"
+PYTHONPATH="$PWD/build/python" MESHCAST_DATA="$PWD/data" /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests
+
+stage "AddressSanitizer + UBSan ($widest walkers), the test counters compiled in, without the Vulkan backend: the CPU suites of asan_suites and the CPU host layer"
 # The Vulkan suites stay out of this build: lavapipe and the loader are not
 # instrumented (their own allocations would read as leaks); they run in the
 # Release build above and the host layer under TSan below.
@@ -78,8 +87,8 @@ stage "AddressSanitizer + UBSan ($widest walkers), the test counters compiled in
 # suites' counted-test checks run in this build alone.
 cmake -S . -B build-asan "${sanitizer_flags[@]}" "-DMESHCAST_ISAS=$widest" -DMESHCAST_SANITIZE=ON -DMESHCAST_COUNT_TESTS=ON \
       -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
-cmake --build build-asan -j"$jobs" --target "${cpu_suites[@]}" host_test
-run_suites build-asan quick "${cpu_suites[@]}" host_test
+cmake --build build-asan -j"$jobs" --target "${asan_suites[@]}" host_test
+run_suites build-asan quick "${asan_suites[@]}" host_test
 
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own

@@ -72,6 +72,19 @@ check info-json 0 '"bytes_per_triangle":\{"header"' -- "$meshcast" info "$mesh" 
 check trace 0 "ns/ray" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out "$work/h.hits" --repeat 2
 check trace-json 0 '"ns_per_ray":' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/h2.hits" --json
 check trace-any 0 '"query":"any"' -- "$meshcast" trace "$mesh" --layout OctTreeCompressed/ClusterBitPackSOA8 --query any --rays "$work/r.rays" --out "$work/ha.hits" --json
+# --threads: the batch split over a pool gives the single thread's hits, byte for byte.
+check trace-threads 0 '"device":"CPU, 2 threads"' -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out "$work/h-t2.hits" --repeat 1 --threads 2 --json
+cmp "$work/h.hits" "$work/h-t2.hits" || { echo "FAIL: trace --threads 2 answered other hits than one thread"; exit 1; }
+check trace-threads-all 0 '"query":"all"' -- "$meshcast" trace "$work/m.blob" --query all --max-hits 4 --rays "$work/r.rays" --out "$work/h-t0.hitc" --repeat 1 --threads 0 --json
+"$meshcast" trace "$work/m.blob" --query all --max-hits 4 --rays "$work/r.rays" --out "$work/h-t1.hitc" --repeat 1 >/dev/null
+cmp "$work/h-t1.hitc" "$work/h-t0.hitc" || { echo "FAIL: trace --query all --threads 0 answered other rows than one thread"; exit 1; }
+check trace-threads-vulkan 2 "threads is for --backend cpu" -- "$meshcast" trace "$work/m.blob" --rays "$work/r.rays" --out "$work/hx.hits" --threads 2 --backend vulkan
+# generate: the benchmarks' generated meshes as OFF, read back as the same mesh (the same rays).
+check generate 0 "131072 triangles" -- "$meshcast" generate terrain_66k --out "$work/terrain.off"
+"$meshcast" rays "$work/terrain.off" --kind probe --count 300 --out "$work/tf.rays" >/dev/null
+"$meshcast" rays terrain_66k --kind probe --count 300 --out "$work/tg.rays" >/dev/null
+cmp "$work/tf.rays" "$work/tg.rays" || { echo "FAIL: the generated OFF did not read back as the generated mesh"; exit 1; }
+check generate-unknown 2 "terrain_2M" -- "$meshcast" generate mountain --out "$work/x.off"
 check trace-query-unknown 2 "query" -- "$meshcast" trace "$mesh" --query nearest --rays "$work/r.rays" --out "$work/hx.hits"
 check trace-all 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hn.hitc" --json
 # HITC: magic, 500 rays, N, 500 counts, then the kept records alone: 12 + 500

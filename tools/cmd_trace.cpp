@@ -12,6 +12,8 @@
 #include "gpu/method.h"
 #include "gpu/scene.h"
 #include "gpu/vulkan.h"
+#include "host/chunks.h"
+#include "host/jobs.h"
 #include "layout/queries.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
@@ -31,6 +33,7 @@ struct TraceArgs {
   std::string backend = "cpu", method = "bruteforce", device, query = "closest", cull = "none";
   uint32_t max_hits = 16;
   float t_min = 0;
+  uint32_t threads = 1;  // the CPU backend's, on a blob (0: every core)
 };
 
 // --t-min on every ray read (the rays files hold no t_min of their own). A
@@ -132,7 +135,10 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--t-min", args->t_min,
                   "the nearest t a hit may have, on every ray read (a hit needs t-min <= t <= t_max; default 0): "
                   "secondary rays from a surface skip it. A ray whose t_max is below it is an invalid ray (a miss)");
-  cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
+  cmd->add_option("--backend", args->backend, "cpu (one thread, or --threads) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
+  cmd->add_option("--threads", args->threads,
+                  "cpu, a mesh or blob: the threads the batch is split over, in chunks of rays (0: every core; default 1)")
+      ->check(integer_in(0, 1024));
   cmd->add_option("--method", args->method, "GPU method: bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
                                             "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
                                             "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4), octtree (OctTreeCompressed/ClusterBitPackSOA8)");
@@ -150,6 +156,8 @@ void add_trace(CLI::App& app) {
       std::snprintf(shown, sizeof shown, "%g", double(args->t_min));
       throw InputError(std::string("trace: --t-min ") + shown + ": a finite number at least 0 (the nearest t a hit may have)");
     }
+    if (args->threads != 1 && (args->backend != "cpu" || is_scene_file(args->input)))
+      throw InputError("trace: --threads is for --backend cpu on a mesh or blob (scene files are cast on one thread)");
     if (is_scene_file(args->input)) {
       trace_scene(*args);
       return;
@@ -186,6 +194,31 @@ void add_trace(CLI::App& app) {
         skipped = query == Query::All ? method->trace_all_hits(rays, lists, &timing) : method->trace(rays, hits, &timing);
         pass_ms.push_back(timing.wall_ms), device_ms.push_back(timing.device_ms);
       }
+    } else if (args->threads != 1) {
+      // The batch split over a pool's threads, as the Python package splits
+      // one: each pass is the whole batch's wall time.
+      BlobView view(in.blob, args->input);
+      host::WorkerPool pool(args->threads);
+      device = "CPU, " + std::to_string(pool.threads()) + " threads";
+      const host::Chunks plan = host::plan_chunks(rays.size(), pool.threads());
+      std::vector<HitLists> parts(query == Query::All ? plan.chunks : 0);
+      for (HitLists& part : parts) part.max_hits = args->max_hits;
+      std::vector<uint64_t> refused(plan.chunks);
+      for (uint32_t r = 0; r < args->repeat; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        host::for_each_chunk(plan, &pool, [&](size_t c) {
+          const auto chunk_rays = std::span(rays).subspan(plan.begin(c), plan.end(c) - plan.begin(c));
+          refused[c] = query == Query::All
+                           ? view.trace_all_hits(chunk_rays, parts[c], HitOutputs::None, cull)
+                           : view.trace(chunk_rays, std::span(hits).subspan(plan.begin(c), chunk_rays.size()),
+                                        HitOutputs::None, query, cull);
+        });
+        pass_ms.push_back(ms_since(t0));
+      }
+      skipped = 0;
+      for (uint64_t n : refused) skipped += n;
+      lists.clear();
+      for (const HitLists& part : parts) lists.append(part);
     } else {
       BlobView view(in.blob, args->input);
       Progress progress("tracing " + std::to_string(rays.size()) + " rays x " + std::to_string(args->repeat),

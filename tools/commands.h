@@ -14,6 +14,7 @@ void add_build(CLI::App& app);
 void add_info(CLI::App& app);
 void add_layouts(CLI::App& app);
 void add_rays(CLI::App& app);
+void add_generate(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_bench(CLI::App& app);
 void add_render(CLI::App& app);
@@ -21,9 +22,9 @@ void add_bench_auto(CLI::App* bench);   // `meshcast bench auto`, under `bench`
 void add_bench_peers(CLI::App* bench);  // `meshcast bench peers`
 void add_bench_scenes(CLI::App* bench);  // `meshcast bench scenes`
 
-// A mesh file, or a generated terrain: "terrain_2M" (2,097,152 triangles,
-// 1,050,625 vertices) or "terrain_66k" (131,072 triangles, 66,049 vertices:
-// just past 16-bit indices).
+// A mesh file, or a generated mesh: "terrain_2M" (2,097,152 triangles,
+// 1,050,625 vertices), "terrain_66k" (131,072 triangles, 66,049 vertices:
+// just past 16-bit indices) or "city_1M" (about a million triangles).
 Mesh bench_mesh(const std::string& input);
 
 // The layout options trace, build and info share: --layout, --leaf,

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   meshcast::tools::add_info(app);
   meshcast::tools::add_layouts(app);
   meshcast::tools::add_rays(app);
+  meshcast::tools::add_generate(app);
   meshcast::tools::add_demo(app);
   meshcast::tools::add_bench(app);
   meshcast::tools::add_render(app);

@@ -35,11 +35,12 @@ import os as _os
 import numpy as _np
 
 from . import _meshcast
+from .images import write_png  # noqa: F401
 from ._meshcast import (NO_HIT, Blob, Scene, __version__, features, layouts,  # noqa: F401
                         walker_isa)
 
 __all__ = ["Blob", "Scene", "RaycastingScene", "build", "load", "read_mesh", "layouts", "features",
-           "walker_isa", "NO_HIT", "__version__"]
+           "walker_isa", "write_png", "from_bytes", "Tensor", "NO_HIT", "__version__"]
 
 
 def build(vertices, triangles, layout="auto", max_bytes=0, leaf_size=0, threads=0, name="mesh"):

@@ -143,6 +143,10 @@ home=$tmp/home
 # compiles are this step's.
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# Absolute paths hashed as they are: a base_dir in a machine's ccache.conf
+# would make them relative to each build's folder, and the two builds'
+# folders differ.
+export CCACHE_BASEDIR=
 libonly_options=(-DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF -DMESHCAST_READER=OFF "${launcher[@]}")
 cmake --no-warn-unused-cli -S . -B "$tmp/libonly" -DCMAKE_BUILD_TYPE=Release "${libonly_options[@]}" \
       -DMESHCAST_TOOLS=OFF -DMESHCAST_TESTS=OFF -DMESHCAST_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 \

@@ -55,20 +55,6 @@ py::array real_array(const py::handle& input, const char* what) {
                         " is not a real number type (float32 or float64 expected)");
 }
 
-Ray RayArrays::ray(size_t i) const {
-  Ray r;
-  const uint8_t* o = org + i * org_stride;
-  const uint8_t* d = dir + i * dir_stride;
-  const size_t os = org_double ? 8 : 4, ds = dir_double ? 8 : 4;
-  for (int k = 0; k < 3; ++k) {
-    r.org[k] = float(read_real(o + k * os, org_double));
-    r.dir[k] = float(read_real(d + k * ds, dir_double));
-  }
-  r.tmax = tmax(i);
-  r.tmin = tmin(i);
-  return r;
-}
-
 RayD RayArrays::ray_d(size_t i) const {
   RayD r;
   const uint8_t* o = org + i * org_stride;
@@ -81,6 +67,11 @@ RayD RayArrays::ray_d(size_t i) const {
   r.tmax = tmax(i);
   r.tmin = tmin(i);
   return r;
+}
+
+Ray RayArrays::ray(size_t i) const {
+  const RayD r = ray_d(i);
+  return {{float(r.org[0]), float(r.org[1]), float(r.org[2])}, {r.dir[0], r.dir[1], r.dir[2]}, r.tmax, r.tmin};
 }
 
 RayArrays rays_from_six(const py::handle& input) {
@@ -292,6 +283,17 @@ Cull parse_cull(const std::string& name) {
   if (name == "back") return Cull::Back;
   if (name == "front") return Cull::Front;
   throw py::value_error("cull \"" + name + "\": none, back or front");
+}
+
+void check_out_keys(const py::object& out, bool instance) {
+  if (out.is_none()) return;
+  if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
+  for (auto item : out.cast<py::dict>()) {
+    const std::string key = py::str(item.first);
+    if (key != "t" && key != "triangle" && key != "uv" && !(instance && key == "instance"))
+      throw py::value_error("out[\"" + key + "\"]: the answer has no such array (t, " +
+                            (instance ? "instance, " : "") + "triangle, uv)");
+  }
 }
 
 }  // namespace meshcast::python

@@ -83,6 +83,10 @@ void vertex_box(const py::handle& vertices, double lo[3], double hi[3]);
 template <class T>
 py::array_t<T> answer_array(const py::object& out, const char* key, const std::vector<py::ssize_t>& shape);
 
+// out= must be None or a dict whose keys the answer has: t, triangle, uv,
+// and instance where `instance` (ValueError otherwise).
+void check_out_keys(const py::object& out, bool instance);
+
 // "closest", "any", "all"; "none", "back", "front": ValueError otherwise.
 Query parse_query(const std::string& name);
 Cull parse_cull(const std::string& name);

@@ -7,6 +7,7 @@
 
 #include "builder/auto_layout.h"
 #include "meshcast/build.h"
+#include "python/src/answers.h"
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
 #if MESHCAST_READER
@@ -40,32 +41,6 @@ host::Caster& PyBlob::vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& l
 
 namespace {
 
-// The answers of a closest or any hit cast, in the rays' shape.
-struct HitArrays {
-  py::array_t<float> t;
-  py::array_t<uint32_t> triangle;
-  py::array_t<float> uv;
-  float* t_out = nullptr;
-  uint32_t* triangle_out = nullptr;
-  float* uv_out = nullptr;
-  void write(size_t i, const Hit& h) const {
-    t_out[i] = h.t;
-    triangle_out[i] = h.triangle;
-    if (uv_out) uv_out[2 * i] = h.u, uv_out[2 * i + 1] = h.v;
-  }
-};
-
-void check_out_keys(const py::object& out, std::initializer_list<const char*> keys) {
-  if (out.is_none()) return;
-  if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
-  for (auto item : out.cast<py::dict>()) {
-    const std::string key = py::str(item.first);
-    bool known = false;
-    for (const char* k : keys) known |= key == k;
-    if (!known) throw py::value_error("out[\"" + key + "\"]: the answer has no such array");
-  }
-}
-
 py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::handle& directions,
                    const py::handle& t_min, const py::handle& t_max, const std::string& query_name,
                    const std::string& cull_name, long long max_hits, bool uv, const py::object& out,
@@ -79,7 +54,6 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
   const BlobTarget target{blob.view()};
-  py::dict answer;
 
   if (query == Query::All) {
     if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
@@ -101,47 +75,10 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
       }
     }
     raise_for_refused(rays, all.refused);
-    const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(all.hits());
-    py::array_t<uint32_t> found({n}), triangle({h});
-    py::array_t<int64_t> offsets({n + 1});
-    py::array_t<float> t({h});
-    py::array_t<float> uvs;
-    if (uv) uvs = py::array_t<float>({h, py::ssize_t(2)});
-    uint32_t* found_out = found.mutable_data();
-    int64_t* offsets_out = offsets.mutable_data();
-    float* t_out = t.mutable_data();
-    uint32_t* triangle_out = triangle.mutable_data();
-    float* uv_out = uv ? uvs.mutable_data() : nullptr;
-    {
-      py::gil_scoped_release release;
-      all.gather([&](size_t i, uint32_t f, size_t offset) { found_out[i] = f, offsets_out[i] = int64_t(offset); },
-                 [&](size_t j, const Hit& hit) {
-                   t_out[j] = hit.t;
-                   triangle_out[j] = hit.triangle;
-                   if (uv_out) uv_out[2 * j] = hit.u, uv_out[2 * j + 1] = hit.v;
-                 });
-      offsets_out[rays.count] = int64_t(all.hits());
-    }
-    answer["found"] = found;
-    answer["offsets"] = offsets;
-    answer["t"] = t;
-    answer["triangle"] = triangle;
-    if (uv) answer["uv"] = uvs;
-    return answer;
+    return all_hits_answer(all, rays.count, uv);
   }
 
-  check_out_keys(out, {"t", "triangle", "uv"});
-  HitArrays a;
-  a.t = answer_array<float>(out, "t", rays.shape);
-  a.triangle = answer_array<uint32_t>(out, "triangle", rays.shape);
-  a.t_out = a.t.mutable_data();
-  a.triangle_out = a.triangle.mutable_data();
-  if (uv) {
-    std::vector<py::ssize_t> shape = rays.shape;
-    shape.push_back(2);
-    a.uv = answer_array<float>(out, "uv", shape);
-    a.uv_out = a.uv.mutable_data();
-  }
+  const OneHitAnswer<Hit> a(out, rays.shape, uv);
   uint64_t refused = 0;
   {
     py::gil_scoped_release release;
@@ -163,10 +100,7 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
     }
   }
   raise_for_refused(rays, refused);
-  answer["t"] = a.t;
-  answer["triangle"] = a.triangle;
-  if (uv) answer["uv"] = a.uv;
-  return answer;
+  return a.dict();
 }
 
 std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,

@@ -195,14 +195,8 @@ class RaycastingScene {
   }
 
   py::array count_intersections(const py::handle& rays_in, long long nthreads) {
-    RayArrays rays = rays_from_six(rays_in);
-    AllHits<SceneTarget> all;
-    {
-      py::gil_scoped_release release;
-      commit();
-      all = cast_all(SceneTarget{scene_}, rays, Cull::None, HitOutputs::None, kMaxHitsLimit, thread_count(nthreads));
-    }
-    raise_for_refused(rays, all.refused);
+    const RayArrays rays = rays_from_six(rays_in);
+    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::None, nthreads);
     py::array_t<int32_t> counts(rays.shape);
     int32_t* out = counts.mutable_data();
     {
@@ -217,14 +211,8 @@ class RaycastingScene {
   }
 
   py::dict list_intersections(const py::handle& rays_in, long long nthreads) {
-    RayArrays rays = rays_from_six(rays_in);
-    AllHits<SceneTarget> all;
-    {
-      py::gil_scoped_release release;
-      commit();
-      all = cast_all(SceneTarget{scene_}, rays, Cull::None, HitOutputs::Uv, kMaxHitsLimit, thread_count(nthreads));
-    }
-    raise_for_refused(rays, all.refused);
+    const RayArrays rays = rays_from_six(rays_in);
+    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::Uv, nthreads);
     // The crossings of each ray, then the arrays of their total.
     std::vector<SceneHit> listed;
     std::vector<uint32_t> splits_of(rays.count + 1, 0);
@@ -287,6 +275,19 @@ class RaycastingScene {
   }
 
  private:
+  // Every hit of every ray (as many as a row keeps: kMaxHitsLimit; the
+  // rest counted), for the crossings to be told from.
+  AllHits<SceneTarget> every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads) {
+    const uint32_t threads = thread_count(nthreads);
+    AllHits<SceneTarget> all;
+    {
+      py::gil_scoped_release release;
+      commit();
+      all = cast_all(SceneTarget{scene_}, rays, Cull::None, outputs, kMaxHitsLimit, threads);
+    }
+    raise_for_refused(rays, all.refused);
+    return all;
+  }
   // The geometries added so far become what casts see, once.
   void commit() {
     std::lock_guard<std::mutex> lock(mutex_);

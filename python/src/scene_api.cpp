@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "meshcast/scene.h"
+#include "python/src/answers.h"
 #include "python/src/arrays.h"
 #include "python/src/blob_api.h"
 #include "python/src/cast.h"
@@ -65,7 +66,6 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
   const SceneTarget target{s.scene, checked_mask(mask)};
-  py::dict answer;
 
   if (query == Query::All) {
     if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
@@ -75,75 +75,17 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
       all = cast_all(target, rays, cull, outputs, kept, threads);
     }
     raise_for_refused(rays, all.refused);
-    const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(all.hits());
-    py::array_t<uint32_t> found({n}), instance({h}), triangle({h});
-    py::array_t<int64_t> offsets({n + 1});
-    py::array_t<float> t({h});
-    py::array_t<float> uvs;
-    if (uv) uvs = py::array_t<float>({h, py::ssize_t(2)});
-    uint32_t* found_out = found.mutable_data();
-    int64_t* offsets_out = offsets.mutable_data();
-    float* t_out = t.mutable_data();
-    uint32_t* instance_out = instance.mutable_data();
-    uint32_t* triangle_out = triangle.mutable_data();
-    float* uv_out = uv ? uvs.mutable_data() : nullptr;
-    {
-      py::gil_scoped_release release;
-      all.gather([&](size_t i, uint32_t f, size_t offset) { found_out[i] = f, offsets_out[i] = int64_t(offset); },
-                 [&](size_t j, const SceneHit& hit) {
-                   t_out[j] = hit.t;
-                   instance_out[j] = hit.instance;
-                   triangle_out[j] = hit.triangle;
-                   if (uv_out) uv_out[2 * j] = hit.u, uv_out[2 * j + 1] = hit.v;
-                 });
-      offsets_out[rays.count] = int64_t(all.hits());
-    }
-    answer["found"] = found;
-    answer["offsets"] = offsets;
-    answer["t"] = t;
-    answer["instance"] = instance;
-    answer["triangle"] = triangle;
-    if (uv) answer["uv"] = uvs;
-    return answer;
+    return all_hits_answer(all, rays.count, uv);
   }
 
-  if (!out.is_none()) {
-    if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
-    for (auto item : out.cast<py::dict>()) {
-      const std::string key = py::str(item.first);
-      if (key != "t" && key != "instance" && key != "triangle" && key != "uv")
-        throw py::value_error("out[\"" + key + "\"]: the answer has no such array");
-    }
-  }
-  py::array_t<float> t = answer_array<float>(out, "t", rays.shape);
-  py::array_t<uint32_t> instance = answer_array<uint32_t>(out, "instance", rays.shape);
-  py::array_t<uint32_t> triangle = answer_array<uint32_t>(out, "triangle", rays.shape);
-  py::array_t<float> uvs;
-  if (uv) {
-    std::vector<py::ssize_t> shape = rays.shape;
-    shape.push_back(2);
-    uvs = answer_array<float>(out, "uv", shape);
-  }
-  float* t_out = t.mutable_data();
-  uint32_t* instance_out = instance.mutable_data();
-  uint32_t* triangle_out = triangle.mutable_data();
-  float* uv_out = uv ? uvs.mutable_data() : nullptr;
+  const OneHitAnswer<SceneHit> a(out, rays.shape, uv);
   uint64_t refused = 0;
   {
     py::gil_scoped_release release;
-    refused = cast_hits(target, rays, query, cull, outputs, threads, [&](size_t i, const SceneHit& h) {
-      t_out[i] = h.t;
-      instance_out[i] = h.instance;
-      triangle_out[i] = h.triangle;
-      if (uv_out) uv_out[2 * i] = h.u, uv_out[2 * i + 1] = h.v;
-    });
+    refused = cast_hits(target, rays, query, cull, outputs, threads, [&a](size_t i, const SceneHit& h) { a.write(i, h); });
   }
   raise_for_refused(rays, refused);
-  answer["t"] = t;
-  answer["instance"] = instance;
-  answer["triangle"] = triangle;
-  if (uv) answer["uv"] = uvs;
-  return answer;
+  return a.dict();
 }
 
 }  // namespace

@@ -39,7 +39,10 @@ class CMakeBuild(build_ext):
             sys.exit("meshcast: setup.py builds from the meshcast repository (python/ inside it)")
         out = Path(self.get_ext_fullpath(ext.name)).resolve().parent  # .../meshcast
         build = Path(self.build_temp).resolve() / "cmake"
-        configure = ["cmake", "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
+        # --fresh: pip builds in the source tree, and a cache left by an
+        # earlier build's MESHCAST_CMAKE_ARGS (scalar walkers, say) would
+        # outlive it; the objects are kept, and rebuilt where flags differ.
+        configure = ["cmake", "--fresh", "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
                      "-DMESHCAST_PYTHON=ON", "-DMESHCAST_TOOLS=OFF", "-DMESHCAST_TESTS=OFF",
                      "-DMESHCAST_INSTALL=OFF", "-DMESHCAST_VULKAN=AUTO", "-DMESHCAST_READER=AUTO",
                      f"-DPython3_EXECUTABLE={sys.executable}"]

@@ -179,12 +179,14 @@ awk '/<!-- python install begins/ {on = 1; next} /<!-- python install ends/ {on 
 awk '/<!-- python example begins/ {on = 1; next} /<!-- python example ends/ {on = 0} on && !/^```/' README.md > "$tmp/scan.py"
 [[ $(wc -l < "$tmp/install.sh") -ge 3 && $(wc -l < "$tmp/scan.py") -ge 10 ]] ||
   { echo "FAIL: no Python install lines or example between the README's markers"; exit 1; }
-root=$PWD
+# The venv in the scratch folder, not the repository's .venv (a
+# developer's own, perhaps).
+sed -i "s|\.venv|$tmp/venv|g" "$tmp/install.sh"
 MESHCAST_CMAKE_ARGS="-DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF ${launcher[*]}" bash -e "$tmp/install.sh" > "$tmp/pip.log" 2>&1 ||
   { echo "FAIL: the README's Python install lines"; tail -40 "$tmp/pip.log"; exit 1; }
 echo "  pip install ./python into a venv: $(tail -1 "$tmp/pip.log")"
 mkdir -p "$tmp/scan" && ln -s "$PWD/data" "$tmp/scan/data"
-(cd "$tmp/scan" && "$root/.venv/bin/python" "$tmp/scan.py" > out.txt 2>&1) ||
+(cd "$tmp/scan" && "$tmp/venv/bin/python" "$tmp/scan.py" > out.txt 2>&1) ||
   { echo "FAIL: the README's Python example"; cat "$tmp/scan/out.txt"; exit 1; }
 [[ $(head -c 8 "$tmp/scan/scan.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] ||
   { echo "FAIL: the README's Python example wrote no PNG"; exit 1; }

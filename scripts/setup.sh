@@ -12,7 +12,7 @@ PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgte
           python3)                   # the CLI test parses every --json output with Python's json module
 # The Python package (built into build/python, tested with pytest; its
 # README install lines make a venv): pybind11, numpy, pytest, venv.
-PACKAGES+=(pybind11-dev python3-dev python3-numpy python3-pytest python3-venv)
+PACKAGES+=(pybind11-dev python3-dev python3-numpy python3-pytest python3-venv python3-wheel)
 # ccache: the package test builds the library twice (cmake, then pip) with the same compiles.
 PACKAGES+=(ccache)
 source scripts/packages.sh

@@ -19,10 +19,12 @@ and the triangle test is watertight: a ray through a shared edge or vertex
 never slips between its triangles. The closest or any hit there is one of
 them; ``query="all"`` lists every triangle holding the point, each once,
 while RaycastingScene's count_intersections and list_intersections count
-such a crossing once (once for each facing among the triangles there: a ray
-touching a closed mesh's silhouette edge counts in and out). A ray with a
+such a crossing of one geometry once for each facing among its triangles
+there: one through an edge or a convex vertex, in and out for a ray that
+touches a closed mesh's silhouette edge (so parity tells inside from
+outside), but two for a ray exactly through a saddle vertex. A ray with a
 NaN or infinite component, a zero direction or ``t_min > t_max`` is refused
-with ``ValueError`` naming it.
+with ``ValueError`` naming it (Open3D answers such a ray as a miss).
 
 Arrays: float32 or float64 (other real types are converted once); C-
 contiguous arrays are read where they lie. Every cast releases the GIL and
@@ -107,7 +109,8 @@ class RaycastingScene:
     """Open3D's ``open3d.t.geometry.RaycastingScene``, on meshcast.
 
     Port with a rename: the methods, argument names, result keys, dtypes and
-    sentinels are Open3D's (``t_hit`` inf and ``INVALID_ID`` on a miss). Rays
+    sentinels are Open3D's (``t_hit`` inf and ``INVALID_ID`` on a miss); a
+    NaN ray raises ValueError where Open3D answers a miss. Rays
     are (..., 6) arrays, [ox, oy, oz, dx, dy, dz], float32 or float64: float64
     origins keep their precision, and each geometry is stored about its own
     float64 centre, so scenes far from the origin answer as at the origin.
@@ -143,15 +146,18 @@ class RaycastingScene:
 
     def count_intersections(self, rays, nthreads=0):
         """How many times each ray crosses the meshes for t >= 0 (int32): a
-        crossing through a shared edge or vertex counts once, so the parity
-        tells inside from outside of a closed mesh."""
+        crossing through a shared edge or a convex vertex counts once, so
+        the parity tells inside from outside of a closed mesh (the module's
+        documentation says where it does not)."""
         return _tensors(self._scene.count_intersections(_array(rays), self._threads(nthreads)))
 
     def list_intersections(self, rays, nthreads=0):
-        """Every hit of every ray, Open3D 0.18's layout: ray i's hits are
+        """Every crossing of every ray, Open3D 0.18's layout: ray i's are
         [ray_splits[i], ray_splits[i + 1]) of ray_ids, geometry_ids,
-        primitive_ids, primitive_uvs and t_hit, nearest first (at most 4096
-        a ray are listed; count_intersections counts them all)."""
+        primitive_ids, primitive_uvs and t_hit, nearest first; a crossing
+        through an edge or vertex is listed as count_intersections counts
+        it, by one of its triangles. At most 4096 hits a ray are looked at
+        (a RuntimeWarning says how many were left out)."""
         return _tensors(self._scene.list_intersections(_array(rays), self._threads(nthreads)))
 
     @property

@@ -24,7 +24,7 @@ template <class Record>
 class OneHitAnswer {
  public:
   OneHitAnswer(const py::object& out, const std::vector<py::ssize_t>& shape, bool uv) {
-    check_out_keys(out, kHasInstance<Record>);
+    check_out_keys(out, kHasInstance<Record>, uv);
     t_ = answer_array<float>(out, "t", shape);
     triangle_ = answer_array<uint32_t>(out, "triangle", shape);
     t_out_ = t_.mutable_data();

@@ -2,6 +2,7 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 
@@ -13,6 +14,12 @@ std::string shape_text(const py::array& a) {
   std::string s = "(";
   for (py::ssize_t d = 0; d < a.ndim(); ++d) s += (d ? ", " : "") + std::to_string(a.shape(d));
   return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::string shape_text(const std::vector<py::ssize_t>& shape) {
+  std::string s = "(";
+  for (size_t d = 0; d < shape.size(); ++d) s += (d ? ", " : "") + std::to_string(shape[d]);
+  return s + (shape.size() == 1 ? ",)" : ")");
 }
 
 bool is_double(const py::array& a) { return a.dtype().itemsize() == 8; }
@@ -40,19 +47,22 @@ std::string triple(const double v[3]) {
 py::array real_array(const py::handle& input, const char* what) {
   py::module_ np = py::module_::import("numpy");
   py::array a = np.attr("asarray")(input);
-  const char kind = a.dtype().kind();
-  if (kind == 'f' && (a.dtype().itemsize() == 4 || a.dtype().itemsize() == 8)) {
-    if (!(a.flags() & py::array::c_style)) a = np.attr("ascontiguousarray")(a);
-    return a;
-  }
-  if (kind == 'f' || kind == 'i' || kind == 'u') {
-    // float16 and integers: float32 is exact for float16 and what the
-    // library computes in; float128 keeps what float64 can.
-    const char* to = (kind == 'f' && a.dtype().itemsize() > 8) ? "float64" : "float32";
-    return np.attr("ascontiguousarray")(a, py::arg("dtype") = to);
-  }
-  throw py::value_error(std::string(what) + ": dtype " + py::str(a.dtype()).cast<std::string>() +
-                        " is not a real number type (float32 or float64 expected)");
+  const py::dtype type = a.dtype();
+  const char kind = type.kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::value_error(std::string(what) + ": dtype " + py::str(py::object(type)).cast<std::string>() +
+                          " is not a real number type (float32 or float64 expected)");
+  // float32 and float64 in this machine's byte order are read where they
+  // lie; the rest once converted: other byte orders (a big-endian file's
+  // '>f4') to native, float16 and integers to float32 (exact for float16;
+  // what the library computes in), float128 to float64. asarray with a
+  // dtype keeps a number a 0-d array (ascontiguousarray makes it 1-d).
+  const bool native = type.attr("isnative").cast<bool>();
+  const size_t size = size_t(type.itemsize());
+  const char* to = kind == 'f' && size >= 8 ? "float64" : "float32";
+  if (!(kind == 'f' && (size == 4 || size == 8) && native)) a = np.attr("asarray")(a, py::arg("dtype") = to);
+  if (!(a.flags() & py::array::c_style)) a = np.attr("ascontiguousarray")(a);
+  return a;
 }
 
 RayD RayArrays::ray_d(size_t i) const {
@@ -130,13 +140,9 @@ void set_end(RayArrays& rays, const py::handle& value, const char* name, py::arr
   }
   bool same = size_t(a.ndim()) == rays.shape.size();
   for (size_t k = 0; same && k < rays.shape.size(); ++k) same = a.shape(py::ssize_t(k)) == rays.shape[k];
-  if (!same) {
-    std::string rays_shape = "(";
-    for (size_t k = 0; k < rays.shape.size(); ++k) rays_shape += (k ? ", " : "") + std::to_string(rays.shape[k]);
-    rays_shape += rays.shape.size() == 1 ? ",)" : ")";
+  if (!same)
     throw py::value_error(std::string(name) + ": shape " + shape_text(a) + " is neither a number nor the rays' " +
-                          rays_shape);
-  }
+                          shape_text(rays.shape));
   keep = py::module_::import("numpy").attr("ascontiguousarray")(a, py::arg("dtype") = "float32");
   values = static_cast<const float*>(keep.data());
 }
@@ -148,14 +154,25 @@ void set_segment(RayArrays& rays, const py::handle& t_min, const py::handle& t_m
   set_end(rays, t_max, "t_max", rays.t_max, rays.t_max_scalar, rays.t_max_values);
 }
 
-std::string refusal(const RayArrays& rays, size_t i) {
-  const RayD r = rays.ray_d(i);
+namespace {
+
+std::string number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", x);
+  return text;
+}
+
+}  // namespace
+
+std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
+  RayD r = rays.ray_d(i);
   double o[3], d[3];
   for (int k = 0; k < 3; ++k) {
-    o[k] = r.org[k];
+    // A blob walks the origin rounded to float: that is the one checked.
+    o[k] = float_origin ? double(float(r.org[k])) : r.org[k];
     d[k] = read_real(rays.dir + i * rays.dir_stride + k * (rays.dir_double ? 8 : 4), rays.dir_double);
   }
-  std::string at = "rays[" + std::to_string(i) + "]: ";
+  const std::string at = "rays[" + std::to_string(i) + "]: ";
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(o[k])) return at + "origin " + triple(o) + " is not finite";
   for (int k = 0; k < 3; ++k)
@@ -167,17 +184,16 @@ std::string refusal(const RayArrays& rays, size_t i) {
     if (std::fabs(r.dir[k]) > kMaxDirection) return at + "direction " + triple(d) + " has a component beyond 2^126";
   if (std::fabs(r.dir[0]) < FLT_MIN && std::fabs(r.dir[1]) < FLT_MIN && std::fabs(r.dir[2]) < FLT_MIN)
     return at + "direction " + triple(d) + " is zero (every component below FLT_MIN)";
-  if (std::isnan(r.tmax) || r.tmax < 0) return at + "t_max " + std::to_string(r.tmax) + " is NaN or negative";
-  if (std::isnan(r.tmin) || r.tmin < 0) return at + "t_min " + std::to_string(r.tmin) + " is NaN or negative";
-  if (r.tmin > r.tmax)
-    return at + "t_min " + std::to_string(r.tmin) + " is above t_max " + std::to_string(r.tmax);
+  if (std::isnan(r.tmax) || r.tmax < 0) return at + "t_max " + number(r.tmax) + " is NaN or negative";
+  if (std::isnan(r.tmin) || r.tmin < 0) return at + "t_min " + number(r.tmin) + " is NaN or negative";
+  if (r.tmin > r.tmax) return at + "t_min " + number(r.tmin) + " is above t_max " + number(r.tmax);
   return "";
 }
 
-void raise_for_refused(const RayArrays& rays, uint64_t refused) {
+void raise_for_refused(const RayArrays& rays, uint64_t refused, bool float_origin) {
   if (refused == 0) return;
   for (size_t i = 0; i < rays.count; ++i) {
-    std::string why = refusal(rays, i);
+    std::string why = refusal(rays, i, float_origin);
     if (!why.empty())
       throw py::value_error(why + " (" + std::to_string(refused) + " of " + std::to_string(rays.count) +
                             " rays refused)");
@@ -211,6 +227,8 @@ Mesh mesh_from_arrays(const py::handle& vertices, const py::handle& triangles, c
   if (t.ndim() != 2 || t.shape(1) != 3)
     throw py::value_error("triangles: shape " + shape_text(t) + " is not (T, 3)");
   const size_t vertex_count = size_t(v.shape(0));
+  if (vertex_count > UINT32_MAX)
+    throw py::value_error("vertices: " + std::to_string(vertex_count) + " of them, beyond 2^32 (32-bit indices)");
   // uint64 would wrap negatives; int64 holds every int32, uint32 and int64.
   py::array_t<int64_t> indices = np.attr("ascontiguousarray")(
       kind == 'u' && t.dtype().itemsize() == 8 ? np.attr("minimum")(t, uint64_t(INT64_MAX)) : t,
@@ -250,12 +268,7 @@ py::array_t<T> answer_array(const py::object& out, const char* key, const std::v
                               py::str(py::dtype::of<T>()).cast<std::string>() + " is written");
       bool same = size_t(a.ndim()) == shape.size();
       for (size_t k = 0; same && k < shape.size(); ++k) same = a.shape(py::ssize_t(k)) == shape[k];
-      if (!same) {
-        std::string want = "(";
-        for (size_t k = 0; k < shape.size(); ++k) want += (k ? ", " : "") + std::to_string(shape[k]);
-        want += shape.size() == 1 ? ",)" : ")";
-        throw py::value_error(name + ": shape " + shape_text(a) + " where the answer's is " + want);
-      }
+      if (!same) throw py::value_error(name + ": shape " + shape_text(a) + " where the answer's is " + shape_text(shape));
       if (!(a.flags() & py::array::c_style)) throw py::value_error(name + " is not C-contiguous");
       if (!a.writeable()) throw py::value_error(name + " is read-only");
       return py::reinterpret_borrow<py::array_t<T>>(o);
@@ -285,14 +298,14 @@ Cull parse_cull(const std::string& name) {
   throw py::value_error("cull \"" + name + "\": none, back or front");
 }
 
-void check_out_keys(const py::object& out, bool instance) {
+void check_out_keys(const py::object& out, bool instance, bool uv) {
   if (out.is_none()) return;
   if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
   for (auto item : out.cast<py::dict>()) {
     const std::string key = py::str(item.first);
-    if (key != "t" && key != "triangle" && key != "uv" && !(instance && key == "instance"))
+    if (key != "t" && key != "triangle" && !(uv && key == "uv") && !(instance && key == "instance"))
       throw py::value_error("out[\"" + key + "\"]: the answer has no such array (t, " +
-                            (instance ? "instance, " : "") + "triangle, uv)");
+                            (instance ? "instance, " : "") + "triangle" + (uv ? ", uv" : "; uv with uv=True") + ")");
   }
 }
 

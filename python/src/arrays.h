@@ -62,12 +62,13 @@ void set_segment(RayArrays& rays, const py::handle& t_min, const py::handle& t_m
 // a reader would look, or "" for a ray the walkers take. What they refuse
 // is what ray_is_walkable refuses (meshcast/ray.h); the scene's rays check
 // their origins in double, whatever their type.
-std::string refusal(const RayArrays& rays, size_t i);
+// `float_origin`: the origin as a blob walks it, rounded to float.
+std::string refusal(const RayArrays& rays, size_t i, bool float_origin);
 // After a batch that counted `refused` rays not walkable: ValueError for
 // the first ray that has a refusal(); nothing when none has (a scene counts
 // a ray some instance's frame cannot take, which it answers through the
 // others).
-void raise_for_refused(const RayArrays& rays, uint64_t refused);
+void raise_for_refused(const RayArrays& rays, uint64_t refused, bool float_origin);
 
 // A mesh from (V,3) vertices and (T,3) triangles: indices int32, uint32 or
 // int64 (any integer dtype is read), each checked against the vertex count;
@@ -83,9 +84,9 @@ void vertex_box(const py::handle& vertices, double lo[3], double hi[3]);
 template <class T>
 py::array_t<T> answer_array(const py::object& out, const char* key, const std::vector<py::ssize_t>& shape);
 
-// out= must be None or a dict whose keys the answer has: t, triangle, uv,
-// and instance where `instance` (ValueError otherwise).
-void check_out_keys(const py::object& out, bool instance);
+// out= must be None or a dict whose keys the answer has: t, triangle, uv
+// where `uv`, instance where `instance` (ValueError otherwise).
+void check_out_keys(const py::object& out, bool instance, bool uv);
 
 // "closest", "any", "all"; "none", "back", "front": ValueError otherwise.
 Query parse_query(const std::string& name);

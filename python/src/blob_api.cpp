@@ -74,7 +74,7 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
         all = cast_all(target, rays, cull, outputs, kept, threads);
       }
     }
-    raise_for_refused(rays, all.refused);
+    raise_for_refused(rays, all.refused, true);
     return all_hits_answer(all, rays.count, uv);
   }
 
@@ -99,7 +99,7 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
                           [&a](size_t i, const Hit& h) { a.write(i, h); });
     }
   }
-  raise_for_refused(rays, refused);
+  raise_for_refused(rays, refused, true);
   return a.dict();
 }
 

@@ -30,18 +30,21 @@ struct BlobTarget {
   }
 };
 
-// A scene walks double-origin rays (a float32 origin widened exactly).
+// A scene walks double-origin rays (a float32 origin widened exactly), on
+// the frame committed when the cast began: every chunk of the cast sees
+// that one, whatever another thread commits meanwhile.
 struct SceneTarget {
   using RayRecord = RayD;
   using Record = SceneHit;
-  const Scene& scene;
+  std::shared_ptr<const SceneSnapshot> frame;
   uint8_t mask = 0xFF;
+  SceneTarget(const Scene& scene, uint8_t mask) : frame(scene.snapshot()), mask(mask) {}
   static RayD ray(const RayArrays& rays, size_t i) { return rays.ray_d(i); }
   uint64_t trace(std::span<const RayD> r, std::span<SceneHit> h, HitOutputs o, Query q, Cull c) const {
-    return scene.trace(r, h, o, q, c, mask);
+    return trace_snapshot(*frame, r, h, o, q, c, mask);
   }
   uint64_t trace_all(std::span<const RayD> r, SceneHitLists& lists, HitOutputs o, Cull c) const {
-    return scene.trace_all_hits(r, lists, o, c, mask);
+    return trace_all_hits_snapshot(*frame, r, lists, o, c, mask);
   }
 };
 

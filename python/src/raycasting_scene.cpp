@@ -33,10 +33,13 @@ constexpr uint32_t kInvalidId = 0xFFFFFFFFu;  // Open3D's RaycastingScene.INVALI
 void storage_centre(const double lo[3], const double hi[3], double centre[3]) {
   double extent = 0;
   for (int k = 0; k < 3; ++k) extent = std::fmax(extent, hi[k] - lo[k]);
-  const double g = extent > 0 && std::isfinite(extent) ? std::exp2(std::ceil(std::log2(extent))) : 1.0;
+  int exponent = 1;  // extent = m 2^exponent, m in [0.5, 1): 2^exponent >= extent, exactly
+  if (extent > 0 && std::isfinite(extent)) std::frexp(extent, &exponent);
+  const double g = std::ldexp(1.0, exponent);
   for (int k = 0; k < 3; ++k) {
     const double mid = 0.5 * lo[k] + 0.5 * hi[k];
-    centre[k] = std::isfinite(mid) ? std::nearbyint(mid / g) * g : 0.0;
+    const double c = std::nearbyint(mid / g) * g;
+    centre[k] = std::isfinite(c) ? c : 0.0;  // a NaN or an overflow is left for check_mesh to name
   }
 }
 
@@ -76,31 +79,40 @@ void unpack_normal(const PackedNormal& p, float out[3]) {
   out[0] = float(x / length), out[1] = float(y / length), out[2] = float(z / length);
 }
 
+// A geometry's normals, and every geometry's as a cast sees them.
+using GeometryNormals = std::shared_ptr<const std::vector<PackedNormal>>;
+using Normals = std::vector<GeometryNormals>;
+
 // Where a ray crosses a mesh exactly on an edge or a vertex, the watertight
 // test reports every triangle there (its edge function is exactly 0 for
 // each), each at its own t, equal but for rounding. Open3D's users count
 // crossings (inside/outside tests by parity, the surfaces a LiDAR return
-// passed): hits within 2^-20 of each other's t make one crossing for each
-// facing among them. Through an edge or vertex into a closed mesh the
-// triangles all face the ray alike: one crossing. A ray that only touches
-// the mesh there (a silhouette edge) meets a front face and a back face:
-// two, in and out, and the parity stays right.
+// passed): hits of one geometry within 2^-20 of each other's t make one
+// crossing for each facing among them. Through an edge, or a convex
+// vertex, into a closed mesh the triangles all face the ray alike: one
+// crossing. A ray that only touches the mesh there (a silhouette edge)
+// meets a front face and a back face: two, in and out, and the parity
+// stays right. Not decided right: a ray exactly through a saddle vertex
+// (triangles around it facing both ways although the ray crosses once)
+// counts two; two surfaces of one geometry closer than 2^-20 of t count
+// one.
 template <class Keep>
-void crossings(std::span<const SceneHit> row, const float dir[3],
-               const std::vector<std::vector<PackedNormal>>& normals, const Keep& keep) {
+void crossings(std::span<const SceneHit> row, const float dir[3], const Normals& normals, const Keep& keep) {
   for (size_t g = 0; g < row.size();) {
     const float t0 = row[g].t;
+    const uint32_t geometry = row[g].instance;
     const float tol = std::ldexp(std::fabs(t0), -20);
     bool front = false, back = false;
     size_t end = g;
-    for (; end < row.size() && row[end].t - t0 <= tol; ++end) {
+    do {  // the first hit always, so a group ends even on a NaN t
       float n[3];
-      unpack_normal(normals[row[end].instance][row[end].triangle], n);
+      unpack_normal((*normals[geometry])[row[end].triangle], n);
       const bool faces_back = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0;
       bool& seen = faces_back ? back : front;
       if (!seen) keep(row[end]);
       seen = true;
-    }
+      ++end;
+    } while (end < row.size() && row[end].instance == geometry && row[end].t - t0 <= tol);
     g = end;
   }
 }
@@ -111,9 +123,13 @@ class RaycastingScene {
     double lo[3], hi[3], centre[3];
     vertex_box(vertices, lo, hi);
     storage_centre(lo, hi, centre);
-    const std::string name = "geometry " + std::to_string(normals_.size());
+    std::string name;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      name = "geometry " + std::to_string(normals_.size());
+    }
     Mesh mesh = mesh_from_arrays(vertices, triangles, centre);
-    std::vector<PackedNormal> normals(mesh.triangle_count());
+    auto normals = std::make_shared<std::vector<PackedNormal>>(mesh.triangle_count());
     std::vector<uint8_t> blob;
     {
       py::gil_scoped_release release;
@@ -127,7 +143,7 @@ class RaycastingScene {
         }
         const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                              e1[0] * e2[1] - e1[1] * e2[0]};
-        normals[i] = pack_normal(n);
+        (*normals)[i] = pack_normal(n);
       }
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -142,6 +158,7 @@ class RaycastingScene {
 
   py::dict cast_rays(const py::handle& rays_in, long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
+    const uint32_t threads = thread_count(nthreads);
     std::vector<py::ssize_t> shape2 = rays.shape, shape3 = rays.shape;
     shape2.push_back(2);
     shape3.push_back(3);
@@ -155,19 +172,20 @@ class RaycastingScene {
     uint64_t refused;
     {
       py::gil_scoped_release release;
-      commit();
-      refused = cast_hits(SceneTarget{scene_}, rays, Query::Closest, Cull::None, HitOutputs::Uv, thread_count(nthreads),
+      const Frame f = frame();
+      refused = cast_hits(f.target, rays, Query::Closest, Cull::None, HitOutputs::Uv, threads,
                           [&](size_t i, const SceneHit& h) {
                             t_out[i] = h.t;
                             g_out[i] = h.instance;
                             p_out[i] = h.triangle;
                             uv_out[2 * i] = h.u;
                             uv_out[2 * i + 1] = h.v;
-                            unpack_normal(h.instance != kNoHit ? normals_[h.instance][h.triangle] : PackedNormal{},
+                            unpack_normal(h.instance != kNoHit ? (*(*f.normals)[h.instance])[h.triangle]
+                                                               : PackedNormal{},
                                           n_out + 3 * i);
                           });
     }
-    raise_for_refused(rays, refused);
+    raise_for_refused(rays, refused, false);
     py::dict answer;
     answer["t_hit"] = t;
     answer["geometry_ids"] = geometry;
@@ -181,29 +199,30 @@ class RaycastingScene {
                             long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
     set_segment(rays, tnear, tfar);
+    const uint32_t threads = thread_count(nthreads);
     py::array_t<bool> occluded(rays.shape);
     bool* out = occluded.mutable_data();
     uint64_t refused;
     {
       py::gil_scoped_release release;
-      commit();
-      refused = cast_hits(SceneTarget{scene_}, rays, Query::Any, Cull::None, HitOutputs::None, thread_count(nthreads),
+      refused = cast_hits(frame().target, rays, Query::Any, Cull::None, HitOutputs::None, threads,
                           [out](size_t i, const SceneHit& h) { out[i] = h.triangle != kNoHit; });
     }
-    raise_for_refused(rays, refused);
+    raise_for_refused(rays, refused, false);
     return occluded;
   }
 
   py::array count_intersections(const py::handle& rays_in, long long nthreads) {
     const RayArrays rays = rays_from_six(rays_in);
-    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::None, nthreads);
+    std::shared_ptr<const Normals> normals;
+    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::None, nthreads, normals);
     py::array_t<int32_t> counts(rays.shape);
     int32_t* out = counts.mutable_data();
     {
       py::gil_scoped_release release;
       all.for_each_row([&](size_t i, uint32_t found, std::span<const SceneHit> row) {
         uint64_t n = found - row.size();  // beyond the kept hits: each counted
-        crossings(row, rays.ray(i).dir, normals_, [&n](const SceneHit&) { ++n; });
+        crossings(row, rays.ray(i).dir, *normals, [&n](const SceneHit&) { ++n; });
         out[i] = int32_t(std::min<uint64_t>(n, INT32_MAX));
       });
     }
@@ -212,7 +231,11 @@ class RaycastingScene {
 
   py::dict list_intersections(const py::handle& rays_in, long long nthreads) {
     const RayArrays rays = rays_from_six(rays_in);
-    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::Uv, nthreads);
+    if (rays.count >= UINT32_MAX)
+      throw py::value_error("list_intersections: " + std::to_string(rays.count) +
+                            " rays; ray_ids and ray_splits are 32-bit (at most 2^32 - 2 rays)");
+    std::shared_ptr<const Normals> normals;
+    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::Uv, nthreads, normals);
     // The crossings of each ray, then the arrays of their total.
     std::vector<SceneHit> listed;
     std::vector<uint32_t> splits_of(rays.count + 1, 0);
@@ -223,10 +246,13 @@ class RaycastingScene {
       all.for_each_row([&](size_t i, uint32_t found, std::span<const SceneHit> row) {
         splits_of[i] = uint32_t(listed.size());
         dropped += found - row.size();
-        crossings(row, rays.ray(i).dir, normals_, [&listed](const SceneHit& h) { listed.push_back(h); });
+        crossings(row, rays.ray(i).dir, *normals, [&listed](const SceneHit& h) { listed.push_back(h); });
       });
       splits_of[rays.count] = uint32_t(listed.size());
     }
+    if (listed.size() > UINT32_MAX)
+      throw py::value_error("list_intersections: " + std::to_string(listed.size()) +
+                            " hits; ray_splits is 32-bit (at most 2^32 - 1 hits a call: cast fewer rays)");
     const py::ssize_t n = py::ssize_t(rays.count), h = py::ssize_t(listed.size());
     py::array_t<uint32_t> splits({n + 1}), ray_ids({h}), geometry({h}), primitive({h});
     py::array_t<float> uvs({h, py::ssize_t(2)}), t({h});
@@ -250,12 +276,13 @@ class RaycastingScene {
           t_out[j] = hit.t;
         }
     }
-    if (dropped)
-      PyErr_WarnEx(PyExc_RuntimeWarning,
-                   ("list_intersections: " + std::to_string(dropped) + " hits beyond " +
-                    std::to_string(kMaxHitsLimit) + " a ray were left out (count_intersections counts them)")
-                       .c_str(),
-                   1);
+    // A warning the caller's filter turns into an error raises it.
+    if (dropped && PyErr_WarnEx(PyExc_RuntimeWarning,
+                                ("list_intersections: " + std::to_string(dropped) + " hits beyond " +
+                                 std::to_string(kMaxHitsLimit) + " a ray were left out (count_intersections counts them)")
+                                    .c_str(),
+                                1) < 0)
+      throw py::error_already_set();
     py::dict answer;
     answer["ray_splits"] = splits;
     answer["ray_ids"] = ray_ids;
@@ -269,34 +296,49 @@ class RaycastingScene {
   // The bytes the scene holds: every geometry's blob, its normals and the
   // top level over the instances.
   size_t nbytes() const {
+    std::lock_guard<std::mutex> lock(mutex_);
     size_t bytes = scene_.owned_blob_bytes() + scene_.top_level_bytes();
-    for (const auto& n : normals_) bytes += n.capacity() * sizeof(PackedNormal);
+    for (const auto& n : normals_) bytes += n->capacity() * sizeof(PackedNormal);
     return bytes;
   }
 
  private:
+  // What a cast walks: the last commit of the scene and the normals of its
+  // geometries, taken together, committing the geometries added since the
+  // last cast first. Casts on other threads keep the frame they took.
+  struct Frame {
+    SceneTarget target;
+    std::shared_ptr<const Normals> normals;
+  };
+  Frame frame() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (changed_) {
+      scene_.commit();
+      committed_normals_ = std::make_shared<const Normals>(normals_);
+      changed_ = false;
+    }
+    return {SceneTarget(scene_, 0xFF), committed_normals_};
+  }
   // Every hit of every ray (as many as a row keeps: kMaxHitsLimit; the
-  // rest counted), for the crossings to be told from.
-  AllHits<SceneTarget> every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads) {
+  // rest counted), for the crossings to be told from, and the normals of
+  // the frame they were found in.
+  AllHits<SceneTarget> every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads,
+                                 std::shared_ptr<const Normals>& normals) {
     const uint32_t threads = thread_count(nthreads);
     AllHits<SceneTarget> all;
     {
       py::gil_scoped_release release;
-      commit();
-      all = cast_all(SceneTarget{scene_}, rays, Cull::None, outputs, kMaxHitsLimit, threads);
+      const Frame f = frame();
+      normals = f.normals;
+      all = cast_all(f.target, rays, Cull::None, outputs, kMaxHitsLimit, threads);
     }
-    raise_for_refused(rays, all.refused);
+    raise_for_refused(rays, all.refused, false);
     return all;
   }
-  // The geometries added so far become what casts see, once.
-  void commit() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (changed_) scene_.commit();
-    changed_ = false;
-  }
-  std::mutex mutex_;
+  mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
-  std::vector<std::vector<PackedNormal>> normals_;  // a triangle's, a geometry's in its order
+  Normals normals_;  // every geometry's, added so far
+  std::shared_ptr<const Normals> committed_normals_ = std::make_shared<const Normals>();
   bool changed_ = false;
 };
 

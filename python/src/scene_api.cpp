@@ -27,8 +27,8 @@ class PyScene {
     blobs.push_back(blob);
     return id;
   }
+  std::vector<std::shared_ptr<PyBlob>> blobs;  // before the scene: they outlive it
   Scene scene;
-  std::vector<std::shared_ptr<PyBlob>> blobs;
   std::vector<Transform> placed;  // each instance's, for set_transform's parts left as they were
 };
 
@@ -65,7 +65,7 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
   set_segment(rays, t_min, t_max);
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
-  const SceneTarget target{s.scene, checked_mask(mask)};
+  const SceneTarget target(s.scene, checked_mask(mask));
 
   if (query == Query::All) {
     if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
@@ -74,7 +74,7 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
       py::gil_scoped_release release;
       all = cast_all(target, rays, cull, outputs, kept, threads);
     }
-    raise_for_refused(rays, all.refused);
+    raise_for_refused(rays, all.refused, false);
     return all_hits_answer(all, rays.count, uv);
   }
 
@@ -84,7 +84,7 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
     py::gil_scoped_release release;
     refused = cast_hits(target, rays, query, cull, outputs, threads, [&a](size_t i, const SceneHit& h) { a.write(i, h); });
   }
-  raise_for_refused(rays, refused);
+  raise_for_refused(rays, refused, false);
   return a.dict();
 }
 
@@ -134,13 +134,10 @@ by casts after commit(). One thread edits and commits; any number cast.)")
           py::arg("instance"), py::arg("enabled"))
       .def(
           "remove_instance", [](PyScene& s, InstanceId i) { s.scene.remove_instance(i); }, py::arg("instance"))
+      // The GIL held: edits from other Python threads wait (the library
+      // takes edits and commits from one thread at a time).
       .def(
-          "commit",
-          [](PyScene& s) {
-            py::gil_scoped_release release;
-            s.scene.commit();
-          },
-          "The edits so far are done: casts from now on see them.")
+          "commit", [](PyScene& s) { s.scene.commit(); }, "The edits so far are done: casts from now on see them.")
       .def_property_readonly("instance_count", [](const PyScene& s) { return s.scene.instance_count(); })
       .def("cast", &cast_scene, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
            py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",

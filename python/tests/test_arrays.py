@@ -5,7 +5,7 @@ import pytest
 
 import meshcast
 import shapes
-from cases import NO_HIT, rays6
+from cases import DEFAULT_LAYOUT, NO_HIT, rays6
 
 
 @pytest.fixture(scope="module")
@@ -198,3 +198,38 @@ def test_inputs_copied_not_kept(soup):
     got = rc.cast_rays(rays6(o, d))
     for k in ("t_hit", "primitive_ids"):
         np.testing.assert_array_equal(np.asarray(got[k]), np.asarray(ref_rc[k]), err_msg=k)
+
+
+def test_other_byte_orders_are_converted():
+    """Big-endian arrays (a '>f4' file read with np.fromfile) answer as the
+    native ones: read in their byte order, not reinterpreted."""
+    v, f = shapes.grid(4, 4)
+    blob = meshcast.build(v, f, layout=DEFAULT_LAYOUT)
+    big = meshcast.build(np.asarray(v, ">f4"), np.asarray(f, ">i8"), layout=DEFAULT_LAYOUT)
+    assert big.to_bytes() == blob.to_bytes()
+    o = np.array([[0.5, 0.5, 2.0], [1.5, 2.5, 3.0]])
+    d = np.array([[0, 0, -1.0], [0, 0, -2.0]])
+    want = blob.cast(o, d)
+    for order in (">f4", ">f8"):
+        got = blob.cast(o.astype(order), d.astype(order), t_max=np.array([5, 5], order))
+        np.testing.assert_array_equal(got["t"], want["t"])
+        np.testing.assert_array_equal(got["triangle"], want["triangle"])
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(np.asarray(v, ">f8"), f)
+    np.testing.assert_array_equal(np.asarray(rc.cast_rays(np.concatenate([o, d], 1).astype(">f4"))["t_hit"]), want["t"])
+
+
+def test_whole_numbers_as_segment_ends():
+    """t_min and t_max as Python ints or numpy scalars of any real type are
+    numbers for every ray, not one-element arrays."""
+    v, f = shapes.grid(4, 4)
+    blob = meshcast.build(v, f, layout=DEFAULT_LAYOUT)
+    o = np.array([[0.5, 0.5, 2.0], [1.5, 2.5, 3.0], [2.5, 0.5, 9.0]])
+    d = np.array([[0, 0, -1.0], [0, 0, -1.0], [0, 0, -1.0]])
+    for t_max in (5, np.float16(5), np.int32(5), 5.0):
+        got = blob.cast(o, d, t_max=t_max, t_min=1)
+        np.testing.assert_array_equal(got["t"], [2.0, 3.0, np.inf])
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    np.testing.assert_array_equal(np.asarray(rc.test_occlusions(np.concatenate([o, d], 1), tnear=0, tfar=5)),
+                                  [True, True, False])

@@ -254,3 +254,36 @@ def test_count_intersections_parity(shape):
     inside = np.asarray(rc.count_intersections(np.concatenate([inside_o, d], axis=1)))
     if np.any(outside != 2) or np.any(inside != 1):
         pytest.fail(f"{shape}: from outside {outside.tolist()} (expected 2), from inside {inside.tolist()} (expected 1)")
+
+
+def test_crossings_of_two_geometries_stay_two():
+    """Two geometries whose surfaces lie at one t are two crossings: only a
+    geometry's own triangles around an edge or vertex make one."""
+    v, f = shapes.grid(2, 2)
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    rc.add_triangles(v, f)
+    rays = np.array([[0.5, 0.25, 1.0, 0, 0, -1.0], [1.0, 1.0, 1.0, 0, 0, -1.0]], np.float32)  # a face; a vertex
+    np.testing.assert_array_equal(np.asarray(rc.count_intersections(rays)), [2, 2])
+    listed = rc.list_intersections(rays)
+    np.testing.assert_array_equal(np.asarray(listed["ray_splits"]), [0, 2, 4])
+    assert sorted(np.asarray(listed["geometry_ids"])[:2].tolist()) == [0, 1]
+
+
+def test_list_intersections_warning_as_error():
+    """More hits on a ray than a row keeps warn; a filter that makes warnings
+    errors raises that error (not a SystemError)."""
+    import warnings
+    n = 4100
+    v = np.array([[0, 0, z] for z in range(n) for _ in range(3)], np.float64)
+    v[1::3, 0] = 1
+    v[2::3, 1] = 1
+    f = np.arange(3 * n).reshape(n, 3)
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    ray = np.array([[0.25, 0.25, -1.0, 0, 0, 1.0]], np.float32)
+    assert int(np.asarray(rc.count_intersections(ray))[0]) == n
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(RuntimeWarning, match="left out"):
+            rc.list_intersections(ray)

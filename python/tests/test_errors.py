@@ -276,3 +276,28 @@ def test_out_of_range_options(grid):
     for edit in (lambda: s.remove_instance(5), lambda: s.set_enabled(5, True), lambda: s.set_flip_facing(5, True),
                  lambda: s.set_transform(5, translation=(1.0, 2.0, 3.0))):
         refused(r"instance", edit)
+
+
+def test_uv_out_needs_uv():
+    """An out= array the cast would not write is refused, not left as it was."""
+    v, f = shapes.grid(2, 2)
+    blob = meshcast.build(v, f)
+    o, d = np.array([[0.5, 0.5, 1.0]]), np.array([[0, 0, -1.0]])
+    with pytest.raises(ValueError, match="uv"):
+        blob.cast(o, d, out={"uv": np.zeros((1, 2), np.float32)})
+    out = {"uv": np.zeros((1, 2), np.float32)}
+    assert blob.cast(o, d, uv=True, out=out)["uv"] is out["uv"]
+
+
+def test_refusal_names_the_ray_and_its_numbers():
+    """The refused ray is the one the walk refused (a blob rounds origins to
+    float32: 2^100 (1 + 2^-40) becomes 2^100, which it takes), and small
+    numbers are printed as numbers, not 0.000000."""
+    v, f = shapes.grid(2, 2)
+    blob = meshcast.build(v, f)
+    o = np.array([[2.0**100 * (1 + 2.0**-40), 0, 0], [np.nan, 0, 0]])
+    d = np.array([[0, 0, -1.0], [0, 0, -1.0]])
+    with pytest.raises(ValueError, match=r"rays\[1\]: origin"):
+        blob.cast(o, d)
+    with pytest.raises(ValueError, match=r"t_max -1\.0+1?e-10 is NaN or negative"):
+        blob.cast(o[:1] * 0, d[:1], t_max=-1e-10)

@@ -187,3 +187,21 @@ def test_gil_released_during_cast(api):
     during = spinner_rate(casts)
     assert during > 0.1 * alone, (f"a Python thread ran {during:.0f} iterations/s during {api} against "
                                   f"{alone:.0f} while this thread slept: the cast seems to hold the GIL")
+
+
+def test_a_forked_child_casts():
+    """multiprocessing's fork on Linux: the child has the parent's worker
+    pools but none of their threads; its casts make pools of its own."""
+    import multiprocessing
+    v, f = shapes.sphere()
+    blob = meshcast.build(v, f)
+    o, d = shapes.rays(v, 4000, seed=2)
+    want = blob.cast(o, d, nthreads=2)["triangle"]
+    ctx = multiprocessing.get_context("fork")
+    with ctx.Pool(1) as pool:
+        got = pool.apply_async(_cast_in_child, (blob.to_bytes(), o, d)).get(timeout=60)
+    np.testing.assert_array_equal(got, want)
+
+
+def _cast_in_child(data, o, d):
+    return meshcast.from_bytes(data).cast(o, d, nthreads=2)["triangle"]

@@ -7,6 +7,8 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <cstring>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -47,11 +49,52 @@ struct RayArrays {
   float tmax(size_t i) const { return t_max_values ? t_max_values[i] : t_max_scalar; }
   // Ray i, its origin rounded to float (a blob's own frame is float).
   Ray ray(size_t i) const;
+  // Rays [begin, begin + n) as the walk's records (Ray or RayD), each
+  // origin less `offset` in double (a stored geometry's centre; null: none)
+  // and then, for a Ray, rounded to float, as a scene brings a ray into an
+  // instance's frame: one loop for each pair of the arrays' types, the
+  // batch's innermost copy.
+  template <class R>
+  void pack(size_t begin, size_t n, R* out, const double* offset = nullptr) const;
   // Ray i with its origin as the caller gave it (float32 widened exactly).
   RayD ray_d(size_t i) const;
 };
 
 // origins may also be one point (3,) that every ray starts from.
+namespace detail {
+template <class O, class D, class R>
+void pack_rays(const RayArrays& a, size_t begin, size_t n, R* out, const double* offset) {
+  using Coordinate = std::remove_reference_t<decltype(out->org[0])>;
+  const double zero[3] = {0, 0, 0};
+  const double* c = offset ? offset : zero;
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* o = a.org + (begin + i) * a.org_stride;
+    const uint8_t* d = a.dir + (begin + i) * a.dir_stride;
+    O oc[3];
+    D dc[3];
+    std::memcpy(oc, o, sizeof oc);  // numpy may hand over unaligned memory
+    std::memcpy(dc, d, sizeof dc);
+    R& r = out[i];
+    for (int k = 0; k < 3; ++k) {
+      r.org[k] = Coordinate(double(oc[k]) - c[k]);
+      r.dir[k] = float(dc[k]);
+    }
+    r.tmax = a.tmax(begin + i);
+    r.tmin = a.tmin(begin + i);
+  }
+}
+}  // namespace detail
+
+template <class R>
+void RayArrays::pack(size_t begin, size_t n, R* out, const double* offset) const {
+  if (org_double)
+    dir_double ? detail::pack_rays<double, double>(*this, begin, n, out, offset)
+               : detail::pack_rays<double, float>(*this, begin, n, out, offset);
+  else
+    dir_double ? detail::pack_rays<float, double>(*this, begin, n, out, offset)
+               : detail::pack_rays<float, float>(*this, begin, n, out, offset);
+}
+
 RayArrays rays_from_pair(const py::handle& origins, const py::handle& directions);
 RayArrays rays_from_six(const py::handle& rays);
 // t_min and t_max: None for the default, a number, or an array of the

@@ -21,7 +21,8 @@ struct BlobTarget {
   using RayRecord = Ray;
   using Record = Hit;
   const BlobView& view;
-  static Ray ray(const RayArrays& rays, size_t i) { return rays.ray(i); }
+  const double* offset = nullptr;  // subtracted from every origin first (a geometry's centre)
+  void pack(const RayArrays& rays, size_t begin, size_t n, Ray* out) const { rays.pack(begin, n, out, offset); }
   uint64_t trace(std::span<const Ray> r, std::span<Hit> h, HitOutputs o, Query q, Cull c) const {
     return view.trace(r, h, o, q, c);
   }
@@ -39,7 +40,7 @@ struct SceneTarget {
   std::shared_ptr<const SceneSnapshot> frame;
   uint8_t mask = 0xFF;
   SceneTarget(const Scene& scene, uint8_t mask) : frame(scene.snapshot()), mask(mask) {}
-  static RayD ray(const RayArrays& rays, size_t i) { return rays.ray_d(i); }
+  static void pack(const RayArrays& rays, size_t begin, size_t n, RayD* out) { rays.pack(begin, n, out); }
   uint64_t trace(std::span<const RayD> r, std::span<SceneHit> h, HitOutputs o, Query q, Cull c) const {
     return trace_snapshot(*frame, r, h, o, q, c, mask);
   }
@@ -64,7 +65,7 @@ uint64_t cast_hits(const Target& target, const RayArrays& rays, Query query, Cul
     const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
     packed.resize(n);
     hits.resize(n);
-    for (size_t i = 0; i < n; ++i) packed[i] = Target::ray(rays, begin + i);
+    target.pack(rays, begin, n, packed.data());
     const uint64_t r = target.trace(std::span<const RayRecord>(packed.data(), n), std::span<Record>(hits.data(), n),
                                     outputs, query, cull);
     if (r) refused += r;
@@ -116,7 +117,7 @@ AllHits<Target> cast_all(const Target& target, const RayArrays& rays, Cull cull,
     static thread_local std::vector<RayRecord> packed;
     const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
     packed.resize(n);
-    for (size_t i = 0; i < n; ++i) packed[i] = Target::ray(rays, begin + i);
+    target.pack(rays, begin, n, packed.data());
     auto& rows = all.parts[chunk];
     rows.max_hits = max_hits;
     const uint64_t r = target.trace_all(std::span<const RayRecord>(packed.data(), n), rows, outputs, cull);

@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "meshcast/build.h"
@@ -96,11 +97,18 @@ using Normals = std::vector<GeometryNormals>;
 // (triangles around it facing both ways although the ray crosses once)
 // counts two; two surfaces of one geometry closer than 2^-20 of t count
 // one.
-template <class Keep>
-void crossings(std::span<const SceneHit> row, const float dir[3], const Normals& normals, const Keep& keep) {
+// The geometry of a hit: a scene's instance, or 0 for the one geometry's
+// blob walked alone (RaycastingScene::Frame).
+inline uint32_t geometry_of(const SceneHit& h) { return h.instance; }
+inline uint32_t geometry_of(const Hit& h) { return h.triangle == kNoHit ? kNoHit : 0; }
+inline SceneHit scene_hit(const SceneHit& h) { return h; }
+inline SceneHit scene_hit(const Hit& h) { return {h.t, geometry_of(h), h.triangle, h.u, h.v}; }
+
+template <class Record, class Keep>
+void crossings(std::span<const Record> row, const float dir[3], const Normals& normals, const Keep& keep) {
   for (size_t g = 0; g < row.size();) {
     const float t0 = row[g].t;
-    const uint32_t geometry = row[g].instance;
+    const uint32_t geometry = geometry_of(row[g]);
     const float tol = std::ldexp(std::fabs(t0), -20);
     bool front = false, back = false;
     size_t end = g;
@@ -112,7 +120,7 @@ void crossings(std::span<const SceneHit> row, const float dir[3], const Normals&
       if (!seen) keep(row[end]);
       seen = true;
       ++end;
-    } while (end < row.size() && row[end].instance == geometry && row[end].t - t0 <= tol);
+    } while (end < row.size() && geometry_of(row[end]) == geometry && row[end].t - t0 <= tol);
     g = end;
   }
 }
@@ -146,12 +154,17 @@ class RaycastingScene {
         (*normals)[i] = pack_normal(n);
       }
     }
+    blob.shrink_to_fit();  // the builder's spare capacity would be memory the scene holds
     std::lock_guard<std::mutex> lock(mutex_);
     const MeshId mesh_id = scene_.add_mesh(std::move(blob), name);
     Transform placed;
     for (int k = 0; k < 3; ++k) placed.translation[k] = centre[k];
     const InstanceId id = scene_.add_instance(mesh_id, placed);
     normals_.push_back(std::move(normals));
+    if (id == 0) {  // the one geometry's blob (validated again: cheap beside its build)
+      first_.emplace(scene_.mesh_blob(mesh_id), name);
+      std::copy(centre, centre + 3, first_centre_);
+    }
     changed_ = true;
     return id;
   }
@@ -173,17 +186,19 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      refused = cast_hits(f.target, rays, Query::Closest, Cull::None, HitOutputs::Uv, threads,
-                          [&](size_t i, const SceneHit& h) {
-                            t_out[i] = h.t;
-                            g_out[i] = h.instance;
-                            p_out[i] = h.triangle;
-                            uv_out[2 * i] = h.u;
-                            uv_out[2 * i + 1] = h.v;
-                            unpack_normal(h.instance != kNoHit ? (*(*f.normals)[h.instance])[h.triangle]
-                                                               : PackedNormal{},
-                                          n_out + 3 * i);
-                          });
+      refused = f.visit([&](const auto& target) {
+        return cast_hits(target, rays, Query::Closest, Cull::None, HitOutputs::Uv, threads,
+                         [&](size_t i, const auto& h) {
+                           const uint32_t geometry = geometry_of(h);
+                           t_out[i] = h.t;
+                           g_out[i] = geometry;
+                           p_out[i] = h.triangle;
+                           uv_out[2 * i] = h.u;
+                           uv_out[2 * i + 1] = h.v;
+                           unpack_normal(geometry != kNoHit ? (*(*f.normals)[geometry])[h.triangle] : PackedNormal{},
+                                         n_out + 3 * i);
+                         });
+      });
     }
     raise_for_refused(rays, refused, false);
     py::dict answer;
@@ -205,8 +220,10 @@ class RaycastingScene {
     uint64_t refused;
     {
       py::gil_scoped_release release;
-      refused = cast_hits(frame().target, rays, Query::Any, Cull::None, HitOutputs::None, threads,
-                          [out](size_t i, const SceneHit& h) { out[i] = h.triangle != kNoHit; });
+      refused = frame().visit([&](const auto& target) {
+        return cast_hits(target, rays, Query::Any, Cull::None, HitOutputs::None, threads,
+                         [out](size_t i, const auto& h) { out[i] = h.triangle != kNoHit; });
+      });
     }
     raise_for_refused(rays, refused, false);
     return occluded;
@@ -214,18 +231,15 @@ class RaycastingScene {
 
   py::array count_intersections(const py::handle& rays_in, long long nthreads) {
     const RayArrays rays = rays_from_six(rays_in);
-    std::shared_ptr<const Normals> normals;
-    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::None, nthreads, normals);
     py::array_t<int32_t> counts(rays.shape);
     int32_t* out = counts.mutable_data();
-    {
-      py::gil_scoped_release release;
-      all.for_each_row([&](size_t i, uint32_t found, std::span<const SceneHit> row) {
+    every_hit(rays, HitOutputs::None, nthreads, [&](const auto& all, const Normals& normals) {
+      all.for_each_row([&](size_t i, uint32_t found, auto row) {
         uint64_t n = found - row.size();  // beyond the kept hits: each counted
-        crossings(row, rays.ray(i).dir, *normals, [&n](const SceneHit&) { ++n; });
+        crossings(row, rays.ray(i).dir, normals, [&n](const auto&) { ++n; });
         out[i] = int32_t(std::min<uint64_t>(n, INT32_MAX));
       });
-    }
+    });
     return counts;
   }
 
@@ -234,22 +248,19 @@ class RaycastingScene {
     if (rays.count >= UINT32_MAX)
       throw py::value_error("list_intersections: " + std::to_string(rays.count) +
                             " rays; ray_ids and ray_splits are 32-bit (at most 2^32 - 2 rays)");
-    std::shared_ptr<const Normals> normals;
-    const AllHits<SceneTarget> all = every_hit(rays, HitOutputs::Uv, nthreads, normals);
     // The crossings of each ray, then the arrays of their total.
     std::vector<SceneHit> listed;
     std::vector<uint32_t> splits_of(rays.count + 1, 0);
     uint64_t dropped = 0;
-    {
-      py::gil_scoped_release release;
+    every_hit(rays, HitOutputs::Uv, nthreads, [&](const auto& all, const Normals& normals) {
       listed.reserve(all.hits());
-      all.for_each_row([&](size_t i, uint32_t found, std::span<const SceneHit> row) {
+      all.for_each_row([&](size_t i, uint32_t found, auto row) {
         splits_of[i] = uint32_t(listed.size());
         dropped += found - row.size();
-        crossings(row, rays.ray(i).dir, *normals, [&listed](const SceneHit& h) { listed.push_back(h); });
+        crossings(row, rays.ray(i).dir, normals, [&listed](const auto& h) { listed.push_back(scene_hit(h)); });
       });
       splits_of[rays.count] = uint32_t(listed.size());
-    }
+    });
     if (listed.size() > UINT32_MAX)
       throw py::value_error("list_intersections: " + std::to_string(listed.size()) +
                             " hits; ray_splits is 32-bit (at most 2^32 - 1 hits a call: cast fewer rays)");
@@ -305,10 +316,21 @@ class RaycastingScene {
  private:
   // What a cast walks: the last commit of the scene and the normals of its
   // geometries, taken together, committing the geometries added since the
-  // last cast first. Casts on other threads keep the frame they took.
+  // last cast first. Casts on other threads keep the frame they took. With
+  // one geometry its blob is walked alone, each ray brought into its frame
+  // as the scene would bring it (the centre subtracted in double, then
+  // rounded to float; the instance's rotation is the identity): the same
+  // answers without the scene's top level and instance records.
   struct Frame {
     SceneTarget target;
     std::shared_ptr<const Normals> normals;
+    const BlobView* single = nullptr;
+    const double* centre = nullptr;
+    template <class Fn>
+    auto visit(const Fn& fn) const -> decltype(fn(target)) {
+      if (single) return fn(BlobTarget{*single, centre});
+      return fn(target);
+    }
   };
   Frame frame() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -317,28 +339,35 @@ class RaycastingScene {
       committed_normals_ = std::make_shared<const Normals>(normals_);
       changed_ = false;
     }
-    return {SceneTarget(scene_, 0xFF), committed_normals_};
+    Frame f{SceneTarget(scene_, 0xFF), committed_normals_};
+    if (committed_normals_->size() == 1) f.single = &*first_, f.centre = first_centre_;
+    return f;
   }
   // Every hit of every ray (as many as a row keeps: kMaxHitsLimit; the
-  // rest counted), for the crossings to be told from, and the normals of
-  // the frame they were found in.
-  AllHits<SceneTarget> every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads,
-                                 std::shared_ptr<const Normals>& normals) {
+  // rest counted), handed to use(all, normals) without the GIL, for the
+  // crossings to be told from with the normals of the frame they were
+  // found in.
+  template <class Use>
+  void every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads, const Use& use) {
     const uint32_t threads = thread_count(nthreads);
-    AllHits<SceneTarget> all;
+    uint64_t refused = 0;
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      normals = f.normals;
-      all = cast_all(f.target, rays, Cull::None, outputs, kMaxHitsLimit, threads);
+      f.visit([&](const auto& target) {
+        const auto all = cast_all(target, rays, Cull::None, outputs, kMaxHitsLimit, threads);
+        refused = all.refused;
+        if (refused == 0) use(all, *f.normals);
+      });
     }
-    raise_for_refused(rays, all.refused, false);
-    return all;
+    raise_for_refused(rays, refused, false);
   }
   mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
   Normals normals_;  // every geometry's, added so far
   std::shared_ptr<const Normals> committed_normals_ = std::make_shared<const Normals>();
+  std::optional<BlobView> first_;  // geometry 0's blob (in the scene), walked alone while it is the only one
+  double first_centre_[3] = {0, 0, 0};
   bool changed_ = false;
 };
 

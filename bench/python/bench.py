@@ -384,7 +384,105 @@ def main():
     scaling_sizes = [n for n in (10_000, 100_000, 1_000_000) if n <= max(args.rays, 10_000)]
     cpp_vs_python = []  # mismatched hit counts
 
-    for mesh_name, mesh_path in meshes:
+    def report(meshes_done, final):
+        """Writes bench.md (and the plot) from the rows so far: after each mesh, so that a run cut
+        short leaves its finished meshes' tables; the last call, after every mesh, is the whole report."""
+        plot_note = plot_all_hits(args.out, scaling_series) if scaling_series else "no all-hits rows: no plot"
+        elapsed = time.time() - started
+        md = ["# meshcast's Python package against the C++ library and Open3D", ""]
+        if not final:
+            md += [f"**Partial: {meshes_done} of {len(meshes)} meshes done; the run goes on.**", ""]
+        md += [f"- Date: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; run took {elapsed / 60:.1f} min",
+               f"- Load average (1, 5, 15 min) at the start {load_at_start}, at the end {load_average()}: the machine is "
+               f"shared, so timings carry other processes' noise",
+               f"- meshcast from {build_dir} (bin/meshcast and python/)",
+               f"- Processor: {processor_name()}; {cores} logical cores (\"threads {cores}\" = every core: meshcast "
+               f"nthreads=0, Open3D nthreads=0{', meshcast trace --threads 0' if cli.has_threads else ''})",
+               f"- meshcast {meshcast.__version__} (walker ISA {meshcast.walker_isa()}), "
+               f"Blob layout {DEFAULT_LAYOUT}; Python {sys.version.split()[0]}, numpy {np.__version__}",
+               f"- Open3D {o3d_version}. {shim_note}",
+               f"- {args.rays} rays a set, `meshcast rays --seed 1`; median of {args.rounds} interleaved rounds (each "
+               f"round times every contender once, the order rotated each round); C++: `meshcast trace --repeat "
+               f"{args.cpp_repeat} --json`, its ns_per_ray (median of its passes), the same blob file and rays file.",
+               "- t_max: closest, count and all are cast with t_max = inf by every contender (Open3D's cast_rays and "
+               "count_intersections take none; the C++ side reads a copy of the rays file with t_max inf); any "
+               "(occlusion) uses the rays file's t_max (Open3D: test_occlusions(tnear=0, tfar=t_max), the same on every ray).",
+               "- count: Blob.cast(query=\"all\", max_hits=1)'s \"found\" (every hit counted, a hit on a shared edge once "
+               "a triangle), RaycastingScene.count_intersections, `trace --query all --max-hits 1`, Open3D "
+               "count_intersections. all: Blob.cast(query=\"all\", max_hits=4096), RaycastingScene.list_intersections, "
+               "`trace --query all --max-hits 4096`; Open3D 0.16.1 has no list_intersections (see the re-query table).",
+               ""]
+        md += [f"- {n}" for n in notes] + [""]
+        md += ["## Answers checked before timing", "",
+               "Where two answers name the same triangle with t more than 1e-4 apart (relative), the float64 intersection "
+               "of the ray with that triangle's plane (its float32 corners as read) says whose t is nearer. The default "
+               "layout stores vertices on a grid of 2^-18 of the mesh's extent (its stated error), so hits close to the "
+               "ray's origin (probe rays start at the surface) or at grazing angles can differ from float32 answers by more "
+               "than 1e-4 relative while the hit points lie within 1e-4 of the diagonal. Open3D is timed on a ray set when "
+               "the same hit holds on at least 99.9% of the checked rays.", ""] + [f"- {c}" for c in correctness]
+        md += ["- C++ `meshcast trace` against Blob.cast, rays hit (and hits, for count and all) on every timed row: " +
+               ("equal on every row" if not cpp_vs_python else "differ on: " + "; ".join(cpp_vs_python)), ""]
+        md += ["## Rays a second (millions), median of the rounds", "",
+               "Blob.cast / C++: time ratio, the binding's overhead (target <= 1.10, ✗ past it). Open3D / Blob.cast: "
+               "Open3D's time over meshcast's (above 1: meshcast faster).", "",
+               markdown_table(["mesh", "rays", "query", "threads", "Blob.cast", "RaycastingScene", "C++ trace", "Open3D",
+                               "Blob.cast / C++", "RaycastingScene / C++", "Open3D / Blob.cast"], throughput_md), ""]
+        md += ["## The binding's overhead, like for like", "",
+               f"Long rays, one thread, millions of rays a second. `meshcast trace --repeat {args.cpp_repeat}` reports the "
+               f"median of {args.cpp_repeat} passes made one after another; here Blob.cast too makes {args.cpp_repeat} calls "
+               f"one after another a round (the median counts), with fresh answer arrays or with out= arrays made once. "
+               f"\"single call\": the table above (one call a round, between other contenders' calls).", "",
+               markdown_table(["mesh", "query", "Blob.cast, single call", f"Blob.cast, median of {args.cpp_repeat}",
+                               f"Blob.cast out=, median of {args.cpp_repeat}", "C++ trace", "single / C++",
+                               f"median of {args.cpp_repeat} / C++", "out= / C++"], overhead_md), ""]
+        md += ["## Build time and memory", "",
+               "Build: meshcast.build (layout " + DEFAULT_LAYOUT + "); meshcast RaycastingScene(nthreads) + add_triangles + "
+               "the first cast_rays of one ray; Open3D RaycastingScene(nthreads) + add_triangles + the first cast_rays of "
+               "one ray (its BVH is built then). Milliseconds, median of the rounds.", "",
+               markdown_table(["mesh", "triangles", "threads", "meshcast.build ms", "RaycastingScene ms", "Open3D ms",
+                               "Open3D / meshcast.build", "Open3D / RaycastingScene"], [r for r in build_md if r[0] != "memory"]), "",
+               "Memory, bytes a triangle: meshcast Blob.nbytes and RaycastingScene.nbytes (exact); Open3D: resident growth "
+               "from before add_triangles to after the first cast (child run with MALLOC_MMAP_THRESHOLD_=65536, "
+               "MALLOC_TRIM_THRESHOLD_=0; median of 3 builds). Target: meshcast / Open3D <= 0.25.", "",
+               markdown_table(["mesh", "triangles", "Blob", "RaycastingScene", "Open3D RSS growth", "Blob / Open3D",
+                               "RaycastingScene / Open3D"], [r[1] for r in build_md if r[0] == "memory"]), ""]
+        md += ["## Every hit of each ray: meshcast against Open3D's re-query", "",
+               f"Long rays, every core. Open3D 0.16.1 has no list_intersections; its users cast_rays, move each ray that hit "
+               f"past its hit (o + (t_hit + eps/|d|) d, eps = 1e-5 x the mesh's diagonal), and cast again until every ray "
+               f"misses. Hits: list_intersections (a crossing through a shared edge once) / Blob.cast all (every triangle "
+               f"holding the point) / re-query; the comparison is per ray against list_intersections. Seconds. "
+               f"Plot: all_hits.png.{' ' + plot_note if plot_note else ''}", "",
+               markdown_table(["mesh", "rays", "list_intersections s", "Blob.cast all s", "Open3D re-query s",
+                               "hits list / Blob / re-query", "re-query / list time", "re-query / Blob time",
+                               "re-query against the list"], scaling_md), ""]
+        misses = [r for r in ratio_rows if not r[7]]
+        md += ["## Ratios against the targets", ""]
+        for name, target in (("Blob.cast / C++ time", "<= 1.10"), ("Open3D / Blob.cast time", ">= 1"),
+                             ("Open3D / RaycastingScene time", ">= 1"),
+                             ("Open3D re-query / list_intersections time", ">= 5"),
+                             ("Open3D re-query / Blob.cast all time", ">= 5"),
+                             ("blob.nbytes / Open3D RSS growth", "<= 0.25"),
+                             ("RaycastingScene.nbytes / Open3D RSS growth", "<= 0.25")):
+            these = [r for r in ratio_rows if r[4] == name]
+            if not these:
+                md.append(f"- {name} (target {target}): no rows")
+                continue
+            bad = [r for r in these if not r[7]]
+            values = [r[5] for r in these]
+            md.append(f"- {name} (target {target}): {len(these) - len(bad)}/{len(these)} rows meet it; range "
+                      f"{fmt(min(values))}..{fmt(max(values))}" +
+                      ("" if not bad else "; misses: " + "; ".join(
+                          (f"{r[0]}: {fmt(r[5])}" if r[2] == "memory" else
+                           f"{r[0]} {r[1]} {r[2]} threads {r[3]}: {fmt(r[5])}") for r in bad)))
+        md.append("")
+        text = "\n".join(md)
+        if final:
+            print(text)
+        with open(os.path.join(args.out, "bench.md"), "w") as f:
+            f.write(text)
+        return misses
+
+    for mesh_index, (mesh_name, mesh_path) in enumerate(meshes):
         try:
             log(f"== {mesh_name}: {mesh_path}")
             V, F = meshcast.read_mesh(mesh_path)
@@ -724,103 +822,16 @@ def main():
             for f in os.listdir(tmp):
                 if f.startswith(mesh_name + "."):
                     os.remove(os.path.join(tmp, f))
+        if mesh_index + 1 < len(meshes):
+            csv_file.flush()
+            report(mesh_index + 1, final=False)
 
     for peer in (plain, o3d_timing, o3d_memory):
         if peer is not None:
             peer.close()
     csv_file.close()
-
-    # --- Report -------------------------------------------------------------------------------------
-    plot_note = plot_all_hits(args.out, scaling_series) if scaling_series else "no all-hits rows: no plot"
+    misses = report(len(meshes), final=True)
     elapsed = time.time() - started
-    md = ["# meshcast's Python package against the C++ library and Open3D", ""]
-    md += [f"- Date: {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC; run took {elapsed / 60:.1f} min",
-           f"- Load average (1, 5, 15 min) at the start {load_at_start}, at the end {load_average()}: the machine is "
-           f"shared, so timings carry other processes' noise",
-           f"- meshcast from {build_dir} (bin/meshcast and python/)",
-           f"- Processor: {processor_name()}; {cores} logical cores (\"threads {cores}\" = every core: meshcast "
-           f"nthreads=0, Open3D nthreads=0{', meshcast trace --threads 0' if cli.has_threads else ''})",
-           f"- meshcast {meshcast.__version__} (walker ISA {meshcast.walker_isa()}), "
-           f"Blob layout {DEFAULT_LAYOUT}; Python {sys.version.split()[0]}, numpy {np.__version__}",
-           f"- Open3D {o3d_version}. {shim_note}",
-           f"- {args.rays} rays a set, `meshcast rays --seed 1`; median of {args.rounds} interleaved rounds (each "
-           f"round times every contender once, the order rotated each round); C++: `meshcast trace --repeat "
-           f"{args.cpp_repeat} --json`, its ns_per_ray (median of its passes), the same blob file and rays file.",
-           "- t_max: closest, count and all are cast with t_max = inf by every contender (Open3D's cast_rays and "
-           "count_intersections take none; the C++ side reads a copy of the rays file with t_max inf); any "
-           "(occlusion) uses the rays file's t_max (Open3D: test_occlusions(tnear=0, tfar=t_max), the same on every ray).",
-           "- count: Blob.cast(query=\"all\", max_hits=1)'s \"found\" (every hit counted, a hit on a shared edge once "
-           "a triangle), RaycastingScene.count_intersections, `trace --query all --max-hits 1`, Open3D "
-           "count_intersections. all: Blob.cast(query=\"all\", max_hits=4096), RaycastingScene.list_intersections, "
-           "`trace --query all --max-hits 4096`; Open3D 0.16.1 has no list_intersections (see the re-query table).",
-           ""]
-    md += [f"- {n}" for n in notes] + [""]
-    md += ["## Answers checked before timing", "",
-           "Where two answers name the same triangle with t more than 1e-4 apart (relative), the float64 intersection "
-           "of the ray with that triangle's plane (its float32 corners as read) says whose t is nearer. The default "
-           "layout stores vertices on a grid of 2^-18 of the mesh's extent (its stated error), so hits close to the "
-           "ray's origin (probe rays start at the surface) or at grazing angles can differ from float32 answers by more "
-           "than 1e-4 relative while the hit points lie within 1e-4 of the diagonal. Open3D is timed on a ray set when "
-           "the same hit holds on at least 99.9% of the checked rays.", ""] + [f"- {c}" for c in correctness]
-    md += ["- C++ `meshcast trace` against Blob.cast, rays hit (and hits, for count and all) on every timed row: " +
-           ("equal on every row" if not cpp_vs_python else "differ on: " + "; ".join(cpp_vs_python)), ""]
-    md += ["## Rays a second (millions), median of the rounds", "",
-           "Blob.cast / C++: time ratio, the binding's overhead (target <= 1.10, ✗ past it). Open3D / Blob.cast: "
-           "Open3D's time over meshcast's (above 1: meshcast faster).", "",
-           markdown_table(["mesh", "rays", "query", "threads", "Blob.cast", "RaycastingScene", "C++ trace", "Open3D",
-                           "Blob.cast / C++", "RaycastingScene / C++", "Open3D / Blob.cast"], throughput_md), ""]
-    md += ["## The binding's overhead, like for like", "",
-           f"Long rays, one thread, millions of rays a second. `meshcast trace --repeat {args.cpp_repeat}` reports the "
-           f"median of {args.cpp_repeat} passes made one after another; here Blob.cast too makes {args.cpp_repeat} calls "
-           f"one after another a round (the median counts), with fresh answer arrays or with out= arrays made once. "
-           f"\"single call\": the table above (one call a round, between other contenders' calls).", "",
-           markdown_table(["mesh", "query", "Blob.cast, single call", f"Blob.cast, median of {args.cpp_repeat}",
-                           f"Blob.cast out=, median of {args.cpp_repeat}", "C++ trace", "single / C++",
-                           f"median of {args.cpp_repeat} / C++", "out= / C++"], overhead_md), ""]
-    md += ["## Build time and memory", "",
-           "Build: meshcast.build (layout " + DEFAULT_LAYOUT + "); meshcast RaycastingScene(nthreads) + add_triangles + "
-           "the first cast_rays of one ray; Open3D RaycastingScene(nthreads) + add_triangles + the first cast_rays of "
-           "one ray (its BVH is built then). Milliseconds, median of the rounds.", "",
-           markdown_table(["mesh", "triangles", "threads", "meshcast.build ms", "RaycastingScene ms", "Open3D ms",
-                           "Open3D / meshcast.build", "Open3D / RaycastingScene"], [r for r in build_md if r[0] != "memory"]), "",
-           "Memory, bytes a triangle: meshcast Blob.nbytes and RaycastingScene.nbytes (exact); Open3D: resident growth "
-           "from before add_triangles to after the first cast (child run with MALLOC_MMAP_THRESHOLD_=65536, "
-           "MALLOC_TRIM_THRESHOLD_=0; median of 3 builds). Target: meshcast / Open3D <= 0.25.", "",
-           markdown_table(["mesh", "triangles", "Blob", "RaycastingScene", "Open3D RSS growth", "Blob / Open3D",
-                           "RaycastingScene / Open3D"], [r[1] for r in build_md if r[0] == "memory"]), ""]
-    md += ["## Every hit of each ray: meshcast against Open3D's re-query", "",
-           f"Long rays, every core. Open3D 0.16.1 has no list_intersections; its users cast_rays, move each ray that hit "
-           f"past its hit (o + (t_hit + eps/|d|) d, eps = 1e-5 x the mesh's diagonal), and cast again until every ray "
-           f"misses. Hits: list_intersections (a crossing through a shared edge once) / Blob.cast all (every triangle "
-           f"holding the point) / re-query; the comparison is per ray against list_intersections. Seconds. "
-           f"Plot: all_hits.png.{' ' + plot_note if plot_note else ''}", "",
-           markdown_table(["mesh", "rays", "list_intersections s", "Blob.cast all s", "Open3D re-query s",
-                           "hits list / Blob / re-query", "re-query / list time", "re-query / Blob time",
-                           "re-query against the list"], scaling_md), ""]
-    misses = [r for r in ratio_rows if not r[7]]
-    md += ["## Ratios against the targets", ""]
-    for name, target in (("Blob.cast / C++ time", "<= 1.10"), ("Open3D / Blob.cast time", ">= 1"),
-                         ("Open3D / RaycastingScene time", ">= 1"),
-                         ("Open3D re-query / list_intersections time", ">= 5"),
-                         ("Open3D re-query / Blob.cast all time", ">= 5"),
-                         ("blob.nbytes / Open3D RSS growth", "<= 0.25"),
-                         ("RaycastingScene.nbytes / Open3D RSS growth", "<= 0.25")):
-        these = [r for r in ratio_rows if r[4] == name]
-        if not these:
-            md.append(f"- {name} (target {target}): no rows")
-            continue
-        bad = [r for r in these if not r[7]]
-        values = [r[5] for r in these]
-        md.append(f"- {name} (target {target}): {len(these) - len(bad)}/{len(these)} rows meet it; range "
-                  f"{fmt(min(values))}..{fmt(max(values))}" +
-                  ("" if not bad else "; misses: " + "; ".join(
-                      (f"{r[0]}: {fmt(r[5])}" if r[2] == "memory" else
-                       f"{r[0]} {r[1]} {r[2]} threads {r[3]}: {fmt(r[5])}") for r in bad)))
-    md.append("")
-    text = "\n".join(md)
-    print(text)
-    with open(os.path.join(args.out, "bench.md"), "w") as f:
-        f.write(text)
     shutil.rmtree(tmp, ignore_errors=True)
     log(f"wrote {args.out}/bench.md, bench.csv, all_hits.png ({elapsed / 60:.1f} min); {len(misses)} ratio rows miss")
 

@@ -438,7 +438,8 @@ def main():
         md += ["## Build time and memory", "",
                "Build: meshcast.build (layout " + DEFAULT_LAYOUT + "); meshcast RaycastingScene(nthreads) + add_triangles + "
                "the first cast_rays of one ray; Open3D RaycastingScene(nthreads) + add_triangles + the first cast_rays of "
-               "one ray (its BVH is built then). Milliseconds, median of the rounds.", "",
+               "one ray (its BVH is built then). Milliseconds, median of the rounds. meshcast's RaycastingScene(nthreads) "
+               "takes nthreads for its casts; its add_triangles builds on every core whatever it is.", "",
                markdown_table(["mesh", "triangles", "threads", "meshcast.build ms", "RaycastingScene ms", "Open3D ms",
                                "Open3D / meshcast.build", "Open3D / RaycastingScene"], [r for r in build_md if r[0] != "memory"]), "",
                "Memory, bytes a triangle: meshcast Blob.nbytes and RaycastingScene.nbytes (exact); Open3D: resident growth "

@@ -589,7 +589,8 @@ def main():
                     plane intersection with this answer, with meshcast's])"""
                     both_miss = ~np.isfinite(ref) & ~np.isfinite(t)
                     both_hit = np.isfinite(ref) & np.isfinite(t)
-                    gap = np.abs(t.astype(np.float64) - ref, where=both_hit, out=np.full(n, np.inf))
+                    gap = np.full(n, np.inf)
+                    gap[both_hit] = np.abs(t[both_hit].astype(np.float64) - ref[both_hit])
                     same_t = both_hit & (gap <= T_AGREE * np.abs(ref))
                     same_hit = both_hit & ((tri == ref_tri) | (gap * d_len <= POINT_AGREE * diag))
                     split = both_hit & (tri == ref_tri) & ~same_t

@@ -119,6 +119,8 @@ class RaycastingScene:
     INVALID_ID = _meshcast.INVALID_ID
 
     def __init__(self, nthreads=0):
+        # nthreads: add_triangles' build threads, and the casts' unless a
+        # call names its own (0: every core).
         self._scene = _meshcast._RaycastingScene(nthreads)
         self._nthreads = nthreads
 

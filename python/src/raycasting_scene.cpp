@@ -127,6 +127,7 @@ void crossings(std::span<const Record> row, const float dir[3], const Normals& n
 
 class RaycastingScene {
  public:
+  explicit RaycastingScene(uint32_t build_threads) : build_threads_(build_threads) {}
   uint32_t add_triangles(const py::handle& vertices, const py::handle& triangles) {
     double lo[3], hi[3], centre[3];
     vertex_box(vertices, lo, hi);
@@ -141,7 +142,9 @@ class RaycastingScene {
     std::vector<uint8_t> blob;
     {
       py::gil_scoped_release release;
-      blob = build_blob(mesh, BuildOptions{}, name);
+      BuildOptions options;
+      options.threads = build_threads_;
+      blob = build_blob(mesh, options, name);
       // Open3D's primitive_normals: the unit geometric normal (b - a) x (c - a).
       for (size_t i = 0; i < mesh.triangle_count(); ++i) {
         double e1[3], e2[3];
@@ -362,6 +365,7 @@ class RaycastingScene {
     }
     raise_for_refused(rays, refused, false);
   }
+  const uint32_t build_threads_;  // BuildOptions::threads of add_triangles (0: every core)
   mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
   Normals normals_;  // every geometry's, added so far
@@ -376,8 +380,8 @@ class RaycastingScene {
 void register_raycasting_scene(py::module_& m) {
   py::class_<RaycastingScene>(m, "_RaycastingScene")
       .def(py::init([](long long nthreads) {
-             thread_count(nthreads);  // checked: Open3D takes it here
-             return std::make_unique<RaycastingScene>();
+             // Open3D's: the threads its build uses (0: every core).
+             return std::make_unique<RaycastingScene>(nthreads == 0 ? 0 : thread_count(nthreads));
            }),
            py::arg("nthreads") = 0)
       .def("add_triangles", &RaycastingScene::add_triangles, py::arg("vertex_positions"), py::arg("triangle_indices"))

@@ -103,4 +103,39 @@ py::dict all_hits_answer(const AllHits<Target>& all, size_t rays, bool uv) {
   return d;
 }
 
+// query="all" answers arrays of the hits' count: out= has nothing to fill.
+inline void refuse_out_for_all(Query query, const py::object& out) {
+  if (query == Query::All && !out.is_none())
+    throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
+}
+
+// A cast on the library's threads answered as Blob.cast and Scene.cast
+// answer: one hit a ray (into out= where given) or every hit's rows.
+// `float_origin`: the walk rounds origins to float (a blob), for the
+// refusal's message.
+template <class Target>
+py::dict cast_answer(const Target& target, const RayArrays& rays, Query query, Cull cull, HitOutputs outputs,
+                     uint32_t max_hits, uint32_t threads, const py::object& out, bool float_origin) {
+  using Record = typename Target::Record;
+  const bool uv = has(outputs, HitOutputs::Uv);
+  refuse_out_for_all(query, out);
+  if (query == Query::All) {
+    AllHits<Target> all;
+    {
+      py::gil_scoped_release release;
+      all = cast_all(target, rays, cull, outputs, max_hits, threads);
+    }
+    raise_for_refused(rays, all.refused, float_origin);
+    return all_hits_answer(all, rays.count, uv);
+  }
+  const OneHitAnswer<Record> a(out, rays.shape, uv);
+  uint64_t refused = 0;
+  {
+    py::gil_scoped_release release;
+    refused = cast_hits(target, rays, query, cull, outputs, threads, [&a](size_t i, const Record& h) { a.write(i, h); });
+  }
+  raise_for_refused(rays, refused, float_origin);
+  return a.dict();
+}
+
 }  // namespace meshcast::python

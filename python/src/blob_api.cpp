@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <optional>
 
 #include "builder/auto_layout.h"
 #include "meshcast/build.h"
@@ -41,6 +42,37 @@ host::Caster& PyBlob::vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& l
 
 namespace {
 
+// backend="vulkan": the batch through the blob's Vulkan caster (the host
+// layer's GPU method for its layout), answered as the CPU's casts are.
+py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery& query, HitOutputs outputs,
+                     const py::object& out) {
+  const bool uv = has(outputs, HitOutputs::Uv);
+  refuse_out_for_all(query.query, out);
+  std::optional<OneHitAnswer<Hit>> one;
+  if (query.query != Query::All) one.emplace(out, rays.shape, uv);
+  AllHits<BlobTarget> all;
+  all.parts.resize(1);
+  all.parts[0].max_hits = query.max_hits;
+  {
+    py::gil_scoped_release release;
+    std::vector<Ray> packed(rays.count);
+    rays.pack(0, rays.count, packed.data());
+    std::unique_lock<std::mutex> lock;
+    host::Caster& caster = blob.vulkan(outputs, lock);
+    const host::Ticket ticket = caster.submit(packed, query);
+    if (one) {
+      std::vector<Hit> hits(rays.count);
+      caster.wait(ticket, hits);
+      for (size_t i = 0; i < rays.count; ++i) one->write(i, hits[i]);
+    } else {
+      caster.wait(ticket, all.parts[0]);
+    }
+    for (const Ray& r : packed) all.refused += !ray_is_walkable(r);
+  }
+  raise_for_refused(rays, all.refused, true);
+  return one ? one->dict() : all_hits_answer(all, rays.count, uv);
+}
+
 py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::handle& directions,
                    const py::handle& t_min, const py::handle& t_max, const std::string& query_name,
                    const std::string& cull_name, long long max_hits, bool uv, const py::object& out,
@@ -53,54 +85,8 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
   set_segment(rays, t_min, t_max);
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
-  const BlobTarget target{blob.view()};
-
-  if (query == Query::All) {
-    if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
-    AllHits<BlobTarget> all;
-    {
-      py::gil_scoped_release release;
-      if (backend == "vulkan") {
-        std::vector<Ray> packed(rays.count);
-        for (size_t i = 0; i < rays.count; ++i) packed[i] = rays.ray(i);
-        std::unique_lock<std::mutex> lock;
-        host::Caster& caster = const_cast<PyBlob&>(blob).vulkan(outputs, lock);
-        all.parts.resize(1);
-        all.parts[0].max_hits = kept;
-        const host::Ticket ticket = caster.submit(packed, {Query::All, cull, kept});
-        caster.wait(ticket, all.parts[0]);
-        for (const Ray& r : packed) all.refused += !ray_is_walkable(r);
-      } else {
-        all = cast_all(target, rays, cull, outputs, kept, threads);
-      }
-    }
-    raise_for_refused(rays, all.refused, true);
-    return all_hits_answer(all, rays.count, uv);
-  }
-
-  const OneHitAnswer<Hit> a(out, rays.shape, uv);
-  uint64_t refused = 0;
-  {
-    py::gil_scoped_release release;
-    if (backend == "vulkan") {
-      std::vector<Ray> packed(rays.count);
-      for (size_t i = 0; i < rays.count; ++i) packed[i] = rays.ray(i);
-      std::vector<Hit> hits(rays.count);
-      std::unique_lock<std::mutex> lock;
-      host::Caster& caster = const_cast<PyBlob&>(blob).vulkan(outputs, lock);
-      const host::Ticket ticket = caster.submit(packed, {query, cull, kept});
-      caster.wait(ticket, hits);
-      for (size_t i = 0; i < rays.count; ++i) {
-        a.write(i, hits[i]);
-        refused += !ray_is_walkable(packed[i]);
-      }
-    } else {
-      refused = cast_hits(target, rays, query, cull, outputs, threads,
-                          [&a](size_t i, const Hit& h) { a.write(i, h); });
-    }
-  }
-  raise_for_refused(rays, refused, true);
-  return a.dict();
+  if (backend == "vulkan") return cast_on_gpu(const_cast<PyBlob&>(blob), rays, {query, cull, kept}, outputs, out);
+  return cast_answer(BlobTarget{blob.view()}, rays, query, cull, outputs, kept, threads, out, true);
 }
 
 std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,

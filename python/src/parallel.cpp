@@ -52,8 +52,6 @@ host::WorkerPool& pool_of(uint32_t threads) {
 
 }  // namespace
 
-Chunks plan_chunks(size_t count, uint32_t threads) { return host::plan_chunks(count, threads); }
-
 void for_each_chunk(const Chunks& plan, uint32_t threads, const std::function<void(size_t)>& chunk) {
   host::for_each_chunk(plan, threads > 1 ? &pool_of(threads) : nullptr, chunk);
 }

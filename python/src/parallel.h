@@ -10,12 +10,11 @@
 namespace meshcast::python {
 
 using host::Chunks;
+using host::plan_chunks;
 
 // The threads a call may use: `requested`, or every core for 0;
 // std::invalid_argument (Python's ValueError) outside 0..1024.
 uint32_t thread_count(long long requested, const char* what = "nthreads");
-
-Chunks plan_chunks(size_t count, uint32_t threads);
 
 // host::for_each_chunk on `threads` threads (1: the calling thread alone,
 // no pool). Called without the GIL: chunk must not touch Python objects.

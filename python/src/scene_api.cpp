@@ -65,27 +65,7 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
   set_segment(rays, t_min, t_max);
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
-  const SceneTarget target(s.scene, checked_mask(mask));
-
-  if (query == Query::All) {
-    if (!out.is_none()) throw py::value_error("out: query \"all\" answers arrays of the hits' count, made by the cast");
-    AllHits<SceneTarget> all;
-    {
-      py::gil_scoped_release release;
-      all = cast_all(target, rays, cull, outputs, kept, threads);
-    }
-    raise_for_refused(rays, all.refused, false);
-    return all_hits_answer(all, rays.count, uv);
-  }
-
-  const OneHitAnswer<SceneHit> a(out, rays.shape, uv);
-  uint64_t refused = 0;
-  {
-    py::gil_scoped_release release;
-    refused = cast_hits(target, rays, query, cull, outputs, threads, [&a](size_t i, const SceneHit& h) { a.write(i, h); });
-  }
-  raise_for_refused(rays, refused, false);
-  return a.dict();
+  return cast_answer(SceneTarget(s.scene, checked_mask(mask)), rays, query, cull, outputs, kept, threads, out, false);
 }
 
 }  // namespace

@@ -96,11 +96,11 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
     }
     if (!ctx) continue;
     for (const gpu::MethodLayout& c : gpu::method_layouts()) {
-      std::fprintf(stderr, "  %s %s on %s\n", in.name.c_str(), c.layout, ctx->device_name().c_str());
+      std::fprintf(stderr, "  %s %s on %s\n", in.name.c_str(), layout_name(c.layout).c_str(), ctx->device_name().c_str());
       std::vector<uint8_t> blob;
       std::unique_ptr<gpu::Method> method;
       try {
-        blob = build_blob(in.mesh, parse_layout(c.layout), in.name);
+        blob = build_blob(in.mesh, parse_layout(layout_name(c.layout)), in.name);
         method = gpu::make_method(*ctx, c.method, blob, in.name);
       } catch (const std::exception&) {  // a limit of the format or the device (maxStorageBufferRange)
         continue;
@@ -113,7 +113,7 @@ std::vector<ErrorRow> bench_error(const std::vector<NamedInput>& meshes, size_t 
         ms.push_back(t.device_ms);
       }
       ErrorRow row;
-      row.backend = "Vulkan " + std::string(c.method) + " (device time)", row.layout = c.layout;
+      row.backend = "Vulkan " + std::string(c.method) + " (device time)", row.layout = layout_name(c.layout);
       row.us_per_ray = median(ms) * 1000.0 / double(rays.size());
       finish(row, blob, hits);
     }

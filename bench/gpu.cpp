@@ -40,7 +40,7 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
                                                    {"BruteForce/Float3SOA128", "41.67 us, 36 B"}};
   std::vector<GpuRow> rows;
   for (const gpu::MethodLayout& c : gpu::method_layouts()) {
-    BuildOptions o = parse_layout(c.layout);
+    BuildOptions o = parse_layout(layout_name(c.layout));
     o.leaf_size = 4;  // the source's GPU table
     std::vector<uint8_t> blob = build_blob(mesh, o, name);
     std::unique_ptr<gpu::Method> method = gpu::make_method(ctx, c.method, blob, name);
@@ -68,8 +68,8 @@ std::vector<GpuRow> bench_gpu(const Mesh& mesh, const std::string& name, size_t 
       all_ms.push_back(ms_of(t));
     }
     const layout::BlobHeader& h = layout::header_of(blob.data());
-    auto figure = seed.find(c.layout);
-    GpuRow row{c.method, c.layout, figure == seed.end() ? "" : figure->second};
+    auto figure = seed.find(layout_name(c.layout));
+    GpuRow row{c.method, layout_name(c.layout), figure == seed.end() ? "" : figure->second};
     row.device_us = median(device_ms) * 1000.0 / double(rays.size());
     row.wall_us = median(wall_ms) * 1000.0 / double(rays.size());
     row.bytes = double(h.vertex_offset + h.vertex_size) / h.triangle_count;

@@ -11,7 +11,7 @@
 #include "bench/peer.h"
 #include "builder/layout_names.h"
 #include "check/generate.h"
-#include "cpu/scene.h"
+#include "scene/snapshot.h"
 #include "meshcast/build.h"
 #include "meshcast/scene.h"
 

@@ -34,7 +34,7 @@ AutoCandidate candidate(const AutoLimits& l, const std::string& layout, uint32_t
 std::string tree_of(const std::string& layout) { return layout.substr(0, layout.find('/')); }
 
 bool readable(const AutoLimits& l, const std::string& layout) {
-  return l.readers.empty() || std::find(l.readers.begin(), l.readers.end(), layout) != l.readers.end();
+  return l.readers.empty() || std::find(l.readers.begin(), l.readers.end(), parse_layout_name(layout)) != l.readers.end();
 }
 
 // The brute-force "tree" and the 128-lane GPU blocks: on the CPU never
@@ -104,13 +104,28 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
   if (!l.readers.empty()) {
     reasons.push_back("CPU and GPU: only the layouts a Vulkan method reads, in the order of their CPU walkers' "
                       "speed (bench combos); the GPU's own order depends on the device (bench gpu)");
-    add("OctTreeCompressed/ClusterBitPackSOA8", "read by a Vulkan method; the fastest CPU walker of bench peers", 16);
-    for (const char* layout : {"QuadTreeHalfFloat/Indexed8BitPackSOA4", "AABBTree/Float3", "StacklessLBVH/Float3",
-                               "AABBTree/UncompressedStrip", "SKDTree/Float3", "AABBList/Float3SOA128",
-                               "AABBList/BitPackSOA128", "BruteForce/Float3SOA128", "BruteForce/BitPackSOA128"})
-      add(layout, "read by a Vulkan method");
-    for (const std::string& r : l.readers)
-      if (std::none_of(out.begin(), out.end(), [&](const AutoCandidate& c) { return c.label == r; })) add(r, "read by a Vulkan method");
+    // The readers in the order of their CPU walkers' speed in bench combos;
+    // a reader the ranking does not know follows in the readers' order.
+    static const Layout kCpuSpeedOrder[] = {
+        {TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8},
+        {TreeFormat::QuadTreeHalfFloat, TriangleFormat::Indexed8BitPackSOA4},
+        {TreeFormat::AABBTree, TriangleFormat::Float3},
+        {TreeFormat::StacklessLBVH, TriangleFormat::Float3},
+        {TreeFormat::AABBTree, TriangleFormat::UncompressedStrip},
+        {TreeFormat::SKDTree, TriangleFormat::Float3},
+        {TreeFormat::AABBList, TriangleFormat::Float3SOA128},
+        {TreeFormat::AABBList, TriangleFormat::BitPackSOA128},
+        {TreeFormat::BruteForce, TriangleFormat::Float3SOA128},
+        {TreeFormat::BruteForce, TriangleFormat::BitPackSOA128}};
+    std::vector<Layout> ordered;
+    for (const Layout& r : kCpuSpeedOrder)
+      if (std::find(l.readers.begin(), l.readers.end(), r) != l.readers.end()) ordered.push_back(r);
+    for (const Layout& r : l.readers)
+      if (std::find(ordered.begin(), ordered.end(), r) == ordered.end()) ordered.push_back(r);
+    for (const Layout& r : ordered)
+      add(layout_name(r), r == kCpuSpeedOrder[0] ? "read by a Vulkan method; the fastest CPU walker of bench peers"
+                                                 : "read by a Vulkan method",
+          default_leaf_size(r));
     return out;
   }
   const std::string w = index_width(s, reasons);
@@ -160,7 +175,7 @@ std::vector<AutoCandidate> memory_list(const MeshStats& s, const AutoLimits& l, 
   };
   if (!l.readers.empty()) {
     reasons.push_back("CPU and GPU: every layout a Vulkan method reads (brute force only up to 4096 triangles)");
-    for (const std::string& r : l.readers) add(r, "read by a Vulkan method");
+    for (const Layout& r : l.readers) add(layout_name(r), "read by a Vulkan method");
     return out;
   }
   if (s.corners_per_vertex >= 2) {

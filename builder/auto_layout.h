@@ -35,7 +35,7 @@ struct AutoLimits {
   double max_error = 0;               // relative_error_bound, of the diagonal; 0: no limit
   // Layouts another backend must read as well (the Vulkan methods':
   // gpu::method_layouts()); empty: the CPU walkers only, which read all.
-  std::vector<std::string> readers;
+  std::vector<Layout> readers;
   // Speed first: time the buildable candidates on this many rays (long
   // rays, their own seed) and take the fastest; 0: no trial, rule order.
   uint32_t trial_rays = 0;

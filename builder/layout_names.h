@@ -1,11 +1,12 @@
-// Layouts and node orders by name (meshcast/build.h has the public
-// parse_layout_name and layout_name of a Layout).
+// Build options by name: a layout's own defaults, and node orders
+// (layout/names.h names the layouts themselves).
 #pragma once
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "builder/binary_tree.h"
+#include "layout/names.h"
 #include "meshcast/build.h"
 
 namespace meshcast {
@@ -21,10 +22,5 @@ std::string node_order_refusal(uint32_t tree_format, NodeOrder order);
 // own defaults: StacklessLBVH builds by Morton middle split), case-insensitive.
 // Throws InputError offering the closest names for anything else.
 BuildOptions parse_layout(const std::string& text);
-// The three layout names nearest `text` ("A, B or C"): a tree or triangle
-// format typed in part ("OctTree") counts as near its whole name.
-std::string closest_layouts(const std::string& text);
-std::string layout_name(uint32_t tree_format, uint32_t triangle_format);
-std::vector<std::string> layout_names();
 
 }  // namespace meshcast

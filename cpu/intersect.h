@@ -23,6 +23,7 @@
 #include "cpu/counters.h"
 #include "cpu/simd.h"
 #include "layout/formats.h"
+#include "layout/ray_record.h"
 #include "meshcast/ray.h"
 
 namespace meshcast {
@@ -97,17 +98,11 @@ struct RayPre {
     for (int a = 0; a < 3; ++a) {
       org[a] = r.org[a];
       dir[a] = walked_direction(r.dir[a]);
-      inv[a] = 1.0f / dir[a];  // +-inf for a zero component: see box_test
       near_is_max[a] = std::signbit(dir[a]) ? 1 : 0;
     }
-    float ax = std::fabs(dir[0]), ay = std::fabs(dir[1]), az = std::fabs(dir[2]);
-    int kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-    if (dir[kz] < 0) std::swap(kx, ky);
-    sx = dir[kx] / dir[kz];
-    sy = dir[ky] / dir[kz];
-    sz = 1.0f / dir[kz];
-    axis[0] = kx, axis[1] = ky, axis[2] = kz;
+    const layout::RayConstants c = layout::ray_constants(dir);  // +-inf in inv for a zero component: see box_test
+    for (int a = 0; a < 3; ++a) inv[a] = c.inv[a], axis[a] = c.axis[a];
+    sx = c.sx, sy = c.sy, sz = c.sz;
   }
 };
 

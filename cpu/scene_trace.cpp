@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstddef>
 
-#include "cpu/scene.h"
+#include "scene/snapshot.h"
 #include "cpu/scratch.h"
 #include "cpu/walk.h"
 #include "cpu/walk_top.h"

@@ -1,5 +1,5 @@
 // Walkers: one per tree family, instantiated per triangle codec. A
-// BlobView (include/meshcast/blob.h) and a scene's mesh (cpu/scene.h) pick
+// BlobView (include/meshcast/blob.h) and a scene's mesh (scene/snapshot.h) pick
 // the instantiation from the blob header once (walker_for, cpu/walk_table.h).
 #pragma once
 #include <algorithm>

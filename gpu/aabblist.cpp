@@ -10,13 +10,8 @@
 #include <cstring>
 
 #include "gpu/batch.h"
-#include "layout/blob_format.h"
 #include "shaders/aabblist_args.h"
-#include "shaders/aabblist_bitpack.h"
 #include "shaders/aabblist_boxes.h"
-#include "shaders/aabblist_float3.h"
-#include "shaders/resolve_bitpack.h"
-#include "shaders/resolve_float3.h"
 
 namespace meshcast::gpu {
 
@@ -24,17 +19,13 @@ namespace {
 
 class AABBListMethod : public BatchMethod {
  public:
-  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint64_t pairs,
-                 uint32_t slots, uint32_t flags, uint32_t max_hits)
-      : BatchMethod(ctx, blob, name, "aabblist", MC_TREE_AABBLIST, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
-                    slots, flags, max_hits),
+  AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const MethodReading& line,
+                 uint64_t pairs, uint32_t slots, uint32_t flags, uint32_t max_hits)
+      : BatchMethod(ctx, blob, name, line, slots, flags, max_hits),
         boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push), slots, flags, max_hits),
         args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push), slots, flags, max_hits),
-        test_(ctx, bitpack ? aabblist_bitpack_spv : aabblist_float3_spv,
-              bitpack ? sizeof aabblist_bitpack_spv : sizeof aabblist_float3_spv, 6, sizeof(Push), slots, flags, max_hits),
-        resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 5, sizeof(Push), slots, flags,
-                 max_hits) {
+        test_(ctx, line.test.words, line.test.bytes, 6, sizeof(Push), slots, flags, max_hits),
+        resolve_(ctx, line.resolve.words, line.resolve.bytes, 5, sizeof(Push), slots, flags, max_hits) {
     const uint64_t capacity = std::max<uint64_t>(pairs, records_);
     for (uint32_t k = 0; k < this->slots(); ++k) {  // every slot in flight has its own pairs and counter
       pairs_.push_back(std::make_unique<Buffer>(ctx, capacity * 8, "AABBList pair buffer"));
@@ -85,8 +76,13 @@ class AABBListMethod : public BatchMethod {
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
                                       uint64_t pairs, uint32_t slots, uint32_t flags, uint32_t max_hits) {
   ctx.require_int64_atomics("aabblist");
-  const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<AABBListMethod>(ctx, blob, name, bitpack, pairs, slots, flags, max_hits);
+  return std::make_unique<AABBListMethod>(ctx, blob, name, method_line("aabblist", blob), pairs, slots, flags, max_hits);
+}
+
+// The table's factory: the line make_aabblist finds is this one.
+std::unique_ptr<Method> make_aabblist_method(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                                             const MethodReading&, uint32_t slots, uint32_t flags, uint32_t max_hits) {
+  return make_aabblist(ctx, blob, name, kAABBListPairs, slots, flags, max_hits);
 }
 
 }  // namespace meshcast::gpu

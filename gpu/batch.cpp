@@ -8,16 +8,14 @@
 #include "meshcast/blob.h"
 #include "gpu/rays.h"
 #include "layout/blob_format.h"
+#include "layout/names.h"
 
 namespace meshcast::gpu {
 
-uint32_t blob_triangle_format(std::span<const uint8_t> blob) {
-  return blob.size() >= sizeof(layout::BlobHeader) ? layout::header_of(blob.data()).triangle_format : 0;
-}
-
-BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
-                         uint32_t tree, uint32_t triangles, uint32_t slots, uint32_t flags, uint32_t max_hits)
-    : ctx_(ctx), method_(method), flags_(flags), max_hits_(max_hits), slots_(std::max(slots, 1u)) {
+BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                         const MethodReading& line, uint32_t slots, uint32_t flags, uint32_t max_hits)
+    : ctx_(ctx), method_(line.what.method), flags_(flags), max_hits_(max_hits), slots_(std::max(slots, 1u)) {
+  const std::string& method = method_;
   const uint32_t known = MC_HIT_UV | MC_HIT_POINT | MC_QUERY_ANY | MC_QUERY_ALL | MC_CULL_BACK | MC_CULL_FRONT;
   if ((flags & ~known) || ((flags & MC_QUERY_ANY) && (flags & MC_QUERY_ALL)) ||
       ((flags & MC_CULL_BACK) && (flags & MC_CULL_FRONT)))
@@ -31,11 +29,9 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
                      std::to_string(kMaxHitsLimit));
   BlobView view(blob, name);  // validates: the shaders trust what validation proved
   const layout::BlobHeader& h = layout::header_of(blob.data());
-  if (h.tree_format != tree || h.triangle_format != triangles)
-    throw InputError(name + ": the GPU method " + method + " reads " + std::string(layout::tree_format_name(tree)) + "/" +
-                     std::string(layout::triangle_format_name(triangles)) + " blobs, not " +
-                     std::string(layout::tree_format_name(h.tree_format)) + "/" +
-                     std::string(layout::triangle_format_name(h.triangle_format)));
+  if (h.tree_format != uint32_t(line.what.layout.tree) || h.triangle_format != uint32_t(line.what.layout.triangles))
+    throw InputError(name + ": the GPU method " + method + " reads " + layouts_read_by(method) + " blobs, not " +
+                     layout_name(h.tree_format, h.triangle_format));
   records_ = h.node_count;
   blob_ = ctx.blob_buffer(blob, name);
   try {

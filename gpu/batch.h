@@ -10,8 +10,9 @@
 #include <vector>
 
 #include "gpu/method.h"
-#include "layout/formats.h"
+#include "gpu/method_table.h"
 #include "gpu/vulkan.h"
+#include "layout/formats.h"
 
 namespace meshcast::gpu {
 
@@ -20,19 +21,15 @@ struct Push {
   uint32_t ray_base, ray_count, records;
 };
 
-// The blob's triangle format (0 for a buffer too short to say): a method
-// that reads several picks its shaders by it, BatchMethod refuses the rest.
-uint32_t blob_triangle_format(std::span<const uint8_t> blob);
-
 class BatchMethod : public Method {
  public:
-  // Validates the blob and requires its layout to be `tree`/`triangles`
-  // (InputError naming the method and both layouts otherwise).
+  // Validates the blob and requires its layout to be the line's
+  // (InputError naming the layouts the method reads and the blob's).
   // `flags`, `max_hits`: the batches' query (make_method); UsageError for
   // flags other than MC_HIT_*, MC_QUERY_*, MC_CULL_* or a row length out
   // of range.
-  BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const std::string& method,
-              uint32_t tree, uint32_t triangles, uint32_t slots, uint32_t flags, uint32_t max_hits);
+  BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const MethodReading& line,
+              uint32_t slots, uint32_t flags, uint32_t max_hits);
   ~BatchMethod() override;
   uint32_t slots() const override { return uint32_t(slots_.size()); }
   std::string refusal(uint32_t rays) const override;

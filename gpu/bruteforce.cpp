@@ -7,12 +7,6 @@
 #include <algorithm>
 
 #include "gpu/batch.h"
-#include "meshcast/mesh.h"
-#include "layout/blob_format.h"
-#include "shaders/bruteforce_bitpack.h"
-#include "shaders/bruteforce_float3.h"
-#include "shaders/resolve_bitpack.h"
-#include "shaders/resolve_float3.h"
 
 namespace meshcast::gpu {
 
@@ -20,16 +14,11 @@ namespace {
 
 class BruteForceMethod : public BatchMethod {
  public:
-  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, bool bitpack, uint32_t slots,
-                   uint32_t flags, uint32_t max_hits)
-      : BatchMethod(ctx, blob, name, "bruteforce", MC_TREE_BRUTEFORCE, bitpack ? MC_TRI_BITPACKSOA128 : MC_TRI_FLOAT3SOA128,
-                    slots, flags, max_hits),
-        test_(ctx, bitpack ? bruteforce_bitpack_spv : bruteforce_float3_spv,
-              bitpack ? sizeof bruteforce_bitpack_spv : sizeof bruteforce_float3_spv, 4, sizeof(Push), slots, flags,
-              max_hits),
-        resolve_(ctx, bitpack ? resolve_bitpack_spv : resolve_float3_spv,
-                 bitpack ? sizeof resolve_bitpack_spv : sizeof resolve_float3_spv, 5, sizeof(Push), slots, flags,
-                 max_hits) {}
+  BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const MethodReading& line,
+                   uint32_t slots, uint32_t flags, uint32_t max_hits)
+      : BatchMethod(ctx, blob, name, line, slots, flags, max_hits),
+        test_(ctx, line.test.words, line.test.bytes, 4, sizeof(Push), slots, flags, max_hits),
+        resolve_(ctx, line.resolve.words, line.resolve.bytes, 5, sizeof(Push), slots, flags, max_hits) {}
 
  protected:
   void bind_all(uint32_t slot) override {
@@ -55,11 +44,9 @@ class BruteForceMethod : public BatchMethod {
 }  // namespace
 
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                        uint32_t slots, uint32_t flags, uint32_t max_hits) {
-  // The codec the blob holds picks the shaders (BatchMethod refuses others).
+                                        const MethodReading& line, uint32_t slots, uint32_t flags, uint32_t max_hits) {
   ctx.require_int64_atomics("bruteforce");
-  const bool bitpack = blob_triangle_format(blob) == MC_TRI_BITPACKSOA128;
-  return std::make_unique<BruteForceMethod>(ctx, blob, name, bitpack, slots, flags, max_hits);
+  return std::make_unique<BruteForceMethod>(ctx, blob, name, line, slots, flags, max_hits);
 }
 
 }  // namespace meshcast::gpu

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "meshcast/build.h"
 #include "meshcast/errors.h"
 #include "meshcast/ray.h"
 
@@ -69,13 +70,8 @@ class Method {
   }
 };
 
-// The methods and the layouts they read so far:
-//   bruteforce  BruteForce/Float3SOA128 or BruteForce/BitPackSOA128
-//   aabblist    AABBList/Float3SOA128 or AABBList/BitPackSOA128
-//   aabbtree    AABBTree/Float3 or AABBTree/UncompressedStrip
-//   skdtree     SKDTree/Float3               lbvh      StacklessLBVH/Float3
-//   quadtree    QuadTreeHalfFloat/Indexed8BitPackSOA4
-//   octtree     OctTreeCompressed/ClusterBitPackSOA8
+// The method named `method` over the blob (method_layouts() lists what each
+// reads; gpu/method_table.cpp is the one table).
 // Throws GpuError, or InputError (an unknown method, or a blob whose layout
 // the method does not read, naming both).
 // `flags`: the per-hit outputs (MC_HIT_UV, MC_HIT_POINT) its shaders
@@ -89,10 +85,11 @@ std::vector<std::string> method_names();
 
 // Every (method, layout) pair the GPU reads, in the order of seed 000 §7's
 // table: the tests, the stiff and extreme suite, bench gpu and bench error
-// run this one list.
+// run this one list, and the automatic layout choice keeps to its layouts
+// when the GPU reads the blob too.
 struct MethodLayout {
   const char* method;
-  const char* layout;
+  Layout layout;
 };
 std::span<const MethodLayout> method_layouts();
 // The first method of that list that reads the blob's layout; "" for none.
@@ -100,8 +97,11 @@ std::string method_reading(std::span<const uint8_t> blob);
 
 // AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs a
 // slot: a batch of rays goes in chunks of pairs / batches rays. make_method's
-// uses 2^21 (16 MiB); a test passes a small one to split batches into many
+// uses kAABBListPairs; a test passes a small one to split batches into many
 // chunks.
+// 2^21 pairs (16 MiB a slot): far below every device's
+// maxStorageBufferRange, and still thousands of rays a chunk on large meshes.
+constexpr uint64_t kAABBListPairs = uint64_t(1) << 21;
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
                                       uint64_t pairs, uint32_t slots = 1, uint32_t flags = 0, uint32_t max_hits = 16);
 

@@ -4,11 +4,12 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "builder/layout_names.h"
-#include "cpu/scene.h"
+#include "layout/names.h"
+#include "scene/snapshot.h"
 #include "gpu/vulkan.h"
 #include "layout/blob_format.h"
 #include "layout/formats.h"
+#include "layout/ray_record.h"
 #include "meshcast/errors.h"
 #include "shaders/scene_octtree.h"
 
@@ -21,6 +22,8 @@ namespace {
 constexpr uint32_t kTopNodes = 18, kTopPlacedAt = 19, kTopWideAt = 20, kTopMeshBase = 24;
 constexpr uint32_t kSceneHitWords = 6;
 constexpr uint32_t kGroup = 64;
+// The one layout the scene shader reads (its walk is the octtree method's).
+constexpr Layout kSceneLayout{TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8};
 
 struct ScenePush {
   uint32_t ray_base, ray_count, mask;
@@ -93,8 +96,8 @@ std::string SceneMethod::refusal(const SceneSnapshot& s) {
   uint64_t bytes = 0;
   for (const auto& m : s.meshes) {
     const layout::BlobHeader& h = layout::header_of(m->bytes.data());
-    if (h.tree_format != MC_TREE_OCTTREECOMPRESSED || h.triangle_format != MC_TRI_CLUSTERBITPACKSOA8)
-      return m->name + ": the GPU scene method reads OctTreeCompressed/ClusterBitPackSOA8 blobs, not " +
+    if (h.tree_format != uint32_t(kSceneLayout.tree) || h.triangle_format != uint32_t(kSceneLayout.triangles))
+      return m->name + ": the GPU scene method reads " + layout_name(kSceneLayout) + " blobs, not " +
              layout_name(h.tree_format, h.triangle_format);
     bytes += (m->bytes.size() + 3) / 4 * 4;  // each blob starts on a word
     if (bytes / 4 >= (uint64_t(1) << 32))
@@ -161,10 +164,11 @@ void SceneMethod::begin(const SceneSnapshot& s, std::span<const RayD> rays, uint
   std::memcpy(top + kTopMeshBase, mesh_base_.data(), mesh_base_.size() * 4);
   std::memcpy(top + placed_at, t.placed.data(), t.placed.size() * sizeof(layout::PlacedInstance));
   std::memcpy(top + wide_at, t.wide.data(), t.wide.size() * sizeof(layout::TopWideNode));
-  // The rays as RayD records (12 words: RAYD_WORDS of the shader), the
-  // answers 6 words a ray.
-  static_assert(sizeof(RayD) == 48 && offsetof(RayD, tmax) == 36 && offsetof(RayD, tmin) == 40,
-                "the scene shader's RAYD_WORDS and its t_max and t_min words");
+  // The rays as RayD records (layout/ray_record.h), the answers 6 words a ray.
+  static_assert(sizeof(RayD) == MC_RAYD_WORDS * 4 && offsetof(RayD, org) == MC_RAYD_ORG * 4 &&
+                    offsetof(RayD, dir) == MC_RAYD_DIR * 4 && offsetof(RayD, tmax) == MC_RAYD_TMAX * 4 &&
+                    offsetof(RayD, tmin) == MC_RAYD_TMIN * 4,
+                "RayD is the scene shader's record");
   const uint32_t n = uint32_t(rays.size());
   fit(rays_, ctx_, uint64_t(n) * sizeof(RayD), "scene ray buffer");
   fit(hits_, ctx_, uint64_t(n) * kSceneHitWords * 4, "scene hit buffer");

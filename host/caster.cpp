@@ -19,7 +19,7 @@
 #include "host/profile.h"
 #include "layout/blob_format.h"
 #include "layout/queries.h"
-#include "cpu/scene.h"
+#include "scene/snapshot.h"
 
 namespace meshcast::host {
 

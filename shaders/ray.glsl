@@ -1,13 +1,13 @@
 // Rays as the host prepares them (gpu/rays.cpp): the ray and the per-ray
-// constants of the CPU's RayPre (cpu/intersect.h), computed once on the host in
-// correctly rounded arithmetic, so the shear the GPU applies is the CPU's
-// bit for bit, and the box test's reciprocals likewise. 16 words a ray:
-//   org xyz, dir xyz, tmax, sx, sy, sz, axes (kx | ky << 2 | kz << 4),
-//   walkable (0: answered as a miss, as the CPU does), inv xyz, tmin
+// constants of the CPU's RayPre, in the record of layout/ray_record.h,
+// computed once on the host in correctly rounded arithmetic, so the shear
+// the GPU applies is the CPU's bit for bit, and the box test's reciprocals
+// likewise.
 #ifndef MESHCAST_RAY_GLSL
 #define MESHCAST_RAY_GLSL
 
-#define MC_GPU_RAY_WORDS 16u
+#include "layout/ray_record.h"
+
 #define kInfinity uintBitsToFloat(0x7F800000u)
 #define kFloatMax uintBitsToFloat(0x7F7FFFFFu)
 
@@ -35,20 +35,24 @@ vec3 walked_direction(vec3 d) {
   return out_d;
 }
 
+float ray_word(uint b, uint word) { return uintBitsToFloat(ray_words[b + word]); }
+
+vec3 ray_vec3(uint b, uint word) { return vec3(ray_word(b, word), ray_word(b, word + 1u), ray_word(b, word + 2u)); }
+
 GpuRay load_ray(uint i) {
-  const uint b = i * MC_GPU_RAY_WORDS;
+  const uint b = i * MC_RAY_WORDS;
   GpuRay r;
-  r.org = vec3(uintBitsToFloat(ray_words[b]), uintBitsToFloat(ray_words[b + 1u]), uintBitsToFloat(ray_words[b + 2u]));
-  r.dir = vec3(uintBitsToFloat(ray_words[b + 3u]), uintBitsToFloat(ray_words[b + 4u]), uintBitsToFloat(ray_words[b + 5u]));
-  r.tmax = uintBitsToFloat(ray_words[b + 6u]);
-  r.sx = uintBitsToFloat(ray_words[b + 7u]);
-  r.sy = uintBitsToFloat(ray_words[b + 8u]);
-  r.sz = uintBitsToFloat(ray_words[b + 9u]);
-  const uint axes = ray_words[b + 10u];
+  r.org = ray_vec3(b, MC_RAY_ORG);
+  r.dir = ray_vec3(b, MC_RAY_DIR);
+  r.tmax = ray_word(b, MC_RAY_TMAX);
+  r.sx = ray_word(b, MC_RAY_SHEAR);
+  r.sy = ray_word(b, MC_RAY_SHEAR + 1u);
+  r.sz = ray_word(b, MC_RAY_SHEAR + 2u);
+  const uint axes = ray_words[b + MC_RAY_AXES];
   r.kx = axes & 3u, r.ky = (axes >> 2) & 3u, r.kz = (axes >> 4) & 3u;
-  r.walkable = ray_words[b + 11u] != 0u;
-  r.inv = vec3(uintBitsToFloat(ray_words[b + 12u]), uintBitsToFloat(ray_words[b + 13u]), uintBitsToFloat(ray_words[b + 14u]));
-  r.tmin = uintBitsToFloat(ray_words[b + 15u]);
+  r.walkable = ray_words[b + MC_RAY_WALKABLE] != 0u;
+  r.inv = ray_vec3(b, MC_RAY_INV);
+  r.tmin = ray_word(b, MC_RAY_TMIN);
   return r;
 }
 

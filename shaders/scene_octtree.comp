@@ -40,7 +40,6 @@ layout(std430, set = 0, binding = 5) readonly buffer Top { uint top_words[]; };
 #define SCENE_HIT_WORDS 6u
 layout(std430, set = 0, binding = 6) writeonly buffer SceneHits { uint scene_hits[]; };
 
-#define RAYD_WORDS 12u
 
 double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_words[word + 1u])); }
 
@@ -81,13 +80,13 @@ GpuRay prepared(vec3 org, vec3 given_dir, float tmin, float tmax) {
 void main() {
   const uint ray = pc.ray_base + gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
-  const uint w = ray * RAYD_WORDS;
+  const uint w = ray * MC_RAYD_WORDS;
   dvec3 org;
-  for (uint a = 0u; a < 3u; ++a) org[a] = packDouble2x32(uvec2(ray_words[w + 2u * a], ray_words[w + 2u * a + 1u]));
-  const vec3 given_dir = vec3(uintBitsToFloat(ray_words[w + 6u]), uintBitsToFloat(ray_words[w + 7u]),
-                              uintBitsToFloat(ray_words[w + 8u]));
+  for (uint a = 0u; a < 3u; ++a)
+    org[a] = packDouble2x32(uvec2(ray_words[w + MC_RAYD_ORG + 2u * a], ray_words[w + MC_RAYD_ORG + 2u * a + 1u]));
+  const vec3 given_dir = ray_vec3(w, MC_RAYD_DIR);
   const vec3 dir = walked_direction(given_dir);  // as WorldRay of cpu/scene_trace.cpp
-  const float tmax = uintBitsToFloat(ray_words[w + 9u]), tmin = uintBitsToFloat(ray_words[w + 10u]);
+  const float tmax = ray_word(w, MC_RAYD_TMAX), tmin = ray_word(w, MC_RAYD_TMIN);
   float best_t = kInfinity, best_u = 0.0, best_v = 0.0;
   uint best_instance = MC_NO_HIT, best_triangle = MC_NO_HIT, incomplete = 0u;
   const double max_coordinate = 1267650600228229401496703205376.0lf;  // 2^100

@@ -95,11 +95,11 @@ TEST(AutoLayout, ImpossibleLimitsAndReaders) {
   // AABBTree/Float3 fits nothing, so no layout meets the limits, rather
   // than one no reader reads.
   AutoLimits narrow;
-  narrow.readers = {"AABBTree/Float3"};
+  narrow.readers = {parse_layout_name("AABBTree/Float3")};
   narrow.max_bytes_per_triangle = 30;
   EXPECT_THROW(choose_layout(sphere, narrow, "sphere"), InputError);
   AutoLimits gpu;
-  gpu.readers = {"AABBTree/Float3", "SKDTree/Float3"};
+  gpu.readers = {parse_layout_name("AABBTree/Float3"), parse_layout_name("SKDTree/Float3")};
   for (AutoGoal goal : {AutoGoal::Speed, AutoGoal::Memory}) {
     gpu.goal = goal;
     const AutoChoice c = choose_layout(sphere, gpu, "sphere");

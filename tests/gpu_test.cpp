@@ -109,13 +109,13 @@ TEST_P(GpuMethods, MatchTheCpuAndTheOracle) {
   const gpu::MethodLayout mc = GetParam();
   for (const NamedMesh& m : test_meshes(false)) {
     if (m.name != "sphere" && m.name != "bunny00" && m.name != "terrain_64k") continue;
-    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(mc.layout), m.name);
+    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout_name(mc.layout)), m.name);
     std::unique_ptr<gpu::Method> method = gpu::make_method(context(), mc.method, blob, m.name);
     // A quantized layout is judged on the mesh it stores, as on the CPU (kept
     // alive across the kinds: the oracle cache refers to it by name).
     NamedMesh reference = m;
-    if (moves_vertices(uint32_t(parse_layout(mc.layout).layout.triangles)))
-      reference = {m.name + "#" + mc.layout, std::make_shared<const Mesh>(stored_mesh(blob))};
+    if (moves_vertices(uint32_t(parse_layout(layout_name(mc.layout)).layout.triangles)))
+      reference = {m.name + "#" + layout_name(mc.layout), std::make_shared<const Mesh>(stored_mesh(blob))};
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
       const size_t count = std::string_view(mc.method) == "bruteforce" ? 1000 : 10000;
       const std::vector<Ray>& rays = test_rays(m, kind, count);
@@ -141,11 +141,11 @@ TEST_P(GpuMethods, QueriesMatchTheOracle) {
   const gpu::MethodLayout mc = GetParam();
   for (const NamedMesh& m : test_meshes(false)) {
     if (!is_chosen_public_mesh(m.name)) continue;
-    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(mc.layout), m.name);
+    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout_name(mc.layout)), m.name);
     const BlobView view(blob, m.name);
     NamedMesh reference = m;
-    if (moves_vertices(uint32_t(parse_layout(mc.layout).layout.triangles)))
-      reference = {m.name + "#" + mc.layout, std::make_shared<const Mesh>(stored_mesh(blob))};
+    if (moves_vertices(uint32_t(parse_layout(layout_name(mc.layout)).layout.triangles)))
+      reference = {m.name + "#" + layout_name(mc.layout), std::make_shared<const Mesh>(stored_mesh(blob))};
     const double tolerance = 1e-5 * m.mesh->bounds().diagonal();
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
       const size_t count = std::string_view(mc.method) == "bruteforce" ? 150 : 500;
@@ -188,8 +188,8 @@ TEST_P(GpuMethods, RowsKeepTheNearestAndCountAll) {
   const gpu::MethodLayout mc = GetParam();
   const Mesh planes = stacked_planes(12);
   const std::vector<Ray> rays = rays_down_through(12, 300);
-  const std::vector<uint8_t> blob = build_blob(planes, parse_layout(mc.layout), "planes");
-  const Mesh stored = moves_vertices(uint32_t(parse_layout(mc.layout).layout.triangles)) ? stored_mesh(blob) : planes;
+  const std::vector<uint8_t> blob = build_blob(planes, parse_layout(layout_name(mc.layout)), "planes");
+  const Mesh stored = moves_vertices(uint32_t(parse_layout(layout_name(mc.layout)).layout.triangles)) ? stored_mesh(blob) : planes;
   for (uint32_t max_hits : {1u, 3u, 12u, kMaxHitsLimit}) {
     HitLists lists;
     gpu::make_method(context(), mc.method, blob, "planes", 1, MC_QUERY_ALL | MC_HIT_POINT, max_hits)->trace_all_hits(rays, lists);
@@ -206,7 +206,7 @@ TEST_P(GpuMethods, RowsKeepTheNearestAndCountAll) {
 
 INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods, ::testing::ValuesIn(gpu::method_layouts().begin(), gpu::method_layouts().end()),
                          [](const auto& info) {
-                           std::string n = info.param.layout;
+                           std::string n = layout_name(info.param.layout);
                            for (char& ch : n)
                              if (ch == '/') ch = '_';
                            return std::string(info.param.method) + "_" + n;

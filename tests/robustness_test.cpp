@@ -575,8 +575,8 @@ std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
 std::vector<std::string> gpu_cases() {
   std::vector<std::string> names;
   for (const gpu::MethodLayout& c : gpu::method_layouts()) {
-    names.push_back(std::string(c.layout) + "@" + c.method);
-    names.push_back(std::string(c.layout) + "+noids@" + c.method);  // the shaders' no-remap path
+    names.push_back(layout_name(c.layout) + "@" + c.method);
+    names.push_back(layout_name(c.layout) + "+noids@" + c.method);  // the shaders' no-remap path
   }
   for (const std::string& setting : auto_settings()) names.push_back("auto:" + setting);
   return names;

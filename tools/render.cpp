@@ -6,7 +6,7 @@
 
 #include "meshcast/blob.h"
 #include "layout/blob_format.h"
-#include "cpu/scene.h"
+#include "scene/snapshot.h"
 #include "meshcast/errors.h"
 #include "tools/common.h"
 

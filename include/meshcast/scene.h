@@ -92,7 +92,7 @@ struct Transform {
 using MeshId = uint32_t;
 using InstanceId = uint32_t;
 
-class SceneSnapshot;  // what one commit() made (internal: cpu/scene.h)
+class SceneSnapshot;  // what one commit() made (internal: scene/snapshot.h)
 
 class Scene {
  public:

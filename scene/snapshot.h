@@ -20,7 +20,7 @@ namespace meshcast {
 struct SceneMesh {
   // `view` validated over bytes that `owner` keeps alive: the scene's copy,
   // a MappedBlob shared with the caller, or null for bytes the caller
-  // guarantees (Scene::add_mesh of a BlobView). cpu/scene.cpp.
+  // guarantees (Scene::add_mesh of a BlobView). scene/scene.cpp.
   SceneMesh(const BlobView& view, std::shared_ptr<const void> owner, std::string mesh_name);
   SceneMesh(const SceneMesh&) = delete;
   SceneMesh& operator=(const SceneMesh&) = delete;

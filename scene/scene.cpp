@@ -6,8 +6,8 @@
 #include <mutex>
 #include <cmath>
 
-#include "builder/top_level.h"
-#include "cpu/scene.h"
+#include "scene/build_top_level.h"
+#include "scene/snapshot.h"
 #include "cpu/walk_table.h"
 #include "layout/blob_format.h"
 #include "layout/message_text.h"

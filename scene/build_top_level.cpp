@@ -1,4 +1,4 @@
-#include "builder/top_level.h"
+#include "scene/build_top_level.h"
 
 #include <algorithm>
 #include <bit>

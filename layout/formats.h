@@ -1,5 +1,5 @@
 // Names and numbers of every blob layout: the one list both the C++ code and
-// (later) the GLSL shaders include. Plain #defines in the common subset of C++
+// the GLSL shaders (shaders/blob.glsl) include. Plain #defines in the common subset of C++
 // and GLSL, so a layout change is one edit.
 //
 // Seed 000 (Rouwé 2019) §3 triangle encodings, §5 tree types.

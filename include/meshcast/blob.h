@@ -61,9 +61,6 @@ class BlobView {
   Walk walk_ = nullptr;
 };
 
-// A blob file read whole into memory (not validated: give it to a BlobView
-// or a Caster). InputError naming the path for a missing, unreadable or
-// non-regular file.
 // The instruction set the CPU walkers run on, chosen once per process: the
 // widest this processor has among those built (AVX-512, AVX2, scalar on
 // x86-64; scalar elsewhere), or the one the environment variable
@@ -73,6 +70,9 @@ enum class WalkerIsa { Scalar, Avx2, Avx512 };
 WalkerIsa walker_isa();
 std::string_view walker_isa_name(WalkerIsa isa);
 
+// A blob file read whole into memory (not validated: give it to a BlobView
+// or a Caster). InputError naming the path for a missing, unreadable or
+// non-regular file.
 std::vector<uint8_t> load_blob(const std::string& path);
 
 // Writes the blob beside `path`, then renames it over `path`, so a failed

@@ -1,4 +1,4 @@
-#include "meshcast/caster.h"
+#include "host/caster_impl.h"
 
 #include <algorithm>
 #include <chrono>
@@ -43,52 +43,19 @@ const char* backend_name(Backend b) {
   return "";
 }
 
-struct Caster::Slot {
-  enum State { Free, Running, Ready, Collecting };
-  uint32_t index = 0;
-  State state = Free;
-  uint64_t id = 0;
-  uint32_t n = 0;
-  std::vector<Ray> rays;
-  BatchQuery query;
-  std::vector<Hit> hits;  // a hit a ray (closest or any)
-  // Query::All on the CPU: each job's compact rows, which wait()
-  // concatenates (kept from batch to batch, so they stop allocating once
-  // warm; the GPU's rows are compacted when read back).
-  std::vector<HitLists> job_rows;
-  gpu::Method* method = nullptr;  // the GPU batch's
-  // A scene batch: the snapshot it walks (held until collected), its world
-  // rays, its hits or each job's rows.
-  std::shared_ptr<const SceneSnapshot> scene;
-  std::vector<RayD> world;
-  std::vector<SceneHit> scene_hits;
-  std::vector<SceneHitLists> job_scene_rows;
-  SceneBatchQuery scene_query;
-  Backend ran_on = Backend::Cpu;
-  double submit_ms = 0, ready_ms = 0, cpu_ms = 0;
-  // What the job system threw when the GPU thread moved the batch to the
-  // CPU (no caller to throw it to then): wait() rethrows it.
-  std::exception_ptr error;
-  // CPU batches: jobs of `chunk` rays; the last to finish completes.
-  uint32_t chunk = 0;
-  std::atomic<uint32_t> jobs_left{0};
-  std::atomic<int64_t> cpu_ns{0};
-  std::function<void(uint32_t)> work;  // made once, handed to the job system every batch
-};
-
-Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options)
+Caster::Impl::Impl(std::span<const uint8_t> blob, const std::string& name, CasterOptions options)
     : view_(std::in_place, blob, name), options_(std::move(options)) {
   setup(blob, name);
 }
 
-Caster::Caster(CasterOptions options) : options_(std::move(options)) {
+Caster::Impl::Impl(CasterOptions options) : options_(std::move(options)) {
   // Scene batches alone: the GPU only when asked for by name (the
   // Automatic backend's crossover is a blob's).
   if (options_.backend == Backend::Automatic) options_.backend = Backend::Cpu;
   setup({}, "");
 }
 
-const BlobView& Caster::blob(const char* who) const {
+const BlobView& Caster::Impl::blob(const char* who) const {
   if (!view_) throw UsageError(std::string(who) + ": this caster was made without a blob (scene batches alone)");
   return *view_;
 }
@@ -127,7 +94,7 @@ void check_options(const CasterOptions& o) {
 
 }  // namespace
 
-void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
+void Caster::Impl::setup(std::span<const uint8_t> blob, const std::string& name) {
   check_options(options_);
   if (options_.jobs) {
     jobs_ = options_.jobs;
@@ -260,7 +227,7 @@ void Caster::setup(std::span<const uint8_t> blob, const std::string& name) {
 }
 
 template <class Ready>
-bool Caster::block(std::unique_lock<std::mutex>& lock, Ready ready) {
+bool Caster::Impl::block(std::unique_lock<std::mutex>& lock, Ready ready) {
   ++blocked_;
   changed_.wait(lock, [&] { return closing_ || ready(); });
   --blocked_;
@@ -268,13 +235,13 @@ bool Caster::block(std::unique_lock<std::mutex>& lock, Ready ready) {
   return ready();
 }
 
-void Caster::wait_for_crossover() {
+void Caster::Impl::wait_for_crossover() {
   std::unique_lock<std::mutex> lock(mutex_);
   if (!block(lock, [this] { return crossover_known_.load(); }))
     throw UsageError("Caster::wait_for_crossover: the caster was destroyed while waiting");
 }
 
-Caster::~Caster() {
+Caster::Impl::~Impl() {
   // No batch starts from now on, and a thread blocked in wait() or
   // wait_for_crossover() throws UsageError: its caster is going.
   {
@@ -323,20 +290,20 @@ VulkanInstances vulkan_instances() { return {}; }
 #endif
 
 #if MESHCAST_VULKAN
-std::string Caster::device_name() const { return gpu_ ? gpu_->device_name() : "none"; }
-uint32_t Caster::validation_messages() const { return gpu_ ? gpu_->validation_messages() : 0; }
+std::string Caster::Impl::device_name() const { return gpu_ ? gpu_->device_name() : "none"; }
+uint32_t Caster::Impl::validation_messages() const { return gpu_ ? gpu_->validation_messages() : 0; }
 #else
-std::string Caster::device_name() const { return "none"; }
-uint32_t Caster::validation_messages() const { return 0; }
+std::string Caster::Impl::device_name() const { return "none"; }
+uint32_t Caster::Impl::validation_messages() const { return 0; }
 #endif
 
-Backend Caster::choose(uint32_t rays) const {
+Backend Caster::Impl::choose(uint32_t rays) const {
   if (!gpu_available() || options_.backend == Backend::Cpu) return Backend::Cpu;
   if (options_.backend == Backend::Vulkan) return Backend::Vulkan;
   return rays >= crossover_.load() ? Backend::Vulkan : Backend::Cpu;
 }
 
-std::string Caster::why(uint32_t rays) const {
+std::string Caster::Impl::why(uint32_t rays) const {
   const std::string n = std::to_string(rays) + " rays: ";
   if (options_.backend == Backend::Cpu) return n + "CPU, as the caster was made";
   if (!gpu_available()) return n + "CPU, the GPU is unavailable (" + gpu_error() + ")";
@@ -361,7 +328,7 @@ static void check_query(Query query, Cull cull, uint32_t max_hits) {
                      std::to_string(kMaxHitsLimit));
 }
 
-Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
+Ticket Caster::Impl::submit(std::span<const Ray> rays, BatchQuery query) {
   check_query(query.query, query.cull, query.max_hits);
   blob("Caster::submit");
   Slot& s = take_slot();
@@ -370,7 +337,7 @@ Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) {
   return {s.id, s.index};
 }
 
-Caster::Slot& Caster::take_slot() {
+Caster::Impl::Slot& Caster::Impl::take_slot() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (closing_) throw UsageError("Caster::submit: the caster is being destroyed");
   for (uint32_t i = 0; i < game_slots_; ++i)
@@ -384,7 +351,7 @@ Caster::Slot& Caster::take_slot() {
                    " frames hold batches not yet collected; wait() for one before submitting more");
 }
 
-void Caster::size_slot(Slot& s, size_t n, bool scene) {
+void Caster::Impl::size_slot(Slot& s, size_t n, bool scene) {
   if (n > UINT32_MAX)
     throw UsageError("Caster::submit: " + std::to_string(n) + " rays, more than a batch holds (2^32 - 1)");
   s.submit_ms = now_ms();
@@ -395,19 +362,19 @@ void Caster::size_slot(Slot& s, size_t n, bool scene) {
   else s.hits.resize(answers);
 }
 
-void Caster::free_slot(Slot& s) {
+void Caster::Impl::free_slot(Slot& s) {
   std::lock_guard<std::mutex> lock(mutex_);
   free_locked(s);
 }
 
-void Caster::free_locked(Slot& s) {
+void Caster::Impl::free_locked(Slot& s) {
   s.scene.reset();  // a scene batch lets its frame go (its arrays may serve a later commit)
   s.error = nullptr;
   s.state = Slot::Free;
   changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
 }
 
-Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
+Ticket Caster::Impl::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
   check_query(query.query, query.cull, query.max_hits);
   std::shared_ptr<const SceneSnapshot> frame = scene.snapshot();  // UsageError for a moved-from scene
   Slot& s = take_slot();
@@ -434,7 +401,7 @@ Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatch
   return {s.id, s.index};
 }
 
-void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
+void Caster::Impl::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   try {
     size_slot(s, rays.size(), false);
     s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
@@ -458,7 +425,7 @@ void Caster::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   }
 }
 
-void Caster::start_cpu(Slot& s) {
+void Caster::Impl::start_cpu(Slot& s) {
   s.ran_on = Backend::Cpu;
   s.cpu_ns = 0;
   // About four jobs a thread, so uneven rays even out; at least 64 rays a
@@ -480,7 +447,7 @@ void Caster::start_cpu(Slot& s) {
   jobs_->run(jobs, s.work);
 }
 
-void Caster::start_gpu(Slot& s) {
+void Caster::Impl::start_gpu(Slot& s) {
   const auto t0 = std::chrono::steady_clock::now();
   {
     std::lock_guard<std::mutex> lock(gpu_mutex_);
@@ -501,7 +468,7 @@ void Caster::start_gpu(Slot& s) {
 // batch's ready time is taken when its fence signals, not when the game
 // happens to ask. A failed wait (a lost device) moves the batch, and every
 // later one, to the CPU.
-void Caster::gpu_completions() {
+void Caster::Impl::gpu_completions() {
   for (;;) {
     Slot* s = nullptr;
     {
@@ -528,7 +495,7 @@ void Caster::gpu_completions() {
   }
 }
 
-void Caster::cpu_instead(Slot& s) {
+void Caster::Impl::cpu_instead(Slot& s) {
   try {
     start_cpu(s);
   } catch (...) {  // the job system's run() threw: the batch is answered with it, and this thread goes on
@@ -537,7 +504,7 @@ void Caster::cpu_instead(Slot& s) {
   }
 }
 
-bool Caster::scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const {
+bool Caster::Impl::scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const {
 #if !MESHCAST_VULKAN
   (void)q, (void)frame;
   return false;
@@ -547,7 +514,7 @@ bool Caster::scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) 
 #endif
 }
 
-void Caster::run_scene_on_gpu(Slot& s) {
+void Caster::Impl::run_scene_on_gpu(Slot& s) {
 #if !MESHCAST_VULKAN
   (void)s;  // not reached: without the Vulkan backend there is no device
 #else
@@ -574,12 +541,12 @@ void Caster::run_scene_on_gpu(Slot& s) {
 #endif
 }
 
-void Caster::gpu_failed(const std::string& why) {
+void Caster::Impl::gpu_failed(const std::string& why) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!gpu_failed_.exchange(true)) gpu_error_ = why;
 }
 
-void Caster::complete(Slot& s, Backend ran_on) {
+void Caster::Impl::complete(Slot& s, Backend ran_on) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     s.ready_ms = now_ms();
@@ -590,14 +557,14 @@ void Caster::complete(Slot& s, Backend ran_on) {
   }
 }
 
-Caster::Slot& Caster::slot_of(const Ticket& t) const {
+Caster::Impl::Slot& Caster::Impl::slot_of(const Ticket& t) const {
   if (t.slot >= game_slots_)
     throw UsageError("ticket " + std::to_string(t.id) + " names frame slot " + std::to_string(t.slot) + " of " +
                      std::to_string(game_slots_) + ": not a ticket of this caster");
   return *slots_[t.slot];
 }
 
-bool Caster::poll(const Ticket& t) {
+bool Caster::Impl::poll(const Ticket& t) {
   std::lock_guard<std::mutex> lock(mutex_);
   const Slot& s = slot_of(t);
   if (s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting)
@@ -605,7 +572,7 @@ bool Caster::poll(const Ticket& t) {
   return s.state == Slot::Ready;
 }
 
-gpu::Method* Caster::method_for(const BatchQuery& q) {
+gpu::Method* Caster::Impl::method_for(const BatchQuery& q) {
 #if !MESHCAST_VULKAN
   (void)q;
   return method_.get();  // not reached: without the Vulkan backend no batch goes to a GPU
@@ -619,9 +586,9 @@ gpu::Method* Caster::method_for(const BatchQuery& q) {
 #endif
 }
 
-BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return collect(slot_of(t), t, hits, nullptr, true); }
+BatchRecord Caster::Impl::wait(const Ticket& t, std::span<Hit> hits) { return collect(slot_of(t), t, hits, nullptr, true); }
 
-BatchRecord Caster::wait(const Ticket& t, HitLists& lists) { return collect(slot_of(t), t, {}, &lists, true); }
+BatchRecord Caster::Impl::wait(const Ticket& t, HitLists& lists) { return collect(slot_of(t), t, {}, &lists, true); }
 
 // What a ticket is collected into must be what its batch asked for.
 static void check_collected(uint64_t id, bool scene_batch, bool scene_wait, bool all, bool lists, size_t room, size_t n) {
@@ -634,7 +601,7 @@ static void check_collected(uint64_t id, bool scene_batch, bool scene_wait, bool
   if (!all && room < n) throw UsageError("wait() needs room for " + std::to_string(n) + " hits, got " + std::to_string(room));
 }
 
-BatchRecord Caster::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists, size_t room) {
+BatchRecord Caster::Impl::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists, size_t room) {
   std::unique_lock<std::mutex> lock(mutex_);
   auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
@@ -655,7 +622,7 @@ BatchRecord Caster::claim(Slot& s, const Ticket& t, bool scene_wait, bool lists,
   return {s.ran_on, s.n, s.ready_ms - s.submit_ms, 0, s.cpu_ms};
 }
 
-void Caster::release(Slot& s, const BatchRecord& r, bool record) {
+void Caster::Impl::release(Slot& s, const BatchRecord& r, bool record) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (record) {
     if (records_.size() < kRecords) records_.push_back(r);
@@ -665,7 +632,7 @@ void Caster::release(Slot& s, const BatchRecord& r, bool record) {
   free_locked(s);
 }
 
-BatchRecord Caster::wait(const Ticket& t, std::span<SceneHit> hits) {
+BatchRecord Caster::Impl::wait(const Ticket& t, std::span<SceneHit> hits) {
   Slot& s = slot_of(t);
   const BatchRecord r = claim(s, t, true, false, hits.size());
   std::copy(s.scene_hits.begin(), s.scene_hits.begin() + s.n, hits.begin());
@@ -681,7 +648,7 @@ static void concatenate(HitRows<Record>& lists, uint32_t max_hits, const std::ve
   for (const HitRows<Record>& rows : jobs) lists.append(rows);
 }
 
-BatchRecord Caster::wait(const Ticket& t, SceneHitLists& lists) {
+BatchRecord Caster::Impl::wait(const Ticket& t, SceneHitLists& lists) {
   Slot& s = slot_of(t);
   const BatchRecord r = claim(s, t, true, true, 0);
   try {
@@ -694,7 +661,7 @@ BatchRecord Caster::wait(const Ticket& t, SceneHitLists& lists) {
   return r;
 }
 
-BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record) {
+BatchRecord Caster::Impl::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record) {
   BatchRecord r = claim(s, t, false, lists != nullptr, hits.size());
   try {
     copy_out(s, r, hits, lists);
@@ -706,7 +673,7 @@ BatchRecord Caster::collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLi
   return r;
 }
 
-void Caster::copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists) {
+void Caster::Impl::copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists) {
   bool copied = false;
   if (r.ran_on == Backend::Vulkan) {
     try {
@@ -734,31 +701,31 @@ void Caster::copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* li
   }
 }
 
-void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {
+void Caster::Impl::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {
   blob("Caster::trace_now").trace(rays, hits, options_.hit_outputs, query.query, query.cull);
 }
 
-void Caster::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const {
+void Caster::Impl::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const {
   blob("Caster::trace_now").trace_all_hits(rays, lists, options_.hit_outputs, cull);
 }
 
-std::vector<BatchRecord> Caster::records() const {
+std::vector<BatchRecord> Caster::Impl::records() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return records_;
 }
 
-void Caster::clear_records() {
+void Caster::Impl::clear_records() {
   std::lock_guard<std::mutex> lock(mutex_);
   records_.clear();
   recorded_ = 0;
 }
 
-std::string Caster::gpu_error() const {
+std::string Caster::Impl::gpu_error() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return gpu_error_;
 }
 
-Percentiles Caster::percentiles(Backend b, uint32_t rays) const {
+Percentiles Caster::Impl::percentiles(Backend b, uint32_t rays) const {
   std::vector<double> latency;
   double total_ms = 0, total_rays = 0;
   for (const BatchRecord& r : records()) {
@@ -788,11 +755,11 @@ std::string profile_key(const std::string& device, const BlobView& view) {
 
 }  // namespace
 
-std::string Caster::unused_profile() const {
+std::string Caster::Impl::unused_profile() const {
   return profile_unused_.empty() ? "" : " (the profile was not used: " + profile_unused_ + ")";
 }
 
-bool Caster::load_crossover() {
+bool Caster::Impl::load_crossover() {
   if (options_.profile.empty()) return false;
   const SavedProfile saved = read_profile(options_.profile, profile_key(device_name(), *view_));
   if (!saved.crossover) {
@@ -810,7 +777,7 @@ bool Caster::load_crossover() {
 // measured on rays aimed at the blob's box from around it, on the slot
 // after the game's (its batches are not the game's records), then saved to
 // options.profile when one is named.
-void Caster::measure_crossover() {
+void Caster::Impl::measure_crossover() {
   const layout::BlobHeader& h = layout::header_of(view_->bytes().data());
   std::vector<Ray> rays(16384);
   uint64_t state = 0x9E3779B97F4A7C15ull;
@@ -878,5 +845,38 @@ void Caster::measure_crossover() {
   crossover_ = crossover;
   crossover_known_ = true;
 }
+
+// The public class: every call is the implementation's.
+Caster::Caster(std::span<const uint8_t> blob, const std::string& name, CasterOptions options)
+    : impl_(std::make_unique<Impl>(blob, name, std::move(options))) {}
+Caster::Caster(CasterOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Caster::~Caster() = default;  // ~Impl() stops the threads before any member goes
+
+Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) { return impl_->submit(rays, query); }
+Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
+  return impl_->submit(scene, rays, query);
+}
+BatchRecord Caster::wait(const Ticket& t, std::span<SceneHit> hits) { return impl_->wait(t, hits); }
+BatchRecord Caster::wait(const Ticket& t, SceneHitLists& lists) { return impl_->wait(t, lists); }
+bool Caster::poll(const Ticket& t) { return impl_->poll(t); }
+BatchRecord Caster::wait(const Ticket& t, std::span<Hit> hits) { return impl_->wait(t, hits); }
+BatchRecord Caster::wait(const Ticket& t, HitLists& lists) { return impl_->wait(t, lists); }
+void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {
+  impl_->trace_now(rays, hits, query);
+}
+void Caster::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const { impl_->trace_now(rays, lists, cull); }
+Backend Caster::choose(uint32_t rays) const { return impl_->choose(rays); }
+std::string Caster::why(uint32_t rays) const { return impl_->why(rays); }
+uint32_t Caster::crossover() const { return impl_->crossover_.load(); }
+bool Caster::crossover_known() const { return impl_->crossover_known_.load(); }
+void Caster::wait_for_crossover() { impl_->wait_for_crossover(); }
+bool Caster::gpu_available() const { return impl_->gpu_available(); }
+std::string Caster::gpu_error() const { return impl_->gpu_error(); }
+std::string Caster::device_name() const { return impl_->device_name(); }
+uint32_t Caster::validation_messages() const { return impl_->validation_messages(); }
+uint32_t Caster::cpu_threads() const { return impl_->cpu_threads(); }
+Percentiles Caster::percentiles(Backend b, uint32_t rays) const { return impl_->percentiles(b, rays); }
+std::vector<BatchRecord> Caster::records() const { return impl_->records(); }
+void Caster::clear_records() { impl_->clear_records(); }
 
 }  // namespace meshcast::host

@@ -16,7 +16,6 @@
 #include "gpu/vulkan.h"
 #endif
 #include "host/jobs.h"
-#include "host/profile.h"
 #include "layout/blob_format.h"
 #include "layout/queries.h"
 #include "cpu/scene.h"
@@ -28,9 +27,6 @@ namespace {
 double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
-
-// Records kept for percentiles: a ring, so a long game does not grow it.
-constexpr size_t kRecords = 1 << 16;
 
 }  // namespace
 
@@ -148,7 +144,6 @@ void Caster::Impl::setup(std::span<const uint8_t> blob, const std::string& name)
     };
     slots_.push_back(std::move(s));
   }
-  records_.reserve(kRecords);
 
   if (options_.backend != Backend::Cpu) {
 #if !MESHCAST_VULKAN
@@ -201,29 +196,34 @@ void Caster::Impl::setup(std::span<const uint8_t> blob, const std::string& name)
     }
 #endif
   }
-  if (options_.backend != Backend::Automatic || !gpu_available() || load_crossover()) {
-    crossover_known_ = true;
+  find_crossover();
+}
+
+void Caster::Impl::find_crossover() {
+  if (options_.backend != Backend::Automatic || !gpu_available()) {
+    crossover_.not_wanted();
     return;
   }
-  crossover_note_ = "being measured in the background" + unused_profile() + "; the CPU answers meanwhile";
-  measuring_ = std::thread([this] {
-    try {
-      measure_crossover();  // publishes the crossover, its note and crossover_known_ together
-    } catch (const GpuError& e) {  // the GPU failed while measured: the CPU it is
-      gpu_failed(std::string("measuring the crossover: ") + e.what());
-    } catch (const std::exception& e) {  // anything else (memory): the GPU stays, the crossover stays unmeasured
-      std::lock_guard<std::mutex> lock(mutex_);
-      crossover_note_ = std::string("not measured: ") + e.what();
-    } catch (...) {  // an engine's job system may throw a type of its own: nothing may leave this thread
-      std::lock_guard<std::mutex> lock(mutex_);
-      crossover_note_ = "not measured: the job system threw an exception not derived from std::exception";
-    }
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      crossover_known_ = true;
-    }
-    changed_.notify_all();
-  });
+  if (crossover_.load(options_.profile, profile_key(device_name(), *view_))) return;
+  crossover_.measure_in_background({
+      &*view_, device_name(), options_.profile,
+      [this](std::span<const Ray> rays, std::span<Hit> hits, Backend b) { return time_measurement_batch(rays, hits, b); },
+      [this] { return gpu_available(); }, [this] { return cpu_threads(); },
+      [this](const std::string& why) { gpu_failed(why); }});
+}
+
+double Caster::Impl::time_measurement_batch(std::span<const Ray> rays, std::span<Hit> hits, Backend backend) {
+  Slot& slot = *slots_[game_slots_];
+  Ticket t;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    slot.state = Slot::Running;
+    slot.id = next_id_++;
+    slot.query = {};  // the crossover is the closest hit's
+    t = {slot.id, slot.index};
+  }
+  start(slot, rays, backend);
+  return collect(slot, t, hits, nullptr, false).latency_ms;
 }
 
 template <class Ready>
@@ -237,7 +237,7 @@ bool Caster::Impl::block(std::unique_lock<std::mutex>& lock, Ready ready) {
 
 void Caster::Impl::wait_for_crossover() {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (!block(lock, [this] { return crossover_known_.load(); }))
+  if (!block(lock, [this] { return crossover_.known(); }))
     throw UsageError("Caster::wait_for_crossover: the caster was destroyed while waiting");
 }
 
@@ -250,8 +250,7 @@ Caster::Impl::~Impl() {
     changed_.notify_all();
   }
   // The measurement stops after its current batch.
-  stop_measuring_ = true;
-  if (measuring_.joinable()) measuring_.join();
+  crossover_.stop();
   // Let what is still running finish, so no job or fence outlives the
   // caster, and every thread that was blocked in a call, or is still
   // copying a batch's hits out, leave it.
@@ -300,7 +299,7 @@ uint32_t Caster::Impl::validation_messages() const { return 0; }
 Backend Caster::Impl::choose(uint32_t rays) const {
   if (!gpu_available() || options_.backend == Backend::Cpu) return Backend::Cpu;
   if (options_.backend == Backend::Vulkan) return Backend::Vulkan;
-  return rays >= crossover_.load() ? Backend::Vulkan : Backend::Cpu;
+  return rays >= crossover_.rays() ? Backend::Vulkan : Backend::Cpu;
 }
 
 std::string Caster::Impl::why(uint32_t rays) const {
@@ -308,13 +307,9 @@ std::string Caster::Impl::why(uint32_t rays) const {
   if (options_.backend == Backend::Cpu) return n + "CPU, as the caster was made";
   if (!gpu_available()) return n + "CPU, the GPU is unavailable (" + gpu_error() + ")";
   if (options_.backend == Backend::Vulkan) return n + "Vulkan on " + device_name() + ", as the caster was made";
-  std::string note;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    note = crossover_note_;
-  }
-  const uint32_t crossover = crossover_.load();
-  if (!crossover_known_) return n + "CPU, while the crossover is " + note;
+  const std::string note = crossover_.note();
+  const uint32_t crossover = crossover_.rays();
+  if (!crossover_.known()) return n + "CPU, while the crossover is " + note;
   if (crossover == ~0u) return n + "CPU, the GPU finished no batch size first (" + note + ")";
   return n + (rays >= crossover ? "Vulkan on " + device_name() + ", at or above" : "CPU, below") +
          " the crossover of " + std::to_string(crossover) + " rays (" + note + ")";
@@ -623,13 +618,8 @@ BatchRecord Caster::Impl::claim(Slot& s, const Ticket& t, bool scene_wait, bool 
 }
 
 void Caster::Impl::release(Slot& s, const BatchRecord& r, bool record) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (record) {
-    if (records_.size() < kRecords) records_.push_back(r);
-    else records_[recorded_ % kRecords] = r;
-    ++recorded_;
-  }
-  free_locked(s);
+  if (record) records_.add(r);
+  free_slot(s);
 }
 
 BatchRecord Caster::Impl::wait(const Ticket& t, std::span<SceneHit> hits) {
@@ -709,141 +699,9 @@ void Caster::Impl::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cu
   blob("Caster::trace_now").trace_all_hits(rays, lists, options_.hit_outputs, cull);
 }
 
-std::vector<BatchRecord> Caster::Impl::records() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return records_;
-}
-
-void Caster::Impl::clear_records() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  records_.clear();
-  recorded_ = 0;
-}
-
 std::string Caster::Impl::gpu_error() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return gpu_error_;
-}
-
-Percentiles Caster::Impl::percentiles(Backend b, uint32_t rays) const {
-  std::vector<double> latency;
-  double total_ms = 0, total_rays = 0;
-  for (const BatchRecord& r : records()) {
-    if (r.ran_on != b || (rays && r.rays != rays)) continue;
-    latency.push_back(r.latency_ms);
-    total_ms += r.latency_ms, total_rays += r.rays;
-  }
-  Percentiles p;
-  p.batches = latency.size();
-  if (latency.empty()) return p;
-  std::sort(latency.begin(), latency.end());
-  p.p50_ms = latency[(latency.size() - 1) / 2];
-  p.p99_ms = latency[std::min(latency.size() - 1, size_t(std::ceil(0.99 * double(latency.size()))) - 1)];
-  p.rays_per_second = total_ms > 0 ? total_rays / (total_ms * 1e-3) : 0;
-  return p;
-}
-
-namespace {
-
-// What a saved profile is known by: the device, the layout, the mesh.
-std::string profile_key(const std::string& device, const BlobView& view) {
-  const layout::BlobHeader& h = layout::header_of(view.bytes().data());
-  return device + " | " + std::string(layout::tree_format_name(h.tree_format)) + "/" +
-         std::string(layout::triangle_format_name(h.triangle_format)) + " | " + std::to_string(h.triangle_count) +
-         " triangles | " + std::to_string(h.checksum);
-}
-
-}  // namespace
-
-std::string Caster::Impl::unused_profile() const {
-  return profile_unused_.empty() ? "" : " (the profile was not used: " + profile_unused_ + ")";
-}
-
-bool Caster::Impl::load_crossover() {
-  if (options_.profile.empty()) return false;
-  const SavedProfile saved = read_profile(options_.profile, profile_key(device_name(), *view_));
-  if (!saved.crossover) {
-    profile_unused_ = saved.note;
-    profile_replaceable_ = saved.replaceable;
-    return false;
-  }
-  crossover_ = *saved.crossover;
-  crossover_note_ = saved.note + ", loaded from " + options_.profile;
-  return true;
-}
-
-// The crossover: the smallest measured batch size from which on the GPU
-// returned every size first (median of 3 batches a size and backend),
-// measured on rays aimed at the blob's box from around it, on the slot
-// after the game's (its batches are not the game's records), then saved to
-// options.profile when one is named.
-void Caster::Impl::measure_crossover() {
-  const layout::BlobHeader& h = layout::header_of(view_->bytes().data());
-  std::vector<Ray> rays(16384);
-  uint64_t state = 0x9E3779B97F4A7C15ull;
-  auto uniform = [&] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return float(double(state >> 40) / double(1ull << 24));
-  };
-  float centre[3], extent = 0;
-  for (int a = 0; a < 3; ++a)
-    centre[a] = 0.5f * (h.bounds_min[a] + h.bounds_max[a]), extent = std::max(extent, h.bounds_max[a] - h.bounds_min[a]);
-  for (Ray& r : rays) {
-    for (int a = 0; a < 3; ++a) {
-      r.org[a] = centre[a] + extent * (2 * uniform() - 1);
-      r.dir[a] = h.bounds_min[a] + (h.bounds_max[a] - h.bounds_min[a]) * uniform() - r.org[a];
-    }
-    r.tmax = INFINITY;
-  }
-  std::vector<Hit> hits(rays.size());
-  Slot& slot = *slots_[game_slots_];
-  std::vector<uint32_t> sizes;
-  std::vector<double> cpu, gpu;
-  for (uint32_t n = 1; n <= rays.size(); n *= 4) {
-    sizes.push_back(n);
-    for (Backend b : {Backend::Cpu, Backend::Vulkan}) {
-      std::vector<double> ms;
-      for (int k = 0; k < 3; ++k) {
-        if (stop_measuring_) return;
-        Ticket t;
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          slot.state = Slot::Running;
-          slot.id = next_id_++;
-          slot.query = {};  // the crossover is the closest hit's
-          t = {slot.id, slot.index};
-        }
-        start(slot, std::span<const Ray>(rays).first(n), b);
-        ms.push_back(collect(slot, t, hits, nullptr, false).latency_ms);
-      }
-      std::sort(ms.begin(), ms.end());
-      (b == Backend::Cpu ? cpu : gpu).push_back(ms[1]);
-    }
-  }
-  if (!gpu_available()) return;
-  size_t first = sizes.size();
-  while (first > 0 && gpu[first - 1] < cpu[first - 1]) --first;
-  const size_t at = first < sizes.size() ? first : sizes.size() - 1;
-  std::ostringstream note;
-  note << "at " << sizes[at] << " rays " << device_name() << " took " << gpu[at] << " ms, " << cpu_threads()
-       << " CPU threads " << cpu[at] << " ms; measured at start-up";
-  const uint32_t crossover = first < sizes.size() ? sizes[first] : ~0u;
-  std::string saved = unused_profile();
-  if (!options_.profile.empty() && !profile_replaceable_) {
-    saved += "; not saved: " + options_.profile + " is left as it is";
-  } else if (!options_.profile.empty()) {
-    try {
-      write_profile(options_.profile, profile_key(device_name(), *view_), crossover, note.str());
-    } catch (const OutputError& e) {  // the crossover stands; only the next start measures again
-      saved += std::string("; not saved: ") + e.what();
-    }
-  }
-  // Published together, after the profile is written: no reader sees a
-  // crossover without its note, or a known crossover the file lacks.
-  std::lock_guard<std::mutex> lock(mutex_);
-  crossover_note_ = note.str() + saved;
-  crossover_ = crossover;
-  crossover_known_ = true;
 }
 
 // The public class: every call is the implementation's.
@@ -867,16 +725,16 @@ void Caster::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuer
 void Caster::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const { impl_->trace_now(rays, lists, cull); }
 Backend Caster::choose(uint32_t rays) const { return impl_->choose(rays); }
 std::string Caster::why(uint32_t rays) const { return impl_->why(rays); }
-uint32_t Caster::crossover() const { return impl_->crossover_.load(); }
-bool Caster::crossover_known() const { return impl_->crossover_known_.load(); }
+uint32_t Caster::crossover() const { return impl_->crossover_.rays(); }
+bool Caster::crossover_known() const { return impl_->crossover_.known(); }
 void Caster::wait_for_crossover() { impl_->wait_for_crossover(); }
 bool Caster::gpu_available() const { return impl_->gpu_available(); }
 std::string Caster::gpu_error() const { return impl_->gpu_error(); }
 std::string Caster::device_name() const { return impl_->device_name(); }
 uint32_t Caster::validation_messages() const { return impl_->validation_messages(); }
 uint32_t Caster::cpu_threads() const { return impl_->cpu_threads(); }
-Percentiles Caster::percentiles(Backend b, uint32_t rays) const { return impl_->percentiles(b, rays); }
-std::vector<BatchRecord> Caster::records() const { return impl_->records(); }
-void Caster::clear_records() { impl_->clear_records(); }
+Percentiles Caster::percentiles(Backend b, uint32_t rays) const { return impl_->records_.percentiles(b, rays); }
+std::vector<BatchRecord> Caster::records() const { return impl_->records_.all(); }
+void Caster::clear_records() { impl_->records_.clear(); }
 
 }  // namespace meshcast::host

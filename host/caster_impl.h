@@ -20,6 +20,8 @@
 
 #include "meshcast/blob.h"
 #include "meshcast/caster.h"
+#include "host/crossover.h"
+#include "host/latency.h"
 
 namespace meshcast::gpu {
 class Context;
@@ -90,9 +92,6 @@ struct Caster::Impl {
   std::string device_name() const;
   uint32_t validation_messages() const;
   uint32_t cpu_threads() const { return jobs_->threads(); }
-  Percentiles percentiles(Backend b, uint32_t rays) const;
-  std::vector<BatchRecord> records() const;
-  void clear_records();
 
   Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
   // Fills the slot with the rays and starts the batch on `backend` (the
@@ -122,13 +121,11 @@ struct Caster::Impl {
   void cpu_instead(Slot& s);
   void gpu_completions();
   void gpu_failed(const std::string& why);
-  bool load_crossover();     // from options.profile; false when it holds none for this device and blob
-  // Why options.profile was not used (host/profile.h), and whether a
-  // measured crossover may be written over it; set by load_crossover().
-  std::string profile_unused_;
-  bool profile_replaceable_ = true;
-  std::string unused_profile() const;  // " (the profile was not used: ...)" for the notes, or ""
-  void measure_crossover();  // on the measurement's slot; the background thread's work
+  // The crossover's: loaded from options.profile, else measured.
+  void find_crossover();
+  // One batch of the crossover's measurement on the slot after the game's
+  // (its batches are not the game's records): its latency.
+  double time_measurement_batch(std::span<const Ray> rays, std::span<Hit> hits, Backend backend);
 
   // The caller's blob, which must outlive the caster (none for a caster of
   // scene batches alone); blob() throws UsageError naming `who` then.
@@ -163,13 +160,8 @@ struct Caster::Impl {
   std::map<uint32_t, std::shared_ptr<gpu::SceneMethod>> scene_methods_;
   std::string gpu_error_;
   std::atomic<bool> gpu_failed_{false};
-  std::atomic<uint32_t> crossover_{~0u};
-  std::atomic<bool> crossover_known_{false};
-  std::string crossover_note_;          // under mutex_ once the measurement has started
-  std::thread measuring_;               // the background measurement
-  std::atomic<bool> stop_measuring_{false};
 
-  mutable std::mutex mutex_;            // slots and records
+  mutable std::mutex mutex_;            // slots and the crossover's note
   std::mutex gpu_mutex_;                // the GPU method's begin and finish
   std::mutex jobs_mutex_;               // one JobSystem::run at a time (game thread, measurement, completions)
   std::atomic<uint32_t> calls_in_work_{0};  // jobs still inside a slot's work, even after it completed
@@ -179,8 +171,10 @@ struct Caster::Impl {
   std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
   uint32_t game_slots_ = 0;
   uint64_t next_id_ = 1;
-  std::vector<BatchRecord> records_;
-  uint64_t recorded_ = 0;
+  // Under mutex_, changed_ notified when it is known; its measurement's
+  // thread is stopped first thing in the destructor.
+  Crossover crossover_{mutex_, changed_};
+  LatencyRecords records_;
 
   std::mutex pending_mutex_;            // GPU batches waiting for their fence (scene batches: to begin), in order
   std::condition_variable pending_changed_;

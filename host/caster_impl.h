@@ -74,7 +74,8 @@ struct Caster::Impl {
     std::function<void(uint32_t)> work;  // made once, handed to the job system every batch
   };
 
-  // The public calls (meshcast/caster.h says what each does).
+  // The public calls (meshcast/caster.h says what each does), each defined
+  // in the file of its job.
   Ticket submit(std::span<const Ray> rays, BatchQuery query);
   Ticket submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query);
   bool poll(const Ticket& t);
@@ -93,51 +94,29 @@ struct Caster::Impl {
   uint32_t validation_messages() const;
   uint32_t cpu_threads() const { return jobs_->threads(); }
 
-  Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
-  // Fills the slot with the rays and starts the batch on `backend` (the
-  // CPU too when the GPU refuses it); collect() waits for it, copies its
-  // hits and frees the slot, keeping its record if `record`.
-  void start(Slot& s, std::span<const Ray> rays, Backend backend);
-  // `lists`: where a Query::All batch's rows go (null for the others).
-  BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record);
-  // collect()'s copy of a claimed batch's answers into the caller's
-  // (the GPU's read back, or the CPU's rows or hits).
-  void copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists);
-  // The GPU method for a batch's query, made on first use (under gpu_mutex_).
-  gpu::Method* method_for(const BatchQuery& q);
-  void start_cpu(Slot& s);
-  void start_gpu(Slot& s);
-  // Whether a scene batch of this query on this frame goes to the GPU
-  // (Backend::Vulkan, a device that has not failed, one hit a ray, every
-  // mesh in the layout the GPU scene method reads).
-  bool scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const;
-  // A scene batch on the GPU thread: begun, waited for, its answers in the
-  // slot (GpuError, `lost` once the batch was begun; InputError or
-  // UsageError for a batch the GPU scene method refuses).
-  void run_scene_on_gpu(Slot& s);
-  void complete(Slot& s, Backend ran_on);
-  // start_cpu() for a batch the GPU thread moves to the CPU: what the job
-  // system throws is kept in the slot for wait(), as no caller is there.
-  void cpu_instead(Slot& s);
-  void gpu_completions();
-  void gpu_failed(const std::string& why);
+  // host/caster.cpp: made, and destroyed.
+  void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
+  // The caller's blob, which must outlive the caster (none for a caster of
+  // scene batches alone); blob() throws UsageError naming `who` then.
+  std::optional<BlobView> view_;
+  const BlobView& blob(const char* who) const;
   // The crossover's: loaded from options.profile, else measured.
   void find_crossover();
   // One batch of the crossover's measurement on the slot after the game's
   // (its batches are not the game's records): its latency.
   double time_measurement_batch(std::span<const Ray> rays, std::span<Hit> hits, Backend backend);
 
-  // The caller's blob, which must outlive the caster (none for a caster of
-  // scene batches alone); blob() throws UsageError naming `who` then.
-  std::optional<BlobView> view_;
-  const BlobView& blob(const char* who) const;
-  void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
+  // host/frame_slots.cpp: a batch from its slot taken to its slot freed.
+  Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
   Slot& take_slot();  // a free game slot, Running; UsageError when none, or while the caster closes
   // A taken slot's batch of n rays under s.query: the clock started, room
   // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
   void size_slot(Slot& s, size_t n, bool scene);
-  void free_slot(Slot& s);  // what started the batch threw: nothing runs
-  void free_locked(Slot& s);  // free_slot() under mutex_
+  // Fills the slot with the rays and starts the batch on `backend` (the
+  // CPU too when the GPU refuses it); collect() waits for it, copies its
+  // hits and frees the slot, keeping its record if `record`.
+  void start(Slot& s, std::span<const Ray> rays, Backend backend);
+  void complete(Slot& s, Backend ran_on);  // Ready, its time taken; waiters woken
   // Waits on changed_ under `lock` (mutex_) until ready() or the caster
   // closes; counted in blocked_, which the destructor waits to be 0.
   // Returns ready(): false when the caster closed first.
@@ -147,7 +126,38 @@ struct Caster::Impl {
   // batch into what it asked for (scene hits or not, rows or not, `room`
   // hits), waits for it and marks it Collecting; release() frees the slot.
   BatchRecord claim(Slot& s, const Ticket& t, bool scene_wait, bool lists, size_t room);
+  // `lists`: where a Query::All batch's rows go (null for the others).
+  BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record);
+  // collect()'s copy of a claimed batch's answers into the caller's
+  // (the GPU's read back, or the CPU's rows or hits).
+  void copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists);
   void release(Slot& s, const BatchRecord& r, bool record);
+  void free_slot(Slot& s);  // what started the batch threw: nothing runs
+  void free_locked(Slot& s);  // free_slot() under mutex_
+
+  // host/cpu_batches.cpp: a batch cut into jobs on the job system.
+  void start_cpu(Slot& s);
+  void walk_job(Slot& s, uint32_t job);  // the slot's work: one job's rays
+  // start_cpu() for a batch the GPU thread moves to the CPU: what the job
+  // system throws is kept in the slot for wait(), as no caller is there.
+  void cpu_instead(Slot& s);
+
+  // host/gpu_batches.cpp: the device, its methods and its thread.
+  void open_gpu(std::span<const uint8_t> blob, const std::string& name);
+  // The GPU method for a batch's query, made on first use (under gpu_mutex_).
+  gpu::Method* method_for(const BatchQuery& q);
+  void start_gpu(Slot& s);
+  void gpu_completions();  // the GPU thread
+  // Whether a scene batch of this query on this frame goes to the GPU
+  // (Backend::Vulkan, a device that has not failed, one hit a ray, every
+  // mesh in the layout the GPU scene method reads).
+  bool scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const;
+  // A scene batch on the GPU thread: begun, waited for, its answers in the
+  // slot (GpuError, `lost` once the batch was begun; InputError or
+  // UsageError for a batch the GPU scene method refuses).
+  void run_scene_on_gpu(Slot& s);
+  void gpu_failed(const std::string& why);  // every batch the CPU's from now on; gpu_error_ says why
+
   CasterOptions options_;
   std::unique_ptr<WorkerPool> pool_;
   JobSystem* jobs_ = nullptr;
@@ -182,5 +192,14 @@ struct Caster::Impl {
   bool stopping_ = false;
   std::thread completion_;
 };
+
+template <class Ready>
+bool Caster::Impl::block(std::unique_lock<std::mutex>& lock, Ready ready) {
+  ++blocked_;
+  changed_.wait(lock, [&] { return closing_ || ready(); });
+  --blocked_;
+  if (closing_) changed_.notify_all();  // the destructor waits for blocked_ to be 0 (and for the lock)
+  return ready();
+}
 
 }  // namespace meshcast::host

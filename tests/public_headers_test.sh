@@ -28,6 +28,13 @@ for h in "$include"/meshcast/*.h; do
     echo "FAIL: $name opens the repository's internal files:"; sed 's/^/  /' "$tmp/other"; failed=1
   fi
 done
+# The Caster is a small class over a private implementation
+# (host/caster_impl.h): the threads, queues, maps and locks it is made of
+# are not the user's to compile, and a change to them rebuilds no user.
+if bad=$(grep -E '^[[:space:]]*#[[:space:]]*include[[:space:]]*<(thread|deque|map|condition_variable|atomic|mutex)>' \
+         "$include/meshcast/caster.h"); then
+  echo "FAIL: meshcast/caster.h includes what only its implementation needs:"; echo "$bad" | sed 's/^/  /'; failed=1
+fi
 [[ $count -gt 0 ]] || { echo "FAIL: no header in $include/meshcast"; exit 1; }
 [[ $failed == 0 ]] && echo "public headers: $count compile alone and bring in nothing but the standard library"
 exit $failed

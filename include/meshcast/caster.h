@@ -40,34 +40,18 @@
 // first batches of a size nothing is allocated per frame. Every method may
 // be called from several threads at once; the blob is only ever read.
 #pragma once
-#include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
-#include <map>
 #include <memory>
-#include <mutex>
-#include <optional>
 #include <span>
 #include <string>
-#include <thread>
 #include <vector>
 
-#include "meshcast/blob.h"
 #include "meshcast/jobs.h"
 #include "meshcast/ray.h"
 #include "meshcast/scene.h"
 
-namespace meshcast::gpu {
-class Context;
-class Method;
-class SceneMethod;
-}
-
 namespace meshcast::host {
-
-class WorkerPool;
 
 enum class Backend { Cpu, Vulkan, Automatic };
 const char* backend_name(Backend b);
@@ -277,14 +261,14 @@ class Caster {
   // measured in the background on a frame slot of its own, every batch
   // going to the CPU meanwhile. wait_for_crossover() blocks until it is
   // known (at once for the other backends).
-  uint32_t crossover() const { return crossover_.load(); }
-  bool crossover_known() const { return crossover_known_.load(); }
+  uint32_t crossover() const;
+  bool crossover_known() const;
   void wait_for_crossover();
   // Whether batches may go to the GPU now: its device was made (the
   // Vulkan or Automatic backend; for a caster of scene batches alone,
   // Vulkan) and has not failed since. Blob batches then go where choose()
   // says, scene batches the GPU scene method reads to the device.
-  bool gpu_available() const { return gpu_ != nullptr && !gpu_failed_.load(); }
+  bool gpu_available() const;
   // Why the GPU is not available although the caster asked for one: the
   // device, or the method for the blob's layout, could not be made, or the
   // device was lost (a failed submission, fence or read-back), after which
@@ -294,7 +278,7 @@ class Caster {
   std::string device_name() const;
   // Messages from the Vulkan validation layers so far (options.validation).
   uint32_t validation_messages() const;
-  uint32_t cpu_threads() const { return jobs_->threads(); }
+  uint32_t cpu_threads() const;
 
   // Latency percentiles and throughput of the collected batches of one
   // backend (all sizes together), or of one batch size.
@@ -303,100 +287,10 @@ class Caster {
   void clear_records();
 
  private:
-  struct Slot;
-  Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
-  // Fills the slot with the rays and starts the batch on `backend` (the
-  // CPU too when the GPU refuses it); collect() waits for it, copies its
-  // hits and frees the slot, keeping its record if `record`.
-  void start(Slot& s, std::span<const Ray> rays, Backend backend);
-  // `lists`: where a Query::All batch's rows go (null for the others).
-  BatchRecord collect(Slot& s, const Ticket& t, std::span<Hit> hits, HitLists* lists, bool record);
-  // collect()'s copy of a claimed batch's answers into the caller's
-  // (the GPU's read back, or the CPU's rows or hits).
-  void copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLists* lists);
-  // The GPU method for a batch's query, made on first use (under gpu_mutex_).
-  gpu::Method* method_for(const BatchQuery& q);
-  void start_cpu(Slot& s);
-  void start_gpu(Slot& s);
-  // Whether a scene batch of this query on this frame goes to the GPU
-  // (Backend::Vulkan, a device that has not failed, one hit a ray, every
-  // mesh in the layout the GPU scene method reads).
-  bool scene_on_gpu(const SceneBatchQuery& q, const SceneSnapshot& frame) const;
-  // A scene batch on the GPU thread: begun, waited for, its answers in the
-  // slot (GpuError, `lost` once the batch was begun; InputError or
-  // UsageError for a batch the GPU scene method refuses).
-  void run_scene_on_gpu(Slot& s);
-  void complete(Slot& s, Backend ran_on);
-  // start_cpu() for a batch the GPU thread moves to the CPU: what the job
-  // system throws is kept in the slot for wait(), as no caller is there.
-  void cpu_instead(Slot& s);
-  void gpu_completions();
-  void gpu_failed(const std::string& why);
-  bool load_crossover();     // from options.profile; false when it holds none for this device and blob
-  // Why options.profile was not used (host/profile.h), and whether a
-  // measured crossover may be written over it; set by load_crossover().
-  std::string profile_unused_;
-  bool profile_replaceable_ = true;
-  std::string unused_profile() const;  // " (the profile was not used: ...)" for the notes, or ""
-  void measure_crossover();  // on the measurement's slot; the background thread's work
-
-  // The caller's blob, which must outlive the caster (none for a caster of
-  // scene batches alone); blob() throws UsageError naming `who` then.
-  std::optional<BlobView> view_;
-  const BlobView& blob(const char* who) const;
-  void setup(std::span<const uint8_t> blob, const std::string& name);  // both constructors' rest
-  Slot& take_slot();  // a free game slot, Running; UsageError when none, or while the caster closes
-  // A taken slot's batch of n rays under s.query: the clock started, room
-  // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
-  void size_slot(Slot& s, size_t n, bool scene);
-  void free_slot(Slot& s);  // what started the batch threw: nothing runs
-  void free_locked(Slot& s);  // free_slot() under mutex_
-  // Waits on changed_ under `lock` (mutex_) until ready() or the caster
-  // closes; counted in blocked_, which the destructor waits to be 0.
-  // Returns ready(): false when the caster closed first.
-  template <class Ready>
-  bool block(std::unique_lock<std::mutex>& lock, Ready ready);
-  // The first half of collecting: checks that the caller collects the
-  // batch into what it asked for (scene hits or not, rows or not, `room`
-  // hits), waits for it and marks it Collecting; release() frees the slot.
-  BatchRecord claim(Slot& s, const Ticket& t, bool scene_wait, bool lists, size_t room);
-  void release(Slot& s, const BatchRecord& r, bool record);
-  CasterOptions options_;
-  std::unique_ptr<WorkerPool> pool_;
-  JobSystem* jobs_ = nullptr;
-  std::shared_ptr<gpu::Context> gpu_;  // shared_ptr: deleted where Vulkan is known (none without it)
-  std::unique_ptr<gpu::Method> method_;  // the closest hit's, two-sided (and the crossover's)
-  std::string method_name_;
-  std::map<std::pair<uint32_t, uint32_t>, std::unique_ptr<gpu::Method>> query_methods_;  // (flags, max_hits)
-  // By flags; the GPU thread's alone. shared_ptr: its deleter is made where
-  // the method is (a build without Vulkan makes none and needs none).
-  std::map<uint32_t, std::shared_ptr<gpu::SceneMethod>> scene_methods_;
-  std::string gpu_error_;
-  std::atomic<bool> gpu_failed_{false};
-  std::atomic<uint32_t> crossover_{~0u};
-  std::atomic<bool> crossover_known_{false};
-  std::string crossover_note_;          // under mutex_ once the measurement has started
-  std::thread measuring_;               // the background measurement
-  std::atomic<bool> stop_measuring_{false};
-
-  mutable std::mutex mutex_;            // slots and records
-  std::mutex gpu_mutex_;                // the GPU method's begin and finish
-  std::mutex jobs_mutex_;               // one JobSystem::run at a time (game thread, measurement, completions)
-  std::atomic<uint32_t> calls_in_work_{0};  // jobs still inside a slot's work, even after it completed
-  std::condition_variable changed_;     // a slot became ready or free, the crossover known, the caster closing
-  bool closing_ = false;                // under mutex_: the destructor has begun
-  uint32_t blocked_ = 0;                // under mutex_: threads in block()
-  std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
-  uint32_t game_slots_ = 0;
-  uint64_t next_id_ = 1;
-  std::vector<BatchRecord> records_;
-  uint64_t recorded_ = 0;
-
-  std::mutex pending_mutex_;            // GPU batches waiting for their fence (scene batches: to begin), in order
-  std::condition_variable pending_changed_;
-  std::deque<Slot*> pending_;
-  bool stopping_ = false;
-  std::thread completion_;
+  // Its slots, threads and GPU methods (host/caster_impl.h): none of them
+  // is part of the API, and their headers stay out of the user's.
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace meshcast::host

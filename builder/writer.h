@@ -1,5 +1,5 @@
-// The blob under construction, shared by every tree writer (cpu/write_*.cpp
-// and encode.cpp): the triangle codec as runtime values, the leaves' blocks,
+// The blob under construction, shared by every tree writer (builder/write_*.cpp
+// and build_blob.cpp): the triangle codec as runtime values, the leaves' blocks,
 // the vertex pool, the remap, and the refit that makes every node bound what
 // the codec decodes.
 #pragma once
@@ -166,7 +166,7 @@ inline uint32_t pns_code(const Box3& first, const Box3& second) {
   return code;
 }
 
-// The tree writers of cpu/write_*.cpp: plan(w) sizes the tree section (header
+// The tree writers of builder/write_*.cpp: plan(w) sizes the tree section (header
 // fields tree_size, node_bytes, node_count, triangle_base, root) before the
 // buffer exists; fill(w) encodes the leaves, refits and writes the nodes.
 struct TreeWriter {

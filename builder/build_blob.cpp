@@ -1,4 +1,4 @@
-// Writes a mesh into a blob (meshcast/build.h's build_blob): quantize (if the
+// Builds a mesh into a blob (meshcast/build.h's build_blob): quantize (if the
 // triangle format does), build the binary tree from the stored triangles,
 // lay it out in the tree format, encode each leaf with the triangle format,
 // then the remap and the header.

@@ -29,69 +29,63 @@ using layout::TriCorners;
 
 namespace {
 
-// BruteForce and AABBList: no tree. The "tree" is node 0 (the whole mesh)
-// followed by one leaf a chunk of `chunk` triangles of `order` (BruteForce:
-// input order; AABBList: batch after batch, and `chunk` divides the batch);
-// each becomes a record [count][block].
-BuildTree chunk_tree(const std::vector<Box3>& boxes, std::vector<uint32_t> order, uint32_t chunk) {
-  BuildTree t;
-  t.order = std::move(order);
-  t.nodes.emplace_back();
-  for (uint32_t i : t.order) t.nodes[0].box.grow(boxes[i]);
-  for (uint32_t first = 0; first < t.order.size(); first += chunk) {
-    BuildNode leaf;
-    leaf.first = first;
-    leaf.count = std::min<uint32_t>(chunk, uint32_t(t.order.size()) - first);
-    for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(boxes[t.order[i]]);
-    t.nodes.push_back(leaf);
-  }
-  return t;
-}
-
 // Seed 003: the tree over pairs (and the triangles left single), each
 // expanded back to its triangles side by side.
-BuildTree build_paired(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, uint32_t depth_limit,
-                       BuildReport* report, BuildThreads* threads) {
+BuildTree build_paired(const TreeInput& in, uint32_t depth_limit) {
+  const BuildOptions& o = in.options;
   if (o.leaf_size < 2) throw InputError("pairing needs leaves of at least 2 triangles (leaf size " + std::to_string(o.leaf_size) + ")");
-  Pairing p = pair_triangles(mesh);
+  Pairing p = pair_triangles(in.mesh);
   std::vector<uint32_t> members, start{0};
   std::vector<Box3> unit_boxes;
   for (uint32_t t = 0; t < p.partner.size(); ++t) {
     const uint32_t q = p.partner[t];
     if (q != MC_NO_HIT && q < t) continue;  // already in its partner's unit
-    Box3 box = boxes[t];
+    Box3 box = in.boxes[t];
     members.push_back(t);
-    if (q != MC_NO_HIT) members.push_back(q), box.grow(boxes[q]);
+    if (q != MC_NO_HIT) members.push_back(q), box.grow(in.boxes[q]);
     start.push_back(uint32_t(members.size()));
     unit_boxes.push_back(box);
   }
-  if (report) report->pairing = p.decision, report->paired_ratio = p.paired_ratio;
+  if (in.report) in.report->pairing = p.decision, in.report->paired_ratio = p.paired_ratio;
   // A leaf of leaf_size / 2 units holds at most leaf_size triangles; at the
   // depth limit half the 5-bit count's 31.
-  BuildTree units = build_tree(unit_boxes, o.splitter, o.leaf_size / 2, depth_limit, MC_QUAD_MAX_COUNT / 2, threads);
+  BuildTree units = build_tree(unit_boxes, o.splitter, o.leaf_size / 2, depth_limit, MC_QUAD_MAX_COUNT / 2, in.threads);
   return expand_groups(units, members, start);
 }
 
-BuildTree build_for(const Mesh& mesh, const BuildOptions& o, const std::vector<Box3>& boxes, const CodecOps& codec,
-                    uint32_t depth_limit, BuildReport* report, BuildThreads* threads) {
-  const uint32_t chunk = layout::brute_chunk(codec.lanes);
-  if (o.pairing && (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE || uint32_t(o.layout.tree) == MC_TREE_AABBLIST))
-    throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) +
-                     " keeps its own triangle order");
-  if (o.pairing) return build_paired(mesh, o, boxes, depth_limit, report, threads);
-  if (uint32_t(o.layout.tree) == MC_TREE_BRUTEFORCE) {
-    std::vector<uint32_t> input(boxes.size());
-    std::iota(input.begin(), input.end(), 0u);
-    return chunk_tree(boxes, std::move(input), chunk);
-  }
-  if (uint32_t(o.layout.tree) == MC_TREE_AABBLIST) {
-    static_assert(MC_LIST_BATCH % MC_BRUTE_CHUNK == 0 && MC_LIST_BATCH % 128 == 0, "records must tile a batch");
-    return chunk_tree(boxes, group_batches(boxes, MC_LIST_BATCH, o.grouping), chunk);
-  }
-  return build_tree(boxes, o.splitter, o.leaf_size, depth_limit, MC_QUAD_MAX_COUNT, threads);
+}  // namespace
+
+void TreeWriter::check(const BuildOptions& o) const {
+  if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
+    throw InputError("leaf size " + std::to_string(o.leaf_size) + " is outside 1.." + std::to_string(MC_QUAD_MAX_COUNT) +
+                     " (5-bit triangle counts, seed 000 5.6)");
+  if (std::string why = node_order_refusal(uint32_t(o.layout.tree), o.node_order); !why.empty()) throw InputError(why);
 }
 
-}  // namespace
+BuildTree TreeWriter::build(const TreeInput& in, uint32_t depth_limit) {
+  const BuildOptions& o = in.options;
+  if (o.pairing) return build_paired(in, depth_limit);
+  return build_tree(in.boxes, o.splitter, o.leaf_size, depth_limit, MC_QUAD_MAX_COUNT, in.threads);
+}
+
+BuildTree record_tree(const TreeInput& in, std::vector<uint32_t> order) {
+  if (in.options.pairing)
+    throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(uint32_t(in.options.layout.tree))) +
+                     " keeps its own triangle order");
+  const uint32_t chunk = layout::brute_chunk(in.codec.lanes);
+  BuildTree t;
+  t.order = std::move(order);
+  t.nodes.emplace_back();
+  for (uint32_t i : t.order) t.nodes[0].box.grow(in.boxes[i]);
+  for (uint32_t first = 0; first < t.order.size(); first += chunk) {
+    BuildNode leaf;
+    leaf.first = first;
+    leaf.count = std::min<uint32_t>(chunk, uint32_t(t.order.size()) - first);
+    for (uint32_t i = first; i < first + leaf.count; ++i) leaf.box.grow(in.boxes[t.order[i]]);
+    t.nodes.push_back(leaf);
+  }
+  return t;
+}
 
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
   return layout::with_tree_format(uint32_t(o.layout.tree), std::unique_ptr<TreeWriter>(), [&](auto tag) {
@@ -162,13 +156,14 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
                      std::to_string(kMaxBuildThreads) + " a build takes (0: one a core)");
   if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
     return build_zerobyte_blob(mesh, o, name, report);
-  if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
-    throw InputError(name + ": leaf size " + std::to_string(o.leaf_size) + " is outside 1.." +
-                     std::to_string(MC_QUAD_MAX_COUNT) + " (5-bit triangle counts, seed 000 5.6)");
-  if (layout::tree_format_name(uint32_t(o.layout.tree)).empty()) throw InputError(name + ": unknown tree format");
+  std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
+  if (!tree_writer) throw InputError(name + ": unknown tree format");
+  try {
+    tree_writer->check(o);
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + e.what());
+  }
   CodecOps codec = codec_ops(uint32_t(o.layout.triangles));
-  if (std::string why = node_order_refusal(uint32_t(o.layout.tree), o.node_order); !why.empty())
-    throw InputError(name + ": " + why);
 
   BlobHeader h{};
   h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
@@ -185,20 +180,15 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
   std::vector<TriCorners>& corners = stored.corners;
   const std::vector<Box3>& boxes = stored.boxes;
 
-  uint32_t depth_limit = ~0u;
-  if (uint32_t(o.layout.tree) == MC_TREE_STACKLESSLBVH) {
-    // The seed's choice, within the heap's reach (the capacity check then
-    // says when a mesh is too large for it).
-    uint32_t d = o.lbvh_depth ? o.lbvh_depth
-                              : std::min(uint32_t(std::bit_width(mesh.triangles.size())) + 1, MC_LBVH_MAX_DEPTH + 1);
-    if (d > MC_LBVH_MAX_DEPTH + 1)
-      throw InputError(name + ": StacklessLBVH depth limit " + std::to_string(d) + " exceeds " +
-                       std::to_string(MC_LBVH_MAX_DEPTH + 1) + " (2^26 node slots)");
-    depth_limit = d - 1;
+  uint32_t depth_limit;
+  try {
+    depth_limit = tree_writer->depth_limit(mesh.triangles.size(), o);
+  } catch (const InputError& e) {
+    throw InputError(name + ": " + e.what());
   }
   BuildTree tree;
   try {
-    tree = build_for(mesh, o, boxes, codec, depth_limit, report, parallel);
+    tree = tree_writer->build(TreeInput{mesh, o, boxes, codec, report, parallel}, depth_limit);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());
   }
@@ -207,7 +197,6 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
   BlobHeader& hd = writer.h;
   writer.measure_leaves();
 
-  std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
   try {
     tree_writer->plan(writer);
   } catch (const InputError& e) {

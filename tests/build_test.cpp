@@ -11,6 +11,7 @@
 #include "builder/build_threads.h"
 #include "check/generate.h"
 #include "layout/blob_format.h"
+#include "layout/catalog.h"
 #include "layout/leaves.h"
 #include "tests/testing.h"
 
@@ -454,6 +455,23 @@ TEST(Build, NodeOrdersAFormatCannotHoldAreRefusedWithTheReason) {
   EXPECT_THROW(build_blob(m, o, "sphere"), InputError);
   EXPECT_EQ(parse_node_order("breadthfirsttriangleslast"), NodeOrder::BreadthFirstTrianglesLast);
   EXPECT_THROW(parse_node_order("Random"), InputError);
+}
+
+// The catalog's leaf size and splitter columns are the defaults the
+// public API states: --leaf's "16 for OctTreeCompressed, 8 for the
+// others", and the seed 001 heap built by Morton-code middle split.
+TEST(Build, CatalogDefaultsAreTheLayoutsOwn) {
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_OCTTREECOMPRESSED).default_leaf_size, 16u);
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_AABBTREE).default_leaf_size, 8u);
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_STACKLESSLBVH).default_splitter, Splitter::Morton);
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_QUADTREEHALFFLOAT).default_splitter, Splitter::Binning);
+  for (const std::string& name : layout_names()) {
+    BuildOptions o = parse_layout(name);
+    layout::TreeFormatInfo info = layout::tree_format_info(uint32_t(o.layout.tree));
+    EXPECT_EQ(default_leaf_size(o.layout), info.default_leaf_size) << name;
+    EXPECT_EQ(o.leaf_size, info.default_leaf_size) << name;
+    EXPECT_EQ(o.splitter, info.default_splitter) << name;
+  }
 }
 
 TEST(Build, LayoutNamesAreCaseInsensitive) {

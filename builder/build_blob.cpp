@@ -20,7 +20,6 @@
 #include "layout/codecs.h"
 #include "layout/quadtree.h"
 #include "builder/writer.h"
-#include "builder/write_zerobyte.h"
 
 namespace meshcast {
 
@@ -55,7 +54,7 @@ BuildTree build_paired(const TreeInput& in, uint32_t depth_limit) {
 
 }  // namespace
 
-void TreeWriter::check(const BuildOptions& o) const {
+void TreeWriter::check(const Mesh&, const BuildOptions& o) const {
   if (o.leaf_size < 1 || o.leaf_size > MC_QUAD_MAX_COUNT)
     throw InputError("leaf size " + std::to_string(o.leaf_size) + " is outside 1.." + std::to_string(MC_QUAD_MAX_COUNT) +
                      " (5-bit triangle counts, seed 000 5.6)");
@@ -88,10 +87,8 @@ BuildTree record_tree(const TreeInput& in, std::vector<uint32_t> order) {
 }
 
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& o) {
-  return layout::with_tree_format(uint32_t(o.layout.tree), std::unique_ptr<TreeWriter>(), [&](auto tag) {
-    if constexpr (decltype(tag)::kTriangles == layout::TreeTriangles::AllCodecs) return make_writer(tag, o);
-    else return std::unique_ptr<TreeWriter>();
-  });
+  return layout::with_tree_format(uint32_t(o.layout.tree), std::unique_ptr<TreeWriter>(),
+                                  [&](auto tag) { return make_writer(tag, o); });
 }
 
 // The remap section after the blob's bytes so far: slot -> input triangle
@@ -154,16 +151,14 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
   if (o.threads > kMaxBuildThreads)
     throw InputError(name + ": " + std::to_string(o.threads) + " build threads asked for, more than the " +
                      std::to_string(kMaxBuildThreads) + " a build takes (0: one a core)");
-  if (uint32_t(o.layout.tree) == MC_TREE_ZEROBYTE || uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID)
-    return build_zerobyte_blob(mesh, o, name, report);
   std::unique_ptr<TreeWriter> tree_writer = make_tree_writer(o);
   if (!tree_writer) throw InputError(name + ": unknown tree format");
   try {
-    tree_writer->check(o);
+    tree_writer->check(mesh, o);
   } catch (const InputError& e) {
     throw InputError(name + ": " + e.what());
   }
-  CodecOps codec = codec_ops(uint32_t(o.layout.triangles));
+  CodecOps codec = tree_writer->codec(o);
 
   BlobHeader h{};
   h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
@@ -207,7 +202,7 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
     throw InputError(name + ": the tree is " + std::to_string(depth) + " levels deep, beyond the walkers' limit of " +
                      std::to_string(MC_MAX_DEPTH));
   hd.max_depth = depth;
-  hd.leaf_count = tree.leaf_count();  // BruteForce: the records
+  hd.leaf_count = tree_writer->leaf_count(tree);
   hd.tree_offset = align(MC_BLOB_HEADER_BYTES, 64);  // 64-byte nodes start on a cache line
   hd.vertex_offset = align(uint64_t(hd.tree_offset) + hd.tree_size, 8);
   writer.bytes.assign(hd.vertex_offset, 0);

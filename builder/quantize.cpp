@@ -64,26 +64,29 @@ StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const l
     float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
     packed[v] = layout::bitpack_encode(p, h.quant_offset, h.quant_scale);
   });
-  StoredTriangles s{std::vector<TriCorners>(mesh.triangles.size()), std::vector<Box3>(mesh.triangles.size())};
-  std::vector<TriCorners>& corners = s.corners;
+  // A format with no blocks to encode (CodecOps::encode null) keeps no
+  // corners: its tree is built from the boxes alone.
+  const bool blocks = codec.encode != nullptr;
+  StoredTriangles s{std::vector<TriCorners>(blocks ? mesh.triangles.size() : 0), std::vector<Box3>(mesh.triangles.size())};
   std::vector<Box3>& boxes = s.boxes;
   for_each_on(threads, mesh.triangles.size(), 4096, [&](uint64_t t) {
+    TriCorners unkept;
+    TriCorners& tri = blocks ? s.corners[t] : unkept;
     for (int c = 0; c < 3; ++c) {
       uint32_t v = mesh.triangles[t][c];
       if (grid) {
-        corners[t].vertex[c] = v;
-        corners[t].packed[c] = packed[v];
-        layout::bitpack_decode(packed[v], h.quant_offset, h.quant_scale, corners[t].v[c]);
+        tri.vertex[c] = v;
+        tri.packed[c] = packed[v];
+        layout::bitpack_decode(packed[v], h.quant_offset, h.quant_scale, tri.v[c]);
       } else {
-        corners[t].packed[c] = 0;
-        corners[t].vertex[c] = v;
-        corners[t].v[c][0] = mesh.vertices[v].x, corners[t].v[c][1] = mesh.vertices[v].y;
-        corners[t].v[c][2] = mesh.vertices[v].z;
+        tri.packed[c] = 0;
+        tri.vertex[c] = v;
+        tri.v[c][0] = mesh.vertices[v].x, tri.v[c][1] = mesh.vertices[v].y;
+        tri.v[c][2] = mesh.vertices[v].z;
       }
-      boxes[t].grow(Vec3{corners[t].v[c][0], corners[t].v[c][1], corners[t].v[c][2]});
+      boxes[t].grow(Vec3{tri.v[c][0], tri.v[c][1], tri.v[c][2]});
     }
   });
-
   return s;
 }
 

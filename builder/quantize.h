@@ -20,7 +20,8 @@ namespace meshcast {
 void set_mesh_grid(const Box3& mesh_box, const CodecOps& codec, const std::string& name, layout::BlobHeader& h);
 
 // Each triangle's corners as stored (on the header's grid when the codec has
-// one) and the box of those corners.
+// one; none for a codec with no blocks to encode) and the box of those
+// corners.
 struct StoredTriangles {
   std::vector<layout::TriCorners> corners;
   std::vector<Box3> boxes;

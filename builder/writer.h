@@ -30,6 +30,8 @@ struct CodecOps {
   bool moves_floats;   // stores floats it has changed (UncompressedStrip)
   bool independent;    // leaves may be encoded at once (layout/block.h)
   uint32_t lanes;
+  // Null for a format with no blocks (the zero-byte trees' Indexed24,
+  // whose writer stores the index words itself).
   uint32_t (*measure)(layout::TriCorners*, uint32_t);  // bytes of a leaf's block
   void (*encode)(layout::TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
@@ -167,17 +169,20 @@ struct TreeInput {
 };
 
 // The tree writers of builder/write_*.cpp, one a tree format, each step of
-// build_blob a member: check(o) refuses the options the format cannot take;
-// depth_limit the deepest level its builder may reach; build(in) the binary
-// tree it lays out (what triangles in what order); plan(w) sizes the tree
-// section (header fields tree_size, node_bytes, node_count, triangle_base,
-// root) before the buffer exists; fill(w) encodes the leaves, refits and
-// writes the nodes. The defaults are the binary trees' (InputError texts
-// without the mesh's name: build_blob adds it).
+// build_blob a member: check refuses a mesh or options the format cannot
+// take; codec is what encodes its leaves; depth_limit the deepest level its
+// builder may reach; build(in) the tree it lays out (what triangles in what
+// order); plan(w) sizes the tree section (header fields tree_size,
+// node_bytes, node_count, triangle_base, root) before the buffer exists;
+// fill(w) encodes the leaves, refits and writes the nodes. The defaults are
+// the binary trees' (InputError texts without the mesh's name: build_blob
+// adds it).
 struct TreeWriter {
   virtual ~TreeWriter() = default;
   // A leaf size within the 5-bit triangle counts, a node order its bits allow.
-  virtual void check(const BuildOptions& o) const;
+  virtual void check(const Mesh& mesh, const BuildOptions& o) const;
+  // The options' triangle format (InputError for one that is no codec).
+  virtual CodecOps codec(const BuildOptions& o) const { return codec_ops(uint32_t(o.layout.triangles)); }
   // ~0u: no limit.
   virtual uint32_t depth_limit(size_t /*triangles*/, const BuildOptions&) const { return ~0u; }
   // The options' splitter over the triangles (or over seed 003's pairs).
@@ -186,6 +191,8 @@ struct TreeWriter {
   virtual void fill(Writer& w) = 0;
   // Deepest node a walker's stack must hold (the wide trees' is their own).
   virtual uint32_t depth(const BuildTree& t) const { return t.depth; }
+  // The header's leaf_count (BruteForce: its records).
+  virtual uint32_t leaf_count(const BuildTree& t) const { return t.leaf_count(); }
 };
 
 // The trees of BruteForce and AABBList, which keep their own triangle order
@@ -194,19 +201,13 @@ struct TreeWriter {
 // [count][block].
 BuildTree record_tree(const TreeInput& in, std::vector<uint32_t> order);
 
-// Each tree format's writer (a make_writer overload on its catalog tag, in
-// its family's write_*.cpp); the zero-byte trees are not written from the
-// binary tree (builder/write_zerobyte.h).
-#define MC_WRITER_AllCodecs(Name) \
-  std::unique_ptr<TreeWriter> make_writer(layout::tree::Name, const BuildOptions& options);
-#define MC_WRITER_Indexed24(Name)
-#define MC_DECLARE_WRITER(Name, id, node_bytes, triangles, ...) MC_WRITER_##triangles(Name)
+// Each tree format's writer: a make_writer overload on its catalog tag, in
+// its family's write_*.cpp.
+#define MC_DECLARE_WRITER(Name, ...) std::unique_ptr<TreeWriter> make_writer(layout::tree::Name, const BuildOptions& options);
 MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WRITER)
 #undef MC_DECLARE_WRITER
-#undef MC_WRITER_Indexed24
-#undef MC_WRITER_AllCodecs
 
-// The writer for options.layout.tree (null for the zero-byte trees).
+// The writer for options.layout.tree (null for an unknown tree format).
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);
 
 }  // namespace meshcast

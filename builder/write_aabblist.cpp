@@ -1,5 +1,5 @@
 // AABBList (seed 000 §7, the GPU's method 2): the leaves of the tree from
-// batch_tree() are records of at most brute_chunk() triangles, batch after
+// record_tree() are records of at most brute_chunk() triangles, batch after
 // batch in group_batches() order; each run of records that adds up to
 // MC_LIST_BATCH triangles (the last: the rest) becomes one batch, written
 // as an entry with the box of what its records decode to.
@@ -12,6 +12,12 @@ namespace {
 
 class ListWriter : public TreeWriter {
  public:
+  // Batch after batch in the options' grouping; the records tile each batch.
+  BuildTree build(const TreeInput& in, uint32_t) override {
+    static_assert(MC_LIST_BATCH % MC_BRUTE_CHUNK == 0 && MC_LIST_BATCH % 128 == 0, "records must tile a batch");
+    return record_tree(in, group_batches(in.boxes, MC_LIST_BATCH, in.options.grouping));
+  }
+
   void plan(Writer& w) override {
     const BuildTree& t = w.tree;
     first_.clear();

@@ -1,6 +1,8 @@
-// BruteForce (seed 000 §3.11): no tree; the "tree" from chunk_tree() is
+// BruteForce (seed 000 §3.11): no tree; the "tree" from record_tree() is
 // node 0 (the whole mesh) and one leaf a chunk, each written as a record
 // [count][block] in input order.
+#include <numeric>
+
 #include "builder/writer.h"
 
 namespace meshcast {
@@ -9,6 +11,13 @@ namespace {
 
 class BruteWriter : public TreeWriter {
  public:
+  // The input order.
+  BuildTree build(const TreeInput& in, uint32_t) override {
+    std::vector<uint32_t> input(in.boxes.size());
+    std::iota(input.begin(), input.end(), 0u);
+    return record_tree(in, std::move(input));
+  }
+
   void plan(Writer& w) override {
     uint64_t size = 0;
     for (uint32_t n = 1; n < w.tree.nodes.size(); ++n) size += w.record_bytes(n);

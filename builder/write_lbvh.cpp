@@ -3,6 +3,8 @@
 // the slots no node uses are holes: zeroed nodes no walk reaches, the
 // format's price for needing no child pointers and no stack. Triangle
 // blocks follow the node array in depth-first order.
+#include <algorithm>
+#include <bit>
 #include <functional>
 
 #include "builder/writer.h"
@@ -15,6 +17,16 @@ namespace {
 class LbvhWriter : public TreeWriter {
  public:
   explicit LbvhWriter(bool near_first) : near_first_(near_first) {}
+
+  // The seed's choice, within the heap's reach (plan's capacity check then
+  // says when a mesh is too large for it). The option counts levels from 1.
+  uint32_t depth_limit(size_t triangles, const BuildOptions& o) const override {
+    uint32_t d = o.lbvh_depth ? o.lbvh_depth : std::min(uint32_t(std::bit_width(triangles)) + 1, MC_LBVH_MAX_DEPTH + 1);
+    if (d > MC_LBVH_MAX_DEPTH + 1)
+      throw InputError("StacklessLBVH depth limit " + std::to_string(d) + " exceeds " + std::to_string(MC_LBVH_MAX_DEPTH + 1) +
+                       " (2^26 node slots)");
+    return d - 1;
+  }
 
   void plan(Writer& w) override {
     const BuildTree& t = w.tree;

@@ -1,11 +1,31 @@
 // QuadTree (seed 000 §5.6) and QuadTreeHalfFloat (§5.7), in the node orders
 // of §4.3.
+#include <algorithm>
+#include <cmath>
+
 #include "builder/wide_plan.h"
 #include "layout/quadtree.h"
 
 namespace meshcast {
 
 namespace {
+
+// The frame the node boxes are stored in, after the refit: QuadTree's are
+// plain floats; QuadTreeHalfFloat's half floats are relative to the root
+// centre, scaled by a power of two that puts the root's half extent near
+// 2^14, far from both the half range limit (65504) and the subnormals.
+void frame_nodes(Writer&, layout::QuadBoundsFloat) {}
+void frame_nodes(Writer& w, layout::QuadBoundsHalf) {
+  const Box3& root = w.tree.nodes[0].box;
+  layout::BlobHeader& h = w.h;
+  float half_extent = 0;
+  for (int a = 0; a < 3; ++a) {
+    h.node_origin[a] = root.centre()[a];
+    half_extent = std::max({half_extent, std::fabs(root.max[a] - h.node_origin[a]),
+                            std::fabs(h.node_origin[a] - root.min[a])});
+  }
+  h.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
+}
 
 // QuadTree (§5.6): every binary node that stays a node takes up to four
 // children (plan_wide); nodes and triangle blocks are laid out in one of
@@ -16,6 +36,7 @@ void fill_quadtree(Writer& w, WidePlan& p) {
   const BuildTree& t = w.tree;
   for (uint32_t leaf : p.leaves) w.write_leaf(leaf, p.leaf_offset[leaf]);
   w.refit();
+  frame_nodes(w, Bounds{});
   auto props = [&](uint32_t n) { return layout::quad_properties(t.nodes[n].leaf() ? t.nodes[n].count : 0, wide_child_offset(t, p, n)); };
   for (size_t q = 0; q < p.binary_of.size(); ++q) {
     layout::QuadChild c[4];

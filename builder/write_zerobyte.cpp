@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <numeric>
@@ -249,47 +248,65 @@ std::string ZeroByteStats::describe() const {
   return text;
 }
 
-std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
-                                         BuildReport* report) {
-  auto start = std::chrono::steady_clock::now();
-  const bool hybrid = uint32_t(o.layout.tree) == MC_TREE_ZEROBYTEHYBRID;
-  const std::string what = name + ": " + (hybrid ? "ZeroByteHybrid" : "ZeroByteTree");
-  if (uint32_t(o.layout.triangles) != MC_TRI_INDEXED24) throw InputError(what + " stores the mesh's own indices: Indexed24 only");
-  if (o.pairing) throw InputError(what + ": pairing builds the other trees; a zero-byte tree picks its own order");
-  if (!hybrid && mesh.triangles.size() > MC_ZBT_MAX_TRIANGLES)
-    throw InputError(what + " holds at most " + std::to_string(MC_ZBT_MAX_TRIANGLES) +
-                     " triangles (21-bit node positions, seed 004); this mesh has " + std::to_string(mesh.triangles.size()) +
-                     " (ZeroByteHybrid takes more)");
-  if (hybrid && (o.hybrid_leaf < 8 || o.hybrid_leaf > MC_ZBT_MAX_TRIANGLES))
-    throw InputError(what + ": hybrid leaf of " + std::to_string(o.hybrid_leaf) + " triangles is outside 8.." +
-                     std::to_string(MC_ZBT_MAX_TRIANGLES));
-  if (mesh.vertices.size() > MC_ZBT_MAX_VERTICES)
-    throw InputError(what + " keeps 24 bits of each vertex index: at most " + std::to_string(MC_ZBT_MAX_VERTICES) +
-                     " vertices; this mesh has " + std::to_string(mesh.vertices.size()));
-  if (12ull * (mesh.triangles.size() + mesh.vertices.size()) + 4096 > 0xF0000000ull)
-    throw InputError(what + ": the blob would exceed the 4 GiB its 32-bit offsets reach");
+namespace {
 
-  std::vector<Box3> boxes(mesh.triangles.size());
-  std::vector<Vec3> centres(mesh.triangles.size());
-  Box3 bounds;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    for (int c = 0; c < 3; ++c) boxes[t].grow(mesh.corner(t, c));
-    centres[t] = boxes[t].centre();
-    bounds.grow(boxes[t]);
+// ZeroByteTree (seed 004) and ZeroByteHybrid (an SAH tree of zero-byte
+// trees): the writer of both. They store the mesh's own indices (24 bits
+// each) and its float vertices, and lay out trees of their own, not the
+// binary tree the others are written from: build() builds them and hands
+// build_blob the triangle order alone, and the leaf size and node order
+// options, which they do not use, are not checked.
+class ZeroByteWriter : public TreeWriter {
+ public:
+  ZeroByteWriter(std::string_view tree_name, bool hybrid, const BuildOptions& o)
+      : tree_name_(tree_name), hybrid_(hybrid), shuffle_(o.zbt_shuffle), box_cache_(o.zbt_box_cache),
+        hybrid_leaf_(o.hybrid_leaf) {}
+
+  void check(const Mesh& mesh, const BuildOptions& o) const override {
+    const std::string what(tree_name_);
+    if (uint32_t(o.layout.triangles) != MC_TRI_INDEXED24) throw InputError(what + " stores the mesh's own indices: Indexed24 only");
+    if (o.pairing) throw InputError(what + ": pairing builds the other trees; a zero-byte tree picks its own order");
+    if (!hybrid_ && mesh.triangles.size() > MC_ZBT_MAX_TRIANGLES)
+      throw InputError(what + " holds at most " + std::to_string(MC_ZBT_MAX_TRIANGLES) +
+                       " triangles (21-bit node positions, seed 004); this mesh has " + std::to_string(mesh.triangles.size()) +
+                       " (ZeroByteHybrid takes more)");
+    if (hybrid_ && (hybrid_leaf_ < 8 || hybrid_leaf_ > MC_ZBT_MAX_TRIANGLES))
+      throw InputError(what + ": hybrid leaf of " + std::to_string(hybrid_leaf_) + " triangles is outside 8.." +
+                       std::to_string(MC_ZBT_MAX_TRIANGLES));
+    if (mesh.vertices.size() > MC_ZBT_MAX_VERTICES)
+      throw InputError(what + " keeps 24 bits of each vertex index: at most " + std::to_string(MC_ZBT_MAX_VERTICES) +
+                       " vertices; this mesh has " + std::to_string(mesh.vertices.size()));
+    if (12ull * (mesh.triangles.size() + mesh.vertices.size()) + 4096 > 0xF0000000ull)
+      throw InputError(what + ": the blob would exceed the 4 GiB its 32-bit offsets reach");
   }
-  ZeroByteStats stats;
-  ZbtBuilder zbt(mesh, boxes, centres, o.zbt_shuffle);
-  std::vector<uint32_t> order, words;
-  std::vector<uint8_t> nodes;
-  uint32_t top_nodes = 0, top_depth = 0;
-  try {
-    if (!hybrid) {
+
+  // Indexed24 as build_blob sees it: float corners, 12 bytes a triangle
+  // slot, and no blocks for it to encode (fill writes the index words).
+  CodecOps codec(const BuildOptions&) const override {
+    return {MC_TRI_INDEXED24, layout::Indexed24::kSlotDivisor, layout::kGridNone, 0, false, false, false, 1, nullptr, nullptr};
+  }
+
+  BuildTree build(const TreeInput& in, uint32_t) override {
+    const Mesh& mesh = *(mesh_ = &in.mesh);
+    const std::vector<Box3>& boxes = in.boxes;
+    std::vector<Vec3> centres(boxes.size());
+    bounds_ = Box3{};
+    for (size_t t = 0; t < boxes.size(); ++t) {
+      centres[t] = boxes[t].centre();
+      bounds_.grow(boxes[t]);
+    }
+    stats_ = ZeroByteStats{};
+    ZbtBuilder zbt(mesh, boxes, centres, shuffle_);
+    BuildTree order_only;
+    std::vector<uint32_t>& order = order_only.order;
+    words_.clear(), nodes_.clear(), top_nodes_ = 0;
+    if (!hybrid_) {
       std::vector<uint32_t> all(mesh.triangles.size());
       std::iota(all.begin(), all.end(), 0u);
-      zbt.build(std::move(all), 0, order, words, stats);
+      zbt.build(std::move(all), 0, order, words_, stats_);
     } else {
-      BuildTree top = build_tree(boxes, Splitter::Binning, o.hybrid_leaf);
-      top_depth = top.depth + 1;  // a leaf's zero-byte root lies one below it
+      BuildTree top = build_tree(boxes, Splitter::Binning, hybrid_leaf_);
+      const uint32_t top_depth = top.depth + 1;  // a leaf's zero-byte root lies one below it
       std::vector<uint32_t> leaf_root(top.nodes.size(), 0);
       std::vector<Box3> leaf_box(top.nodes.size());
       for (size_t n = 0; n < top.nodes.size(); ++n) {
@@ -298,57 +315,70 @@ std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o
         leaf_root[n] = uint32_t(order.size());
         std::vector<uint32_t> items(top.order.begin() + b.first, top.order.begin() + b.first + b.count);
         for (uint32_t t : items) leaf_box[n].grow(boxes[t]);
-        zbt.build(std::move(items), top_depth, order, words, stats);
+        zbt.build(std::move(items), top_depth, order, words_, stats_);
       }
       Box3 root_box;
-      write_hybrid_nodes(top, 0, leaf_root, leaf_box, nodes, &root_box);
-      top_nodes = uint32_t(top.nodes.size());
+      write_hybrid_nodes(top, 0, leaf_root, leaf_box, nodes_, &root_box);
+      top_nodes_ = uint32_t(top.nodes.size());
     }
-  } catch (const InputError& e) {
-    throw InputError(what + ": " + e.what());
+    if (in.report) in.report->zerobyte = stats_.describe() + (box_cache_ ? "; box cache on" : "; box cache off");
+    return order_only;
   }
 
-  // Everything the blob holds, counted in 64 bits before any header field
-  // narrows to 32: header, the hybrid's nodes, indices, vertices, and the
-  // remap (at most 8 bytes a triangle with its bitmap and ranks).
-  const uint64_t total = 256 + uint64_t(nodes.size()) + 12ull * mesh.triangles.size() + 12ull * mesh.vertices.size() +
-                         8ull * mesh.triangles.size() + 64;
-  if (total > 0xF0000000ull)
-    throw InputError(what + ": the blob would take about " + std::to_string(total >> 20) +
-                     " MiB, beyond the 4 GiB its 32-bit offsets reach");
+  // The hybrid's nodes, then 12 bytes a triangle: its three index words.
+  void plan(Writer& w) override {
+    // Everything the blob holds, counted in 64 bits before any header field
+    // narrows to 32: header, the hybrid's nodes, indices, vertices, and the
+    // remap (at most 8 bytes a triangle with its bitmap and ranks).
+    const uint64_t triangles = mesh_->triangles.size(), vertices = mesh_->vertices.size();
+    const uint64_t total = 256 + uint64_t(nodes_.size()) + 12ull * triangles + 12ull * vertices + 8ull * triangles + 64;
+    if (total > 0xF0000000ull)
+      throw InputError(std::string(tree_name_) + ": the blob would take about " + std::to_string(total >> 20) +
+                       " MiB, beyond the 4 GiB its 32-bit offsets reach");
+    w.h.node_count = stats_.nodes + top_nodes_;
+    w.h.leaf_size = hybrid_ ? hybrid_leaf_ : MC_ZBT_MAX_COUNT;
+    w.h.root = box_cache_ ? MC_ZBT_FLAG_BOX_CACHE : 0;
+    w.h.node_bytes = w.h.triangle_base = uint32_t(nodes_.size());
+    w.h.tree_size = uint32_t(nodes_.size() + 12ull * triangles);
+  }
 
-  BlobHeader h{};
-  h.magic = MC_BLOB_MAGIC, h.version = MC_BLOB_VERSION;
-  h.tree_format = uint32_t(o.layout.tree), h.triangle_format = MC_TRI_INDEXED24;
-  h.triangle_count = uint32_t(mesh.triangles.size());
-  h.node_count = stats.nodes + top_nodes;
-  h.leaf_count = stats.leaves;
-  h.max_depth = stats.depth;
-  h.leaf_size = hybrid ? o.hybrid_leaf : MC_ZBT_MAX_COUNT;
-  h.root = o.zbt_box_cache ? MC_ZBT_FLAG_BOX_CACHE : 0;
-  for (int a = 0; a < 3; ++a) h.bounds_min[a] = bounds.min[a], h.bounds_max[a] = bounds.max[a];
-  h.slot_divisor = layout::Indexed24::kSlotDivisor;
-  h.tree_offset = align(MC_BLOB_HEADER_BYTES, 64);
-  h.node_bytes = h.triangle_base = uint32_t(nodes.size());
-  h.tree_size = uint32_t(nodes.size() + 12ull * h.triangle_count);
-  h.vertex_offset = align(uint64_t(h.tree_offset) + h.tree_size, 8);
-  h.vertex_size = uint32_t(12ull * mesh.vertices.size());
-  std::vector<uint8_t> bytes(uint64_t(h.vertex_offset) + h.vertex_size, 0);
-  if (!nodes.empty()) std::memcpy(bytes.data() + h.tree_offset, nodes.data(), nodes.size());
-  std::memcpy(bytes.data() + h.tree_offset + h.triangle_base, words.data(), 4ull * words.size());
-  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
-    float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
-    std::memcpy(bytes.data() + h.vertex_offset + 12 * v, p, 12);
+  // The words in place, the mesh's vertices as the vertex pool, the
+  // triangle order as the remap.
+  void fill(Writer& w) override {
+    uint8_t* tree = w.bytes.data() + w.h.tree_offset;
+    if (!nodes_.empty()) std::memcpy(tree, nodes_.data(), nodes_.size());
+    std::memcpy(tree + w.h.triangle_base, words_.data(), 4ull * words_.size());
+    w.pool.resize(12 * mesh_->vertices.size());
+    for (size_t v = 0; v < mesh_->vertices.size(); ++v) {
+      float p[3] = {mesh_->vertices[v].x, mesh_->vertices[v].y, mesh_->vertices[v].z};
+      std::memcpy(w.pool.data() + 12 * v, p, 12);
+    }
+    w.remap = w.tree.order;
+    w.frame(bounds_);
   }
-  append_remap(bytes, h, order, o.triangle_ids);
-  h.total_size = uint32_t(bytes.size());
-  std::memcpy(bytes.data(), &h, sizeof h);
-  layout::seal(bytes);
-  if (report) {
-    report->zerobyte = stats.describe() + (o.zbt_box_cache ? "; box cache on" : "; box cache off");
-    report->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  }
-  return bytes;
+
+  uint32_t depth(const BuildTree&) const override { return stats_.depth; }
+  uint32_t leaf_count(const BuildTree&) const override { return stats_.leaves; }
+
+ private:
+  std::string_view tree_name_;
+  const Mesh* mesh_ = nullptr;  // build's
+  bool hybrid_, shuffle_, box_cache_;
+  uint32_t hybrid_leaf_;
+  ZeroByteStats stats_;
+  Box3 bounds_;
+  std::vector<uint32_t> words_;
+  std::vector<uint8_t> nodes_;  // the hybrid's
+  uint32_t top_nodes_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<TreeWriter> make_writer(layout::tree::ZeroByteTree tag, const BuildOptions& o) {
+  return std::make_unique<ZeroByteWriter>(tag.kName, false, o);
+}
+std::unique_ptr<TreeWriter> make_writer(layout::tree::ZeroByteHybrid tag, const BuildOptions& o) {
+  return std::make_unique<ZeroByteWriter>(tag.kName, true, o);
 }
 
 }  // namespace meshcast

@@ -1,5 +1,6 @@
-// Zero-byte trees (seed 004) and the hybrid: the builder's entry point
-// (builder/write_zerobyte.cpp) and its statistics. The walkers are in
+// Zero-byte trees (seed 004) and the hybrid: the statistics of their
+// builder (builder/write_zerobyte.cpp, whose make_writer overloads
+// builder/writer.h declares). The walkers are in
 // cpu/walk_zerobyte.cpp, the bits in layout/zerobyte.h.
 #pragma once
 #include <cstdint>
@@ -16,11 +17,5 @@ struct ZeroByteStats {
   uint64_t bound_triangles = 0;  // over interior nodes
   std::string describe() const;
 };
-
-// build_blob() for MC_TREE_ZEROBYTE and MC_TREE_ZEROBYTEHYBRID. Throws
-// InputError naming `name` and the limit a mesh exceeds (2^21 triangles
-// for one zero-byte tree, 2^24 vertices).
-std::vector<uint8_t> build_zerobyte_blob(const Mesh& mesh, const BuildOptions& o, const std::string& name,
-                                         BuildReport* report);
 
 }  // namespace meshcast

@@ -1,5 +1,5 @@
-// The blob under construction, shared by every tree writer (cpu/write_*.cpp
-// and encode.cpp): the triangle codec as runtime values, the leaves' blocks,
+// The blob under construction, shared by every tree writer (builder/write_*.cpp
+// and build_blob.cpp): the triangle codec as runtime values, the leaves' blocks,
 // the vertex pool, the remap, and the refit that makes every node bound what
 // the codec decodes.
 #pragma once
@@ -30,6 +30,8 @@ struct CodecOps {
   bool moves_floats;   // stores floats it has changed (UncompressedStrip)
   bool independent;    // leaves may be encoded at once (layout/block.h)
   uint32_t lanes;
+  // Null for a format with no blocks (the zero-byte trees' Indexed24,
+  // whose writer stores the index words itself).
   uint32_t (*measure)(layout::TriCorners*, uint32_t);  // bytes of a leaf's block
   void (*encode)(layout::TriCorners*, uint32_t, layout::BlockContext&, uint8_t*);
 };
@@ -122,7 +124,7 @@ struct Writer {
   }
 
   // Interior boxes from the refitted leaves (children follow their parent
-  // in the builder's node order), then the header's frame from the root.
+  // in the builder's node order), then the header's bounds from the root.
   void refit() {
     for (size_t n = tree.nodes.size(); n-- > 0;) {
       BuildNode& b = tree.nodes[n];
@@ -133,21 +135,10 @@ struct Writer {
     frame(tree.nodes[0].box);
   }
 
-  // Header bounds, and for QuadTreeHalfFloat the frame of its half-float
-  // bounds: relative to the root centre, scaled by a power of two that puts
-  // the root's half extent near 2^14, far from both the half range limit
-  // (65504) and the subnormals. The other trees leave node_origin and
-  // node_scale as they are (OctTreeCompressed writes its node reach there).
+  // The header's bounds: the box of what the tree's leaves decode to (a
+  // writer whose nodes need a frame of their own sets it beside them).
   void frame(const Box3& root) {
     for (int a = 0; a < 3; ++a) h.bounds_min[a] = root.min[a], h.bounds_max[a] = root.max[a];
-    if (h.tree_format != MC_TREE_QUADTREEHALFFLOAT) return;
-    float half_extent = 0;
-    for (int a = 0; a < 3; ++a) {
-      h.node_origin[a] = root.centre()[a];
-      half_extent = std::max({half_extent, std::fabs(root.max[a] - h.node_origin[a]),
-                              std::fabs(h.node_origin[a] - root.min[a])});
-    }
-    h.node_scale = std::max(std::ldexp(1.0f, half_extent > 0 ? std::ilogb(half_extent) - 13 : 0), 0x1p-126f);
   }
 };
 
@@ -166,30 +157,57 @@ inline uint32_t pns_code(const Box3& first, const Box3& second) {
   return code;
 }
 
-// The tree writers of cpu/write_*.cpp: plan(w) sizes the tree section (header
-// fields tree_size, node_bytes, node_count, triangle_base, root) before the
-// buffer exists; fill(w) encodes the leaves, refits and writes the nodes.
+// What a tree is built from: the mesh, the options, each triangle's box
+// (of its stored corners) and the build's threads (none: this one).
+struct TreeInput {
+  const Mesh& mesh;
+  const BuildOptions& options;
+  const std::vector<Box3>& boxes;
+  const CodecOps& codec;
+  BuildReport* report;
+  BuildThreads* threads;
+};
+
+// The tree writers of builder/write_*.cpp, one a tree format, each step of
+// build_blob a member: check refuses a mesh or options the format cannot
+// take; codec is what encodes its leaves; depth_limit the deepest level its
+// builder may reach; build(in) the tree it lays out (what triangles in what
+// order); plan(w) sizes the tree section (header fields tree_size,
+// node_bytes, node_count, triangle_base, root) before the buffer exists;
+// fill(w) encodes the leaves, refits and writes the nodes. The defaults are
+// the binary trees' (InputError texts without the mesh's name: build_blob
+// adds it).
 struct TreeWriter {
   virtual ~TreeWriter() = default;
+  // A leaf size within the 5-bit triangle counts, a node order its bits allow.
+  virtual void check(const Mesh& mesh, const BuildOptions& o) const;
+  // The options' triangle format (InputError for one that is no codec).
+  virtual CodecOps codec(const BuildOptions& o) const { return codec_ops(uint32_t(o.layout.triangles)); }
+  // ~0u: no limit.
+  virtual uint32_t depth_limit(size_t /*triangles*/, const BuildOptions&) const { return ~0u; }
+  // The options' splitter over the triangles (or over seed 003's pairs).
+  virtual BuildTree build(const TreeInput& in, uint32_t depth_limit);
   virtual void plan(Writer& w) = 0;
   virtual void fill(Writer& w) = 0;
   // Deepest node a walker's stack must hold (the wide trees' is their own).
   virtual uint32_t depth(const BuildTree& t) const { return t.depth; }
+  // The header's leaf_count (BruteForce: its records).
+  virtual uint32_t leaf_count(const BuildTree& t) const { return t.leaf_count(); }
 };
 
-// Each tree format's writer (a make_writer overload on its catalog tag, in
-// its family's write_*.cpp); the zero-byte trees are not written from the
-// binary tree (builder/write_zerobyte.h).
-#define MC_WRITER_AllCodecs(Name) \
-  std::unique_ptr<TreeWriter> make_writer(layout::tree::Name, const BuildOptions& options);
-#define MC_WRITER_Indexed24(Name)
-#define MC_DECLARE_WRITER(Name, id, node_bytes, triangles, ...) MC_WRITER_##triangles(Name)
+// The trees of BruteForce and AABBList, which keep their own triangle order
+// (so refuse pairing): node 0 (the whole mesh) followed by one leaf a chunk
+// of brute_chunk(lanes) triangles of `order`, each written as a record
+// [count][block].
+BuildTree record_tree(const TreeInput& in, std::vector<uint32_t> order);
+
+// Each tree format's writer: a make_writer overload on its catalog tag, in
+// its family's write_*.cpp.
+#define MC_DECLARE_WRITER(Name, ...) std::unique_ptr<TreeWriter> make_writer(layout::tree::Name, const BuildOptions& options);
 MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WRITER)
 #undef MC_DECLARE_WRITER
-#undef MC_WRITER_Indexed24
-#undef MC_WRITER_AllCodecs
 
-// The writer for options.layout.tree (null for the zero-byte trees).
+// The writer for options.layout.tree (null for an unknown tree format).
 std::unique_ptr<TreeWriter> make_tree_writer(const BuildOptions& options);
 
 }  // namespace meshcast

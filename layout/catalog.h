@@ -16,26 +16,32 @@
 #include "layout/formats.h"
 #include "meshcast/build.h"
 
-// X(Name, id, smallest node in bytes, triangles, order, GPU method)
+// X(Name, id, smallest node in bytes, triangles, order, GPU method, leaf size, splitter)
 //   triangles  AllCodecs: every codec of layout/codecs.h; Indexed24: the
 //              mesh's own indices only (the zero-byte trees)
 //   order      the node order its bits allow (seed 000 §4.3): AnyOrder,
 //              NoTree, or the one its addressing fixes
 //   GPU method the Vulkan method that reads it ("" for none)
-#define MC_FOR_EACH_TREE_FORMAT(X)                                                                                \
-  X(AABBTree, MC_TREE_AABBTREE, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, "aabbtree")                         \
-  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, "")               \
-  X(AABBTreePNS, MC_TREE_AABBTREEPNS, MC_AABB_NODE_BYTES, AllCodecs, DepthFirstIndex, "")                         \
-  X(AABBTreeCompressed, MC_TREE_AABBTREECOMPRESSED, MC_COMPRESSED_NODE_BYTES, AllCodecs, BehindTheNode, "")       \
-  X(SKDTree, MC_TREE_SKDTREE, MC_SKD_LEAF_BYTES, AllCodecs, BehindTheNode, "skdtree")                             \
-  X(StacklessLBVH, MC_TREE_STACKLESSLBVH, MC_LBVH_NODE_BYTES, AllCodecs, Heap, "lbvh")                            \
-  X(QuadTree, MC_TREE_QUADTREE, MC_QUAD_NODE_BYTES, AllCodecs, AnyOrder, "")                                      \
-  X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT, MC_QUADHALF_NODE_BYTES, AllCodecs, AnyOrder, "quadtree")        \
-  X(OctTreeCompressed, MC_TREE_OCTTREECOMPRESSED, MC_OCT_NODE_BYTES, AllCodecs, AnyOrder, "octtree")            \
-  X(BruteForce, MC_TREE_BRUTEFORCE, MC_BRUTE_RECORD_BYTES, AllCodecs, NoTree, "bruteforce")                      \
-  X(AABBList, MC_TREE_AABBLIST, MC_LIST_ENTRY_BYTES, AllCodecs, NoTree, "aabblist")                               \
-  X(ZeroByteTree, MC_TREE_ZEROBYTE, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "")                         \
-  X(ZeroByteHybrid, MC_TREE_ZEROBYTEHYBRID, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "")
+//   leaf size  the largest leaf it is built with unless the caller says
+//              (meshcast/build.h's default_leaf_size): OctTreeCompressed's
+//              8-wide nodes fill best from leaves of 16; the zero-byte
+//              trees' leaves are fixed by their bits (or hybrid_leaf)
+//   splitter   the binary tree's splitter unless the caller says: the seed
+//              001 heap is built by Morton-code middle split, the rest by SAH
+#define MC_FOR_EACH_TREE_FORMAT(X)                                                                                      \
+  X(AABBTree, MC_TREE_AABBTREE, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, "aabbtree", 8, Binning)                   \
+  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, "", 8, Binning)         \
+  X(AABBTreePNS, MC_TREE_AABBTREEPNS, MC_AABB_NODE_BYTES, AllCodecs, DepthFirstIndex, "", 8, Binning)                   \
+  X(AABBTreeCompressed, MC_TREE_AABBTREECOMPRESSED, MC_COMPRESSED_NODE_BYTES, AllCodecs, BehindTheNode, "", 8, Binning) \
+  X(SKDTree, MC_TREE_SKDTREE, MC_SKD_LEAF_BYTES, AllCodecs, BehindTheNode, "skdtree", 8, Binning)                       \
+  X(StacklessLBVH, MC_TREE_STACKLESSLBVH, MC_LBVH_NODE_BYTES, AllCodecs, Heap, "lbvh", 8, Morton)                       \
+  X(QuadTree, MC_TREE_QUADTREE, MC_QUAD_NODE_BYTES, AllCodecs, AnyOrder, "", 8, Binning)                                \
+  X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT, MC_QUADHALF_NODE_BYTES, AllCodecs, AnyOrder, "quadtree", 8, Binning)  \
+  X(OctTreeCompressed, MC_TREE_OCTTREECOMPRESSED, MC_OCT_NODE_BYTES, AllCodecs, AnyOrder, "octtree", 16, Binning)       \
+  X(BruteForce, MC_TREE_BRUTEFORCE, MC_BRUTE_RECORD_BYTES, AllCodecs, NoTree, "bruteforce", 8, Binning)                 \
+  X(AABBList, MC_TREE_AABBLIST, MC_LIST_ENTRY_BYTES, AllCodecs, NoTree, "aabblist", 8, Binning)                         \
+  X(ZeroByteTree, MC_TREE_ZEROBYTE, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "", 8, Binning)                    \
+  X(ZeroByteHybrid, MC_TREE_ZEROBYTEHYBRID, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "", 8, Binning)
 
 namespace meshcast::layout {
 
@@ -52,7 +58,7 @@ enum class TreeOrder {
 
 // One tag type a tree format, for the overloads each room defines.
 namespace tree {
-#define MC_TREE_TAG(Name, id, node_bytes, triangles, order, method)   \
+#define MC_TREE_TAG(Name, id, node_bytes, triangles, order, method, leaf_size, splitter) \
   struct Name {                                                       \
     static constexpr uint32_t kId = id;                               \
     static constexpr std::string_view kName = #Name;                  \
@@ -60,6 +66,8 @@ namespace tree {
     static constexpr TreeTriangles kTriangles = TreeTriangles::triangles; \
     static constexpr TreeOrder kOrder = TreeOrder::order;             \
     static constexpr std::string_view kGpuMethod = method;            \
+    static constexpr uint32_t kDefaultLeafSize = leaf_size;           \
+    static constexpr Splitter kDefaultSplitter = Splitter::splitter;  \
   };
 MC_FOR_EACH_TREE_FORMAT(MC_TREE_TAG)
 #undef MC_TREE_TAG
@@ -74,12 +82,15 @@ struct TreeFormatInfo {
   TreeTriangles triangles = TreeTriangles::AllCodecs;
   TreeOrder order = TreeOrder::AnyOrder;
   std::string_view gpu_method;
+  uint32_t default_leaf_size = 0;
+  Splitter default_splitter = Splitter::Binning;
 };
 
 constexpr TreeFormatInfo tree_format_info(uint32_t id) {
 #define MC_TREE_INFO(Name, ...) \
   if (id == tree::Name::kId)    \
-    return {tree::Name::kId, tree::Name::kName, tree::Name::kSmallestNode, tree::Name::kTriangles, tree::Name::kOrder, tree::Name::kGpuMethod};
+    return {tree::Name::kId,        tree::Name::kName,       tree::Name::kSmallestNode,    tree::Name::kTriangles, \
+            tree::Name::kOrder,     tree::Name::kGpuMethod,  tree::Name::kDefaultLeafSize, tree::Name::kDefaultSplitter};
   MC_FOR_EACH_TREE_FORMAT(MC_TREE_INFO)
 #undef MC_TREE_INFO
   return {};

@@ -12,7 +12,7 @@
 // times 2^m, m the smallest that fits the block in 16 bits, and its offset a
 // multiple of that step: the lattices of all blocks nest. The writer first
 // moves each vertex to the coarsest lattice among the blocks that use it
-// (block_step, and snap_to_block_lattices in builder/encode.cpp), so every code
+// (block_step, and snap_to_block_lattices in builder/build_blob.cpp), so every code
 // decodes exactly and a shared vertex decodes to the same bits in every
 // block: no cracks. A vertex moves at most G/2 + G * 2^m / 2 for the largest
 // m of its blocks; the header keeps the largest m of the blob (max_block_shift).

@@ -9,8 +9,10 @@
 
 #include "builder/binary_tree.h"
 #include "builder/build_threads.h"
+#include "builder/writer.h"
 #include "check/generate.h"
 #include "layout/blob_format.h"
+#include "layout/catalog.h"
 #include "layout/leaves.h"
 #include "tests/testing.h"
 
@@ -454,6 +456,53 @@ TEST(Build, NodeOrdersAFormatCannotHoldAreRefusedWithTheReason) {
   EXPECT_THROW(build_blob(m, o, "sphere"), InputError);
   EXPECT_EQ(parse_node_order("breadthfirsttriangleslast"), NodeOrder::BreadthFirstTrianglesLast);
   EXPECT_THROW(parse_node_order("Random"), InputError);
+}
+
+// The catalog's leaf size and splitter columns are the defaults the
+// public API states: --leaf's "16 for OctTreeCompressed, 8 for the
+// others", and the seed 001 heap built by Morton-code middle split.
+TEST(Build, CatalogDefaultsAreTheLayoutsOwn) {
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_OCTTREECOMPRESSED).default_leaf_size, 16u);
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_AABBTREE).default_leaf_size, 8u);
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_STACKLESSLBVH).default_splitter, Splitter::Morton);
+  EXPECT_EQ(layout::tree_format_info(MC_TREE_QUADTREEHALFFLOAT).default_splitter, Splitter::Binning);
+  for (const std::string& name : layout_names()) {
+    BuildOptions o = parse_layout(name);
+    layout::TreeFormatInfo info = layout::tree_format_info(uint32_t(o.layout.tree));
+    EXPECT_EQ(default_leaf_size(o.layout), info.default_leaf_size) << name;
+    EXPECT_EQ(o.leaf_size, info.default_leaf_size) << name;
+    EXPECT_EQ(o.splitter, info.default_splitter) << name;
+  }
+}
+
+// Every tree format of the catalog, the zero-byte trees included, is built
+// through its writer (builder/writer.h), not a path of its own.
+TEST(Build, EveryTreeFormatHasAWriter) {
+  for (const std::string& name : layout_names()) EXPECT_NE(make_tree_writer(parse_layout(name)), nullptr) << name;
+  BuildOptions unknown;
+  unknown.layout.tree = TreeFormat(0xFFFF);
+  EXPECT_EQ(make_tree_writer(unknown), nullptr);
+  try {
+    build_blob(make_sphere(4, 8, 1, {0, 0, 0}), unknown, "sphere");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "sphere: unknown tree format");
+  }
+}
+
+// The zero-byte trees' leaves and order are fixed by their bits: the leaf
+// size and node order options, which the binary trees check, change
+// nothing there.
+TEST(Build, ZeroByteTreesIgnoreLeafSizeAndNodeOrder) {
+  Mesh m = make_sphere(12, 24, 1, {0, 0, 0});
+  for (const char* name : {"ZeroByteTree/Indexed24", "ZeroByteHybrid/Indexed24"}) {
+    BuildOptions o = parse_layout(name);
+    o.hybrid_leaf = 64;
+    const std::vector<uint8_t> plain = build_blob(m, o, "sphere");
+    o.leaf_size = 200;
+    o.node_order = NodeOrder::BreadthFirst;
+    EXPECT_EQ(build_blob(m, o, "sphere"), plain) << name;
+  }
 }
 
 TEST(Build, LayoutNamesAreCaseInsensitive) {

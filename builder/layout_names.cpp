@@ -9,14 +9,14 @@
 
 namespace meshcast {
 
-uint32_t default_leaf_size(Layout layout) { return layout.tree == TreeFormat::OctTreeCompressed ? 16 : 8; }
+// The catalog's columns (layout/catalog.h).
+uint32_t default_leaf_size(Layout layout) { return layout::tree_format_info(uint32_t(layout.tree)).default_leaf_size; }
 
 BuildOptions parse_layout(const std::string& text) {
   BuildOptions o;
   o.layout = parse_layout_name(text);
   o.leaf_size = default_leaf_size(o.layout);
-  // The seed 001 heap is built by Morton-code middle split.
-  if (o.layout.tree == TreeFormat::StacklessLBVH) o.splitter = Splitter::Morton;
+  o.splitter = layout::tree_format_info(uint32_t(o.layout.tree)).default_splitter;
   return o;
 }
 

@@ -7,7 +7,9 @@
 //   builder/   its writer (a make_writer overload on its tag),
 //   cpu/       its walker (a walk overload on its tag, instantiated for
 //              every triangle codec),
-//   shaders/   its compute shader, if a GPU method reads it.
+//   shaders/   its compute shader, if a GPU method reads it, with a line in
+//              gpu/method_table.cpp (the one table of what the GPU reads).
+// docs/adding-formats.md walks through it file by file.
 // The triangle formats' list is MC_FOR_EACH_TRIANGLE_CODEC (layout/codecs.h).
 #pragma once
 #include <cstdint>
@@ -16,32 +18,31 @@
 #include "layout/formats.h"
 #include "meshcast/build.h"
 
-// X(Name, id, smallest node in bytes, triangles, order, GPU method, leaf size, splitter)
+// X(Name, id, smallest node in bytes, triangles, order, leaf size, splitter)
 //   triangles  AllCodecs: every codec of layout/codecs.h; Indexed24: the
 //              mesh's own indices only (the zero-byte trees)
 //   order      the node order its bits allow (seed 000 §4.3): AnyOrder,
 //              NoTree, or the one its addressing fixes
-//   GPU method the Vulkan method that reads it ("" for none)
 //   leaf size  the largest leaf it is built with unless the caller says
 //              (meshcast/build.h's default_leaf_size): OctTreeCompressed's
 //              8-wide nodes fill best from leaves of 16; the zero-byte
 //              trees' leaves are fixed by their bits (or hybrid_leaf)
 //   splitter   the binary tree's splitter unless the caller says: the seed
 //              001 heap is built by Morton-code middle split, the rest by SAH
-#define MC_FOR_EACH_TREE_FORMAT(X)                                                                                      \
-  X(AABBTree, MC_TREE_AABBTREE, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, "aabbtree", 8, Binning)                   \
-  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, "", 8, Binning)         \
-  X(AABBTreePNS, MC_TREE_AABBTREEPNS, MC_AABB_NODE_BYTES, AllCodecs, DepthFirstIndex, "", 8, Binning)                   \
-  X(AABBTreeCompressed, MC_TREE_AABBTREECOMPRESSED, MC_COMPRESSED_NODE_BYTES, AllCodecs, BehindTheNode, "", 8, Binning) \
-  X(SKDTree, MC_TREE_SKDTREE, MC_SKD_LEAF_BYTES, AllCodecs, BehindTheNode, "skdtree", 8, Binning)                       \
-  X(StacklessLBVH, MC_TREE_STACKLESSLBVH, MC_LBVH_NODE_BYTES, AllCodecs, Heap, "lbvh", 8, Morton)                       \
-  X(QuadTree, MC_TREE_QUADTREE, MC_QUAD_NODE_BYTES, AllCodecs, AnyOrder, "", 8, Binning)                                \
-  X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT, MC_QUADHALF_NODE_BYTES, AllCodecs, AnyOrder, "quadtree", 8, Binning)  \
-  X(OctTreeCompressed, MC_TREE_OCTTREECOMPRESSED, MC_OCT_NODE_BYTES, AllCodecs, AnyOrder, "octtree", 16, Binning)       \
-  X(BruteForce, MC_TREE_BRUTEFORCE, MC_BRUTE_RECORD_BYTES, AllCodecs, NoTree, "bruteforce", 8, Binning)                 \
-  X(AABBList, MC_TREE_AABBLIST, MC_LIST_ENTRY_BYTES, AllCodecs, NoTree, "aabblist", 8, Binning)                         \
-  X(ZeroByteTree, MC_TREE_ZEROBYTE, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "", 8, Binning)                    \
-  X(ZeroByteHybrid, MC_TREE_ZEROBYTEHYBRID, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, "", 8, Binning)
+#define MC_FOR_EACH_TREE_FORMAT(X)                                                                            \
+  X(AABBTree, MC_TREE_AABBTREE, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, 8, Binning)                     \
+  X(AABBTreeSplitAxis, MC_TREE_AABBTREESPLITAXIS, MC_AABB_NODE_BYTES, AllCodecs, BehindTheNode, 8, Binning)   \
+  X(AABBTreePNS, MC_TREE_AABBTREEPNS, MC_AABB_NODE_BYTES, AllCodecs, DepthFirstIndex, 8, Binning)             \
+  X(AABBTreeCompressed, MC_TREE_AABBTREECOMPRESSED, MC_COMPRESSED_NODE_BYTES, AllCodecs, BehindTheNode, 8, Binning)\
+  X(SKDTree, MC_TREE_SKDTREE, MC_SKD_LEAF_BYTES, AllCodecs, BehindTheNode, 8, Binning)                        \
+  X(StacklessLBVH, MC_TREE_STACKLESSLBVH, MC_LBVH_NODE_BYTES, AllCodecs, Heap, 8, Morton)                     \
+  X(QuadTree, MC_TREE_QUADTREE, MC_QUAD_NODE_BYTES, AllCodecs, AnyOrder, 8, Binning)                          \
+  X(QuadTreeHalfFloat, MC_TREE_QUADTREEHALFFLOAT, MC_QUADHALF_NODE_BYTES, AllCodecs, AnyOrder, 8, Binning)    \
+  X(OctTreeCompressed, MC_TREE_OCTTREECOMPRESSED, MC_OCT_NODE_BYTES, AllCodecs, AnyOrder, 16, Binning)        \
+  X(BruteForce, MC_TREE_BRUTEFORCE, MC_BRUTE_RECORD_BYTES, AllCodecs, NoTree, 8, Binning)                     \
+  X(AABBList, MC_TREE_AABBLIST, MC_LIST_ENTRY_BYTES, AllCodecs, NoTree, 8, Binning)                           \
+  X(ZeroByteTree, MC_TREE_ZEROBYTE, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, 8, Binning)              \
+  X(ZeroByteHybrid, MC_TREE_ZEROBYTEHYBRID, MC_BRUTE_RECORD_BYTES, Indexed24, BehindTheNode, 8, Binning)
 
 namespace meshcast::layout {
 
@@ -58,14 +59,13 @@ enum class TreeOrder {
 
 // One tag type a tree format, for the overloads each room defines.
 namespace tree {
-#define MC_TREE_TAG(Name, id, node_bytes, triangles, order, method, leaf_size, splitter) \
+#define MC_TREE_TAG(Name, id, node_bytes, triangles, order, leaf_size, splitter) \
   struct Name {                                                       \
     static constexpr uint32_t kId = id;                               \
     static constexpr std::string_view kName = #Name;                  \
     static constexpr uint32_t kSmallestNode = node_bytes;             \
     static constexpr TreeTriangles kTriangles = TreeTriangles::triangles; \
     static constexpr TreeOrder kOrder = TreeOrder::order;             \
-    static constexpr std::string_view kGpuMethod = method;            \
     static constexpr uint32_t kDefaultLeafSize = leaf_size;           \
     static constexpr Splitter kDefaultSplitter = Splitter::splitter;  \
   };
@@ -81,7 +81,6 @@ struct TreeFormatInfo {
   uint32_t smallest_node = 0;
   TreeTriangles triangles = TreeTriangles::AllCodecs;
   TreeOrder order = TreeOrder::AnyOrder;
-  std::string_view gpu_method;
   uint32_t default_leaf_size = 0;
   Splitter default_splitter = Splitter::Binning;
 };
@@ -89,8 +88,8 @@ struct TreeFormatInfo {
 constexpr TreeFormatInfo tree_format_info(uint32_t id) {
 #define MC_TREE_INFO(Name, ...) \
   if (id == tree::Name::kId)    \
-    return {tree::Name::kId,        tree::Name::kName,       tree::Name::kSmallestNode,    tree::Name::kTriangles, \
-            tree::Name::kOrder,     tree::Name::kGpuMethod,  tree::Name::kDefaultLeafSize, tree::Name::kDefaultSplitter};
+    return {tree::Name::kId,    tree::Name::kName,            tree::Name::kSmallestNode,   tree::Name::kTriangles, \
+            tree::Name::kOrder, tree::Name::kDefaultLeafSize, tree::Name::kDefaultSplitter};
   MC_FOR_EACH_TREE_FORMAT(MC_TREE_INFO)
 #undef MC_TREE_INFO
   return {};

@@ -67,7 +67,7 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
 // for the plain one (process-wide; set it before tracing, not during).
 enum class TriangleTest { Watertight, MollerTrumbore };
 inline std::atomic<TriangleTest> triangle_test_choice{TriangleTest::Watertight};
-void set_triangle_test(TriangleTest t);  // cpu/trace.cpp
+void set_triangle_test(TriangleTest t);  // cpu/watertight_double.cpp
 
 MC_ISA_BEGIN
 

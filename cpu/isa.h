@@ -5,7 +5,7 @@
 // library; everything of cpu/ that a set compiles differently lives in
 // `meshcast::isa_<set>` (an inline namespace: the code names it as plain
 // meshcast), so no two sets share a symbol and the linker never hands one
-// set's instructions to another. cpu/trace.cpp picks a set at run time.
+// set's instructions to another. cpu/isa_choice.cpp picks a set at run time.
 #pragma once
 
 #if defined(MESHCAST_ISA_SCALAR) || defined(MESHCAST_SCALAR) || !defined(__AVX2__) || !defined(__FMA__) || \

@@ -202,8 +202,7 @@ struct Loader<layout::Indexed24> {
   }
 };
 
-// Tests the `count` triangles of the block at blob offset `block`; slots of
-// the leaf start at `slot0`.
+// Triangles a test takes at once: the loader's kWidth, or 4.
 template <class L>
 constexpr int width_of() {
   if constexpr (requires { L::kWidth; }) return L::kWidth;
@@ -302,15 +301,22 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
   return (at - block + 3) / 4 * 4;
 }
 
+// Tests the `count` triangles of the block at blob offset `block`, the
+// leaf's slots from `slot0`, the way its codec's kind of leaf is tested: the
+// one place that tells the kinds apart. Returns the block's bytes, which a
+// BruteForce or AABBList walk steps over (cpu/records.h) and a tree walk
+// drops: strips, pair blocks and clusters measure theirs as they decode it,
+// fixed-size blocks take block_bytes(count). Indexed24 has none: its
+// triangles are words of a zero-byte tree's nodes, never records.
 template <class Codec>
-inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
-                      Closest& c) {
+inline uint64_t test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
+                          Closest& c) {
   if constexpr (requires { Codec::kClusters; }) {
-    test_cluster_leaf<Codec>(blob, r, block, count, slot0, c);
+    return test_cluster_leaf<Codec>(blob, r, block, count, slot0, c);
   } else if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
-    test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
+    return test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
   } else if constexpr (requires { Codec::kPairLanes; }) {
-    test_pair_leaf<Codec>(blob, r, block, count, slot0, c);
+    return test_pair_leaf<Codec>(blob, r, block, count, slot0, c);
   } else {
     constexpr int kWidth = width_of<Loader<Codec>>();
     for (uint32_t first = 0; first < count && c.t >= 0; first += kWidth) {  // below 0: any's hit taken
@@ -327,6 +333,8 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
       }
       c.offer(h, lanes, [&](uint32_t lane) { return slot0 + first + lane; });
     }
+    if constexpr (requires { Codec::block_bytes(count); }) return Codec::block_bytes(count);
+    else return 0;
   }
 }
 

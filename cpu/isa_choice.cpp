@@ -49,21 +49,6 @@ bool cpu_has(WalkerIsa isa) {
 #endif
 }
 
-std::span<const WalkEntry> table_of(WalkerIsa isa) {
-#if MESHCAST_HAS_ISA_AVX512
-  if (isa == WalkerIsa::Avx512) return isa_avx512::walk_table();
-#endif
-#if MESHCAST_HAS_ISA_AVX2
-  if (isa == WalkerIsa::Avx2) return isa_avx2::walk_table();
-#endif
-  (void)isa;
-#if MESHCAST_HAS_ISA_SCALAR
-  return isa_scalar::walk_table();
-#else
-  return {};  // not reached: choose_isa picks a set this build has
-#endif
-}
-
 // Chosen once, on first use: the widest set the processor has, or the one
 // MESHCAST_ISA names (scalar, avx2, avx512) when the processor has it. A
 // build without the scalar set (MESHCAST_ISAS, the test scripts' sanitizer
@@ -88,7 +73,7 @@ IsaChoice choose_isa() {
     if (std::string(asked) != walker_isa_name(isa))
       throw UsageError(std::string("MESHCAST_ISA=") + asked + ": not one of scalar, avx2, avx512");
   }
-  return {isa, table_of(isa)};
+  return {isa, walk_table_of<TriangleTest::Watertight>(isa)};
 }
 
 const IsaChoice& chosen() {

@@ -7,8 +7,6 @@
 
 namespace meshcast {
 
-void set_triangle_test(TriangleTest t) { triangle_test_choice.store(t, std::memory_order_relaxed); }
-
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
                             float cull, float tmin, float closest, LaneHit* out) {

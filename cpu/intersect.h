@@ -113,7 +113,7 @@ inline float max_keep(float a, float b) { return a > b ? a : b; }
 inline float min_keep(float a, float b) { return a < b ? a : b; }
 
 // The ray's interval [tn, tf] inside the box, before the closest-hit cut.
-inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], float* tn, float* tf) {
+[[gnu::always_inline]] inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], float* tn, float* tf) {
   *tn = 0.0f, *tf = INFINITY;
   for (int a = 0; a < 3; ++a) {
     float nearp = r.near_is_max[a] ? mx[a] : mn[a];
@@ -129,7 +129,7 @@ inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], 
 inline bool interval_open(float tn, float tf, float closest) { return tn <= min_keep(tf, closest) * kFarScale; }
 
 // Scalar box test; returns the entry distance, or +inf for a miss.
-inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
+[[gnu::always_inline]] inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
   count_boxes(1);
   float tn, tf;
   box_interval(r, mn, mx, &tn, &tf);
@@ -137,7 +137,7 @@ inline float box_test(const RayPre& r, const float mn[3], const float mx[3], flo
 }
 
 // Four boxes at once; `nearp[a]`/`farp[a]` are the near and far planes of axis a.
-inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
+[[gnu::always_inline]] inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
   count_boxes(4);
   using simd::F4;
   F4 tn = F4::splat(0.0f), tf = F4::splat(INFINITY);

@@ -5,6 +5,7 @@
 
 #include "check/agreement.h"
 #include "cpu/counters.h"
+#include "cpu/trace_with_triangle_test.h"
 #include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "layout/blob_format.h"
@@ -37,11 +38,12 @@ Setup setup(const Mesh& mesh, size_t count) {
   return s;
 }
 
-std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat) {
+std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat,
+                                TriangleTest test) {
   std::vector<double> ms;
   for (uint32_t r = 0; r < repeat; ++r) {
     auto t0 = std::chrono::steady_clock::now();
-    view.trace(rays, hits);
+    trace_with_triangle_test(view, test, rays, hits);
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::sort(ms.begin(), ms.end());
@@ -49,12 +51,12 @@ std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& ra
 }
 
 Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
-               const std::vector<OracleHit>& oracle, uint32_t repeat) {
+               const std::vector<OracleHit>& oracle, uint32_t repeat, TriangleTest test) {
   BuildReport report;
   std::vector<uint8_t> blob = build_blob(mesh, options, name, &report);
   BlobView view(blob, name);
   std::vector<Hit> hits(rays.size());
-  std::vector<double> ms = time_passes(view, rays, hits, repeat);
+  std::vector<double> ms = time_passes(view, rays, hits, repeat, test);
   const layout::BlobHeader& h = layout::header_of(blob.data());
   // Bytes of the triangle encoding: its blocks and its shared vertices.
   double bytes = double(h.tree_size - h.node_bytes + h.vertex_size) / h.triangle_count;
@@ -65,7 +67,7 @@ Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& op
   t.error_bound = relative_error_bound(blob, mesh.bounds().diagonal());
   if constexpr (kCountTests) {
     test_counts = {};
-    view.trace(rays, hits);
+    trace_with_triangle_test(view, test, rays, hits);
     t.boxes_per_ray = double(test_counts.boxes) / double(rays.size());
     t.triangles_per_ray = double(test_counts.triangles) / double(rays.size());
   }

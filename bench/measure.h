@@ -7,6 +7,7 @@
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "check/oracle.h"
+#include "cpu/which_triangle_test.h"
 #include "meshcast/blob.h"
 
 namespace meshcast::bench {
@@ -41,10 +42,12 @@ uint64_t oracle_mistakes(const Mesh& mesh, const std::vector<uint8_t>& blob, con
                          const std::vector<Hit>& hits, const std::vector<OracleHit>& oracle);
 
 // Traces `rays` `repeat` times through `view` (the hits of the last pass
-// kept); returns each pass's milliseconds, sorted.
-std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat);
+// kept); returns each pass's milliseconds, sorted. `test`: the triangle test
+// walked (cpu/trace_with_triangle_test.h), the library's own by default.
+std::vector<double> time_passes(const BlobView& view, const std::vector<Ray>& rays, std::vector<Hit>& hits, uint32_t repeat,
+                                TriangleTest test = TriangleTest::Watertight);
 
 Timing measure(const Mesh& mesh, const std::string& name, const BuildOptions& options, const std::vector<Ray>& rays,
-               const std::vector<OracleHit>& oracle, uint32_t repeat);
+               const std::vector<OracleHit>& oracle, uint32_t repeat, TriangleTest test = TriangleTest::Watertight);
 
 }  // namespace meshcast::bench

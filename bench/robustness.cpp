@@ -7,6 +7,7 @@
 #include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "check/generate.h"
+#include "cpu/trace_with_triangle_test.h"
 
 namespace meshcast::bench {
 
@@ -29,10 +30,10 @@ std::vector<Ray> probes(const Mesh& sphere) {
   return rays;
 }
 
-uint64_t leaks(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays) {
+uint64_t leaks(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, TriangleTest test) {
   BlobView view(blob, "probe sphere");
   std::vector<Hit> hits(rays.size());
-  view.trace(rays, hits);
+  trace_with_triangle_test(view, test, rays, hits);
   return uint64_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.triangle == MC_NO_HIT; }));
 }
 
@@ -54,12 +55,10 @@ std::vector<RobustnessRow> bench_robustness(const Mesh& mesh, const std::string&
     std::vector<uint8_t> sphere_blob = build_blob(sphere, o, "probe sphere");
     row.probes = probe.size();
     for (TriangleTest test : {TriangleTest::Watertight, TriangleTest::MollerTrumbore}) {
-      set_triangle_test(test);
       bool plain = test == TriangleTest::MollerTrumbore;
-      (plain ? row.plain : row.watertight) = measure(mesh, name, o, rays, oracle, repeat);
-      (plain ? row.leaks_plain : row.leaks_watertight) = leaks(sphere_blob, probe);
+      (plain ? row.plain : row.watertight) = measure(mesh, name, o, rays, oracle, repeat, test);
+      (plain ? row.leaks_plain : row.leaks_watertight) = leaks(sphere_blob, probe, test);
     }
-    set_triangle_test(TriangleTest::Watertight);
     rows.push_back(row);
   }
   return rows;

@@ -15,13 +15,13 @@
 // a miss (the hit record carries t as a float).
 #pragma once
 #include <algorithm>
-#include <atomic>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
 
 #include "cpu/counters.h"
 #include "cpu/simd.h"
+#include "cpu/which_triangle_test.h"
 #include "layout/formats.h"
 #include "layout/ray_record.h"
 #include "meshcast/ray.h"
@@ -63,12 +63,6 @@ inline float cull_sign(uint32_t flags) {
 bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
                             const float cy, const float az, const float bz, const float cz, const float sz,
                             float cull, float tmin, float closest, LaneHit* out);
-
-// Which test the walkers run: the watertight one unless a benchmark asks
-// for the plain one (process-wide; set it before tracing, not during).
-enum class TriangleTest { Watertight, MollerTrumbore };
-inline std::atomic<TriangleTest> triangle_test_choice{TriangleTest::Watertight};
-void set_triangle_test(TriangleTest t);  // cpu/trace.cpp
 
 MC_ISA_BEGIN
 
@@ -114,7 +108,7 @@ inline float max_keep(float a, float b) { return a > b ? a : b; }
 inline float min_keep(float a, float b) { return a < b ? a : b; }
 
 // The ray's interval [tn, tf] inside the box, before the closest-hit cut.
-inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], float* tn, float* tf) {
+[[gnu::always_inline]] inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], float* tn, float* tf) {
   *tn = 0.0f, *tf = INFINITY;
   for (int a = 0; a < 3; ++a) {
     float nearp = r.near_is_max[a] ? mx[a] : mn[a];
@@ -130,7 +124,7 @@ inline void box_interval(const RayPre& r, const float mn[3], const float mx[3], 
 inline bool interval_open(float tn, float tf, float closest) { return tn <= min_keep(tf, closest) * kFarScale; }
 
 // Scalar box test; returns the entry distance, or +inf for a miss.
-inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
+[[gnu::always_inline]] inline float box_test(const RayPre& r, const float mn[3], const float mx[3], float closest) {
   count_boxes(1);
   float tn, tf;
   box_interval(r, mn, mx, &tn, &tf);
@@ -138,7 +132,7 @@ inline float box_test(const RayPre& r, const float mn[3], const float mx[3], flo
 }
 
 // Four boxes at once; `nearp[a]`/`farp[a]` are the near and far planes of axis a.
-inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
+[[gnu::always_inline]] inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
   count_boxes(4);
   using simd::F4;
   F4 tn = F4::splat(0.0f), tf = F4::splat(INFINITY);
@@ -199,7 +193,8 @@ template <class F4, class Limit, class Take>
 // double-precision fallback, no epsilon (a triangle with det = 0 is missed,
 // as by the watertight test). Corners in the ray's axis order, as below;
 // the permutation flips both crosses' signs together, so u, v, t do not
-// change. Off unless set_triangle_test() picks it.
+// change. Only in walkers instantiated with TriangleTest::MollerTrumbore
+// (cpu/which_triangle_test.h).
 template <class F4, class M4>
 inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest, LaneSet* every) {
   constexpr int kW = F4::kLanes;
@@ -241,14 +236,14 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
 //
 // Returns the closest accepted lane; with `every` (Query::All), every
 // accepted lane goes there too, and the double redo is limited by `closest`
-// alone.
-template <class F4, class M4>
+// alone. `kTest`: the walker's test (cpu/which_triangle_test.h), the
+// watertight one below unless it names the plain one.
+template <TriangleTest kTest, class F4, class M4>
 [[gnu::always_inline]] inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest,
                                                     LaneSet* every = nullptr) {
   constexpr int kW = F4::kLanes;
   if constexpr (kCountTests) count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(valid)))));
-  if (triangle_test_choice.load(std::memory_order_relaxed) == TriangleTest::MollerTrumbore) [[unlikely]]
-    return moller_trumbore_test(r, v, valid, closest, every);
+  if constexpr (kTest == TriangleTest::MollerTrumbore) return moller_trumbore_test(r, v, valid, closest, every);
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
   const F4 sx = F4::splat(r.sx), sy = F4::splat(r.sy), sz = F4::splat(r.sz);
   F4 ax = v[0][0] - ox, ay = v[0][1] - oy, az = v[0][2] - oz;

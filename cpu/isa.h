@@ -2,10 +2,12 @@
 // from the compiler's own target macros, and the namespace that keeps each
 // set's code apart. The walkers (cpu/walk_*.cpp, cpu/walk_table.cpp) are
 // compiled once a set (CMakeLists.txt: scalar, AVX2, AVX-512) into one
-// library; everything of cpu/ that a set compiles differently lives in
-// `meshcast::isa_<set>` (an inline namespace: the code names it as plain
-// meshcast), so no two sets share a symbol and the linker never hands one
-// set's instructions to another. cpu/trace.cpp picks a set at run time.
+// library (and once more, for the benchmark alone, with the plain triangle
+// test: cpu/which_triangle_test.h); everything of cpu/ that a set compiles
+// differently lives in `meshcast::isa_<set>` (an inline namespace: the code
+// names it as plain meshcast), so no two sets share a symbol and the linker
+// never hands one set's instructions to another. cpu/isa_choice.cpp picks a
+// set at run time.
 #pragma once
 
 #if defined(MESHCAST_ISA_SCALAR) || defined(MESHCAST_SCALAR) || !defined(__AVX2__) || !defined(__FMA__) || \

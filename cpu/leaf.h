@@ -202,8 +202,7 @@ struct Loader<layout::Indexed24> {
   }
 };
 
-// Tests the `count` triangles of the block at blob offset `block`; slots of
-// the leaf start at `slot0`.
+// Triangles a test takes at once: the loader's kWidth, or 4.
 template <class L>
 constexpr int width_of() {
   if constexpr (requires { L::kWidth; }) return L::kWidth;
@@ -213,7 +212,7 @@ constexpr int width_of() {
 // Strips decode vertex after vertex: the whole leaf into SOA rows first
 // (at most 31 triangles, MC_QUAD_MAX_COUNT), then the same 4-wide test.
 // Returns the block's bytes (what the decode read).
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count,
                                      uint32_t slot0, Closest& c) {
   alignas(16) float rows[9][32];
@@ -228,7 +227,7 @@ inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint3
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < 3; ++j) v[k][j] = simd::F4::load(&rows[k * 3 + r.axis[j]][first]);
     LaneSet lanes;
-    LaneHit h = triangle_test(r, v, simd::lanes_below(count - first), c.t, c.every(lanes));
+    LaneHit h = triangle_test<kTest>(r, v, simd::lanes_below(count - first), c.t, c.every(lanes));
     c.offer(h, lanes, [&](uint32_t lane) { return slot0 + first + lane; });
   }
   return bytes;
@@ -267,7 +266,7 @@ inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t bl
 // registers once, a row of 8 corners permuted out of them per corner and
 // axis, 8 triangles a test. The leaf's triangles are numbered cluster by
 // cluster. Returns the leaf's bytes (what the decode read, padded to 4).
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                               Closest& c) {
   const layout::BlobHeader& h = layout::header_of(blob);
@@ -293,7 +292,7 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
         for (int j = 0; j < 3; ++j) v[k][j] = simd::cluster_pick(corner_axis[j], nibbles);
       }
       LaneSet lanes;
-      LaneHit hit = triangle_test(r, v, simd::lanes_below8(triangles - first), c.t, c.every(lanes));
+      LaneHit hit = triangle_test<kTest>(r, v, simd::lanes_below8(triangles - first), c.t, c.every(lanes));
       c.offer(hit, lanes, [&](uint32_t lane) { return slot0 + made + first + lane; });
     }
     made += triangles;
@@ -302,15 +301,22 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
   return (at - block + 3) / 4 * 4;
 }
 
-template <class Codec>
-inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
-                      Closest& c) {
+// Tests the `count` triangles of the block at blob offset `block`, the
+// leaf's slots from `slot0`, the way its codec's kind of leaf is tested: the
+// one place that tells the kinds apart. Returns the block's bytes, which a
+// BruteForce or AABBList walk steps over (cpu/records.h) and a tree walk
+// drops: strips, pair blocks and clusters measure theirs as they decode it,
+// fixed-size blocks take block_bytes(count). Indexed24 has none: its
+// triangles are words of a zero-byte tree's nodes, never records.
+template <class Codec, TriangleTest kTest>
+inline uint64_t test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
+                          Closest& c) {
   if constexpr (requires { Codec::kClusters; }) {
-    test_cluster_leaf<Codec>(blob, r, block, count, slot0, c);
+    return test_cluster_leaf<Codec, kTest>(blob, r, block, count, slot0, c);
   } else if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
-    test_sequential_leaf<Codec>(blob, r, block, count, slot0, c);
-  } else if constexpr (requires { Codec::kPairLanes; }) {
-    test_pair_leaf<Codec>(blob, r, block, count, slot0, c);
+    return test_sequential_leaf<Codec, kTest>(blob, r, block, count, slot0, c);
+  } else if constexpr (requires { Codec::kPairLanes; }) {  // the pair test is watertight alone, whatever kTest
+    return test_pair_leaf<Codec>(blob, r, block, count, slot0, c);
   } else {
     constexpr int kWidth = width_of<Loader<Codec>>();
     for (uint32_t first = 0; first < count && c.t >= 0; first += kWidth) {  // below 0: any's hit taken
@@ -319,14 +325,16 @@ inline void test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint
       if constexpr (kWidth == 8) {
         simd::F8 v[3][3];
         Loader<Codec>::load(blob, block, first, count, r.axis, v);
-        h = triangle_test(r, v, simd::lanes_below8(count - first), c.t, c.every(lanes));
+        h = triangle_test<kTest>(r, v, simd::lanes_below8(count - first), c.t, c.every(lanes));
       } else {
         simd::F4 v[3][3];
         Loader<Codec>::load(blob, block, first, count, r.axis, v);
-        h = triangle_test(r, v, simd::lanes_below(count - first), c.t, c.every(lanes));
+        h = triangle_test<kTest>(r, v, simd::lanes_below(count - first), c.t, c.every(lanes));
       }
       c.offer(h, lanes, [&](uint32_t lane) { return slot0 + first + lane; });
     }
+    if constexpr (requires { Codec::block_bytes(count); }) return Codec::block_bytes(count);
+    else return 0;
   }
 }
 

@@ -2,7 +2,7 @@
 // max_hits records there, and the trace copies the kept hits out into the
 // caller's compact rows (meshcast/ray.h HitRows). Made once a thread and
 // grown to the largest asked for, so a caster's workers stop allocating
-// once warm. Included by the baseline code alone (cpu/trace.cpp,
+// once warm. Included by the baseline code alone (cpu/blob_view.cpp,
 // cpu/scene_trace.cpp), never by a walker's instruction-set file: an
 // instantiation there could carry that set's instructions to every caller.
 #pragma once

@@ -40,9 +40,11 @@ using WalkFn = void (*)(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
 
 // One walker a tree format, chosen by the catalog's tag (layout/catalog.h):
 // each family's walk_*.cpp defines its formats' overloads and instantiates
-// them for every triangle codec (the zero-byte trees: Indexed24 alone).
+// them for every triangle codec (the zero-byte trees: Indexed24 alone) with
+// the triangle test it is compiled for (kWalkersTriangleTest), which every
+// walker carries down to its triangle tests.
 #define MC_DECLARE_WALK(Name, ...)                                                                          \
-  template <class Codec>                                                                                     \
+  template <class Codec, TriangleTest kTest>                                                                 \
   void walk(layout::tree::Name, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, \
             const WalkRequest& request);
 MC_FOR_EACH_TREE_FORMAT(MC_DECLARE_WALK)

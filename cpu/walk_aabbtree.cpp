@@ -9,14 +9,14 @@
 namespace meshcast {
 MC_ISA_BEGIN
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
   for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     walk_aabb_nodes(tree, r, c, [&](const layout::AABBNode& node, uint32_t at) {
       uint32_t block = at + MC_AABB_NODE_BYTES;
-      test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
+      test_leaf<Codec, kTest>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
     });
   });
 }
@@ -25,7 +25,7 @@ void walk(layout::tree::AABBTree, const uint8_t* blob, const Ray* rays, Hit* hit
 // is reached; an interior node sends the ray first into the child on its
 // side of the split axis (the first child is the lower one) and pushes the
 // other.
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
@@ -44,7 +44,7 @@ void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays,
           continue;
         }
         uint32_t block = at + MC_AABB_NODE_BYTES;
-        test_leaf<Codec>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
+        test_leaf<Codec, kTest>(blob, r, h.tree_offset + block, node.value(), layout::slot_of(h, block, 0), c);
       }
       if (top < 0) break;
       at = stack[top--];
@@ -54,7 +54,7 @@ void walk(layout::tree::AABBTreeSplitAxis, const uint8_t* blob, const Ray* rays,
 
 // AABBTreePNS walker (seed 000 §5.3, seed 002): as AABBTreeSplitAxis, but
 // the near child is one AND away: bit octant(dir) of the node's 8 bits.
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
@@ -74,7 +74,7 @@ void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* 
           continue;
         }
         uint32_t block = layout::pns_leaf_block(node, h);
-        test_leaf<Codec>(blob, r, h.tree_offset + block, layout::pns_leaf_count(node), layout::slot_of(h, block, 0), c);
+        test_leaf<Codec, kTest>(blob, r, h.tree_offset + block, layout::pns_leaf_count(node), layout::slot_of(h, block, 0), c);
       }
       if (top < 0) break;
       index = stack[top--];
@@ -83,9 +83,9 @@ void walk(layout::tree::AABBTreePNS, const uint8_t* blob, const Ray* rays, Hit* 
 }
 
 #define MC_INSTANTIATE(Codec, name)                                                                 \
-  template void walk<layout::Codec>(layout::tree::AABBTreePNS, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&); \
-  template void walk<layout::Codec>(layout::tree::AABBTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&); \
-  template void walk<layout::Codec>(layout::tree::AABBTreeSplitAxis, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::AABBTreePNS, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&); \
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::AABBTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&); \
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::AABBTreeSplitAxis, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

@@ -8,7 +8,7 @@
 namespace meshcast {
 MC_ISA_BEGIN
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
@@ -41,7 +41,7 @@ void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays
           continue;
         }
       } else {
-        test_leaf<Codec>(blob, r, h.tree_offset + at, count, layout::slot_of(h, at, 0), c);
+        test_leaf<Codec, kTest>(blob, r, h.tree_offset + at, count, layout::slot_of(h, at, 0), c);
       }
       while (top >= 0 && stack[top].tnear > c.t * kFarScale) --top;
       if (top < 0) break;
@@ -52,7 +52,7 @@ void walk(layout::tree::AABBTreeCompressed, const uint8_t* blob, const Ray* rays
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::AABBTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::AABBTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

@@ -17,7 +17,7 @@
 namespace meshcast {
 MC_ISA_BEGIN
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
@@ -32,7 +32,7 @@ void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit
           node_index = v ^ o;
           continue;
         }
-        test_leaf<Codec>(blob, r, h.tree_offset + node.position, uint32_t(node.count),
+        test_leaf<Codec, kTest>(blob, r, h.tree_offset + node.position, uint32_t(node.count),
                          layout::slot_of(h, node.position, 0), c);
       }
       // next(v) = (v + 1) >> ctz(v + 1); the root again ends the walk.
@@ -45,7 +45,7 @@ void walk(layout::tree::StacklessLBVH, const uint8_t* blob, const Ray* rays, Hit
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::StacklessLBVH, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::StacklessLBVH, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

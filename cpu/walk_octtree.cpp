@@ -152,7 +152,7 @@ inline void prefetch_child(const uint8_t* child) {
 // as they come, unsorted and without their entries (nothing is culled on
 // popping before the first hit, and the walk ends at that hit), as
 // Embree's any-hit traversal does.
-template <class Codec, bool Fused, bool Any>
+template <class Codec, TriangleTest kTest, bool Fused, bool Any>
 inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, const OctFused& fused,
                      Closest& c) {
   const uint8_t* tree = blob + h.tree_offset;
@@ -200,7 +200,7 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
         continue;
       }
     } else {
-      test_leaf<Codec>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
+      test_leaf<Codec, kTest>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
       if (Any && c.slot != MC_NO_HIT) return;
     }
     if constexpr (Any) {
@@ -218,7 +218,7 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
 
 }  // namespace
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
           const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
@@ -226,17 +226,17 @@ void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays,
   for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
     const OctFused fused(r, h, blob_fits);
     if (c.any) {
-      if (fused.applies) walk_ray<Codec, true, true>(blob, h, r, fused, c);
-      else walk_ray<Codec, false, true>(blob, h, r, fused, c);
+      if (fused.applies) walk_ray<Codec, kTest, true, true>(blob, h, r, fused, c);
+      else walk_ray<Codec, kTest, false, true>(blob, h, r, fused, c);
     } else {
-      if (fused.applies) walk_ray<Codec, true, false>(blob, h, r, fused, c);
-      else walk_ray<Codec, false, false>(blob, h, r, fused, c);
+      if (fused.applies) walk_ray<Codec, kTest, true, false>(blob, h, r, fused, c);
+      else walk_ray<Codec, kTest, false, false>(blob, h, r, fused, c);
     }
   });
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::OctTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::OctTreeCompressed, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 #undef MC_INSTANTIATE
 

@@ -47,7 +47,7 @@ constexpr int kStackSize = 3 * MC_MAX_DEPTH + 8;
 
 }  // namespace
 
-template <class Bounds, class Codec>
+template <class Bounds, class Codec, TriangleTest kTest>
 void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
@@ -85,7 +85,7 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
         for (int k = 0; k < m; ++k) fraction_stack[top + k] = sf[k], node_stack[top + k] = sp[k];
         top += m;
       } else {
-        test_leaf<Codec>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
+        test_leaf<Codec, kTest>(blob, r, h.tree_offset + offset, count, layout::slot_of(h, offset, 0), c);
       }
       do --top;
       while (top >= 0 && fraction_stack[top] > c.t * kFarScale);
@@ -93,19 +93,19 @@ void walk_quadtree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, ui
   });
 }
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::QuadTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
-  walk_quadtree<layout::QuadBoundsFloat, Codec>(blob, rays, hits, n, skipped, request);
+  walk_quadtree<layout::QuadBoundsFloat, Codec, kTest>(blob, rays, hits, n, skipped, request);
 }
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::QuadTreeHalfFloat, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
-  walk_quadtree<layout::QuadBoundsHalf, Codec>(blob, rays, hits, n, skipped, request);
+  walk_quadtree<layout::QuadBoundsHalf, Codec, kTest>(blob, rays, hits, n, skipped, request);
 }
 
 #define MC_INSTANTIATE(Codec, name)                                                                              \
-  template void walk<layout::Codec>(layout::tree::QuadTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);                                                 \
-  template void walk<layout::Codec>(layout::tree::QuadTreeHalfFloat, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::QuadTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);                                                 \
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::QuadTreeHalfFloat, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

@@ -13,7 +13,7 @@
 namespace meshcast {
 MC_ISA_BEGIN
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   const uint8_t* tree = blob + h.tree_offset;
@@ -47,7 +47,7 @@ void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits
         }
       } else {
         uint32_t block = at + MC_SKD_LEAF_BYTES;
-        test_leaf<Codec>(blob, r, h.tree_offset + block, layout::skd_value(properties), layout::slot_of(h, block, 0), c);
+        test_leaf<Codec, kTest>(blob, r, h.tree_offset + block, layout::skd_value(properties), layout::slot_of(h, block, 0), c);
       }
       while (top >= 0 && !open(stack[top].tnear, stack[top].tfar)) --top;
       if (top < 0) break;
@@ -58,7 +58,7 @@ void walk(layout::tree::SKDTree, const uint8_t* blob, const Ray* rays, Hit* hits
 }
 
 #define MC_INSTANTIATE(Codec, name) \
-  template void walk<layout::Codec>(layout::tree::SKDTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+  template void walk<layout::Codec, kWalkersTriangleTest>(layout::tree::SKDTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
 
 MC_ISA_END

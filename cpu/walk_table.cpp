@@ -10,9 +10,9 @@ MC_ISA_BEGIN
 
 namespace {
 
-template <class Tree, class Codec>
+template <class Tree, class Codec, TriangleTest kTest>
 void walk_as(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
-  walk<Codec>(Tree{}, blob, rays, hits, n, skipped, request);
+  walk<Codec, kTest>(Tree{}, blob, rays, hits, n, skipped, request);
 }
 
 // Every (tree, triangle format) pair the catalog allows: every codec under
@@ -25,17 +25,18 @@ constexpr size_t kEntries = 0 MC_FOR_EACH_TREE_FORMAT(MC_COUNT_TREE);
 #undef MC_COUNT_TREE
 #undef MC_COUNT_ONE
 
+template <TriangleTest kTest>
 std::array<WalkEntry, kEntries> make_walkers() {
   std::array<WalkEntry, kEntries> entries{};
   size_t n = 0;
   auto add = [&](auto tree) {
     using Tree = decltype(tree);
     if constexpr (Tree::kTriangles == layout::TreeTriangles::AllCodecs) {
-#define MC_CODEC_ENTRY(Codec, name) entries[n++] = {Tree::kId, layout::Codec::kFormat, &walk_as<Tree, layout::Codec>};
+#define MC_CODEC_ENTRY(Codec, name) entries[n++] = {Tree::kId, layout::Codec::kFormat, &walk_as<Tree, layout::Codec, kTest>};
       MC_FOR_EACH_TRIANGLE_CODEC(MC_CODEC_ENTRY)
 #undef MC_CODEC_ENTRY
     } else {
-      entries[n++] = {Tree::kId, layout::Indexed24::kFormat, &walk_as<Tree, layout::Indexed24>};
+      entries[n++] = {Tree::kId, layout::Indexed24::kFormat, &walk_as<Tree, layout::Indexed24, kTest>};
     }
   };
 #define MC_TREE_ENTRIES(Name, ...) add(layout::tree::Name{});
@@ -48,10 +49,14 @@ std::array<WalkEntry, kEntries> make_walkers() {
 
 // Made on first use, not at static initialisation: a BlobView made by
 // another translation unit's static initialiser finds it ready.
+template <TriangleTest kTest>
 std::span<const WalkEntry> walk_table() {
-  static const std::array<WalkEntry, kEntries> table = make_walkers();
+  static const std::array<WalkEntry, kEntries> table = make_walkers<kTest>();
   return table;
 }
+
+// The test these sources are compiled with alone (CMakeLists.txt).
+template std::span<const WalkEntry> walk_table<kWalkersTriangleTest>();
 
 MC_ISA_END
 }  // namespace meshcast

@@ -1,7 +1,7 @@
 // The walk of a scene's top level (layout/top_level.h), compiled once an
 // instruction set like the walkers (cpu/isa.h), its node test inlined. The
 // scene's walk (cpu/scene_trace.cpp) calls the chosen set's (walk_top_fn(),
-// cpu/trace.cpp) and walks each instance it is handed.
+// cpu/isa_choice.cpp) and walks each instance it is handed.
 #pragma once
 #include <cstdint>
 

@@ -21,7 +21,7 @@ namespace {
 
 // The zero-byte tree whose root triangle is at blob offset `root`, its
 // slots from `slot0`.
-template <bool kCache>
+template <TriangleTest kTest, bool kCache>
 void walk_zbt(const uint8_t* blob, const layout::BlobHeader& h, uint32_t root, uint32_t slot0, uint32_t octant,
               const RayPre& r, Closest& c, BoxCache* cache) {
   const uint8_t* tris = blob + root;
@@ -44,7 +44,7 @@ void walk_zbt(const uint8_t* blob, const layout::BlobHeader& h, uint32_t root, u
       }
       if (box_test(r, mn, mx, c.t) == INFINITY) continue;
     }
-    test_leaf<layout::Indexed24>(blob, r, root + p * layout::Indexed24::kSlotDivisor, n.count, slot0 + p, c);
+    test_leaf<layout::Indexed24, kTest>(blob, r, root + p * layout::Indexed24::kSlotDivisor, n.count, slot0 + p, c);
     if (!n.child) continue;
     uint32_t children[2] = {n.child, n.child + layout::zbt_node(tris, n.child).count};
     uint32_t bit = n.count >= 2 ? layout::zbt_pns(tris, p) >> octant & 1 : 0;
@@ -53,16 +53,16 @@ void walk_zbt(const uint8_t* blob, const layout::BlobHeader& h, uint32_t root, u
   }
 }
 
-template <bool kCache>
+template <TriangleTest kTest, bool kCache>
 void walk_zerobyte_tree(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
   for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
-    walk_zbt<kCache>(blob, h, h.tree_offset + h.triangle_base, 0, layout::pns_octant(r.dir), r, c, cache);
+    walk_zbt<kTest, kCache>(blob, h, h.tree_offset + h.triangle_base, 0, layout::pns_octant(r.dir), r, c, cache);
   });
 }
 
-template <bool kCache>
+template <TriangleTest kTest, bool kCache>
 void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const layout::BlobHeader& h = layout::header_of(blob);
   BoxCache* cache = kCache ? &BoxCache::for_this_thread() : nullptr;
@@ -70,40 +70,40 @@ void walk_zerobyte_hybrid(const uint8_t* blob, const Ray* rays, Hit* hits, size_
     const uint32_t octant = layout::pns_octant(r.dir);
     walk_aabb_nodes(blob + h.tree_offset, r, c, [&](const layout::AABBNode& node, uint32_t) {
       uint32_t root = h.tree_offset + h.triangle_base + node.value() * layout::Indexed24::kSlotDivisor;
-      walk_zbt<kCache>(blob, h, root, node.value(), octant, r, c, cache);
+      walk_zbt<kTest, kCache>(blob, h, root, node.value(), octant, r, c, cache);
     });
   });
 }
 
 // Both zero-byte formats: the header's box-cache flag picks the instantiation.
-template <class Tree>
+template <class Tree, TriangleTest kTest>
 void walk_zero_byte(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   const bool cache = layout::header_of(blob).root & MC_ZBT_FLAG_BOX_CACHE;
   if constexpr (std::is_same_v<Tree, layout::tree::ZeroByteHybrid>)
-    return cache ? walk_zerobyte_hybrid<true>(blob, rays, hits, n, skipped, request)
-                 : walk_zerobyte_hybrid<false>(blob, rays, hits, n, skipped, request);
+    return cache ? walk_zerobyte_hybrid<kTest, true>(blob, rays, hits, n, skipped, request)
+                 : walk_zerobyte_hybrid<kTest, false>(blob, rays, hits, n, skipped, request);
   else
-    return cache ? walk_zerobyte_tree<true>(blob, rays, hits, n, skipped, request)
-                 : walk_zerobyte_tree<false>(blob, rays, hits, n, skipped, request);
+    return cache ? walk_zerobyte_tree<kTest, true>(blob, rays, hits, n, skipped, request)
+                 : walk_zerobyte_tree<kTest, false>(blob, rays, hits, n, skipped, request);
 }
 
 }  // namespace
 
 // The zero-byte trees hold the mesh's own indices: Indexed24 is their one codec.
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::ZeroByteTree tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   static_assert(std::is_same_v<Codec, layout::Indexed24>);
-  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, request);
+  walk_zero_byte<decltype(tree), kTest>(blob, rays, hits, n, skipped, request);
 }
 
-template <class Codec>
+template <class Codec, TriangleTest kTest>
 void walk(layout::tree::ZeroByteHybrid tree, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped, const WalkRequest& request) {
   static_assert(std::is_same_v<Codec, layout::Indexed24>);
-  walk_zero_byte<decltype(tree)>(blob, rays, hits, n, skipped, request);
+  walk_zero_byte<decltype(tree), kTest>(blob, rays, hits, n, skipped, request);
 }
 
-template void walk<layout::Indexed24>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
-template void walk<layout::Indexed24>(layout::tree::ZeroByteHybrid, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+template void walk<layout::Indexed24, kWalkersTriangleTest>(layout::tree::ZeroByteTree, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
+template void walk<layout::Indexed24, kWalkersTriangleTest>(layout::tree::ZeroByteHybrid, const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
 
 MC_ISA_END
 }  // namespace meshcast

@@ -46,7 +46,7 @@ double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_wor
 // See MC_TOP_MAX_DEPTH (layout/formats.h).
 #define TOP_STACK_SIZE (7u * MC_TOP_MAX_DEPTH + 8u)
 
-// ray_is_walkable of cpu/trace.cpp: an origin within 2^100, a direction
+// ray_is_walkable of cpu/ray_is_walkable.cpp: an origin within 2^100, a direction
 // within 2^126 and not below 2^-126 on every axis, t_max and t_min not NaN
 // nor < 0, t_min not past t_max (the comparisons fail on NaN).
 bool directions_walkable(vec3 dir, float tmin, float tmax) {

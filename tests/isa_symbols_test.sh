@@ -10,19 +10,23 @@ set -euo pipefail
 build=${1:?usage: isa_symbols_test.sh BUILD_DIR}
 status=0
 checked=0
+# The library's walkers (meshcast_walkers_<set>) and the plain
+# Möller–Trumbore ones the benchmark links (meshcast_walkers_moller_trumbore_<set>).
 for isa in avx2 avx512; do
-  dir="$build/CMakeFiles/meshcast_walkers_$isa.dir"
-  [[ -d $dir ]] || continue
-  checked=1
-  leaks=$(find "$dir" -name '*.o' -exec nm -C --defined-only {} + | awk '$2 == "W" { $1 = ""; $2 = ""; print }' |
-          grep -v "isa_$isa" | sort -u || true)
-  if [[ -n $leaks ]]; then
-    echo "meshcast_walkers_$isa shares weak code outside meshcast::isa_$isa:"
-    echo "$leaks"
-    status=1
-  else
-    echo "meshcast_walkers_$isa: every weak code symbol lies in meshcast::isa_$isa"
-  fi
+  for objects in "meshcast_walkers_$isa" "meshcast_walkers_moller_trumbore_$isa"; do
+    dir="$build/CMakeFiles/$objects.dir"
+    [[ -d $dir ]] || continue
+    checked=1
+    leaks=$(find "$dir" -name '*.o' -exec nm -C --defined-only {} + | awk '$2 == "W" { $1 = ""; $2 = ""; print }' |
+            grep -v "isa_$isa" | sort -u || true)
+    if [[ -n $leaks ]]; then
+      echo "$objects shares weak code outside meshcast::isa_$isa:"
+      echo "$leaks"
+      status=1
+    else
+      echo "$objects: every weak code symbol lies in meshcast::isa_$isa"
+    fi
+  done
 done
 [[ $checked == 1 ]] || echo "no wide instruction set built (scalar only): nothing to check"
 exit $status

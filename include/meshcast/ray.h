@@ -159,6 +159,6 @@ constexpr float kMaxDirection = 0x1p126f;
 // not above tmax (tmin = tmax is the one point; infinity for both is
 // walkable and hits nothing). Any other ray is answered as a miss and
 // counted.
-bool ray_is_walkable(const Ray& r);  // defined once in the library (cpu/trace.cpp)
+bool ray_is_walkable(const Ray& r);  // defined once in the library (cpu/ray_is_walkable.cpp)
 
 }  // namespace meshcast

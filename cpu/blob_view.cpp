@@ -1,0 +1,89 @@
+// BlobView (meshcast/blob.h): a validated blob and its walker, and the
+// batches it walks.
+#include <algorithm>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cpu/scratch.h"
+#include "cpu/walk_table.h"
+#include "layout/blob_format.h"
+#include "layout/queries.h"
+#include "meshcast/blob.h"
+
+namespace meshcast {
+
+BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : bytes_(bytes) {
+  std::string why = layout::validate(bytes);
+  if (!why.empty()) throw InputError(name + ": " + why);
+  const layout::BlobHeader& h = layout::header_of(bytes.data());
+  walk_ = walker_for(h.tree_format, h.triangle_format);
+  if (!walk_) throw InputError(name + ": no walker for this layout");
+}
+
+namespace {
+
+// The walkers' flags word: only the outputs' own bits (the query's and the
+// culling's share the word), checked names for the rest.
+uint32_t flags_of(const char* who, HitOutputs outputs, Query query, Cull cull) {
+  layout::check_query(who, query, cull);
+  return (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | layout::query_bits(query, cull);
+}
+
+}  // namespace
+
+uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs, Query query,
+                         Cull cull) const {
+  if (hits.size() < rays.size())
+    throw UsageError("BlobView::trace: " + std::to_string(rays.size()) + " rays but room for " +
+                     std::to_string(hits.size()) + " hits; the hits span must hold one hit a ray");
+  if (query == Query::All)
+    throw UsageError("BlobView::trace: Query::All has a list of hits a ray: BlobView::trace_all_hits answers it");
+  WalkRequest request{flags_of("BlobView::trace", outputs, query, cull)};
+  uint64_t skipped = 0;
+  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, request);
+  return skipped;
+}
+
+namespace {
+
+// Query::All walks a few rays at a time into a thread's scratch rows
+// (cpu/scratch.h), at most kScratchRecords records (448 KiB) whatever
+// max_hits, and copies each ray's kept hits out: the answers' memory and
+// time follow the hits found, not rays x max_hits.
+constexpr size_t kScratchRecords = 16384;
+constexpr size_t kMostRaysAWalk = 64;
+
+}  // namespace
+
+uint64_t BlobView::trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs, Cull cull) const {
+  const uint32_t max_hits = lists.max_hits;
+  if (max_hits < 1 || max_hits > kMaxHitsLimit)
+    throw UsageError("BlobView::trace_all_hits: max_hits " + std::to_string(max_hits) + " is not in 1.." +
+                     std::to_string(kMaxHitsLimit));
+  const uint32_t flags = flags_of("BlobView::trace_all_hits", outputs, Query::All, cull);
+  lists.clear();
+  lists.found.reserve(rays.size());
+  lists.offsets.reserve(rays.size() + 1);
+  const size_t per_walk = std::clamp<size_t>(kScratchRecords / max_hits, 1, kMostRaysAWalk);
+  const std::span<Hit> rows = thread_scratch<Hit>(per_walk * max_hits);
+  uint32_t found[kMostRaysAWalk];
+  const WalkRequest request{flags, max_hits, found, rows.data()};
+  uint64_t skipped = 0;
+  for (size_t begin = 0; begin < rays.size(); begin += per_walk) {
+    const size_t n = std::min(per_walk, rays.size() - begin);
+    walk_(bytes_.data(), rays.data() + begin, nullptr, n, &skipped, request);
+    for (size_t i = 0; i < n; ++i)
+      lists.add_row(found[i], rows.subspan(i * max_hits, std::min(found[i], max_hits)));
+  }
+  return skipped;
+}
+
+Layout BlobView::layout() const {
+  const layout::BlobHeader& h = layout::header_of(bytes_.data());
+  return {TreeFormat(h.tree_format), TriangleFormat(h.triangle_format)};
+}
+
+uint32_t BlobView::triangle_count() const { return layout::header_of(bytes_.data()).triangle_count; }
+
+}  // namespace meshcast

@@ -350,15 +350,14 @@ TEST(TriangleTests, MollerTrumboreWalkersFindTheOraclesHits) {
 // They walk the plain test indeed, and the library's walkers the watertight
 // one alone: rays aimed at a closed sphere's shared edges and vertices leak
 // through the former and never through the latter, on the layouts the
-// benchmark compares and on a tree of every other kind of walk (the
-// zero-byte tree's one-at-a-time leaves, the octree's 8-wide ones, the
-// records of a brute-force list). Pair blocks have no plain test.
+// benchmark compares and the AABBTree family's depth-first-index variant.
+// The plain walkers exist for those trees alone; any other is refused,
+// naming its layout. Pair blocks have no plain test.
 TEST(TriangleTests, OnlyTheMollerTrumboreWalkersLeak) {
   const Mesh sphere = make_sphere(48, 96, 1.0f, {0, 0, 0});
   const std::vector<Ray> rays = sphere_probes(sphere);
-  for (const char* layout : {"AABBTree/Float3", "AABBTree/Float3SOA8", "QuadTree/Float3SOA4",
-                             "QuadTreeHalfFloat/Indexed8BitPackSOA4", "OctTreeCompressed/Float3SOA8", "BruteForce/Float3",
-                             "ZeroByteTree/Indexed24"}) {
+  for (const char* layout : {"AABBTree/Float3", "AABBTree/Float3SOA8", "AABBTreePNS/Float3SOA4", "QuadTree/Float3SOA4",
+                             "QuadTreeHalfFloat/Indexed8BitPackSOA4"}) {
     const std::vector<uint8_t> blob = build_blob(sphere, parse_layout(layout), "probe sphere");
     const BlobView view(blob, "probe sphere");
     std::vector<Hit> library(rays.size()), watertight(rays.size()), plain(rays.size());
@@ -368,6 +367,14 @@ TEST(TriangleTests, OnlyTheMollerTrumboreWalkersLeak) {
     EXPECT_EQ(misses(library), 0u) << layout;
     EXPECT_EQ(misses(watertight), 0u) << layout;
     EXPECT_GT(misses(plain), 0u) << layout;
+  }
+  const std::vector<uint8_t> blob = build_blob(sphere, parse_layout("OctTreeCompressed/Float3SOA8"), "probe sphere");
+  std::vector<Hit> plain(rays.size());
+  try {
+    trace_with_triangle_test(BlobView(blob, "probe sphere"), TriangleTest::MollerTrumbore, rays, plain);
+    ADD_FAILURE() << "a tree without plain-test walkers was walked";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("OctTreeCompressed/Float3SOA8"), std::string::npos) << e.what();
   }
 }
 

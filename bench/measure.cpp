@@ -9,7 +9,7 @@
 #include "check/ray_files.h"
 #include "meshcast/blob.h"
 #include "layout/blob_format.h"
-#include "layout/lbvh.h"
+#include "layout/tree/lbvh.h"
 
 namespace meshcast::bench {
 

@@ -85,7 +85,7 @@ double time_rays(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays,
 }
 
 // The narrowest index the indexed encodings can use: they store each used
-// vertex once (layout/indexed.h), so the used vertices decide. Says why.
+// vertex once (layout/triangles/indexed.h), so the used vertices decide. Says why.
 std::string index_width(const MeshStats& s, std::vector<std::string>& reasons) {
   const bool narrow = s.used_vertices <= 65536;
   reasons.push_back(format(narrow ? "%.0f used vertices (<= 65,536): 16-bit indices"

@@ -16,9 +16,9 @@
 #include "builder/layout_names.h"
 #include "builder/pairing.h"
 #include "builder/quantize.h"
-#include "layout/aabbtree.h"
-#include "layout/codecs.h"
-#include "layout/quadtree.h"
+#include "layout/tree/aabbtree.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/quadtree.h"
 #include "builder/writer.h"
 
 namespace meshcast {

@@ -1,8 +1,8 @@
 // What the builder needs of each triangle codec, looked up by format id
 // (builder/writer.h's CodecOps): the codec's constants and its optional
-// traits (layout/block.h defaults them).
+// traits (layout/triangles/block.h defaults them).
 #include "builder/writer.h"
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 
 namespace meshcast {
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <unordered_map>
 
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "layout/message_text.h"
 
 namespace meshcast {
@@ -90,7 +90,7 @@ StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const l
   return s;
 }
 
-// kGridPowerOfTwo formats (BitPackSOA, layout/soa.h): blocks of `lanes`
+// kGridPowerOfTwo formats (BitPackSOA, layout/triangles/soa.h): blocks of `lanes`
 // consecutive triangles of each leaf; every position goes to the coarsest
 // block lattice among the blocks that use it, repeated until no block needs
 // a coarser step, so all blocks decode a shared position to the same bits.

@@ -1,7 +1,7 @@
 // Quantization: the mesh grid a bit-packed triangle format stores positions
 // on, the triangles' corners as the format stores them (and their boxes,
 // from which every tree is built), and the nested block lattices of the
-// BitPackSOA formats (layout/soa.h).
+// BitPackSOA formats (layout/triangles/soa.h).
 #pragma once
 #include <cstdint>
 #include <string>

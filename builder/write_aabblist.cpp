@@ -4,7 +4,7 @@
 // MC_LIST_BATCH triangles (the last: the rest) becomes one batch, written
 // as an entry with the box of what its records decode to.
 #include "builder/writer.h"
-#include "layout/aabblist.h"
+#include "layout/tree/aabblist.h"
 
 namespace meshcast {
 

@@ -3,7 +3,7 @@
 #include <functional>
 
 #include "builder/writer.h"
-#include "layout/aabbtree.h"
+#include "layout/tree/aabbtree.h"
 
 namespace meshcast {
 

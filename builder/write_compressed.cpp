@@ -1,12 +1,12 @@
 // AABBTreeCompressed writer (seed 000 §5.4): depth first, the left child
 // (node or triangle block) right behind its node, the right child after the
 // left's subtree. Codes are chosen top down against the parent's decoded
-// box (layout/compressed.h), so they round outward from what the walker
+// box (layout/tree/compressed.h), so they round outward from what the walker
 // will decode, not from the exact boxes.
 #include <functional>
 
 #include "builder/writer.h"
-#include "layout/compressed.h"
+#include "layout/tree/compressed.h"
 
 namespace meshcast {
 

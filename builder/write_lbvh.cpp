@@ -8,7 +8,7 @@
 #include <functional>
 
 #include "builder/writer.h"
-#include "layout/lbvh.h"
+#include "layout/tree/lbvh.h"
 
 namespace meshcast {
 

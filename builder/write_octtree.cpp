@@ -12,7 +12,7 @@
 #include <limits>
 
 #include "builder/wide_plan.h"
-#include "layout/octtree.h"
+#include "layout/tree/octtree.h"
 
 namespace meshcast {
 
@@ -85,7 +85,7 @@ class OctWriter : public TreeWriter {
     w.write_leaves(plan_.leaves, plan_.leaf_offset);
     w.refit();
     // The nodes, each its own bytes (on the build's threads); then the
-    // header's reach of their frames (layout/octtree.h), the largest over
+    // header's reach of their frames (layout/tree/octtree.h), the largest over
     // the nodes (0 where the root is a leaf).
     for_each_on(w.threads, plan_.binary_of.size(), Writer::kGrain, [&](uint64_t q) {
       write_oct_node(t, plan_, uint32_t(q), w.bytes.data() + w.h.tree_offset + plan_.node_offset[q]);

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "builder/wide_plan.h"
-#include "layout/quadtree.h"
+#include "layout/tree/quadtree.h"
 
 namespace meshcast {
 

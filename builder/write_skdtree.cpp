@@ -6,7 +6,7 @@
 #include <functional>
 
 #include "builder/writer.h"
-#include "layout/skdtree.h"
+#include "layout/tree/skdtree.h"
 
 namespace meshcast {
 

@@ -16,8 +16,8 @@
 
 #include "builder/build_topdown.h"
 #include "builder/writer.h"
-#include "layout/aabbtree.h"
-#include "layout/zerobyte.h"
+#include "layout/tree/aabbtree.h"
+#include "layout/tree/zerobyte.h"
 
 namespace meshcast {
 

@@ -1,7 +1,7 @@
 // Zero-byte trees (seed 004) and the hybrid: the statistics of their
 // builder (builder/write_zerobyte.cpp, whose make_writer overloads
 // builder/writer.h declares). The walkers are in
-// cpu/walk_zerobyte.cpp, the bits in layout/zerobyte.h.
+// cpu/walk_zerobyte.cpp, the bits in layout/tree/zerobyte.h.
 #pragma once
 #include <cstdint>
 #include <string>

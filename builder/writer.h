@@ -16,7 +16,7 @@
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "layout/blob_format.h"
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 #include "layout/catalog.h"
 
 namespace meshcast {
@@ -28,7 +28,7 @@ struct CodecOps {
   uint32_t grid_bits;  // codes a component of the mesh grid (21; CompressedStrip 20)
   bool nested;         // blocks on nested lattices of the grid (BitPackSOA)
   bool moves_floats;   // stores floats it has changed (UncompressedStrip)
-  bool independent;    // leaves may be encoded at once (layout/block.h)
+  bool independent;    // leaves may be encoded at once (layout/triangles/block.h)
   uint32_t lanes;
   // Null for a format with no blocks (the zero-byte trees' Indexed24,
   // whose writer stores the index words itself).

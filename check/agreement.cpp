@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "layout/blob_format.h"
-#include "layout/block.h"
-#include "layout/leaves.h"
+#include "layout/triangles/block.h"
+#include "layout/tree/leaves.h"
 
 namespace meshcast {
 

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "builder/ray_sets.h"
-#include "layout/files.h"
+#include "io/files.h"
 #include "meshcast/ray.h"
 #include "meshcast/scene.h"
 

@@ -4,7 +4,7 @@
 // no longer beat the closest hit. leaf(node, offset) handles each leaf.
 #pragma once
 #include "cpu/leaf.h"
-#include "layout/aabbtree.h"
+#include "layout/tree/aabbtree.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

@@ -6,8 +6,8 @@
 #include <bit>
 
 #include "cpu/intersect.h"
-#include "layout/codecs.h"
-#include "layout/zerobyte.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/zerobyte.h"
 
 namespace meshcast {
 MC_ISA_BEGIN
@@ -233,7 +233,7 @@ inline uint64_t test_sequential_leaf(const uint8_t* blob, const RayPre& r, uint3
   return bytes;
 }
 
-// Pair blocks (layout/pairsoa.h): 4 lanes of pairs a pass, the leaf's
+// Pair blocks (layout/triangles/pairsoa.h): 4 lanes of pairs a pass, the leaf's
 // triangles numbered lane by lane. Returns the blocks' bytes.
 template <class Codec>
 inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
@@ -262,7 +262,7 @@ inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t bl
   return at;
 }
 
-// Cluster leaves (layout/cluster.h): each cluster's 16 vertices decoded into
+// Cluster leaves (layout/triangles/cluster.h): each cluster's 16 vertices decoded into
 // registers once, a row of 8 corners permuted out of them per corner and
 // axis, 8 triangles a test. The leaf's triangles are numbered cluster by
 // cluster. Returns the leaf's bytes (what the decode read, padded to 4).

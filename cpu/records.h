@@ -3,7 +3,7 @@
 // each block's length: the whole of a BruteForce walk, and one batch of an
 // AABBList walk.
 #pragma once
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "cpu/walk.h"
 
 namespace meshcast {

@@ -11,8 +11,8 @@
 #include <cstring>
 
 #include "cpu/isa.h"
-#include "layout/block.h"
-#include "layout/half.h"
+#include "layout/triangles/block.h"
+#include "layout/tree/half.h"
 
 #if MC_ISA_SIMD
 #include <immintrin.h>
@@ -146,7 +146,7 @@ inline F8 from_u8x8(const uint8_t* p) {  // 8 bytes -> 8 floats
   std::memcpy(&x, p, 8);
   return {_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_cvtsi64_si128(x)))};
 }
-// A cluster's vertex coordinates of one axis (layout/cluster.h), lanes 0-7
+// A cluster's vertex coordinates of one axis (layout/triangles/cluster.h), lanes 0-7
 // and 8-15: the row's `count` offsets (uint16, or uint32 when wide) plus the
 // origin's code, decoded with BitPack's fma (lanes past count: the origin);
 // and a row of 8 corners picked from them by 4-bit vertex numbers (nibble i:

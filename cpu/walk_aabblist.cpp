@@ -3,7 +3,7 @@
 // GPU's two passes (shaders/aabblist_*.comp) do the same work spread over
 // (ray, batch) pairs.
 #include "cpu/records.h"
-#include "layout/aabblist.h"
+#include "layout/tree/aabblist.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

@@ -2,9 +2,9 @@
 // nearer, push the farther with its entry distance, and drop a popped node
 // that can no longer beat the closest hit.
 #include "cpu/aabb_walk.h"
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "cpu/walk.h"
-#include "layout/aabbtree.h"
+#include "layout/tree/aabbtree.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

@@ -1,9 +1,9 @@
 // AABBTreeCompressed walker (seed 000 §5.4): as the AABBTree walker, but a
 // node's child boxes are decoded from its own decoded box, so each stack
 // entry carries the box, the child's offset and its triangle count.
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "cpu/walk.h"
-#include "layout/compressed.h"
+#include "layout/tree/compressed.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

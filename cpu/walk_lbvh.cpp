@@ -9,10 +9,10 @@
 // Nodes whose bits are all 0 walk exactly as the seed.
 #include <bit>
 
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "cpu/walk.h"
-#include "layout/aabbtree.h"
-#include "layout/lbvh.h"
+#include "layout/tree/aabbtree.h"
+#include "layout/tree/lbvh.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

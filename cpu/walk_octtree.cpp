@@ -10,8 +10,8 @@
 #include <cmath>
 
 #include "cpu/walk.h"
-#include "layout/codecs.h"
-#include "layout/octtree.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/octtree.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

@@ -3,9 +3,9 @@
 // nearest is walked next, and popped entries skipped once the closest hit is
 // nearer than their entry distance. The two formats differ only in how a
 // node's bounds are loaded (Bounds::load below).
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "cpu/walk.h"
-#include "layout/quadtree.h"
+#include "layout/tree/quadtree.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

@@ -6,9 +6,9 @@
 // conservative box test (Ize 2013), so no region the ray touches is culled;
 // a direction component of 0 gives an infinite distance (or NaN on the
 // plane), which max_keep/min_keep ignore, as box_test does.
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 #include "cpu/walk.h"
-#include "layout/skdtree.h"
+#include "layout/tree/skdtree.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

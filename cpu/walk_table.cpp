@@ -3,8 +3,8 @@
 #include <array>
 #include <type_traits>
 
-#include "layout/codecs.h"
-#include "layout/zerobyte.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/zerobyte.h"
 
 namespace meshcast {
 MC_ISA_BEGIN

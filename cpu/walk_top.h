@@ -1,4 +1,4 @@
-// The walk of a scene's top level (layout/top_level.h), compiled once an
+// The walk of a scene's top level (layout/tree/top_level.h), compiled once an
 // instruction set like the walkers (cpu/isa.h), its node test inlined. The
 // scene's walk (cpu/scene_trace.cpp) calls the chosen set's (walk_top_fn(),
 // cpu/isa_choice.cpp) and walks each instance it is handed.
@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "cpu/isa.h"
-#include "layout/top_level.h"
+#include "layout/tree/top_level.h"
 
 namespace meshcast {
 

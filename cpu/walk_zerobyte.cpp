@@ -9,8 +9,8 @@
 #include "cpu/aabb_walk.h"
 #include "cpu/box_cache.h"
 #include "cpu/walk.h"
-#include "layout/aabbtree.h"
-#include "layout/zerobyte.h"
+#include "layout/tree/aabbtree.h"
+#include "layout/tree/zerobyte.h"
 
 #include <type_traits>
 

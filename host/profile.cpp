@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "layout/files.h"
+#include "io/files.h"
 
 namespace meshcast::host {
 

@@ -33,7 +33,7 @@
 // we never create a DefaultLogger, so it uses its NullLogger.
 #include "meshcast/read.h"
 
-#include "layout/files.h"
+#include "io/files.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/scene.h>

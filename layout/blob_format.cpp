@@ -1,5 +1,5 @@
 #include "layout/blob_format.h"
-#include "layout/zerobyte.h"
+#include "layout/tree/zerobyte.h"
 
 #include <algorithm>
 #include <bit>
@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "layout/catalog.h"
-#include "layout/codecs.h"
-#include "layout/tree_walks.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/tree_walks.h"
 
 namespace meshcast::layout {
 

@@ -2,7 +2,7 @@
 // each. Every switch on a tree format is generated from it (validation,
 // leaf descent, the writers, the walkers' dispatch, names), so a new tree
 // format is one line here and one file per room:
-//   layout/    its bits, validator and leaf descent (validate_tree and
+//   layout/tree/  its bits, validator and leaf descent (validate_tree and
 //              for_each_leaf_of overloads on its tag),
 //   builder/   its writer (a make_writer overload on its tag),
 //   cpu/       its walker (a walk overload on its tag, instantiated for
@@ -10,7 +10,7 @@
 //   shaders/   its compute shader, if a GPU method reads it, with a line in
 //              gpu/method_table.cpp (the one table of what the GPU reads).
 // docs/adding-formats.md walks through it file by file.
-// The triangle formats' list is MC_FOR_EACH_TRIANGLE_CODEC (layout/codecs.h).
+// The triangle formats' list is MC_FOR_EACH_TRIANGLE_CODEC (layout/triangles/codecs.h).
 #pragma once
 #include <cstdint>
 #include <string_view>
@@ -19,7 +19,7 @@
 #include "meshcast/build.h"
 
 // X(Name, id, smallest node in bytes, triangles, order, leaf size, splitter)
-//   triangles  AllCodecs: every codec of layout/codecs.h; Indexed24: the
+//   triangles  AllCodecs: every codec of layout/triangles/codecs.h; Indexed24: the
 //              mesh's own indices only (the zero-byte trees)
 //   order      the node order its bits allow (seed 000 §4.3): AnyOrder,
 //              NoTree, or the one its addressing fixes

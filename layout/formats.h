@@ -285,7 +285,7 @@
 // Hit triangle for a miss.
 #define MC_NO_HIT 0xFFFFFFFFu
 
-// A scene's top level (layout/top_level.h), as the Vulkan scene method
+// A scene's top level (layout/tree/top_level.h), as the Vulkan scene method
 // reads the snapshot's arrays unchanged: a placed instance's record and
 // its fields' bytes, an 8-wide node's (lo[3][8], hi[3][8] floats, then 8
 // slot words), and what a slot holds.

@@ -7,8 +7,8 @@
 
 #include "layout/blob_format.h"
 #include "layout/catalog.h"
-#include "layout/codecs.h"
-#include "layout/zerobyte.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/zerobyte.h"
 #include "meshcast/errors.h"
 
 namespace meshcast {

@@ -1,5 +1,5 @@
 // Layouts by name: "OctTreeCompressed/ClusterBitPackSOA8" and back, every
-// layout the catalog (layout/catalog.h) and the codecs (layout/codecs.h)
+// layout the catalog (layout/catalog.h) and the codecs (layout/triangles/codecs.h)
 // make, and the names nearest a mistyped one. meshcast/build.h declares the
 // public part (layout_name of a Layout, parse_layout_name, all_layouts).
 #pragma once

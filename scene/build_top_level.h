@@ -1,11 +1,11 @@
-// Builds and refits a scene's top level (layout/top_level.h) over the
+// Builds and refits a scene's top level (layout/tree/top_level.h) over the
 // instances' world boxes: what Scene::commit() does once a frame.
 #pragma once
 #include <cstdint>
 #include <span>
 #include <vector>
 
-#include "layout/top_level.h"
+#include "layout/tree/top_level.h"
 
 namespace meshcast {
 

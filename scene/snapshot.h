@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "layout/top_level.h"
+#include "layout/tree/top_level.h"
 #include "meshcast/blob.h"
 #include "meshcast/scene.h"
 

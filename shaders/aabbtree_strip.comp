@@ -1,6 +1,6 @@
 // Method 3 of seed 000 §7: AABBTree with UncompressedStrip triangles
 // (§3.10): a leaf's strip is decoded vertex after vertex, the flag bits in
-// the floats' lowest bits, by the state machine of layout/strip.h, and each
+// the floats' lowest bits, by the state machine of layout/triangles/strip.h, and each
 // triangle tested as it is made (slots in decode order, as on the CPU).
 // Validation proved every leaf's strip makes its count of triangles inside
 // the block.

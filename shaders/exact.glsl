@@ -1,6 +1,6 @@
 // Arithmetic the CPU does in one rounding that a Vulkan device may not:
 // Vulkan lets fma() round twice, so the CPU's std::fma (the BitPack decode
-// of layout/block.cpp) is rebuilt from double operations, which Vulkan does
+// of layout/triangles/block.cpp) is rebuilt from double operations, which Vulkan does
 // round correctly: the product of two floats is exact in double, the sum is
 // rounded to odd (TwoSum, then the last bit set when anything was lost), and
 // the one conversion to float then rounds exactly as a fused fma would

@@ -1,5 +1,5 @@
-// The walk of OctTreeCompressed (layout/octtree.h) with ClusterBitPackSOA8
-// leaves (layout/cluster.h), one ray a thread: cpu/walk_octtree.cpp's (8
+// The walk of OctTreeCompressed (layout/tree/octtree.h) with ClusterBitPackSOA8
+// leaves (layout/triangles/cluster.h), one ray a thread: cpu/walk_octtree.cpp's (8
 // child boxes decoded and tested, the hit ones pushed farthest first,
 // popped entries dropped once the closest hit is nearer). A child bound is
 // Origin + q * 2^e, exact in float, so a plain product and sum (precise)

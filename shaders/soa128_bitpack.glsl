@@ -1,6 +1,6 @@
 // BitPackSOA128 records of BruteForce and AABBList: [count][one block of 128 lanes]: rows
 // X1 Y1 Z1 X2 ... Z3 of 128 uint16, then the block's scale and offset (3
-// floats each); v = q * scale + offset (layout/soa.h). The scale is a power
+// floats each); v = q * scale + offset (layout/triangles/soa.h). The scale is a power
 // of two (the mesh grid's step times 2^m), so the product is exact and the
 // sum rounds once, as the CPU's fma does.
 #ifndef MESHCAST_SOA128_GLSL

@@ -1,5 +1,5 @@
 // Float3SOA128 records of BruteForce and AABBList (layout/formats.h): [count][one block of
-// 128 lanes], rows X1 Y1 Z1 X2 ... Z3 of 128 floats (layout/soa.h).
+// 128 lanes], rows X1 Y1 Z1 X2 ... Z3 of 128 floats (layout/triangles/soa.h).
 #ifndef MESHCAST_SOA128_GLSL
 #define MESHCAST_SOA128_GLSL
 

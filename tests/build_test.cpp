@@ -13,7 +13,7 @@
 #include "check/generate.h"
 #include "layout/blob_format.h"
 #include "layout/catalog.h"
-#include "layout/leaves.h"
+#include "layout/tree/leaves.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {

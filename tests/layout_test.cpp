@@ -10,9 +10,9 @@
 
 #include "check/generate.h"
 #include "layout/blob_format.h"
-#include "layout/block.h"
-#include "layout/half.h"
-#include "layout/octtree.h"
+#include "layout/triangles/block.h"
+#include "layout/tree/half.h"
+#include "layout/tree/octtree.h"
 #include "tests/testing.h"
 
 #if defined(__x86_64__)

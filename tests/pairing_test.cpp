@@ -11,8 +11,8 @@
 #include "builder/pairing.h"
 #include "check/generate.h"
 #include "layout/blob_format.h"
-#include "layout/leaves.h"
-#include "layout/pairsoa.h"
+#include "layout/tree/leaves.h"
+#include "layout/triangles/pairsoa.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -173,7 +173,7 @@ TEST(PairedTrees, WhatCannotPairIsRefusedWithTheReason) {
 }  // namespace
 }  // namespace meshcast::testing
 
-// Float3PairSOA4 (layout/pairsoa.h): a quad's two triangles become one lane
+// Float3PairSOA4 (layout/triangles/pairsoa.h): a quad's two triangles become one lane
 // of 4 corners, the second stored as (B, A, D) after the first (A, B, C);
 // the header says lane 0 is used and holds a pair; a header with bits no
 // block may hold is refused.

@@ -11,7 +11,7 @@
 #include "check/generate.h"
 #include "cpu/trace_with_triangle_test.h"
 #include "layout/blob_format.h"
-#include "layout/leaves.h"
+#include "layout/tree/leaves.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {

@@ -9,7 +9,7 @@
 #include "cpu/box_cache.h"
 #include "builder/write_zerobyte.h"
 #include "check/generate.h"
-#include "layout/zerobyte.h"
+#include "layout/tree/zerobyte.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {

@@ -12,7 +12,7 @@
 #include "bench/peers.h"
 #include "bench/plot.h"
 #include "meshcast/blob.h"
-#include "layout/files.h"
+#include "io/files.h"
 #include "layout/queries.h"
 #include "tools/commands.h"
 #include "tools/common.h"

@@ -4,7 +4,7 @@
 
 #include "bench/scenes.h"
 #include "meshcast/blob.h"
-#include "layout/files.h"
+#include "io/files.h"
 #include "tools/commands.h"
 #include "tools/common.h"
 

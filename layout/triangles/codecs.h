@@ -1,14 +1,14 @@
 // The one list of triangle formats: validation, the writer, the walkers'
 // dispatch table and the layout names are all generated from it.
 #pragma once
-#include "layout/bitpack.h"
-#include "layout/cluster.h"
-#include "layout/float3.h"
-#include "layout/soa.h"
-#include "layout/strip.h"
-#include "layout/indexed.h"
-#include "layout/indexed8bitpacksoa4.h"
-#include "layout/pairsoa.h"
+#include "layout/triangles/bitpack.h"
+#include "layout/triangles/cluster.h"
+#include "layout/triangles/float3.h"
+#include "layout/triangles/soa.h"
+#include "layout/triangles/strip.h"
+#include "layout/triangles/indexed.h"
+#include "layout/triangles/indexed8bitpacksoa4.h"
+#include "layout/triangles/pairsoa.h"
 
 // X(codec type in meshcast::layout, its name as the seed writes it)
 #define MC_FOR_EACH_TRIANGLE_CODEC(X)                  \

@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 
 namespace meshcast::layout {
 

@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "layout/indexed8bitpacksoa4.h"
+#include "layout/triangles/indexed8bitpacksoa4.h"
 
 namespace meshcast::layout {
 
@@ -80,7 +80,7 @@ bool Indexed8BitPackSOA4::check(const uint8_t* blob, uint32_t block, uint32_t co
 
 }  // namespace meshcast::layout
 
-#include "layout/strip.h"
+#include "layout/triangles/strip.h"
 
 namespace meshcast::layout {
 

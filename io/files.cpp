@@ -1,4 +1,4 @@
-#include "layout/files.h"
+#include "io/files.h"
 
 #include <fcntl.h>
 #include <sys/mman.h>

@@ -1,10 +1,10 @@
 // The leaf descent's entry: the catalog's switch to each family's from_root
-// (in its layout/<family>.cpp).
-#include "layout/leaves.h"
+// (in its layout/tree/<family>.cpp).
+#include "layout/tree/leaves.h"
 
-#include "layout/codecs.h"
-#include "layout/tree_walks.h"
-#include "layout/zerobyte.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/tree_walks.h"
+#include "layout/tree/zerobyte.h"
 
 namespace meshcast::layout {
 

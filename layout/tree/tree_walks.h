@@ -1,7 +1,7 @@
 // What every tree family's two readings of its nodes share: validation
 // (proves every offset and count in range, before any walker trusts them)
 // and the leaf descent (a validated blob's leaves with the boxes above them).
-// Each family's own readings live beside its bits in layout/<family>.cpp,
+// Each family's own readings live beside its bits in layout/tree/<family>.cpp,
 // declared here from the catalog: validate_tree (one template a format,
 // instantiated for every codec there) and from_root.
 #pragma once
@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "layout/blob_format.h"
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 #include "layout/catalog.h"
-#include "layout/leaves.h"
+#include "layout/tree/leaves.h"
 
 namespace meshcast::layout {
 

@@ -1,9 +1,9 @@
 // The AABBTree family's readings (AABBTree, AABBTreeSplitAxis, AABBTreePNS):
-// validation and the leaf descent over the nodes of layout/aabbtree.h.
-#include "layout/tree_walks.h"
+// validation and the leaf descent over the nodes of layout/tree/aabbtree.h.
+#include "layout/tree/tree_walks.h"
 
-#include "layout/aabbtree.h"
-#include "layout/codecs.h"
+#include "layout/tree/aabbtree.h"
+#include "layout/triangles/codecs.h"
 
 namespace meshcast::layout {
 

@@ -1,9 +1,9 @@
 // StacklessLBVH's readings: validation and the leaf descent over the heap
-// of layout/lbvh.h.
-#include "layout/tree_walks.h"
+// of layout/tree/lbvh.h.
+#include "layout/tree/tree_walks.h"
 
-#include "layout/codecs.h"
-#include "layout/lbvh.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/lbvh.h"
 
 namespace meshcast::layout {
 

@@ -1,4 +1,4 @@
-#include "layout/cluster.h"
+#include "layout/triangles/cluster.h"
 
 #include <algorithm>
 #include <cmath>

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 
 namespace meshcast::layout {
 

@@ -16,7 +16,7 @@
 #pragma once
 #include <string>
 
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 
 namespace meshcast::layout {
 

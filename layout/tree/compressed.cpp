@@ -1,9 +1,9 @@
 // AABBTreeCompressed's readings: validation and the leaf descent over the
-// nodes of layout/compressed.h.
-#include "layout/tree_walks.h"
+// nodes of layout/tree/compressed.h.
+#include "layout/tree/tree_walks.h"
 
-#include "layout/codecs.h"
-#include "layout/compressed.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/compressed.h"
 
 namespace meshcast::layout {
 

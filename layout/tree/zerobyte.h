@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "layout/blob_format.h"
-#include "layout/leaves.h"
+#include "layout/tree/leaves.h"
 
 namespace meshcast::layout {
 

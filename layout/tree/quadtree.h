@@ -16,7 +16,7 @@
 #include <cstring>
 
 #include "layout/blob_format.h"
-#include "layout/half.h"
+#include "layout/tree/half.h"
 
 namespace meshcast::layout {
 

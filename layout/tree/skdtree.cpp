@@ -1,9 +1,9 @@
 // SKDTree's readings: validation and the leaf descent over the nodes of
-// layout/skdtree.h.
-#include "layout/tree_walks.h"
+// layout/tree/skdtree.h.
+#include "layout/tree/tree_walks.h"
 
-#include "layout/codecs.h"
-#include "layout/skdtree.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/skdtree.h"
 
 namespace meshcast::layout {
 

@@ -1,10 +1,10 @@
 // Validation and the read-back walk of the zero-byte formats (seed 004).
-#include "layout/zerobyte.h"
+#include "layout/tree/zerobyte.h"
 
 #include <cmath>
 
-#include "layout/aabbtree.h"
-#include "layout/tree_walks.h"
+#include "layout/tree/aabbtree.h"
+#include "layout/tree/tree_walks.h"
 
 namespace meshcast::layout {
 

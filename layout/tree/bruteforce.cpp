@@ -1,8 +1,8 @@
 // BruteForce's readings (seed 000 §3.11: records [count][block], no tree):
 // validation and the leaf descent; AABBList's batches are such records too.
-#include "layout/tree_walks.h"
+#include "layout/tree/tree_walks.h"
 
-#include "layout/codecs.h"
+#include "layout/triangles/codecs.h"
 
 namespace meshcast::layout {
 

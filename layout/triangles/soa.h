@@ -23,7 +23,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 
 namespace meshcast::layout {
 

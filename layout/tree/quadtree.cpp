@@ -1,9 +1,9 @@
 // The quad trees' readings (QuadTree, QuadTreeHalfFloat): validation and
-// the leaf descent over the nodes of layout/quadtree.h.
-#include "layout/tree_walks.h"
+// the leaf descent over the nodes of layout/tree/quadtree.h.
+#include "layout/tree/tree_walks.h"
 
-#include "layout/codecs.h"
-#include "layout/quadtree.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/quadtree.h"
 
 namespace meshcast::layout {
 

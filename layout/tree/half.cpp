@@ -1,4 +1,4 @@
-#include "layout/half.h"
+#include "layout/tree/half.h"
 
 #include <bit>
 #include <cmath>
@@ -71,7 +71,7 @@ uint16_t float_to_half_up(float f) {
 
 }  // namespace meshcast::layout
 
-#include "layout/quadtree.h"
+#include "layout/tree/quadtree.h"
 
 namespace meshcast::layout {
 

@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 
 namespace meshcast::layout {
 

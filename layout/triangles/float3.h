@@ -2,7 +2,7 @@
 #pragma once
 #include <cstring>
 
-#include "layout/block.h"
+#include "layout/triangles/block.h"
 
 namespace meshcast::layout {
 

@@ -1,9 +1,9 @@
 // AABBList's readings: validation and the leaf descent over the batch
-// entries of layout/aabblist.h and their records.
-#include "layout/tree_walks.h"
+// entries of layout/tree/aabblist.h and their records.
+#include "layout/tree/tree_walks.h"
 
-#include "layout/aabblist.h"
-#include "layout/codecs.h"
+#include "layout/tree/aabblist.h"
+#include "layout/triangles/codecs.h"
 
 namespace meshcast::layout {
 

@@ -1,12 +1,12 @@
 // OctTreeCompressed's frame coding, validation and leaf descent over the
-// nodes of layout/octtree.h.
-#include "layout/octtree.h"
+// nodes of layout/tree/octtree.h.
+#include "layout/tree/octtree.h"
 
 #include <algorithm>
 #include <cfloat>
 
-#include "layout/codecs.h"
-#include "layout/tree_walks.h"
+#include "layout/triangles/codecs.h"
+#include "layout/tree/tree_walks.h"
 #include "meshcast/errors.h"
 
 namespace meshcast::layout {

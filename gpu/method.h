@@ -94,6 +94,9 @@ struct MethodLayout {
 std::span<const MethodLayout> method_layouts();
 // The first method of that list that reads the blob's layout; "" for none.
 std::string method_reading(std::span<const uint8_t> blob);
+// What `method` reads, as a refusal or a --help names it: "AABBTree/Float3
+// or AABBTree/UncompressedStrip".
+std::string layouts_read_by(const std::string& method);
 
 // AABBList (method 2) with a pair buffer of `pairs` (ray, batch) pairs a
 // slot: a batch of rays goes in chunks of pairs / batches rays. make_method's

@@ -40,11 +40,10 @@ std::span<const MethodReading> method_table();
 
 // The line of `method` for the blob's layout; the method's first line when
 // the blob is too short to say or is of a layout the method does not read
-// (the method's constructor refuses it then, naming layouts_read_by).
+// (the method's constructor refuses it then, naming layouts_read_by:
+// gpu/method.h).
 // InputError listing the methods for an unknown one.
 const MethodReading& method_line(const std::string& method, std::span<const uint8_t> blob);
-// "AABBTree/Float3 or AABBTree/UncompressedStrip".
-std::string layouts_read_by(const std::string& method);
 
 // The factories the table's lines name (gpu/walkers.cpp, gpu/bruteforce.cpp,
 // gpu/aabblist.cpp).

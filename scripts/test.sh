@@ -23,10 +23,13 @@ cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_
 # Under AddressSanitizer: the suites that read hostile input, walk, place
 # instances and allocate per frame. The layouts' own suites (layout_test,
 # pairing_test, auto_test), the builder's (build_test: its threads run
-# under TSan below) and the oracle's run in Release alone: their encoders
-# are the builds the suites below make, and the fuzz targets' ASan builds
-# read, build and walk every layout again.
-asan_suites=(walker_test robustness_test limits_test zerobyte_test scene_test hostile_test io_test)
+# under TSan below), the oracle's and the stiff and extreme inputs'
+# (robustness_test: the walks walker_test and hostile_test drive here, on
+# rays of extreme range) run in Release alone, on every instruction set:
+# their encoders are the builds the suites below make, and the fuzz
+# targets' ASan builds read, build and walk every layout on arbitrary
+# bytes and rays again.
+asan_suites=(walker_test limits_test zerobyte_test scene_test hostile_test io_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
 walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...

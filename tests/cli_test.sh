@@ -291,6 +291,7 @@ check render-vulkan 0 "device: " -- "$meshcast" render "$mesh" --backend vulkan 
 # The same bytes walked on the GPU give the same picture.
 cmp -s "$work/rc.png" "$work/rv.png" || { echo "FAIL the Vulkan picture differs from the CPU's"; failures=$((failures + 1)); }
 check vulkan-wrong-layout 2 "reads BruteForce/BitPackSOA128 or BruteForce/Float3SOA128 blobs, not AABBTree/Float3" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-help-methods 0 "octtree \(OctTreeCompressed/ClusterBitPackSOA8\), aabblist \(AABBList/Float3SOA128 or AABBList/BitPackSOA128\)" -- "$meshcast" trace --help
 check vulkan-no-device 3 "no device matches" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --device nonesuch --rays "$work/r.rays" --out "$work/hx.hits"
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
 printf 'OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n' >"$work/nan.off"

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ostream>
 #include <string_view>
 
 #include "gpu/method.h"
@@ -12,6 +13,11 @@
 #include "gpu/vulkan.h"
 #include "check/generate.h"
 #include "tests/testing.h"
+
+namespace meshcast::gpu {
+// What a test's parameter prints as: "aabbtree reading AABBTree/Float3".
+void PrintTo(const MethodLayout& m, std::ostream* os) { *os << m.method << " reading " << layout_name(m.layout); }
+}  // namespace meshcast::gpu
 
 namespace meshcast::testing {
 namespace {

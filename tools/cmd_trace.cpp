@@ -139,9 +139,11 @@ void add_trace(CLI::App& app) {
   cmd->add_option("--threads", args->threads,
                   "cpu, a mesh or blob: the threads the batch is split over, in chunks of rays (0: every core; default 1)")
       ->check(integer_in(0, 1024));
-  cmd->add_option("--method", args->method, "GPU method: bruteforce (BruteForce/Float3SOA128), aabbtree (AABBTree/Float3), "
-                                            "skdtree (SKDTree/Float3), lbvh (StacklessLBVH/Float3), "
-                                            "quadtree (QuadTreeHalfFloat/Indexed8BitPackSOA4), octtree (OctTreeCompressed/ClusterBitPackSOA8)");
+  // The methods and what each reads, from the one table (gpu/method_table.cpp).
+  std::string methods = "GPU method (default: the one that reads the blob's layout):";
+  for (const std::string& m : gpu::method_names()) methods += " " + m + " (" + gpu::layouts_read_by(m) + "),";
+  methods.back() = '.';
+  cmd->add_option("--method", args->method, methods);
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args, max_hits] {

@@ -1,6 +1,8 @@
 #!/bin/bash
-# usage: perf36.sh OLD NEW — interleaved rounds, median ns/ray of each
-OLD=$1; NEW=$2; D=/work/main/data; W=/tmp/perf36; mkdir -p $W
+# usage: walk_before_after.sh OLD_MESHCAST NEW_MESHCAST (from the repository root)
+# One thread; 5 interleaved rounds of `trace --repeat 3` a binary, the median
+# ns a ray of each, and whether their hits files are byte-identical.
+OLD=$1; NEW=$2; D=${MESHCAST_DATA:-data}; W=${TMPDIR:-/tmp}/walk_before_after; mkdir -p $W
 for mesh in bunny00 armadillo; do
   for kind in long radial; do
     $NEW rays $D/$mesh.off --kind $kind --count 200000 --out $W/${mesh}_$kind.rays >/dev/null 2>&1

@@ -71,18 +71,26 @@ class AABBListMethod : public BatchMethod {
   uint32_t chunk_ = 1;  // rays a chunk: chunk * batches pairs fit a pair buffer
 };
 
+// The method over the table's `line` for the blob, with a pair buffer of
+// `pairs` a slot: what both entries below make.
+std::unique_ptr<Method> make_over(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
+                                  const MethodReading& line, uint64_t pairs, uint32_t slots, uint32_t flags,
+                                  uint32_t max_hits) {
+  ctx.require_int64_atomics("aabblist");
+  return std::make_unique<AABBListMethod>(ctx, blob, name, line, pairs, slots, flags, max_hits);
+}
+
 }  // namespace
 
 std::unique_ptr<Method> make_aabblist(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
                                       uint64_t pairs, uint32_t slots, uint32_t flags, uint32_t max_hits) {
-  ctx.require_int64_atomics("aabblist");
-  return std::make_unique<AABBListMethod>(ctx, blob, name, method_line("aabblist", blob), pairs, slots, flags, max_hits);
+  return make_over(ctx, blob, name, method_line("aabblist", blob), pairs, slots, flags, max_hits);
 }
 
-// The table's factory: the line make_aabblist finds is this one.
+// The table's factory: make_method has found the line already.
 std::unique_ptr<Method> make_aabblist_method(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                             const MethodReading&, uint32_t slots, uint32_t flags, uint32_t max_hits) {
-  return make_aabblist(ctx, blob, name, kAABBListPairs, slots, flags, max_hits);
+                                             const MethodReading& line, uint32_t slots, uint32_t flags, uint32_t max_hits) {
+  return make_over(ctx, blob, name, line, kAABBListPairs, slots, flags, max_hits);
 }
 
 }  // namespace meshcast::gpu

@@ -17,15 +17,20 @@ namespace meshcast::gpu {
 
 namespace {
 
+// The passes before the resolve read the rays, keys and hits in windows;
+// their bindings 4 and 5 are the pairs and the dispatch arguments.
+constexpr uint32_t kPassWindows = 0b01110;
+
 class AABBListMethod : public BatchMethod {
  public:
   AABBListMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const MethodReading& line,
                  uint64_t pairs, uint32_t slots, uint32_t flags, uint32_t max_hits)
       : BatchMethod(ctx, blob, name, line, slots, flags, max_hits),
-        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push), slots, flags, max_hits),
-        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push), slots, flags, max_hits),
-        test_(ctx, line.test.words, line.test.bytes, 6, sizeof(Push), slots, flags, max_hits),
-        resolve_(ctx, line.resolve.words, line.resolve.bytes, 5, sizeof(Push), slots, flags, max_hits) {
+        boxes_(ctx, aabblist_boxes_spv, sizeof aabblist_boxes_spv, 6, sizeof(Push), slots, flags, max_hits, kPassWindows),
+        args_(ctx, aabblist_args_spv, sizeof aabblist_args_spv, 6, sizeof(Push), slots, flags, max_hits, kPassWindows),
+        test_(ctx, line.test.words, line.test.bytes, 6, sizeof(Push), slots, flags, max_hits, kPassWindows),
+        resolve_(ctx, line.resolve.words, line.resolve.bytes, kBatchBindings, sizeof(Push), slots, flags, max_hits,
+                 kPerRayWindows) {
     const uint64_t capacity = std::max<uint64_t>(pairs, records_);
     for (uint32_t k = 0; k < this->slots(); ++k) {  // every slot in flight has its own pairs and counter
       pairs_.push_back(std::make_unique<Buffer>(ctx, capacity * 8, "AABBList pair buffer"));
@@ -41,28 +46,28 @@ class AABBListMethod : public BatchMethod {
     std::vector<const Buffer*> all = buffers(slot);
     all.resize(4);
     all.push_back(pairs_[slot].get()), all.push_back(control_[slot].get());
-    for (Pipeline* p : {&boxes_, &args_, &test_}) p->bind(all, slot);
-    resolve_.bind(buffers(slot), slot);
+    for (Pipeline* p : {&boxes_, &args_, &test_}) p->bind(all, slot, windows(slot));
+    resolve_.bind(buffers(slot), slot, windows(slot));
   }
 
   // The append counter starts at 0 (the slot's previous batch is finished).
   void prepare(uint32_t slot, uint32_t) override { std::memset(control_[slot]->data(), 0, control_[slot]->size()); }
 
-  void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
+  void record(VkCommandBuffer cb, uint32_t slot, const Piece& piece) override {
     const VkPhysicalDeviceLimits& limits = ctx_.limits();
+    const uint32_t n = piece.rays;
     const uint32_t box_groups = (records_ + 63) / 64;
     for (uint32_t base = 0; base < n; base += chunk_) {
       const uint32_t end = std::min(n, base + chunk_);
       const Push boxes{base, end, records_}, args{0, 0, limits.maxComputeWorkGroupCount[0]}, test{0, n, records_};
-      boxes_.dispatch(cb, slot, &boxes, box_groups, end - base, 1);
+      boxes_.dispatch(cb, slot, &boxes, box_groups, end - base, 1, piece.offsets);
       ctx_.compute_barrier(cb);
-      args_.dispatch(cb, slot, &args, 1, 1, 1);
+      args_.dispatch(cb, slot, &args, 1, 1, 1, piece.offsets);
       ctx_.indirect_barrier(cb);
-      test_.dispatch_indirect(cb, slot, &test, *control_[slot], 4);
+      test_.dispatch_indirect(cb, slot, &test, *control_[slot], 4, piece.offsets);
       ctx_.compute_barrier(cb);
     }
-    const Push resolve{0, n, records_};
-    resolve_.dispatch(cb, slot, &resolve, (n + 63) / 64, 1, 1);
+    dispatch_rays(resolve_, cb, slot, piece);
   }
 
  private:

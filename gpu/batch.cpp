@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <cstring>
+#include <limits>
 
 #include "meshcast/mesh.h"
 #include "meshcast/blob.h"
-#include "gpu/rays.h"
 #include "layout/blob_format.h"
+#include "layout/ray_record.h"
 #include "layout/names.h"
 
 namespace meshcast::gpu {
@@ -36,6 +38,7 @@ BatchMethod::BatchMethod(Context& ctx, std::span<const uint8_t> blob, const std:
   blob_ = ctx.blob_buffer(blob, name);
   try {
     for (Slot& s : slots_) {
+      s.counters = std::make_unique<Buffer>(ctx, 16, "batch counters", VK_BUFFER_USAGE_TRANSFER_DST_BIT);
       VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
       check(ctx_.vk().CreateFence(ctx.device(), &fci, nullptr, &s.fence), "vkCreateFence");
       s.cb = ctx.allocate_command_buffer();
@@ -62,46 +65,84 @@ void BatchMethod::release_slots() {
   }
 }
 
+static_assert(sizeof(Ray) == MC_RAY_WORDS * 4 && offsetof(Ray, org) == MC_RAY_ORG * 4 &&
+                  offsetof(Ray, dir) == MC_RAY_DIR * 4 && offsetof(Ray, tmax) == MC_RAY_TMAX * 4 &&
+                  offsetof(Ray, tmin) == MC_RAY_TMIN * 4,
+              "meshcast::Ray is the shaders' ray record (layout/ray_record.h)");
+
+BatchMethod::PerRay BatchMethod::per_ray() const {
+  // A row: found, then max_hits (t, triangle) records (shaders/hit_rows.glsl).
+  return {sizeof(Ray), reads_keys() ? uint64_t(keys_a_ray()) * 8 : 0, sizeof(Hit),
+          all() ? uint64_t(1 + 2 * max_hits_) * 4 : 0};
+}
+
+uint32_t BatchMethod::piece_rays() const {
+  const PerRay r = per_ray();
+  const uint64_t widest = std::max({r.rays, r.keys, r.hits, r.rows});
+  uint64_t most = ctx_.limits().maxStorageBufferRange / widest / 256 * 256;
+  most = std::clamp<uint64_t>(most, 256, uint64_t(1) << 30);
+  if (piece_limit_) most = std::min<uint64_t>(most, (uint64_t(piece_limit_) + 255) / 256 * 256);
+  return uint32_t(most);
+}
+
+uint64_t BatchMethod::capacity_for(uint64_t n) const {
+  // Within one piece: the batch, at least 1024 rays. Past it: whole
+  // pieces, so the last piece's windows lie inside the buffers.
+  const uint64_t piece = piece_rays();
+  if (n <= piece) return std::max<uint64_t>(n, std::min<uint64_t>(1024, piece));
+  return (n + piece - 1) / piece * piece;
+}
+
 std::vector<const Buffer*> BatchMethod::buffers(uint32_t slot) const {
   const Slot& s = slots_[slot];
-  return {blob_.get(), s.rays.get(), s.keys.get(), s.hits.get(), s.rows.get()};
+  return {blob_.get(), s.rays.get(), s.keys.get(), s.hits.get(), s.rows.get(), s.counters.get()};
 }
 
-BatchMethod::SlotBytes BatchMethod::slot_bytes(uint32_t capacity) const {
-  // A row: found, then max_hits (t, triangle) records (shaders/hit_rows.glsl).
-  return {uint64_t(capacity) * kRayWords * 4, uint64_t(capacity) * keys_a_ray() * 8, uint64_t(capacity) * sizeof(Hit),
-          all() ? uint64_t(capacity) * (1 + 2 * max_hits_) * 4 : 16};
+std::vector<uint64_t> BatchMethod::windows(uint32_t slot) const {
+  const Slot& s = slots_[slot];
+  const uint64_t rays = std::min<uint64_t>(s.capacity, piece_rays());
+  const std::array<uint64_t, 4> each = per_ray().each();
+  std::vector<uint64_t> bytes(kBatchBindings, 0);
+  for (int k = 0; k < 4; ++k) bytes[1 + k] = each[k] ? rays * each[k] : 16;
+  return bytes;
 }
 
-std::string BatchMethod::refusal(uint32_t rays) const {
-  const SlotBytes b = slot_bytes(capacity_for(rays));
+std::string BatchMethod::refusal(uint64_t rays) const {
   const std::string batch = "GPU method " + method_ + ": a batch of " + std::to_string(rays) + " rays" +
-                            (all() ? " (rows of " + std::to_string(max_hits_) + " hits a ray)" : "") + " needs ";
-  const uint64_t range = ctx_.limits().maxStorageBufferRange;
-  for (auto [bytes, what] : {std::pair{b.rays, "ray buffer"}, std::pair{b.keys, "key buffer"},
-                             std::pair{b.hits, "hit buffer"}, std::pair{b.rows, "hit row buffer"}})
-    if (bytes > range)
-      return batch + "a " + what + " of " + std::to_string(bytes) + " bytes, more than " + ctx_.device_name() +
-             "'s maxStorageBufferRange (" + std::to_string(range) + " bytes)";
+                            (all() ? " (rows of " + std::to_string(max_hits_) + " hits a ray)" : "");
+  if (rays > std::numeric_limits<uint32_t>::max())
+    return batch + " is more than a batch addresses (2^32 - 1 rays); submit it in parts";
+  const PerRay r = per_ray();
+  const uint64_t bytes = capacity_for(rays) * r.total();
   const uint64_t heap = ctx_.mapped_heap_bytes();
-  if (b.total() > heap)
-    return batch + std::to_string(b.total()) + " bytes of host-visible memory, more than " + ctx_.device_name() +
-           "'s largest host-visible heap (" + std::to_string(heap) + " bytes)";
+  if (bytes > heap)
+    return batch + " needs " + std::to_string(bytes) + " bytes of host-visible memory, more than " +
+           ctx_.device_name() + "'s largest host-visible heap (" + std::to_string(heap) + " bytes)";
   return "";
 }
 
-void BatchMethod::reserve(uint32_t slot, uint32_t n) {
+void BatchMethod::limit_piece(uint32_t rays) {
+  for (Slot& s : slots_)
+    if (s.in_flight) throw std::logic_error("limit_piece() with a batch in flight");
+  piece_limit_ = rays;
+  for (Slot& s : slots_) s.capacity = 0, s.recorded = 0;  // every slot's windows made again
+}
+
+void BatchMethod::reserve(uint32_t slot, uint64_t n) {
   Slot& s = slots_[slot];
   if (s.capacity >= n) return;
   // Refused before anything is made; then all four made before any is
   // replaced: a refusal (memory) leaves the slot as it was.
   if (const std::string why = refusal(n); !why.empty()) throw GpuError(why);
-  const uint32_t capacity = capacity_for(n);
-  const SlotBytes bytes = slot_bytes(capacity);
-  auto rays = std::make_unique<Buffer>(ctx_, bytes.rays, "ray buffer");
-  auto keys = std::make_unique<Buffer>(ctx_, bytes.keys, "key buffer");
-  auto hits = std::make_unique<Buffer>(ctx_, bytes.hits, "hit buffer");
-  auto rows = std::make_unique<Buffer>(ctx_, bytes.rows, "hit row buffer");
+  const uint64_t capacity = capacity_for(n);
+  const PerRay r = per_ray();
+  auto make = [&](uint64_t per, const char* what, VkBufferUsageFlags usage) {
+    return std::make_unique<Buffer>(ctx_, per ? capacity * per : 16, what, usage, Memory::Mapped, true);
+  };
+  auto rays = make(r.rays, "ray buffer", 0);
+  auto keys = make(r.keys, "key buffer", VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  auto hits = make(r.hits, "hit buffer", 0);
+  auto rows = make(r.rows, "hit row buffer", 0);
   s.rays = std::move(rays), s.keys = std::move(keys), s.hits = std::move(hits), s.rows = std::move(rows);
   s.capacity = capacity;
   s.recorded = 0;  // the command buffer names the old buffers
@@ -112,33 +153,64 @@ static double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-uint64_t BatchMethod::begin(uint32_t slot, std::span<const Ray> rays) {
+std::span<Ray> BatchMethod::rays(uint32_t slot, uint64_t n) {
   Slot& s = slots_.at(slot);
   if (s.in_flight) throw std::logic_error("GPU slot " + std::to_string(slot) + " is still in flight");
   s.begin_ms = now_ms();
-  s.n = uint32_t(rays.size());
-  if (s.n == 0) return 0;
-  reserve(slot, s.n);
-  uint64_t skipped = pack_rays(rays, static_cast<uint32_t*>(s.rays->data()));
-  std::memset(s.keys->data(), 0xFF, uint64_t(s.n) * keys_a_ray() * 8);
-  prepare(slot, s.n);
-  if (s.recorded != s.n) {  // recorded once a batch size, resubmitted after
-    check(ctx_.vk().ResetCommandBuffer(s.cb, 0), "vkResetCommandBuffer");
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    check(ctx_.vk().BeginCommandBuffer(s.cb, &bi), "vkBeginCommandBuffer");
-    if (s.queries) {
-      ctx_.vk().CmdResetQueryPool(s.cb, s.queries, 0, 2);
-      ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
-    }
-    record(s.cb, slot, s.n);
-    ctx_.host_barrier(s.cb);  // the hits, read by the host after the fence
-    if (s.queries) ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
-    check(ctx_.vk().EndCommandBuffer(s.cb), "vkEndCommandBuffer");
-    s.recorded = s.n;
+  s.submitted = false;
+  s.n = 0;
+  if (n == 0) return {};
+  reserve(slot, n);
+  s.n = uint32_t(n);
+  return {static_cast<Ray*>(s.rays->data()), n};
+}
+
+void BatchMethod::record_batch(Slot& s, uint32_t slot) {
+  check(ctx_.vk().ResetCommandBuffer(s.cb, 0), "vkResetCommandBuffer");
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  check(ctx_.vk().BeginCommandBuffer(s.cb, &bi), "vkBeginCommandBuffer");
+  if (s.queries) {
+    ctx_.vk().CmdResetQueryPool(s.cb, s.queries, 0, 2);
+    ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 0);
   }
+  // The counters and the keys start on the device: the host touches no
+  // buffer of the batch but the rays it writes and the hits it reads.
+  ctx_.vk().CmdFillBuffer(s.cb, s.counters->handle(), 0, VK_WHOLE_SIZE, 0);
+  const PerRay r = per_ray();
+  if (r.keys) ctx_.vk().CmdFillBuffer(s.cb, s.keys->handle(), 0, uint64_t(s.n) * r.keys, 0xFFFFFFFFu);
+  ctx_.fill_barrier(s.cb);
+  const uint32_t piece = piece_rays();
+  const std::array<uint64_t, 4> each = r.each();
+  for (uint32_t first = 0, k = 0; first < s.n; first += piece, ++k) {
+    if (k) ctx_.compute_barrier(s.cb);  // a piece's passes reuse the slot's scratch (AABBList's pairs)
+    Piece p{std::min(piece, s.n - first), {}};
+    for (int b = 0; b < 4; ++b) p.offsets[b] = uint32_t(uint64_t(first) * each[b]);
+    record(s.cb, slot, p);
+  }
+  ctx_.host_barrier(s.cb);  // the hits, read by the host after the fence
+  if (s.queries) ctx_.vk().CmdWriteTimestamp(s.cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 1);
+  check(ctx_.vk().EndCommandBuffer(s.cb), "vkEndCommandBuffer");
+  s.recorded = s.n;
+}
+
+void BatchMethod::submit(uint32_t slot) {
+  Slot& s = slots_.at(slot);
+  if (s.in_flight) throw std::logic_error("GPU slot " + std::to_string(slot) + " is still in flight");
+  s.submitted = true;
+  if (s.n == 0) return;
+  prepare(slot, s.n);
+  if (s.recorded != s.n) record_batch(s, slot);  // recorded once a batch size, resubmitted after
   ctx_.submit_async(s.cb, s.fence);
   s.in_flight = true;
-  return skipped;
+}
+
+void BatchMethod::dispatch_rays(const Pipeline& p, VkCommandBuffer cb, uint32_t slot, const Piece& piece) const {
+  const uint64_t most = uint64_t(ctx_.limits().maxComputeWorkGroupCount[0]) * 64;
+  for (uint64_t base = 0; base < piece.rays; base += most) {
+    const Push push{uint32_t(base), piece.rays, records_};
+    const uint64_t rays = std::min<uint64_t>(most, piece.rays - base);
+    p.dispatch(cb, slot, &push, uint32_t((rays + 63) / 64), 1, 1, piece.offsets);
+  }
 }
 
 bool BatchMethod::ready(uint32_t slot) {
@@ -156,40 +228,45 @@ void BatchMethod::wait(uint32_t slot) {
     check(ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
 }
 
-void BatchMethod::finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) {
+std::span<const Hit> BatchMethod::hits(uint32_t slot, GpuTiming* timing, uint64_t* unwalkable) {
   if (all()) throw UsageError("GPU method made for Query::All: finish_lists() reads its rows");
   Slot& s = slots_.at(slot);
   finish_batch(s, timing);
-  if (s.n) std::memcpy(hits.data(), s.hits->data(), uint64_t(std::min<size_t>(s.n, hits.size())) * sizeof(Hit));
+  if (unwalkable) *unwalkable = s.n ? static_cast<const uint32_t*>(s.counters->data())[0] : 0;
+  if (!s.n) return {};
+  return {static_cast<const Hit*>(s.hits->data()), s.n};
 }
 
-void BatchMethod::finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing) {
+uint64_t BatchMethod::finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing) {
   if (!all()) throw UsageError("GPU method made for one hit a ray: finish() reads its hits");
   Slot& s = slots_.at(slot);
   finish_batch(s, timing);
   // The device's rows stay fixed (found, then max_hits (t, triangle)
-  // records, slot_bytes()); each ray's kept records alone are read back.
+  // records, per_ray()); each ray's kept records alone are read back.
   lists.max_hits = max_hits_;
   lists.clear();
   lists.found.reserve(s.n);
   lists.offsets.reserve(size_t(s.n) + 1);
+  if (!s.n) return 0;
   const uint32_t* row = static_cast<const uint32_t*>(s.rows->data());
-  const float* ray = static_cast<const float*>(s.rays->data());  // packed: origin, direction first (gpu/rays.h)
-  for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_, ray += kRayWords) {
+  const Ray* ray = static_cast<const Ray*>(s.rays->data());  // as the caller wrote them
+  for (uint32_t i = 0; i < s.n; ++i, row += 1 + 2 * max_hits_) {
     const uint32_t kept = std::min(row[0], max_hits_);
     for (uint32_t k = 0; k < kept; ++k) {
       Hit h;
       std::memcpy(&h.t, &row[1 + 2 * k], 4);
       h.triangle = row[2 + 2 * k];
       if (flags_ & MC_HIT_POINT)
-        for (int a = 0; a < 3; ++a) h.point[a] = ray[a] + h.t * ray[3 + a];
+        for (int a = 0; a < 3; ++a) h.point[a] = ray[i].org[a] + h.t * walked_direction(ray[i].dir[a]);
       lists.hits.push_back(h);
     }
     lists.end_row(row[0]);
   }
+  return static_cast<const uint32_t*>(s.counters->data())[0];
 }
 
 void BatchMethod::finish_batch(Slot& s, GpuTiming* timing) {
+  if (!s.submitted) throw std::logic_error("a GPU slot read before its rays were submitted");
   if (s.in_flight) {
     check(ctx_.vk().WaitForFences(ctx_.device(), 1, &s.fence, VK_TRUE, 600ull * 1000 * 1000 * 1000), "waiting for the GPU");
     s.in_flight = false;  // only once done: a failed wait leaves the destructor to wait again

@@ -1,9 +1,12 @@
 // The part every GPU method shares: the blob uploaded once into device
-// memory (checked against the layouts the method reads), ray/key/hit
-// buffers that grow with the batch, one submission a batch between two timestamps, and the read-back.
-// A method adds its pipelines and records its dispatches.
+// memory (checked against the layouts the method reads), a slot's ray, key,
+// hit and row buffers that grow with the batch, a batch cut into pieces
+// that fit the device's buffer windows, one submission a batch between two
+// timestamps, and the read-back. A method adds its pipelines and records
+// each piece's dispatches.
 #pragma once
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <span>
 #include <string>
@@ -16,10 +19,17 @@
 
 namespace meshcast::gpu {
 
-// Push constants every shader of this backend declares.
+// Push constants every shader of this backend declares. A piece's rays
+// from ray_base on, of ray_count; indices are the piece's own.
 struct Push {
   uint32_t ray_base, ray_count, records;
 };
+
+// The bindings every batch shader shares: 0 the blob, then the per-ray
+// buffers read in windows (1 rays, 2 keys, 3 hits, 4 Query::All's rows),
+// 5 the batch counters (shaders/batch_counters.glsl).
+constexpr uint32_t kBatchBindings = 6;
+constexpr uint32_t kPerRayWindows = 0b11110;
 
 class BatchMethod : public Method {
  public:
@@ -32,26 +42,40 @@ class BatchMethod : public Method {
               uint32_t slots, uint32_t flags, uint32_t max_hits);
   ~BatchMethod() override;
   uint32_t slots() const override { return uint32_t(slots_.size()); }
-  std::string refusal(uint32_t rays) const override;
-  uint64_t begin(uint32_t slot, std::span<const Ray> rays) override;
+  std::string refusal(uint64_t rays) const override;
+  std::span<Ray> rays(uint32_t slot, uint64_t n) override;
+  void submit(uint32_t slot) override;
   bool ready(uint32_t slot) override;
   void wait(uint32_t slot) override;
-  void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing) override;
-  void finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing) override;
+  std::span<const Hit> hits(uint32_t slot, GpuTiming* timing, uint64_t* unwalkable) override;
+  uint64_t finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing) override;
+  void limit_piece(uint32_t rays) override;
 
  protected:
-  // Points every pipeline's set `slot` at (blob, rays, keys, hits, rows,
-  // ...) after the slot's buffers change.
+  // A piece of a batch: its rays, and where its windows of the per-ray
+  // buffers start (rays, keys, hits, rows: Pipeline::dispatch's offsets).
+  struct Piece {
+    uint32_t rays;
+    std::array<uint32_t, 4> offsets;
+  };
+  // Points every pipeline's set `slot` at buffers(slot) with windows(slot)
+  // after the slot's buffers change.
   virtual void bind_all(uint32_t slot) = 0;
   // Host-side work before every submission of the slot (the command buffer
   // is recorded once and resubmitted while the batch size stays the same).
   virtual void prepare(uint32_t, uint32_t) {}
-  // Records the dispatches for `n` packed rays in `slot`.
-  virtual void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) = 0;
+  // Records the dispatches of one piece of the slot's batch.
+  virtual void record(VkCommandBuffer cb, uint32_t slot, const Piece& piece) = 0;
   // Whether the shaders fold hits into keys (the brute force, AABBList),
   // not into the rows directly (the tree walkers).
   virtual bool reads_keys() const { return true; }
+  // The slot's buffers in binding order (kBatchBindings), and the bytes of
+  // each window binding's window.
   std::vector<const Buffer*> buffers(uint32_t slot) const;
+  std::vector<uint64_t> windows(uint32_t slot) const;
+  // A dispatch of one thread a ray over a piece, in as many dispatches as
+  // the device's workgroup count limit asks (ray_base steps through it).
+  void dispatch_rays(const Pipeline& p, VkCommandBuffer cb, uint32_t slot, const Piece& piece) const;
 
   Context& ctx_;
   uint32_t records_ = 0;  // the header's node_count (BruteForce: its records)
@@ -62,28 +86,37 @@ class BatchMethod : public Method {
  private:
   void release_slots();
   struct Slot {
-    std::unique_ptr<Buffer> rays, keys, hits, rows;  // rows: Query::All's (a token buffer otherwise)
-    uint32_t capacity = 0, recorded = 0, n = 0;  // recorded: the batch size its command buffer holds
+    std::unique_ptr<Buffer> rays, keys, hits, rows, counters;
+    uint64_t capacity = 0;                 // rays the buffers hold
+    uint32_t recorded = 0, n = 0;          // recorded: the batch size its command buffer holds
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
     VkQueryPool queries = VK_NULL_HANDLE;
-    bool in_flight = false;
-    double begin_ms = 0;  // steady clock at begin()
+    bool in_flight = false, submitted = false;
+    double begin_ms = 0;  // steady clock at rays()
   };
-  // The bytes of a slot's buffers for `capacity` rays, as reserve() makes them.
-  struct SlotBytes {
+  // The bytes a ray takes in each per-ray buffer (0: a 16-byte token the
+  // method's shaders never read).
+  struct PerRay {
     uint64_t rays, keys, hits, rows;
     uint64_t total() const { return rays + keys + hits + rows; }
+    std::array<uint64_t, 4> each() const { return {rays, keys, hits, rows}; }
   };
-  SlotBytes slot_bytes(uint32_t capacity) const;
-  static uint32_t capacity_for(uint32_t n) { return std::max<uint32_t>(n, 1024); }
+  PerRay per_ray() const;
+  // Rays a piece: the most whose every window fits maxStorageBufferRange,
+  // a multiple of 256 (every window's offset then meets any device's
+  // minStorageBufferOffsetAlignment), or limit_piece's.
+  uint32_t piece_rays() const;
+  uint64_t capacity_for(uint64_t n) const;
   // Room for n rays in the slot (GpuError with refusal(n) when it cannot fit).
-  void reserve(uint32_t slot, uint32_t n);
+  void reserve(uint32_t slot, uint64_t n);
+  void record_batch(Slot& s, uint32_t slot);
   void finish_batch(Slot& s, GpuTiming* timing);
   // shaders/keys.glsl: a row of keys a ray for Query::All, where the method reads keys at all.
-  uint32_t keys_a_ray() const { return all() && reads_keys() ? max_hits_ + 1 : 1; }
+  uint32_t keys_a_ray() const { return all() ? max_hits_ + 1 : 1; }
   std::shared_ptr<Buffer> blob_;  // shared by the methods made on the same blob (Context::blob_buffer)
   std::vector<Slot> slots_;
+  uint32_t piece_limit_ = 0;  // limit_piece's (0: the device's)
 };
 
 }  // namespace meshcast::gpu

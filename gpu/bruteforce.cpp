@@ -17,24 +17,24 @@ class BruteForceMethod : public BatchMethod {
   BruteForceMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const MethodReading& line,
                    uint32_t slots, uint32_t flags, uint32_t max_hits)
       : BatchMethod(ctx, blob, name, line, slots, flags, max_hits),
-        test_(ctx, line.test.words, line.test.bytes, 4, sizeof(Push), slots, flags, max_hits),
-        resolve_(ctx, line.resolve.words, line.resolve.bytes, 5, sizeof(Push), slots, flags, max_hits) {}
+        test_(ctx, line.test.words, line.test.bytes, 4, sizeof(Push), slots, flags, max_hits, kPerRayWindows & 0b1111),
+        resolve_(ctx, line.resolve.words, line.resolve.bytes, kBatchBindings, sizeof(Push), slots, flags, max_hits,
+                 kPerRayWindows) {}
 
  protected:
   void bind_all(uint32_t slot) override {
     const std::vector<const Buffer*> all = buffers(slot);
-    test_.bind({all.begin(), all.begin() + 4}, slot);  // no rows: the resolve pass writes them
-    resolve_.bind(buffers(slot), slot);
+    test_.bind({all.begin(), all.begin() + 4}, slot, windows(slot));  // no rows: the resolve pass writes them
+    resolve_.bind(all, slot, windows(slot));
   }
-  void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
-    const uint32_t max_y = ctx_.limits().maxComputeWorkGroupCount[1];
+  void record(VkCommandBuffer cb, uint32_t slot, const Piece& piece) override {
+    const uint32_t max_y = ctx_.limits().maxComputeWorkGroupCount[1], n = piece.rays;
     for (uint32_t base = 0; base < n; base += max_y) {
       Push push{base, n, records_};
-      test_.dispatch(cb, slot, &push, records_, std::min(max_y, n - base), 1);
+      test_.dispatch(cb, slot, &push, records_, std::min(max_y, n - base), 1, piece.offsets);
     }
     ctx_.compute_barrier(cb);
-    Push push{0, n, records_};
-    resolve_.dispatch(cb, slot, &push, (n + 63) / 64, 1, 1);
+    dispatch_rays(resolve_, cb, slot, piece);
   }
 
  private:

@@ -21,12 +21,20 @@ class Context;
 
 struct GpuTiming {
   double device_ms = 0;  // between the batch's first and last GPU timestamps (0 without timestamps)
-  double wall_ms = 0;    // packing, submission, waiting and reading back
+  double wall_ms = 0;    // from rays() (or begin()) to the hits read
 };
 
-// A method runs batches in frame slots: begin() packs a batch into a
-// slot's buffers and submits it without waiting, ready() asks whether it
-// is done, finish() waits for it and copies its hits out. Slots run
+// A method runs batches in frame slots, each batch in three steps:
+// rays() hands out room for the batch in the slot's mapped ray buffer,
+// where the caller writes meshcast::Ray records as they are (the device
+// prepares each ray itself: no packing), submit() sends it without
+// waiting, and hits() (or finish(), finish_lists()) waits and reads the
+// answers where the device wrote them. begin() is rays() filled with a
+// copy, then submit(). A batch of any size the device's memory holds
+// runs, cut into pieces that fit its buffer and dispatch limits, in one
+// submission; a slot's buffers grow to the largest batch it has run and
+// its command buffer is recorded again only when the batch size changes,
+// so after the first batch of a size nothing is allocated. Slots run
 // independently, so a game can keep several frames in flight. A Method is
 // not thread-safe: one caller at a time (host/ serializes its threads).
 class Method {
@@ -36,37 +44,58 @@ class Method {
   // Why a batch of `rays` cannot run on this device, naming the bytes its
   // buffers would need and the device's limit they exceed (Query::All's
   // device rows are max_hits records a ray whatever the hits: 100,000 rays
-  // of 4096 take 3.3 GB); "" when it fits. begin() refuses such a batch
+  // of 4096 take 3.3 GB); "" when it fits. rays() refuses such a batch
   // with GpuError before it allocates anything; a caller may ask first.
-  virtual std::string refusal(uint32_t rays) const = 0;
-  // Returns the unwalkable rays (answered as misses, as on the CPU). The
-  // slot must be idle (never begun, or finished).
-  virtual uint64_t begin(uint32_t slot, std::span<const Ray> rays) = 0;
+  virtual std::string refusal(uint64_t rays) const = 0;
+  // Room for `n` rays in the slot's mapped ray buffer, written by the
+  // caller and read by the device as they are after submit(). The slot
+  // must be idle (never begun, or finished).
+  virtual std::span<Ray> rays(uint32_t slot, uint64_t n) = 0;
+  // Sends the slot's rays to the device without waiting.
+  virtual void submit(uint32_t slot) = 0;
+  void begin(uint32_t slot, std::span<const Ray> batch) {
+    std::span<Ray> to = rays(slot, batch.size());
+    std::copy(batch.begin(), batch.end(), to.begin());
+    submit(slot);
+  }
   virtual bool ready(uint32_t slot) = 0;
   // Blocks until the slot's batch is done. Safe to call from another thread
   // while the owner begins or finishes other slots (it only waits on the
   // slot's fence); GpuError when the device is lost.
   virtual void wait(uint32_t slot) = 0;
-  // Hits of the slot's batch into `hits` (at least the batch's size).
-  virtual void finish(uint32_t slot, std::span<Hit> hits, GpuTiming* timing = nullptr) = 0;
+  // Waits, then the slot's hits where the device wrote them (host-visible
+  // memory: no copy), valid until the slot's next rays(). `unwalkable`:
+  // the rays answered as misses because no walker walks them
+  // (ray_is_walkable). UsageError for a Query::All method.
+  virtual std::span<const Hit> hits(uint32_t slot, GpuTiming* timing = nullptr, uint64_t* unwalkable = nullptr) = 0;
+  // hits() copied into `hits` (at least the batch's size); returns the
+  // unwalkable rays.
+  uint64_t finish(uint32_t slot, std::span<Hit> out, GpuTiming* timing = nullptr) {
+    uint64_t unwalkable = 0;
+    std::span<const Hit> h = hits(slot, timing, &unwalkable);
+    std::copy(h.begin(), h.begin() + std::min(h.size(), out.size()), out.begin());
+    return unwalkable;
+  }
   // A Query::All method's rows of the slot's batch into `lists`, compact
   // (meshcast/ray.h: cleared, then each ray's kept hits alone; max_hits
-  // the method's). UsageError for a method made for another query.
-  virtual void finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing = nullptr) = 0;
+  // the method's); returns the unwalkable rays. UsageError for a method
+  // made for another query.
+  virtual uint64_t finish_lists(uint32_t slot, HitLists& lists, GpuTiming* timing = nullptr) = 0;
+  // Tests: cut batches into pieces of at most `rays` (rounded up to 256),
+  // fewer than the device's limits would, to run many pieces on few rays.
+  virtual void limit_piece(uint32_t rays) = 0;
 
-  // One batch in slot 0, waited for.
+  // One batch in slot 0, waited for; returns the unwalkable rays.
   uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, GpuTiming* timing = nullptr) {
     if (rays.empty() || hits.empty()) return 0;
     const size_t n = std::min(rays.size(), hits.size());
-    uint64_t skipped = begin(0, rays.first(n));
-    finish(0, hits.first(n), timing);
-    return skipped;
+    begin(0, rays.first(n));
+    return finish(0, hits.first(n), timing);
   }
   // One Query::All batch in slot 0, waited for.
   uint64_t trace_all_hits(std::span<const Ray> rays, HitLists& lists, GpuTiming* timing = nullptr) {
-    uint64_t skipped = begin(0, rays);
-    finish_lists(0, lists, timing);
-    return skipped;
+    begin(0, rays);
+    return finish_lists(0, lists, timing);
   }
 };
 

@@ -83,6 +83,7 @@
   X(CmdDispatchIndirect)                \
   X(CmdPipelineBarrier)                 \
   X(CmdCopyBuffer)                      \
+  X(CmdFillBuffer)                      \
   X(CmdResetQueryPool)                  \
   X(CmdWriteTimestamp)
 

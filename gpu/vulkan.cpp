@@ -409,11 +409,12 @@ uint32_t Context::memory_type(uint32_t bits, VkMemoryPropertyFlags wanted, bool 
   throw GpuError("Vulkan: " + name_ + " has no host-visible coherent memory for storage buffers");
 }
 
-Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage, Memory memory)
+Buffer::Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage, Memory memory,
+               bool windowed)
     : ctx_(ctx), size_(std::max<uint64_t>(bytes, 4)) {
   const bool mapped = memory == Memory::Mapped;
   if (!mapped) usage |= VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  if (size_ > ctx.limits().maxStorageBufferRange)
+  if (!windowed && size_ > ctx.limits().maxStorageBufferRange)
     throw GpuError("Vulkan: the " + what + " of " + std::to_string(size_) + " bytes exceeds " + ctx.device_name() +
                    "'s maxStorageBufferRange (" + std::to_string(ctx.limits().maxStorageBufferRange) + " bytes)");
   // A refusal part way leaves nothing behind (an engine's device lives on).
@@ -470,13 +471,13 @@ void Buffer::release() {  // null handles are ignored by Vulkan's destroy calls
 }
 
 Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
-                   uint32_t sets, uint32_t flags, uint32_t max_hits)
-    : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes) {
+                   uint32_t sets, uint32_t flags, uint32_t max_hits, uint32_t windows)
+    : ctx_(ctx), bindings_(bindings), push_bytes_(push_bytes), windows_(windows) {
   try {
     VkDevice d = ctx.device();
     std::vector<VkDescriptorSetLayoutBinding> b(bindings);
     for (uint32_t i = 0; i < bindings; ++i)
-      b[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      b[i] = {i, type_of(i), 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
     VkDescriptorSetLayoutCreateInfo dl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     dl.bindingCount = bindings, dl.pBindings = b.data();
     check(ctx_.vk().CreateDescriptorSetLayout(d, &dl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
@@ -500,9 +501,12 @@ Pipeline::Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint
     VkResult r = ctx_.vk().CreateComputePipelines(d, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_);
     ctx_.vk().DestroyShaderModule(d, module, nullptr);
     check(r, "vkCreateComputePipelines");
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings * sets};
+    const uint32_t dynamic = uint32_t(std::popcount(windows_));
+    std::vector<VkDescriptorPoolSize> sizes;
+    if (bindings > dynamic) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, (bindings - dynamic) * sets});
+    if (dynamic) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC, dynamic * sets});
     VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    dp.maxSets = sets, dp.poolSizeCount = 1, dp.pPoolSizes = &size;
+    dp.maxSets = sets, dp.poolSizeCount = uint32_t(sizes.size()), dp.pPoolSizes = sizes.data();
     check(ctx_.vk().CreateDescriptorPool(d, &dp, nullptr, &pool_), "vkCreateDescriptorPool");
     std::vector<VkDescriptorSetLayout> layouts(sets, set_layout_);
     sets_handles_.resize(sets);
@@ -525,31 +529,45 @@ void Pipeline::release() {  // null handles are ignored by Vulkan's destroy call
   ctx_.vk().DestroyDescriptorSetLayout(d, set_layout_, nullptr);
 }
 
-void Pipeline::bind(const std::vector<const Buffer*>& buffers, uint32_t set) {
+VkDescriptorType Pipeline::type_of(uint32_t binding) const {
+  return (windows_ >> binding & 1) ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+}
+
+void Pipeline::bind(const std::vector<const Buffer*>& buffers, uint32_t set, const std::vector<uint64_t>& window_bytes) {
   std::vector<VkDescriptorBufferInfo> info(bindings_);
   std::vector<VkWriteDescriptorSet> writes(bindings_);
+  const uint64_t range = ctx_.limits().maxStorageBufferRange;
   for (uint32_t i = 0; i < bindings_; ++i) {
-    info[i] = {buffers[i]->handle(), 0, VK_WHOLE_SIZE};
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_handles_[set], i, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    const bool window = (windows_ >> i & 1) != 0;
+    const uint64_t bytes = window && i < window_bytes.size() ? window_bytes[i] : buffers[i]->size();
+    if (bytes > range)
+      throw GpuError("Vulkan: binding " + std::to_string(i) + " of " + std::to_string(bytes) + " bytes exceeds " +
+                     ctx_.device_name() + "'s maxStorageBufferRange (" + std::to_string(range) + " bytes)");
+    info[i] = {buffers[i]->handle(), 0, window ? bytes : VK_WHOLE_SIZE};
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, nullptr, sets_handles_[set], i, 0, 1, type_of(i),
                  nullptr, &info[i], nullptr};
   }
   ctx_.vk().UpdateDescriptorSets(ctx_.device(), bindings_, writes.data(), 0, nullptr);
 }
 
-void Pipeline::bind_for(VkCommandBuffer cb, uint32_t set, const void* push) const {
+void Pipeline::bind_for(VkCommandBuffer cb, uint32_t set, const void* push, std::span<const uint32_t> offsets) const {
+  const uint32_t dynamic = uint32_t(std::popcount(windows_));
+  if (offsets.size() < dynamic) throw std::logic_error("a dispatch without an offset for each window binding");
   ctx_.vk().CmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  ctx_.vk().CmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_handles_[set], 0, nullptr);
+  ctx_.vk().CmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &sets_handles_[set], dynamic,
+                                  dynamic ? offsets.data() : nullptr);
   if (push_bytes_) ctx_.vk().CmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes_, push);
 }
 
-void Pipeline::dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z) const {
-  bind_for(cb, set, push);
+void Pipeline::dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z,
+                        std::span<const uint32_t> offsets) const {
+  bind_for(cb, set, push, offsets);
   ctx_.vk().CmdDispatch(cb, x, y, z);
 }
 
 void Pipeline::dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* push, const Buffer& args,
-                                 uint64_t offset) const {
-  bind_for(cb, set, push);
+                                 uint64_t offset, std::span<const uint32_t> offsets) const {
+  bind_for(cb, set, push, offsets);
   ctx_.vk().CmdDispatchIndirect(cb, args.handle(), offset);
 }
 
@@ -574,6 +592,14 @@ void Context::barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAcc
 
 void Context::compute_barrier(VkCommandBuffer cb) const {
   barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+void Context::fill_barrier(VkCommandBuffer cb) const {
+  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vk_.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0,
+                         nullptr);
 }
 
 void Context::host_barrier(VkCommandBuffer cb) const { barrier(cb, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); }

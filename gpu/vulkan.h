@@ -139,6 +139,8 @@ class Context {
   void compute_barrier(VkCommandBuffer cb) const;
   // The same, and visible as the arguments of the next indirect dispatch.
   void indirect_barrier(VkCommandBuffer cb) const;
+  // vkCmdFillBuffer's writes made visible to the next dispatch.
+  void fill_barrier(VkCommandBuffer cb) const;
   // Compute-shader writes to mapped memory made visible to the host that
   // reads them once the submission's fence signals.
   void host_barrier(VkCommandBuffer cb) const;
@@ -196,8 +198,10 @@ enum class Memory { Mapped, DeviceLocal };
 
 class Buffer {
  public:
+  // `windowed`: bound only in windows (Pipeline's window bindings), so its
+  // size is not held to maxStorageBufferRange.
   Buffer(Context& ctx, uint64_t bytes, const std::string& what, VkBufferUsageFlags usage = 0,
-         Memory memory = Memory::Mapped);
+         Memory memory = Memory::Mapped, bool windowed = false);
   ~Buffer();
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
@@ -225,26 +229,36 @@ class Buffer {
 // `bindings` storage buffers (binding i = buffer i) and `push_bytes` of push
 // constants. `hit_outputs` (MC_HIT_*) is specialization constant 0, which
 // shaders/hits.glsl reads: the per-hit outputs are fixed with the pipeline.
+// The bindings in `windows` (a bit a binding) are dynamic storage buffers:
+// each dispatch reads a window of its buffer at an offset of its own (a
+// batch's piece: gpu/batch.h), so a buffer may pass maxStorageBufferRange.
 class Pipeline {
  public:
   // `flags` and `max_hits`: specialization constants 0 and 1 (the batch's
   // MC_HIT_*, MC_QUERY_* and MC_CULL_* word; Query::All's row length).
   Pipeline(Context& ctx, const uint32_t* spirv, size_t spirv_bytes, uint32_t bindings, uint32_t push_bytes,
-           uint32_t sets = 1, uint32_t flags = 0, uint32_t max_hits = 1);
+           uint32_t sets = 1, uint32_t flags = 0, uint32_t max_hits = 1, uint32_t windows = 0);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
-  // Points binding i of descriptor set `set` at buffers[i] (whole buffer).
-  void bind(const std::vector<const Buffer*>& buffers, uint32_t set = 0);
-  void dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z) const;
+  // Points binding i of descriptor set `set` at buffers[i]: the whole
+  // buffer, or for a window binding its first window_bytes[i] bytes
+  // (GpuError past maxStorageBufferRange, naming the buffer).
+  void bind(const std::vector<const Buffer*>& buffers, uint32_t set = 0, const std::vector<uint64_t>& window_bytes = {});
+  // `offsets`: where each window binding's window starts, in binding
+  // order (the first popcount(windows) of them are read).
+  void dispatch(VkCommandBuffer cb, uint32_t set, const void* push, uint32_t x, uint32_t y, uint32_t z,
+                std::span<const uint32_t> offsets = {}) const;
   // The workgroup counts from a VkDispatchIndirectCommand at `offset` of `args`.
-  void dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* push, const Buffer& args, uint64_t offset) const;
+  void dispatch_indirect(VkCommandBuffer cb, uint32_t set, const void* push, const Buffer& args, uint64_t offset,
+                         std::span<const uint32_t> offsets = {}) const;
 
  private:
-  void bind_for(VkCommandBuffer cb, uint32_t set, const void* push) const;
+  void bind_for(VkCommandBuffer cb, uint32_t set, const void* push, std::span<const uint32_t> offsets) const;
+  VkDescriptorType type_of(uint32_t binding) const;
   void release();
   Context& ctx_;
-  uint32_t bindings_, push_bytes_;
+  uint32_t bindings_, push_bytes_, windows_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;

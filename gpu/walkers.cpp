@@ -13,15 +13,12 @@ class WalkMethod : public BatchMethod {
   WalkMethod(Context& ctx, std::span<const uint8_t> blob, const std::string& name, const MethodReading& line,
              uint32_t slots, uint32_t flags, uint32_t max_hits)
       : BatchMethod(ctx, blob, name, line, slots, flags, max_hits),
-        walk_(ctx, line.test.words, line.test.bytes, 5, sizeof(Push), slots, flags, max_hits) {}
+        walk_(ctx, line.test.words, line.test.bytes, kBatchBindings, sizeof(Push), slots, flags, max_hits, kPerRayWindows) {}
 
  protected:
-  void bind_all(uint32_t slot) override { walk_.bind(buffers(slot), slot); }
+  void bind_all(uint32_t slot) override { walk_.bind(buffers(slot), slot, windows(slot)); }
   bool reads_keys() const override { return false; }
-  void record(VkCommandBuffer cb, uint32_t slot, uint32_t n) override {
-    Push push{0, n, records_};
-    walk_.dispatch(cb, slot, &push, (n + 63) / 64, 1, 1);
-  }
+  void record(VkCommandBuffer cb, uint32_t slot, const Piece& piece) override { dispatch_rays(walk_, cb, slot, piece); }
 
  private:
   Pipeline walk_;

@@ -1,23 +1,20 @@
-// The rays as the GPU reads them, one header for the host that packs them
-// (gpu/rays.cpp, gpu/scene.cpp), the shaders that load them
+// The rays as the GPU reads them, one header for the host that writes them
+// (gpu/batch.cpp, gpu/scene.cpp), the shaders that load them
 // (shaders/ray.glsl, shaders/scene_octtree.comp) and the CPU walkers whose
-// per-ray constants they carry (cpu/intersect.h's RayPre). Word offsets are
-// plain #defines in the common subset of C++ and GLSL; the constants'
-// arithmetic is C++ only, computed on the host in correctly rounded float so
-// the GPU shears exactly as the CPU does.
+// per-ray constants the shaders compute again (cpu/intersect.h's RayPre).
+// Word offsets are plain #defines in the common subset of C++ and GLSL; the
+// constants' arithmetic below is the CPU's, in correctly rounded float,
+// which shaders/ray.glsl repeats with every division rounded once.
 #ifndef MESHCAST_LAYOUT_RAY_RECORD_H
 #define MESHCAST_LAYOUT_RAY_RECORD_H
 
-// A float ray with its constants: 16 words.
-#define MC_RAY_WORDS 16u
-#define MC_RAY_ORG 0u       // x, y, z
-#define MC_RAY_DIR 3u       // x, y, z: walked_direction of the given one
+// A float ray: meshcast::Ray as the caller writes it, 8 words (the
+// shaders prepare its constants: no host pass over the rays).
+#define MC_RAY_WORDS 8u
+#define MC_RAY_ORG 0u   // x, y, z
+#define MC_RAY_DIR 3u   // x, y, z as given (walked_direction applied on the device)
 #define MC_RAY_TMAX 6u
-#define MC_RAY_SHEAR 7u     // sx, sy, sz of the watertight test
-#define MC_RAY_AXES 10u     // kx | ky << 2 | kz << 4
-#define MC_RAY_WALKABLE 11u // 0: answered as a miss, as the CPU does
-#define MC_RAY_INV 12u      // 1 / dir: x, y, z (+-inf for a zero component)
-#define MC_RAY_TMIN 15u
+#define MC_RAY_TMIN 7u
 
 // A scene's double-precision ray (meshcast::RayD as the caller gives it): 12 words.
 #define MC_RAYD_WORDS 12u

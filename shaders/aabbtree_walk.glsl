@@ -3,6 +3,8 @@
 // walked, the farther pushed with its entry distance and dropped once the
 // closest hit is nearer). The including file defines test_leaf() for its
 // triangle format.
+#include "shaders/batch_counters.glsl"
+
 layout(local_size_x = 64) in;
 
 layout(push_constant) uniform Push { uint ray_base, ray_count, records; } pc;
@@ -11,9 +13,10 @@ vec3 node_min(uint at) { return blob_vec3(at + MC_AABB_MIN_AT); }
 vec3 node_max(uint at) { return blob_vec3(at + MC_AABB_MAX_AT); }
 
 void main() {
-  const uint ray = gl_GlobalInvocationID.x;
+  const uint ray = pc.ray_base + gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
+  count_unwalkable(r.walkable);
   Closest c = closest_start(ray, r);
   const uint tree = header(MC_HDR_TREE_OFFSET);
   if (r.walkable && box_test(r, node_min(tree), node_max(tree), c.t) != kInfinity) {

@@ -6,6 +6,7 @@
 #include "shaders/watertight.glsl"
 #include "shaders/hits.glsl"
 #include "shaders/hit_rows.glsl"
+#include "shaders/batch_counters.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -32,8 +33,10 @@ void resolve_row(uint ray) {
 }
 
 void main() {
-  const uint ray = gl_GlobalInvocationID.x;
+  const uint ray = pc.ray_base + gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
+  const GpuRay r = load_ray(ray);
+  count_unwalkable(r.walkable);
   if ((kFlags & MC_QUERY_ALL) != 0u) {
     resolve_row(ray);
     return;
@@ -48,6 +51,6 @@ void main() {
   vec3 corner[3];
   brute_corners(at, lane, corner);
   float t, u = 0.0, v = 0.0;
-  watertight(load_ray(ray), corner[0], corner[1], corner[2], load_ray(ray).tmax, t, u, v);
+  watertight(r, corner[0], corner[1], corner[2], r.tmax, t, u, v);
   write_hit(ray, uintBitsToFloat(uint(key >> 32)), remap_entry(slot_of_position(position)), u, v);
 }

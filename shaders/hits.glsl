@@ -26,10 +26,8 @@ void write_hit(uint ray, float t, uint triangle, float u, float v) {
     h.v = v;
   }
   if ((kFlags & MC_HIT_POINT) != 0u) {
-    const GpuRay r = load_ray(ray);
-    h.px = r.org.x + t * r.dir.x;
-    h.py = r.org.y + t * r.dir.y;
-    h.pz = r.org.z + t * r.dir.z;
+    const vec3 p = ray_point(ray, t);
+    h.px = p.x, h.py = p.y, h.pz = p.z;
   }
   hits[ray] = h;
 }

@@ -15,6 +15,8 @@
 #include "shaders/walk.glsl"
 #include "shaders/exact.glsl"
 
+#include "shaders/batch_counters.glsl"
+
 layout(local_size_x = 64) in;
 
 layout(push_constant) uniform Push { uint ray_base, ray_count, records; } pc;
@@ -57,9 +59,10 @@ void test_i8_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closest c)
 #define STACK_SIZE (3u * MC_MAX_DEPTH + 8u)
 
 void main() {
-  const uint ray = gl_GlobalInvocationID.x;
+  const uint ray = pc.ray_base + gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
+  count_unwalkable(r.walkable);
   Closest c = closest_start(ray, r);
   if (r.walkable) {
     const uint tree = header(MC_HDR_TREE_OFFSET);

@@ -46,37 +46,6 @@ double top_f64(uint word) { return packDouble2x32(uvec2(top_words[word], top_wor
 // See MC_TOP_MAX_DEPTH (layout/formats.h).
 #define TOP_STACK_SIZE (7u * MC_TOP_MAX_DEPTH + 8u)
 
-// ray_is_walkable of cpu/ray_is_walkable.cpp: an origin within 2^100, a direction
-// within 2^126 and not below 2^-126 on every axis, t_max and t_min not NaN
-// nor < 0, t_min not past t_max (the comparisons fail on NaN).
-bool directions_walkable(vec3 dir, float tmin, float tmax) {
-  const float biggest = max(max(abs(dir.x), abs(dir.y)), abs(dir.z));
-  return all(lessThanEqual(abs(dir), vec3(uintBitsToFloat(0x7E800000u)))) && biggest >= uintBitsToFloat(0x00800000u) &&
-         !isnan(tmax) && !isnan(tmin) && tmax >= 0.0 && tmin >= 0.0 && tmin <= tmax;
-}
-
-// RayPre of cpu/intersect.h for a ray made here (gpu/rays.cpp makes the
-// blob methods' on the host): 1/d, the dominant axis, the shear.
-GpuRay prepared(vec3 org, vec3 given_dir, float tmin, float tmax) {
-  GpuRay r;
-  const vec3 dir = walked_direction(given_dir);
-  r.org = org, r.dir = dir, r.tmin = tmin, r.tmax = tmax;
-  for (int a = 0; a < 3; ++a) r.inv[a] = div_exact(1.0, dir[a]);
-  const float ax = abs(dir.x), ay = abs(dir.y), az = abs(dir.z);
-  const uint kz = ax > ay ? (ax > az ? 0u : 2u) : (ay > az ? 1u : 2u);
-  uint kx = (kz + 1u) % 3u, ky = (kx + 1u) % 3u;
-  if (dir[kz] < 0.0) {
-    const uint k = kx;
-    kx = ky, ky = k;
-  }
-  r.sx = div_exact(dir[kx], dir[kz]);
-  r.sy = div_exact(dir[ky], dir[kz]);
-  r.sz = div_exact(1.0, dir[kz]);
-  r.kx = kx, r.ky = ky, r.kz = kz;
-  r.walkable = all(lessThanEqual(abs(org), vec3(uintBitsToFloat(0x71800000u)))) && directions_walkable(dir, tmin, tmax);
-  return r;
-}
-
 void main() {
   const uint ray = pc.ray_base + gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;

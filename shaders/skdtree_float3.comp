@@ -11,14 +11,17 @@
 #include "shaders/hits.glsl"
 #include "shaders/walk.glsl"
 
+#include "shaders/batch_counters.glsl"
+
 layout(local_size_x = 64) in;
 
 layout(push_constant) uniform Push { uint ray_base, ray_count, records; } pc;
 
 void main() {
-  const uint ray = gl_GlobalInvocationID.x;
+  const uint ray = pc.ray_base + gl_GlobalInvocationID.x;
   if (ray >= pc.ray_count) return;
   const GpuRay r = load_ray(ray);
+  count_unwalkable(r.walkable);
   Closest c = closest_start(ray, r);
   const uint tree = header(MC_HDR_TREE_OFFSET);
   float tn, tf;

@@ -210,6 +210,75 @@ TEST_P(GpuMethods, RowsKeepTheNearestAndCountAll) {
   EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
 }
 
+// Batches as a game runs them: three frames in flight on one method, each
+// batch cut into pieces of 256 rays (limit_piece: more pieces than the
+// device's limits would make on these few rays), the rays written straight
+// into the slots' mapped buffers, collected out of order, then the ring
+// run again with the sizes swapped round (a slot grows, the others keep
+// their buffers); every query and culling. Unwalkable rays among them are
+// misses and counted, as on the CPU.
+TEST_P(GpuMethods, PiecesAndFramesInFlightMatchTheCpu) {
+  const gpu::MethodLayout mc = GetParam();
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (m.name != "sphere") continue;
+    std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout_name(mc.layout)), m.name);
+    const BlobView view(blob, m.name);
+    std::vector<Ray> rays = test_rays(m, RayKind::Long, 1800);
+    rays[5].org[0] = NAN, rays[300].dir[0] = rays[300].dir[1] = rays[300].dir[2] = 0, rays[1001].tmin = 2 * rays[1001].tmax;
+    const std::vector<uint32_t> sizes = {700, 333, 767};
+    for (Query query : {Query::Closest, Query::Any, Query::All})
+      for (Cull cull : {Cull::None, Cull::Back, Cull::Front}) {
+        const std::string what = std::string(mc.method) + " query " + std::to_string(int(query)) + " cull " +
+                                 std::to_string(int(cull));
+        const std::unique_ptr<gpu::Method> method =
+            gpu::make_method(context(), mc.method, blob, m.name, 3, layout::query_bits(query, cull), 8);
+        method->limit_piece(256);
+        for (int round = 0; round < 2; ++round) {
+          std::vector<std::vector<Ray>> batches;
+          for (uint32_t slot = 0, first = 0; slot < 3; ++slot) {
+            const uint32_t n = sizes[(slot + round) % 3];
+            batches.emplace_back(rays.begin() + first, rays.begin() + first + n);
+            first += n;
+            std::span<Ray> to = method->rays(slot, n);
+            ASSERT_EQ(to.size(), n);
+            std::copy(batches.back().begin(), batches.back().end(), to.begin());
+            method->submit(slot);
+          }
+          for (uint32_t slot : {2u, 0u, 1u}) {
+            const std::vector<Ray>& batch = batches[slot];
+            uint64_t cpu_skipped = 0;
+            for (const Ray& r : batch) cpu_skipped += !ray_is_walkable(r);
+            const std::string at = what + ", round " + std::to_string(round) + ", slot " + std::to_string(slot);
+            if (query == Query::All) {
+              HitLists lists;
+              EXPECT_EQ(method->finish_lists(slot, lists), cpu_skipped) << at;
+              const HitLists cpu = trace_lists(view, batch, 8, cull);
+              ASSERT_EQ(lists.rays(), batch.size()) << at;
+              for (size_t i = 0; i < batch.size(); ++i) {
+                ASSERT_EQ(lists.found[i], cpu.found[i]) << at << ", ray " << i;
+                for (size_t k = 0; k < lists.row(i).size(); ++k)
+                  EXPECT_EQ(lists.row(i)[k].triangle, cpu.row(i)[k].triangle) << at << ", ray " << i;
+              }
+              continue;
+            }
+            uint64_t skipped = 0;
+            const std::span<const Hit> hits = method->hits(slot, nullptr, &skipped);
+            EXPECT_EQ(skipped, cpu_skipped) << at;
+            const std::vector<Hit> gpu(hits.begin(), hits.end()), cpu = trace_all(view, batch, query, cull);
+            ASSERT_EQ(gpu.size(), batch.size()) << at;
+            if (query == Query::Closest) {
+              expect_same_as_cpu(gpu, cpu, at);
+              continue;
+            }
+            for (size_t i = 0; i < batch.size(); ++i)  // any hit: hit or miss as the CPU, the triangle its own
+              EXPECT_EQ(gpu[i].triangle == MC_NO_HIT, cpu[i].triangle == MC_NO_HIT) << at << ", ray " << i;
+          }
+        }
+      }
+  }
+  EXPECT_EQ(context().validation_messages(), 0u) << context().last_validation_message();
+}
+
 INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods, ::testing::ValuesIn(gpu::method_layouts().begin(), gpu::method_layouts().end()),
                          [](const auto& info) {
                            std::string n = layout_name(info.param.layout);
@@ -218,25 +287,29 @@ INSTANTIATE_TEST_SUITE_P(Methods, GpuMethods, ::testing::ValuesIn(gpu::method_la
                            return std::string(info.param.method) + "_" + n;
                          });
 
-// A batch whose buffers exceed the device's is refused before anything is
-// allocated, the refusal naming the bytes and the limit: 140,000 rows of
-// 4096 hits are 4.6 GB of device rows (maxStorageBufferRange is a
-// uint32). The method goes on with the batches that fit.
-TEST(Gpu, ABatchBeyondTheDeviceBuffersIsRefusedUpFront) {
+// A batch whose buffers exceed the device's host-visible memory is refused
+// before anything is allocated, the refusal naming the bytes and the
+// limit: rows of 4096 hits take 32,832 bytes a ray (the 32-byte ray, the
+// 28-byte hit, the row's count and 4096 (t, triangle) pairs), and a batch
+// past 2^32 - 1 rays is refused as such. The method goes on with the
+// batches that fit.
+TEST(Gpu, ABatchBeyondTheDeviceMemoryIsRefusedUpFront) {
   const Mesh planes = stacked_planes(12);
   const std::vector<Ray> rays = rays_down_through(12, 300);
   const std::vector<uint8_t> blob = build_blob(planes, parse_layout("AABBTree/Float3"), "planes");
   const std::unique_ptr<gpu::Method> method =
       gpu::make_method(context(), "aabbtree", blob, "planes", 1, MC_QUERY_ALL, kMaxHitsLimit);
   EXPECT_EQ(method->refusal(uint32_t(rays.size())), "");
-  const std::string why = method->refusal(140000);
-  for (const char* word : {"aabbtree", "140000 rays", "rows of 4096 hits a ray", "hit row buffer of 4588080000 bytes",
-                           "maxStorageBufferRange"})
+  const uint64_t too_many = context().mapped_heap_bytes() / (32 + 28 + 4 * (1 + 2 * 4096)) + 4096;
+  const std::string why = method->refusal(too_many);
+  for (const std::string word : {std::string("aabbtree"), std::to_string(too_many) + " rays",
+                                 std::string("rows of 4096 hits a ray"), std::string("bytes of host-visible memory"),
+                                 std::to_string(context().mapped_heap_bytes()) + " bytes"})
     EXPECT_NE(why.find(word), std::string::npos) << "'" << word << "' not in: " << why;
-  std::vector<Ray> many(140000, rays[0]);
+  EXPECT_NE(method->refusal(uint64_t(1) << 32).find("2^32 - 1 rays"), std::string::npos);
   try {
-    method->begin(0, many);
-    ADD_FAILURE() << "a batch of 140000 rows of 4096 was begun";
+    method->rays(0, too_many);
+    ADD_FAILURE() << "a batch of " << too_many << " rows of 4096 was given room";
   } catch (const GpuError& e) {
     EXPECT_EQ(std::string(e.what()), why);
     EXPECT_FALSE(e.lost);

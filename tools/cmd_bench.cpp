@@ -12,6 +12,7 @@
 #include "bench/encodings.h"
 #include "bench/error.h"
 #include "bench/gpu.h"
+#include "bench/gpu_scale.h"
 #include "bench/latency.h"
 #include "bench/pairing.h"
 #include "bench/plot.h"
@@ -167,21 +168,86 @@ void add_bench_tables(CLI::App* bench) {
   }
 }
 
-// Seed 000 §7 on this machine's Vulkan device.
+// "1k", "16k", "1M", "4096": a batch size as --sizes takes it.
+uint64_t parse_size(const std::string& text) {
+  size_t used = 0;
+  uint64_t n = 0;
+  try {
+    n = std::stoull(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = text.substr(used);
+  const uint64_t scale = unit == "" ? 1 : unit == "k" ? 1024 : unit == "M" ? 1024 * 1024 : 0;
+  if (used == 0 || scale == 0 || n == 0 || n * scale > (uint64_t(1) << 26))
+    throw CLI::ValidationError("--sizes", "'" + text + "' is not a batch size from 1 to 64M (a number, or with k or M)");
+  return n * scale;
+}
+
+// The batch-size sweep: a table, a CSV and a plot of rays a second.
+void print_gpu_scale(const bench::GpuScaleResult& res, const std::string& mesh_name, size_t triangles, uint32_t repeat,
+                     const std::string& out_dir) {
+  std::printf("\n%s, %zu triangles, long random rays, method %s on %s, device: %s; median of %u passes a size. "
+              "device: GPU timestamps; wall: submit() until the hits are readable in host-visible memory, one batch; "
+              "stream: %u batches in flight, each slot refilled as it is read; host: the submitting thread's CPU time "
+              "in rays(), submit() and hits(), waits left out; copy: the bench writing its rays into the mapped "
+              "buffer; CPU: BlobView::trace on %u threads of this machine; differ: rays whose triangle is not the "
+              "CPU's\n\n"
+              "| rays | device ms | wall ms | device Grays/s | wall Grays/s | stream Grays/s | host ns/ray | copy ns/ray "
+              "| CPU ms | CPU Grays/s | differ |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+              mesh_name.c_str(), triangles, res.method.c_str(), res.layout.c_str(), res.device.c_str(), repeat,
+              res.frames, res.cpu_threads);
+  std::filesystem::create_directories(out_dir);
+  const std::string stem = out_dir + "/gpu_scale";
+  OutputText csv(stem + ".csv");
+  csv << "rays,device_ms,wall_ms,device_rays_per_s,wall_rays_per_s,stream_rays_per_s,host_ns_per_ray,copy_ns_per_ray,"
+         "cpu_ms,cpu_rays_per_s,differ\n";
+  std::vector<bench::Series> series = {{"GPU device", {}}, {"GPU wall, one batch", {}}, {"GPU stream", {}},
+                                       {"CPU, every core", {}}};
+  auto per_s = [](uint64_t rays, double ms) { return ms > 0 ? double(rays) / (ms * 1e-3) : 0.0; };
+  for (const bench::GpuScaleRow& r : res.rows) {
+    const double device = per_s(r.rays, r.device_ms), wall = per_s(r.rays, r.wall_ms), cpu = per_s(r.rays, r.cpu_ms);
+    std::printf("| %llu | %.3f | %.3f | %.4f | %.4f | %.4f | %.3f | %.3f | %.3f | %.4f | %llu |\n",
+                (unsigned long long)r.rays, r.device_ms, r.wall_ms, device * 1e-9, wall * 1e-9,
+                r.stream_rays_per_s * 1e-9, r.host_ns_per_ray, r.copy_ns_per_ray, r.cpu_ms, cpu * 1e-9,
+                (unsigned long long)r.differ);
+    csv << r.rays << "," << r.device_ms << "," << r.wall_ms << "," << device << "," << wall << "," << r.stream_rays_per_s
+        << "," << r.host_ns_per_ray << "," << r.copy_ns_per_ray << "," << r.cpu_ms << "," << cpu << "," << r.differ << "\n";
+    const double x = double(r.rays);
+    if (device > 0) series[0].points.push_back({x, device, ""});
+    series[1].points.push_back({x, wall, ""});
+    series[2].points.push_back({x, r.stream_rays_per_s, ""});
+    series[3].points.push_back({x, cpu, ""});
+  }
+  csv.commit();
+  const std::string png = stem + ".png";
+  const std::string why = bench::plot_scatter(png, "rays a second against batch size, " + res.device, "rays a batch",
+                                              "rays a second", series, true, true, true);
+  std::printf("\ncsv: %s.csv\nplot: %s\n", stem.c_str(), why.empty() ? png.c_str() : why.c_str());
+}
+
+// Seed 000 §7 on this machine's Vulkan device, then the batch-size sweep.
 void add_bench_gpu(CLI::App* bench) {
   auto gargs = std::make_shared<BenchArgs>();
   auto gdevice = std::make_shared<std::string>();
-  CLI::App* gsub = bench->add_subcommand("gpu", "Rouwe 2019, 7: the GPU methods on the Vulkan device, the CPU's best beside them");
+  auto gsizes = std::make_shared<std::vector<std::string>>(std::vector<std::string>{"1k", "16k", "256k", "1M", "4M", "16M"});
+  CLI::App* gsub = bench->add_subcommand("gpu", "Rouwe 2019, 7: the GPU methods on the Vulkan device, the CPU's best "
+                                                "beside them; then batches from 1k to 16M rays against every core");
   gsub->add_option("mesh", gargs->input, "mesh file (default data/bunny00.off)");
   gsub->add_option("--rays", gargs->rays, "long random rays (the source used 1024)")->check(integer_in(1, 1000000));
   gsub->add_option("--repeat", gargs->repeat, "passes; the median is reported")->check(integer_in(1, 1000));
   gsub->add_option("--device", *gdevice, "Vulkan device: index or part of its name");
-  gsub->callback([gargs, gdevice] {
+  gsub->add_option("--sizes", *gsizes, "the sweep's batch sizes (1k = 1024, 1M = 1048576), comma separated")
+      ->delimiter(',');
+  gsub->add_option("--out-dir", gargs->out_dir, "where gpu_scale.csv and gpu_scale.png go");
+  gsub->callback([gargs, gdevice, gsizes] {
+    std::vector<uint64_t> sizes;
+    for (const std::string& text : *gsizes) sizes.push_back(parse_size(text));
     Mesh mesh = bench_mesh(gargs->input);
     std::string device;
     std::vector<bench::GpuRow> rows = bench::bench_gpu(mesh, gargs->input, gargs->rays, gargs->repeat, *gdevice, &device);
     std::printf("\n%s, %zu triangles, %zu long rays, device: %s; us per ray, median of %u passes (device: GPU "
-                "timestamps; wall: packing, submission and read-back); leaf 4 as the source's GPU table; any / closest, "
+                "timestamps; wall: copy into the mapped buffer, submission and read-back); leaf 4 as the source's GPU table; any / closest, "
                 "all / closest: each query's time (device, else wall) on the same rays, all hits in rows of 16\n\n"
                 "| method | layout | us/ray device | us/ray wall | walked B/tri | seed (GTX 1050, DX11) | disagreements "
                 "| any / closest | all / closest |\n"
@@ -192,6 +258,9 @@ void add_bench_gpu(CLI::App* bench) {
                   r.device_us > 0 ? std::to_string(r.device_us).substr(0, std::to_string(r.device_us).find('.') + 4).c_str() : "-",
                   r.wall_us, r.bytes, r.seed.empty() ? "-" : r.seed.c_str(), (unsigned long long)r.disagreements,
                   r.any_to_closest, r.all_to_closest);
+    std::fflush(stdout);
+    const bench::GpuScaleResult scale = bench::bench_gpu_scale(mesh, gargs->input, sizes, gargs->repeat, *gdevice);
+    print_gpu_scale(scale, gargs->input, mesh.triangles.size(), gargs->repeat, gargs->out_dir);
   });
 }
 

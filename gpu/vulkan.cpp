@@ -89,11 +89,17 @@ Context::Context(const DeviceChoice& choice) {
   app.pApplicationName = "meshcast";
   app.apiVersion = VK_API_VERSION_1_2;
   const char* layer = "VK_LAYER_KHRONOS_validation";
-  const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+  const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
+  // Synchronization validation besides the layer's default checks: a
+  // missing barrier between a fill, a dispatch and the host's read (hazards
+  // the default checks do not see) is a message like any other.
+  const VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1, features.pEnabledValidationFeatures = enables;
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   ici.pApplicationInfo = &app;
-  if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 1,
-                  ici.ppEnabledExtensionNames = &ext;
+  if (validation) ici.enabledLayerCount = 1, ici.ppEnabledLayerNames = &layer, ici.enabledExtensionCount = 2,
+                  ici.ppEnabledExtensionNames = extensions, ici.pNext = &features;
   check(vk_.CreateInstance(&ici, nullptr, &instance_), "vkCreateInstance");
   ++g_instances_created, ++g_instances_alive;
   // A throw below (no such device, a missing feature) would skip the

@@ -26,6 +26,11 @@
 #include <thread>
 
 #include "meshcast/caster.h"
+#if MESHCAST_VULKAN
+#include "gpu/method.h"
+#include "gpu/vulkan.h"
+#include "layout/formats.h"
+#endif
 #include "check/generate.h"
 #include "host/profile.h"
 #include "tests/testing.h"
@@ -677,6 +682,68 @@ TEST(Host, AWarmCasterAllocatesNothingAFrame) {
   EXPECT_GT(lists.hits.size(), a.size() / 2);
   EXPECT_EQ(scene_lists.hits.size(), lists.hits.size());
 }
+
+#if MESHCAST_VULKAN
+// The GPU's side of the same (no validation layer: it allocates on every
+// call it checks). A method's batches through rays(), submit() and hits()
+// in two frame slots, sizes alternating, closest and every hit: after the
+// first batch of each slot nothing is allocated, and each slot's mapped
+// ray and hit memory stays where it was (no buffer made again). Then a
+// caster on the Vulkan backend, frames in flight: nothing either.
+TEST(Host, AWarmGpuBatchAllocatesNothing) {
+  if (cpu_only()) GTEST_SKIP() << "the Vulkan backend is kept out";
+  Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "sphere");
+  std::vector<Ray> a = make_rays(m, RayKind::Long, 2000, 1), b = make_rays(m, RayKind::Radial, 1500, 2);
+  gpu::Context ctx(gpu::DeviceChoice{"", false});
+  const std::unique_ptr<gpu::Method> closest = gpu::make_method(ctx, "octtree", blob, "sphere", 2);
+  const std::unique_ptr<gpu::Method> every = gpu::make_method(ctx, "octtree", blob, "sphere", 2, MC_QUERY_ALL, 8);
+  HitLists lists;
+  std::vector<const void*> where;
+  where.reserve(4 * 21);  // the frames' records, kept out of the count
+  uint64_t hit_sum = 0;
+  auto frame = [&](bool record) {
+    for (uint32_t slot = 0; slot < 2; ++slot) {
+      const std::vector<Ray>& rays = slot ? b : a;
+      const std::span<Ray> to = closest->rays(slot, rays.size());
+      std::copy(rays.begin(), rays.end(), to.begin());
+      closest->submit(slot);
+      every->begin(slot, rays);
+      if (record) where.push_back(to.data());
+    }
+    for (uint32_t slot = 0; slot < 2; ++slot) {
+      const std::span<const Hit> hits = closest->hits(slot);
+      hit_sum += hits[0].triangle != MC_NO_HIT;
+      if (record) where.push_back(hits.data());
+      every->finish_lists(slot, lists);
+    }
+  };
+  for (int k = 0; k < 2; ++k) frame(false);  // warm-up: each slot grows its buffers once
+  frame(true);
+  const std::vector<const void*> first = where;
+  const uint64_t before = g_allocations.load();
+  for (int k = 0; k < 20; ++k) frame(true);
+  EXPECT_EQ(g_allocations.load() - before, 0u);
+  for (size_t i = first.size(); i < where.size(); ++i) EXPECT_EQ(where[i], first[i % first.size()]) << i;
+  EXPECT_GT(lists.hits.size(), b.size() / 2);
+
+  CasterOptions o = options(Backend::Vulkan, 2);
+  o.validation = false;
+  Caster caster(blob, "sphere", o);
+  ASSERT_EQ(caster.gpu_error(), "");
+  std::vector<Hit> hits(2000);
+  auto caster_frame = [&] {
+    host::Ticket ta = caster.submit(a), tb = caster.submit(b);  // two frames in flight
+    caster.wait(ta, hits);
+    caster.wait(tb, hits);
+  };
+  for (int k = 0; k < 3; ++k) caster_frame();
+  const uint64_t before_caster = g_allocations.load();
+  for (int k = 0; k < 20; ++k) caster_frame();
+  EXPECT_EQ(g_allocations.load() - before_caster, 0u);
+  EXPECT_EQ(caster.percentiles(Backend::Vulkan).batches, 46u);
+}
+#endif
 
 TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
   Mesh m = make_sphere(16, 32, 1, {0, 0, 0});

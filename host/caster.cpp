@@ -87,6 +87,7 @@ void Caster::Impl::setup(std::span<const uint8_t> blob, const std::string& name)
     s->work = [this, sp](uint32_t job) { walk_job(*sp, job); };
     slots_.push_back(std::move(s));
   }
+  pending_.items.assign(slots_.size(), nullptr);
 
   if (options_.backend != Backend::Cpu) open_gpu(blob, name);
   find_crossover();
@@ -202,6 +203,8 @@ Caster::Caster(CasterOptions options) : impl_(std::make_unique<Impl>(std::move(o
 Caster::~Caster() = default;  // ~Impl() stops the threads before any member goes
 
 Ticket Caster::submit(std::span<const Ray> rays, BatchQuery query) { return impl_->submit(rays, query); }
+OpenBatch Caster::open(uint32_t rays, BatchQuery query) { return impl_->open(rays, query); }
+Ticket Caster::submit(const OpenBatch& batch) { return impl_->submit(batch); }
 Ticket Caster::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
   return impl_->submit(scene, rays, query);
 }

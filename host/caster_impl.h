@@ -6,7 +6,6 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <exception>
 #include <functional>
 #include <map>
@@ -14,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -42,12 +42,16 @@ struct Caster::Impl {
   // One batch in flight: the game's (a ticket names it) or the crossover
   // measurement's. Its buffers are kept from batch to batch.
   struct Slot {
-    enum State { Free, Running, Ready, Collecting };
+    enum State { Free, Open, Running, Ready, Collecting };  // Open: open() gave its room, not submitted
     uint32_t index = 0;
     State state = Free;
     uint64_t id = 0;
     uint32_t n = 0;
-    std::vector<Ray> rays;
+    std::vector<Ray> rays;  // a CPU batch's (the GPU's are in its method's mapped memory)
+    // Where the batch's rays are: `rays`, or the GPU method's slot (a
+    // batch begun there, or open() in place: then `in_place`).
+    std::span<Ray> placed;
+    bool in_place = false;
     BatchQuery query;
     std::vector<Hit> hits;  // a hit a ray (closest or any)
     // Query::All on the CPU: each job's compact rows, which wait()
@@ -77,6 +81,8 @@ struct Caster::Impl {
   // The public calls (meshcast/caster.h says what each does), each defined
   // in the file of its job.
   Ticket submit(std::span<const Ray> rays, BatchQuery query);
+  OpenBatch open(uint32_t rays, BatchQuery query);
+  Ticket submit(const OpenBatch& batch);
   Ticket submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query);
   bool poll(const Ticket& t);
   BatchRecord wait(const Ticket& t, std::span<Hit> hits);
@@ -116,6 +122,8 @@ struct Caster::Impl {
   // CPU too when the GPU refuses it); collect() waits for it, copies its
   // hits and frees the slot, keeping its record if `record`.
   void start(Slot& s, std::span<const Ray> rays, Backend backend);
+  // Whether a blob batch of the slot's query and size may go to the GPU.
+  bool gpu_takes(const Slot& s, Backend backend) const;
   void complete(Slot& s, Backend ran_on);  // Ready, its time taken; waiters woken
   // Waits on changed_ under `lock` (mutex_) until ready() or the caster
   // closes; counted in blocked_, which the destructor waits to be 0.
@@ -146,7 +154,14 @@ struct Caster::Impl {
   void open_gpu(std::span<const uint8_t> blob, const std::string& name);
   // The GPU method for a batch's query, made on first use (under gpu_mutex_).
   gpu::Method* method_for(const BatchQuery& q);
+  // The slot's GPU method, and room for its rays there (s.placed); GpuError
+  // when the device refuses the batch.
+  void place_on_gpu(Slot& s);
+  // Submits the slot's placed rays; the GPU thread waits for them.
   void start_gpu(Slot& s);
+  // A batch the GPU refused at submission: its rays into the slot's own
+  // array, then the CPU's jobs.
+  void gpu_refused(Slot& s, const GpuError& e);
   void gpu_completions();  // the GPU thread
   // Whether a scene batch of this query on this frame goes to the GPU
   // (Backend::Vulkan, a device that has not failed, one hit a ray, every
@@ -188,7 +203,21 @@ struct Caster::Impl {
 
   std::mutex pending_mutex_;            // GPU batches waiting for their fence (scene batches: to begin), in order
   std::condition_variable pending_changed_;
-  std::deque<Slot*> pending_;
+  // A ring of one entry a slot (a slot is pending at most once), so
+  // queueing a batch allocates nothing: a std::deque allocated a block
+  // every 64 batches.
+  struct PendingRing {
+    std::vector<Slot*> items;
+    size_t head = 0, count = 0;
+    bool empty() const { return count == 0; }
+    void push_back(Slot* s) {
+      if (count == items.size()) throw std::logic_error("more GPU batches pending than the caster has slots");
+      items[(head + count++) % items.size()] = s;
+    }
+    Slot* front() const { return items[head]; }
+    void pop_front() { head = (head + 1) % items.size(), --count; }
+  };
+  PendingRing pending_;
   bool stopping_ = false;
   std::thread completion_;
 };

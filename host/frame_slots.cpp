@@ -103,21 +103,86 @@ void Caster::Impl::free_locked(Slot& s) {
   changed_.notify_all();  // under the lock: the caster may be destroyed once it is released
 }
 
+bool Caster::Impl::gpu_takes(const Slot& s, Backend backend) const {
+  // The GPU's rows of every hit carry no u, v (gpu::BatchMethod): such a batch is the CPU's.
+  const bool gpu_answers = !(s.query.query == Query::All && has(options_.hit_outputs, HitOutputs::Uv));
+  return backend == Backend::Vulkan && gpu_available() && s.n > 0 && gpu_answers;
+}
+
 void Caster::Impl::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   try {
     size_slot(s, rays.size(), false);
-    s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
-    const bool all = s.query.query == Query::All;
-    // The GPU's rows of every hit carry no u, v (gpu::BatchMethod): such a batch is the CPU's.
-    const bool gpu_answers = !(all && has(options_.hit_outputs, HitOutputs::Uv));
-    if (backend == Backend::Vulkan && gpu_available() && s.n > 0 && gpu_answers) {
+    s.in_place = false;
+    if (gpu_takes(s, backend)) {
       try {
+        place_on_gpu(s);  // the rays go straight into the device's mapped memory
+        std::copy(rays.begin(), rays.end(), s.placed.begin());
         start_gpu(s);
         return;
       } catch (const GpuError& e) {
-        // A lost device is given up; any other refusal (a batch beyond a
-        // buffer limit, memory) sends just this batch to the CPU.
+        // A lost device is given up; any other refusal (memory) sends just
+        // this batch to the CPU.
         if (e.lost) gpu_failed(e.what());
+      }
+    }
+    s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+    s.placed = s.rays;
+    start_cpu(s);
+  } catch (...) {
+    free_slot(s);
+    throw;
+  }
+}
+
+OpenBatch Caster::Impl::open(uint32_t rays, BatchQuery query) {
+  check_query(query.query, query.cull, query.max_hits);
+  blob("Caster::open");
+  Slot& s = take_slot();
+  try {
+    s.query = query;
+    size_slot(s, rays, false);
+    s.in_place = false;
+    if (gpu_takes(s, choose(rays))) {
+      try {
+        place_on_gpu(s);
+        s.in_place = true;
+      } catch (const GpuError& e) {
+        if (e.lost) gpu_failed(e.what());
+      }
+    }
+    if (!s.in_place) {
+      s.rays.resize(rays);  // keeps its capacity: no allocation once warm
+      s.placed = s.rays;
+    }
+  } catch (...) {
+    free_slot(s);
+    throw;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.state = Slot::Open;
+  }
+  return {{s.id, s.index}, s.placed};
+}
+
+Ticket Caster::Impl::submit(const OpenBatch& batch) {
+  const Ticket& t = batch.ticket;
+  Slot& s = slot_of(t);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (s.id != t.id || s.state != Slot::Open)
+      throw UsageError("Caster::submit: ticket " + std::to_string(t.id) + " is not an open batch of this caster");
+    if (closing_) throw UsageError("Caster::submit: the caster is being destroyed");
+    s.state = Slot::Running;
+  }
+  try {
+    if (s.in_place) {
+      try {
+        start_gpu(s);
+        return t;
+      } catch (const GpuError& e) {
+        gpu_refused(s, e);
+        return t;
       }
     }
     start_cpu(s);
@@ -125,6 +190,7 @@ void Caster::Impl::start(Slot& s, std::span<const Ray> rays, Backend backend) {
     free_slot(s);
     throw;
   }
+  return t;
 }
 
 void Caster::Impl::complete(Slot& s, Backend ran_on) {
@@ -150,6 +216,7 @@ bool Caster::Impl::poll(const Ticket& t) {
   const Slot& s = slot_of(t);
   if (s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting)
     throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
+  if (s.state == Slot::Open) throw UsageError("ticket " + std::to_string(t.id) + " is open: submit(batch) starts it");
   return s.state == Slot::Ready;
 }
 
@@ -172,6 +239,7 @@ BatchRecord Caster::Impl::claim(Slot& s, const Ticket& t, bool scene_wait, bool 
   std::unique_lock<std::mutex> lock(mutex_);
   auto gone = [&] { return s.id != t.id || s.state == Slot::Free || s.state == Slot::Collecting; };
   if (gone()) throw UsageError("ticket " + std::to_string(t.id) + " is unknown or already collected");
+  if (s.state == Slot::Open) throw UsageError("ticket " + std::to_string(t.id) + " is open: submit(batch) starts it");
   check_collected(t.id, s.scene != nullptr, scene_wait, s.query.query == Query::All, lists, room, s.n);
   // Another thread may collect the same ticket first: then this one throws.
   // The measurement's own batches are waited for while the caster closes.
@@ -249,9 +317,9 @@ void Caster::Impl::copy_out(Slot& s, BatchRecord& r, std::span<Hit> hits, HitLis
       gpu_failed(e.what());
       if (lists) {
         lists->max_hits = s.query.max_hits;  // the batch's rows, not what the caller's lists held
-        trace_now(s.rays, *lists, s.query.cull);
+        trace_now(s.placed, *lists, s.query.cull);
       }
-      else trace_now(s.rays, hits.first(s.n), s.query);
+      else trace_now(s.placed, hits.first(s.n), s.query);
       r.ran_on = Backend::Cpu;
       copied = true;
     }

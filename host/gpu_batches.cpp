@@ -103,13 +103,18 @@ gpu::Method* Caster::Impl::method_for(const BatchQuery& q) {
 #endif
 }
 
+void Caster::Impl::place_on_gpu(Slot& s) {
+  std::lock_guard<std::mutex> lock(gpu_mutex_);
+  s.method = method_for(s.query);
+  s.placed = s.method->rays(s.index, s.n);
+}
+
 void Caster::Impl::start_gpu(Slot& s) {
   const auto t0 = std::chrono::steady_clock::now();
   {
     std::lock_guard<std::mutex> lock(gpu_mutex_);
     if (options_.before_gpu_submit) options_.before_gpu_submit();
-    s.method = method_for(s.query);
-    s.method->begin(s.index, s.rays);
+    s.method->submit(s.index);
   }
   s.ran_on = Backend::Vulkan;
   s.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -118,6 +123,14 @@ void Caster::Impl::start_gpu(Slot& s) {
     pending_.push_back(&s);
   }
   pending_changed_.notify_one();
+}
+
+void Caster::Impl::gpu_refused(Slot& s, const GpuError& e) {
+  if (e.lost) gpu_failed(e.what());
+  s.rays.assign(s.placed.begin(), s.placed.end());  // the mapped memory is the method's, the next batch's
+  s.placed = s.rays;
+  s.in_place = false;
+  start_cpu(s);
 }
 
 // The one thread that waits for GPU batches, in submission order, so each

@@ -34,8 +34,8 @@
 //   scene.set_transform(a, moved); scene.commit();  // the batch still sees the last frame
 //   scenes.wait(f, scene_hits);                 // or a SceneHitLists for Query::All
 //
-// A caster owns a ring of `frames` slots; each submitted batch holds one
-// until it is collected with wait(). Slot buffers (rays, hits, the GPU's
+// A caster owns a ring of `frames` slots; each submitted (or open()) batch
+// holds one until it is collected with wait(). Slot buffers (rays, hits, the GPU's
 // mapped buffers, the recorded command buffers) are reused, so after the
 // first batches of a size nothing is allocated per frame. Every method may
 // be called from several threads at once; the blob is only ever read.
@@ -59,6 +59,12 @@ const char* backend_name(Backend b);
 struct Ticket {
   uint64_t id = 0;
   uint32_t slot = 0;
+};
+
+// A batch open() gave: its ticket, and where its rays go.
+struct OpenBatch {
+  Ticket ticket;
+  std::span<Ray> rays;
 };
 
 // The question a batch asks (ray.h): the query, the faces culled, and for
@@ -85,8 +91,8 @@ struct SceneBatchQuery {
 // What one batch cost. latency: submit() to the moment the hits were ready
 // (for the GPU, the fence; for the CPU, the last job's end). device: the
 // GPU's own time between its timestamps. cpu: the CPU time the batch took,
-// the workers' summed time for a CPU batch, packing and submitting for a GPU
-// batch.
+// the workers' summed time for a CPU batch, the submission for a GPU batch
+// (the rays are read by the device as written: no packing).
 struct BatchRecord {
   Backend ran_on = Backend::Cpu;
   uint32_t rays = 0;
@@ -216,11 +222,23 @@ class Caster {
   Caster(const Caster&) = delete;
   Caster& operator=(const Caster&) = delete;
 
-  // Copies the rays and starts the batch; returns at once. Throws
+  // Copies the rays and starts the batch; returns at once (a GPU batch's
+  // rays are copied once, into the device's mapped memory). Throws
   // UsageError when all `frames` slots hold uncollected batches, or for a
   // query out of range; what an engine's JobSystem::run() throws, as it
   // threw it (the slot stays free).
   Ticket submit(std::span<const Ray> rays, BatchQuery query = {});
+  // Room for a batch of `rays` rays that the caller writes in place, then
+  // starts with submit(batch): for a batch the GPU will answer, the
+  // device's own mapped memory, read as written (no copy of the rays at
+  // all: what a batch of millions wants); else the slot's array. The batch
+  // holds a frame slot from now on; poll() and wait() refuse it until it is
+  // submitted. Write Ray records only into the span, and nothing after
+  // submit(). Throws as submit(rays).
+  OpenBatch open(uint32_t rays, BatchQuery query = {});
+  // Starts a batch open() gave: UsageError for one not open (submitted
+  // already, or another caster's).
+  Ticket submit(const OpenBatch& batch);
   // A scene batch (see above): the scene's last commit, taken now; call it
   // from the thread that edits and commits the scene. The rays are copied.
   // HitOutputs::Point is left out of scene hits (they carry none). Throws

@@ -182,11 +182,7 @@ void BatchMethod::record_batch(Slot& s, uint32_t slot) {
   const uint32_t piece = piece_rays();
   const std::array<uint64_t, 4> each = r.each();
   for (uint32_t first = 0, k = 0; first < s.n; first += piece, ++k) {
-    if (k) {  // a piece's passes reuse the slot's scratch (AABBList's pairs) and its ray counter
-      ctx_.fill_after_compute_barrier(s.cb);
-      ctx_.vk().CmdFillBuffer(s.cb, s.counters->handle(), 4, 4, 0);  // next_ray (shaders/batch_counters.glsl)
-      ctx_.fill_barrier(s.cb);
-    }
+    if (k) ctx_.compute_barrier(s.cb);  // a piece's passes reuse the slot's scratch (AABBList's pairs)
     Piece p{std::min(piece, s.n - first), {}};
     for (int b = 0; b < 4; ++b) p.offsets[b] = uint32_t(uint64_t(first) * each[b]);
     record(s.cb, slot, p);

@@ -49,11 +49,6 @@ const MethodReading& method_line(const std::string& method, std::span<const uint
 // gpu/aabblist.cpp).
 std::unique_ptr<Method> make_walker(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
                                     const MethodReading& line, uint32_t slots, uint32_t flags, uint32_t max_hits);
-// A walker whose shader takes its rays from the batch counter (persistent
-// threads: shaders/octtree_cluster.comp).
-std::unique_ptr<Method> make_persistent_walker(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
-                                               const MethodReading& line, uint32_t slots, uint32_t flags,
-                                               uint32_t max_hits);
 std::unique_ptr<Method> make_bruteforce(Context& ctx, std::span<const uint8_t> blob, const std::string& name,
                                         const MethodReading& line, uint32_t slots, uint32_t flags, uint32_t max_hits);
 std::unique_ptr<Method> make_aabblist_method(Context& ctx, std::span<const uint8_t> blob, const std::string& name,

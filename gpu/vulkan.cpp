@@ -608,11 +608,6 @@ void Context::fill_barrier(VkCommandBuffer cb) const {
                          nullptr);
 }
 
-void Context::fill_after_compute_barrier(VkCommandBuffer cb) const {
-  barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-          VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-}
-
 void Context::host_barrier(VkCommandBuffer cb) const { barrier(cb, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); }
 
 void Context::indirect_barrier(VkCommandBuffer cb) const {

@@ -139,10 +139,8 @@ class Context {
   void compute_barrier(VkCommandBuffer cb) const;
   // The same, and visible as the arguments of the next indirect dispatch.
   void indirect_barrier(VkCommandBuffer cb) const;
-  // vkCmdFillBuffer's writes made visible to the next dispatch, and a
-  // dispatch's reads and writes done before a fill.
+  // vkCmdFillBuffer's writes made visible to the next dispatch.
   void fill_barrier(VkCommandBuffer cb) const;
-  void fill_after_compute_barrier(VkCommandBuffer cb) const;
   // Compute-shader writes to mapped memory made visible to the host that
   // reads them once the submission's fence signals.
   void host_barrier(VkCommandBuffer cb) const;

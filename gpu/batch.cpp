@@ -118,6 +118,11 @@ std::string BatchMethod::refusal(uint64_t rays) const {
   if (bytes > heap)
     return batch + " needs " + std::to_string(bytes) + " bytes of host-visible memory, more than " +
            ctx_.device_name() + "'s largest host-visible heap (" + std::to_string(heap) + " bytes)";
+  // A piece's window starts at a 32-bit dynamic offset (vkCmdBindDescriptorSets).
+  const uint64_t widest = capacity_for(rays) * std::max({r.rays, r.keys, r.hits, r.rows});
+  if (widest > (uint64_t(1) << 32))
+    return batch + " needs a buffer of " + std::to_string(widest) +
+           " bytes, past the 4 GiB a buffer's 32-bit offsets reach; submit it in parts";
   return "";
 }
 

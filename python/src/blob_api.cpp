@@ -55,11 +55,16 @@ py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery
   all.parts[0].max_hits = query.max_hits;
   {
     py::gil_scoped_release release;
-    std::vector<Ray> packed(rays.count);
-    rays.pack(0, rays.count, packed.data());
+    if (rays.count > UINT32_MAX)
+      throw py::value_error(std::to_string(rays.count) + " rays in one Vulkan cast, more than a batch holds (2^32 - 1)");
     std::unique_lock<std::mutex> lock;
     host::Caster& caster = blob.vulkan(outputs, lock);
-    const host::Ticket ticket = caster.submit(packed, query);
+    // The rays converted straight into the batch's room: the device's own
+    // mapped memory when the GPU answers it.
+    const host::OpenBatch batch = caster.open(uint32_t(rays.count), query);
+    rays.pack(0, rays.count, batch.rays.data());
+    for (const Ray& r : batch.rays) all.refused += !ray_is_walkable(r);
+    const host::Ticket ticket = caster.submit(batch);
     if (one) {
       std::vector<Hit> hits(rays.count);
       caster.wait(ticket, hits);
@@ -67,7 +72,6 @@ py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery
     } else {
       caster.wait(ticket, all.parts[0]);
     }
-    for (const Ray& r : packed) all.refused += !ray_is_walkable(r);
   }
   raise_for_refused(rays, all.refused, true);
   return one ? one->dict() : all_hits_answer(all, rays.count, uv);

@@ -589,11 +589,12 @@ std::shared_ptr<Buffer> Context::blob_buffer(std::span<const uint8_t> blob, cons
   return buffer;
 }
 
-void Context::barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access) const {
+void Context::barrier(VkCommandBuffer cb, VkPipelineStageFlags dst_stages, VkAccessFlags dst_access,
+                      VkPipelineStageFlags src_stages, VkAccessFlags src_access) const {
   VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT;
+  mb.srcAccessMask = src_access;
   mb.dstAccessMask = dst_access;
-  vk_.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, dst_stages, 0, 1, &mb, 0, nullptr, 0, nullptr);
+  vk_.CmdPipelineBarrier(cb, src_stages, dst_stages, 0, 1, &mb, 0, nullptr, 0, nullptr);
 }
 
 void Context::compute_barrier(VkCommandBuffer cb) const {
@@ -601,11 +602,8 @@ void Context::compute_barrier(VkCommandBuffer cb) const {
 }
 
 void Context::fill_barrier(VkCommandBuffer cb) const {
-  VkMemoryBarrier mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vk_.CmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &mb, 0, nullptr, 0,
-                         nullptr);
+  barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
 }
 
 void Context::host_barrier(VkCommandBuffer cb) const { barrier(cb, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT); }

@@ -49,9 +49,15 @@ struct Caster::Impl {
     uint32_t n = 0;
     std::vector<Ray> rays;  // a CPU batch's (the GPU's are in its method's mapped memory)
     // Where the batch's rays are: `rays`, or the GPU method's slot (a
-    // batch begun there, or open() in place: then `in_place`).
+    // batch begun there, or open() in place).
     std::span<Ray> placed;
-    bool in_place = false;
+    bool placed_on_gpu() const { return placed.data() != rays.data(); }
+    // A batch the CPU takes over from the GPU: its rays into `rays`.
+    void rays_to_own_array() {
+      if (!placed_on_gpu()) return;
+      rays.assign(placed.begin(), placed.end());
+      placed = rays;
+    }
     BatchQuery query;
     std::vector<Hit> hits;  // a hit a ray (closest or any)
     // Query::All on the CPU: each job's compact rows, which wait()

@@ -74,10 +74,7 @@ void Caster::Impl::start_cpu(Slot& s) {
 
 void Caster::Impl::cpu_instead(Slot& s) {
   try {
-    if (!s.scene && s.placed.data() != s.rays.data()) {  // a blob batch's rays in the GPU method's memory
-      s.rays.assign(s.placed.begin(), s.placed.end());
-      s.placed = s.rays;
-    }
+    if (!s.scene) s.rays_to_own_array();
     start_cpu(s);
   } catch (...) {  // the job system's run() threw: the batch is answered with it, and this thread goes on
     s.error = std::current_exception();

@@ -112,7 +112,6 @@ bool Caster::Impl::gpu_takes(const Slot& s, Backend backend) const {
 void Caster::Impl::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   try {
     size_slot(s, rays.size(), false);
-    s.in_place = false;
     if (gpu_takes(s, backend)) {
       try {
         place_on_gpu(s);  // the rays go straight into the device's mapped memory
@@ -141,16 +140,16 @@ OpenBatch Caster::Impl::open(uint32_t rays, BatchQuery query) {
   try {
     s.query = query;
     size_slot(s, rays, false);
-    s.in_place = false;
+    bool on_gpu = false;
     if (gpu_takes(s, choose(rays))) {
       try {
         place_on_gpu(s);
-        s.in_place = true;
+        on_gpu = true;
       } catch (const GpuError& e) {
         if (e.lost) gpu_failed(e.what());
       }
     }
-    if (!s.in_place) {
+    if (!on_gpu) {
       s.rays.resize(rays);  // keeps its capacity: no allocation once warm
       s.placed = s.rays;
     }
@@ -176,7 +175,7 @@ Ticket Caster::Impl::submit(const OpenBatch& batch) {
     s.state = Slot::Running;
   }
   try {
-    if (s.in_place) {
+    if (s.placed_on_gpu()) {
       try {
         start_gpu(s);
         return t;

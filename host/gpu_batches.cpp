@@ -127,9 +127,7 @@ void Caster::Impl::start_gpu(Slot& s) {
 
 void Caster::Impl::gpu_refused(Slot& s, const GpuError& e) {
   if (e.lost) gpu_failed(e.what());
-  s.rays.assign(s.placed.begin(), s.placed.end());  // the mapped memory is the method's, the next batch's
-  s.placed = s.rays;
-  s.in_place = false;
+  s.rays_to_own_array();  // the mapped memory is the method's, the next batch's
   start_cpu(s);
 }
 

@@ -320,7 +320,7 @@ TEST(Gpu, ABatchBeyondTheDeviceMemoryIsRefusedUpFront) {
   EXPECT_EQ(method->refusal(uint32_t(rays.size())), "");
   const uint64_t too_many = context().mapped_heap_bytes() / (32 + 28 + 4 * (1 + 2 * 4096)) + 4096;
   const std::string why = method->refusal(too_many);
-  for (const std::string word : {std::string("aabbtree"), std::to_string(too_many) + " rays",
+  for (const std::string& word : {std::string("aabbtree"), std::to_string(too_many) + " rays",
                                  std::string("rows of 4096 hits a ray")})
     EXPECT_NE(why.find(word), std::string::npos) << "'" << word << "' not in: " << why;
   // The heap where it is under 4 GiB (lavapipe's 2 GiB), else the 32-bit

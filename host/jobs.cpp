@@ -1,6 +1,10 @@
 #include "host/jobs.h"
 
 #include <algorithm>
+#include <string>
+#include <system_error>
+
+#include "meshcast/errors.h"
 
 namespace meshcast::host {
 
@@ -9,9 +13,15 @@ WorkerPool::WorkerPool(uint32_t threads) {
   queue_.reserve(64);
   try {
     for (uint32_t i = 0; i < threads; ++i) workers_.emplace_back([this] { loop(); });
-  } catch (...) {  // the system refused a thread: those started are joined, not destroyed joinable (std::terminate)
+  } catch (const std::system_error& e) {
+    // The system refused a thread (its limit of threads or of address
+    // space): those started are joined, not destroyed joinable
+    // (std::terminate), and the caller hears why in words.
+    const size_t started = workers_.size();
     stop();
-    throw;
+    throw Error("meshcast: the system refused to start worker thread " + std::to_string(started + 1) + " of " +
+                std::to_string(threads) + " (" + e.what() +
+                "): ask for fewer threads, or raise the process's limits on threads and address space");
   }
 }
 

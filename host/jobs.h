@@ -16,7 +16,9 @@ namespace meshcast::host {
 // keeps its capacity, so after warm-up posting allocates nothing.
 class WorkerPool : public JobSystem {
  public:
-  explicit WorkerPool(uint32_t threads);  // 0: std::thread::hardware_concurrency()
+  // 0: std::thread::hardware_concurrency(). meshcast::Error, saying which
+  // thread, when the system refuses to start one.
+  explicit WorkerPool(uint32_t threads);
   ~WorkerPool() override;
   void run(uint32_t count, const std::function<void(uint32_t)>& work) override;
   uint32_t threads() const override { return uint32_t(workers_.size()); }

@@ -82,7 +82,12 @@ void save_blob(const std::string& path, std::span<const uint8_t> blob);
 
 // A blob file mapped read-only into memory: no copy, the pages shared with
 // every process that maps it. InputError naming the path when it cannot be
-// opened or mapped. The bytes live as long as the MappedBlob.
+// opened or mapped. The bytes live as long as the MappedBlob, and are the
+// file's as it is now: a BlobView validates them once, so the file must not
+// be rewritten in place while it is mapped (its new bytes would be walked
+// unvalidated), and a file truncated under the map raises SIGBUS on the
+// next read. save_blob() renames a new file over the old name, which a
+// mapping of the old file never sees; load_blob() keeps a copy instead.
 class MappedBlob {
  public:
   explicit MappedBlob(const std::string& path);

@@ -2,8 +2,8 @@
 
 Two ways in:
 
-* meshcast's own: ``build(vertices, triangles)`` (or ``load(path)``, memory-
-  mapped) gives a :class:`Blob`, the mesh's whole ray-cast structure in one
+* meshcast's own: ``build(vertices, triangles)`` (or ``load(path)``, read
+  into memory or, with ``mmap=True``, mapped) gives a :class:`Blob`, the mesh's whole ray-cast structure in one
   buffer of about 14 bytes a triangle; ``blob.cast(origins, directions)``
   answers the closest hit, any hit or every hit of each ray, with face
   culling, on every core or on the GPU (``backend="vulkan"``). A
@@ -19,10 +19,12 @@ and the triangle test is watertight: a ray through a shared edge or vertex
 never slips between its triangles. The closest or any hit there is one of
 them; ``query="all"`` lists every triangle holding the point, each once,
 while RaycastingScene's count_intersections and list_intersections count
-such a crossing of one geometry once for each facing among its triangles
-there: one through an edge or a convex vertex, in and out for a ray that
-touches a closed mesh's silhouette edge (so parity tells inside from
-outside), but two for a ray exactly through a saddle vertex. A ray with a
+a surface the ray crosses there once, decided from the triangles' corners
+(as a ray moved off the point by an infinitely small step would count),
+never from their winding: once through an edge or any vertex the ray
+crosses, twice or not at all where it only touches a closed mesh (a
+silhouette edge or vertex), so parity tells inside from outside on any
+closed mesh, wound one way, the other or both. A ray with a
 NaN or infinite component, a zero direction or ``t_min > t_max`` is refused
 with ``ValueError`` naming it (Open3D answers such a ray as a miss).
 
@@ -61,12 +63,27 @@ def build(vertices, triangles, layout="auto", max_bytes=0, leaf_size=0, threads=
     return _meshcast._build(vertices, triangles, layout, float(max_bytes), leaf_size, threads, name)
 
 
-def load(path):
-    """A blob file, memory-mapped read-only and validated (``Blob.mapped``)."""
+def load(path, mmap=False):
+    """A blob file (``Blob.save``), validated.
+
+    By default the file is read whole into memory: the Blob holds its own
+    copy of the bytes that were validated, and rewriting, truncating or
+    deleting the file afterwards changes nothing it answers.
+
+    ``mmap=True`` maps the file read-only instead (``Blob.mapped``): no copy,
+    and the pages are shared with every process that maps the same file
+    (many workers on one machine). The bytes are validated once, when the
+    file is loaded, and then read where they lie, so the file must not
+    change while the Blob lives: replace it with a new file (``Blob.save``
+    writes a new file and renames it over the old name, which a mapping of
+    the old file does not see). A file rewritten in place is read as it now
+    is, unvalidated: wrong answers, or a crash on corrupted bytes; a file
+    truncated under the map kills the process with SIGBUS on the next cast.
+    """
     path = _os.fspath(path)
     with open(path, "rb"):  # the system's own error for a missing or unreadable file
         pass
-    return _meshcast._load(path)
+    return _meshcast._load(path, bool(mmap))
 
 
 def from_bytes(data, name="bytes"):
@@ -148,9 +165,9 @@ class RaycastingScene:
 
     def count_intersections(self, rays, nthreads=0):
         """How many times each ray crosses the meshes for t >= 0 (int32): a
-        crossing through a shared edge or a convex vertex counts once, so
-        the parity tells inside from outside of a closed mesh (the module's
-        documentation says where it does not)."""
+        crossing through a shared edge or a vertex counts once, whichever
+        way the triangles are wound, so the parity tells inside from
+        outside of a closed mesh."""
         return _tensors(self._scene.count_intersections(_array(rays), self._threads(nthreads)))
 
     def list_intersections(self, rays, nthreads=0):

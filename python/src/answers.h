@@ -129,7 +129,7 @@ py::dict cast_answer(const Target& target, const RayArrays& rays, Query query, C
     return all_hits_answer(all, rays.count, uv);
   }
   const OneHitAnswer<Record> a(out, rays.shape, uv);
-  uint64_t refused = 0;
+  Refused refused;
   {
     py::gil_scoped_release release;
     refused = cast_hits(target, rays, query, cull, outputs, threads, [&a](size_t i, const Record& h) { a.write(i, h); });

@@ -190,14 +190,22 @@ std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
   return "";
 }
 
-void raise_for_refused(const RayArrays& rays, uint64_t refused, bool float_origin) {
-  if (refused == 0) return;
-  for (size_t i = 0; i < rays.count; ++i) {
-    std::string why = refusal(rays, i, float_origin);
-    if (!why.empty())
-      throw py::value_error(why + " (" + std::to_string(refused) + " of " + std::to_string(rays.count) +
-                            " rays refused)");
+void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin) {
+  if (refused.count == 0) return;
+  const size_t i = std::min(refused.first, rays.count - 1);
+  std::string why = refusal(rays, i, float_origin);
+  if (why.empty()) {
+    // The ray is fine in the world but not in the frame of a geometry it
+    // passes: that frame's rounding would answer it wrongly, so it is not
+    // answered at all.
+    RayD r = rays.ray_d(i);
+    double d[3] = {r.dir[0], r.dir[1], r.dir[2]};
+    why = "rays[" + std::to_string(i) + "]: origin " + triple(r.org) + ", direction " + triple(d) +
+          " cannot be walked in the frame of a geometry it passes: the origin lies beyond 2^100 of that geometry's "
+          "position (or its scale takes the direction beyond 2^126); cast it from nearer the geometry";
   }
+  throw py::value_error(why + " (" + std::to_string(refused.count) + " of " + std::to_string(rays.count) +
+                        " rays refused)");
 }
 
 void vertex_box(const py::handle& vertices, double lo[3], double hi[3]) {
@@ -239,9 +247,9 @@ Mesh mesh_from_arrays(const py::handle& vertices, const py::handle& triangles, c
   for (size_t i = 0; i < mesh.triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const int64_t index = in[i * 3 + k];
-      if (index < 0 || uint64_t(index) >= vertex_count)
+      if (index < 0 || uint64_t(index) >= vertex_count)  // named as the caller's array holds it, not as converted
         throw py::value_error("triangles[" + std::to_string(i) + ", " + std::to_string(k) + "] = " +
-                              std::to_string(index) + ": a vertex index must lie in [0, " +
+                              py::str(t[py::make_tuple(i, k)]).cast<std::string>() + ": a vertex index must lie in [0, " +
                               std::to_string(vertex_count) + ")");
       mesh.triangles[i][k] = uint32_t(index);
     }

@@ -107,11 +107,20 @@ void set_segment(RayArrays& rays, const py::handle& t_min, const py::handle& t_m
 // their origins in double, whatever their type.
 // `float_origin`: the origin as a blob walks it, rounded to float.
 std::string refusal(const RayArrays& rays, size_t i, bool float_origin);
-// After a batch that counted `refused` rays not walkable: ValueError for
-// the first ray that has a refusal(); nothing when none has (a scene counts
-// a ray some instance's frame cannot take, which it answers through the
-// others).
-void raise_for_refused(const RayArrays& rays, uint64_t refused, bool float_origin);
+// The rays a cast's walk refused: how many, and the first of them in the
+// caller's order (cast.h finds it again ray by ray in the chunks that
+// refused any: a refusal is rare, and a walk reports only a count).
+struct Refused {
+  uint64_t count = 0;
+  size_t first = SIZE_MAX;
+};
+
+// After a batch that refused rays: ValueError naming the first of them,
+// with its refusal(), or, for a ray fine in the world that the frame of
+// some geometry cannot take (a translation puts its origin beyond the
+// walkers' range there), saying so. A refused ray is never answered as a
+// miss: the geometry it cannot see may lie on it.
+void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin);
 
 // A mesh from (V,3) vertices and (T,3) triangles: indices int32, uint32 or
 // int64 (any integer dtype is read), each checked against the vertex count;

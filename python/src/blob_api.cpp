@@ -3,6 +3,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <optional>
 
@@ -26,14 +28,35 @@ PyBlob::PyBlob(std::shared_ptr<const MappedBlob> file, std::string name)
   view_.emplace(mapped_->bytes(), name_);
 }
 
+PyBlob::~PyBlob() {
+  GpuCasters* gpu = gpu_.load();
+  if (gpu && gpu->process == getpid()) delete gpu;  // a parent's casters are left alone (gpu_casters())
+}
+
+PyBlob::GpuCasters& PyBlob::gpu_casters() {
+  const pid_t process = getpid();
+  GpuCasters* gpu = gpu_.load();
+  while (!gpu || gpu->process != process) {
+    auto* made = new GpuCasters;
+    made->process = process;
+    if (gpu_.compare_exchange_strong(gpu, made)) return *made;  // a parent's set, if any, is dropped unread
+    delete made;  // another thread of this process made one first: `gpu` is that one now
+  }
+  return *gpu;
+}
+
 host::Caster& PyBlob::vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& lock) {
-  lock = std::unique_lock<std::mutex>(vulkan_mutex_);
-  std::unique_ptr<host::Caster>& caster = casters_[uint32_t(outputs)];
+  GpuCasters& gpu = gpu_casters();
+  lock = std::unique_lock<std::mutex>(gpu.mutex);
+  std::unique_ptr<host::Caster>& caster = gpu.casters[uint32_t(outputs)];
   if (!caster) {
     host::CasterOptions options;
     options.backend = host::Backend::Vulkan;
     options.frames = 1;  // one batch at a time, under the lock
     options.hit_outputs = outputs;
+    // The process's pool, not one more of every core's threads a blob.
+    if (!gpu.pool) gpu.pool = shared_pool(thread_count(0));
+    options.jobs = gpu.pool.get();
     caster = std::make_unique<host::Caster>(view_->bytes(), name_, options);
   }
   if (!caster->gpu_available()) throw GpuError("backend \"vulkan\": " + caster->gpu_error());
@@ -63,7 +86,10 @@ py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery
     // mapped memory when the GPU answers it.
     const host::OpenBatch batch = caster.open(uint32_t(rays.count), query);
     rays.pack(0, rays.count, batch.rays.data());
-    for (const Ray& r : batch.rays) all.refused += !ray_is_walkable(r);
+    for (size_t i = 0; i < rays.count; ++i)
+      if (!ray_is_walkable(batch.rays[i])) {
+        if (all.refused.count++ == 0) all.refused.first = i;
+      }
     const host::Ticket ticket = caster.submit(batch);
     if (one) {
       std::vector<Hit> hits(rays.count);
@@ -100,7 +126,10 @@ std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& tria
   const uint32_t build_threads = threads == 0 ? 0 : thread_count(threads, "threads");
   const double no_centre[3] = {0, 0, 0};
   const Mesh mesh = mesh_from_arrays(vertices, triangles, no_centre);
-  if (!(max_bytes >= 0)) throw py::value_error("max_bytes: " + std::to_string(max_bytes) + " is negative");
+  // The value as Python writes it (nan, 1e+39, 1000.5), as the caller gave it.
+  const std::string max_bytes_text = py::repr(py::float_(max_bytes)).cast<std::string>();
+  if (std::isnan(max_bytes)) throw py::value_error("max_bytes: " + max_bytes_text + " is not a number of bytes");
+  if (max_bytes < 0) throw py::value_error("max_bytes: " + max_bytes_text + " is negative");
   std::vector<uint8_t> bytes;
   {
     py::gil_scoped_release release;
@@ -118,7 +147,7 @@ std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& tria
       bytes = build_blob(mesh, options, name);
       if (max_bytes > 0 && double(bytes.size()) > max_bytes)
         throw InputError(name + ": the " + layout + " blob is " + std::to_string(bytes.size()) +
-                         " bytes, above max_bytes " + std::to_string(uint64_t(max_bytes)) +
+                         " bytes, above max_bytes " + max_bytes_text +
                          " (layout=\"auto\" chooses a layout within it)");
     }
   }
@@ -136,14 +165,15 @@ uint32_t checked_max_hits(long long max_hits) {
 void register_blob(py::module_& m) {
   py::class_<PyBlob, std::shared_ptr<PyBlob>>(m, "Blob", R"(A mesh's ray-cast structure: one byte buffer, validated once.
 
-Made by meshcast.build() or meshcast.load() (memory-mapped). Any number of
+Made by meshcast.build(), meshcast.load() (the file read into memory, or
+memory-mapped with mmap=True) or meshcast.from_bytes(). Any number of
 Python threads may cast through one Blob at once.)")
       .def_property_readonly("layout", [](const PyBlob& b) { return layout_name(b.view().layout()); },
                              "The layout: tree format / triangle format.")
       .def_property_readonly("triangle_count", [](const PyBlob& b) { return b.view().triangle_count(); })
       .def_property_readonly("nbytes", [](const PyBlob& b) { return b.view().bytes().size(); },
                              "The blob's bytes: all the memory the structure takes (the mesh included).")
-      .def_property_readonly("mapped", &PyBlob::mapped, "Whether the bytes are a file's, mapped read-only.")
+      .def_property_readonly("mapped", &PyBlob::mapped, "Whether the bytes are a file's, mapped read-only (load(path, mmap=True)).")
       .def_property_readonly("name", &PyBlob::name)
       .def(
           "save", [](const PyBlob& b, const std::string& path) { save_blob(path, b.view().bytes()); },
@@ -169,11 +199,16 @@ Python threads may cast through one Blob at once.)")
         py::arg("max_bytes") = 0.0, py::arg("leaf_size") = 0, py::arg("threads") = 0, py::arg("name") = "mesh");
   m.def(
       "_load",
-      [](const std::string& path) {
-        auto file = std::make_shared<const MappedBlob>(path);
-        return std::make_shared<PyBlob>(file, path);
+      [](const std::string& path, bool mmap) {
+        if (mmap) return std::make_shared<PyBlob>(std::make_shared<const MappedBlob>(path), path);
+        std::vector<uint8_t> bytes;
+        {
+          py::gil_scoped_release release;
+          bytes = load_blob(path);
+        }
+        return std::make_shared<PyBlob>(std::move(bytes), path);
       },
-      py::arg("path"));
+      py::arg("path"), py::arg("mmap") = false);
   m.def(
       "_from_bytes",
       [](const py::bytes& data, const std::string& name) {

@@ -5,6 +5,7 @@
 // the GIL.
 #pragma once
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
@@ -49,15 +50,39 @@ struct SceneTarget {
   }
 };
 
+// Tallies a cast's refusals from its chunks, on any thread.
+class RefusedTally {
+ public:
+  // A chunk of rays from `begin` refused `count`; refuses(i) says whether
+  // ray begin + i alone is refused.
+  template <class Refuses>
+  void add(uint64_t count, size_t begin, size_t n, const Refuses& refuses) {
+    if (count == 0) return;
+    count_ += count;
+    for (size_t i = 0; i < n; ++i)
+      if (refuses(i)) {
+        size_t seen = first_.load();
+        while (begin + i < seen && !first_.compare_exchange_weak(seen, begin + i)) {
+        }
+        return;
+      }
+  }
+  Refused result() const { return {count_.load(), first_.load()}; }
+
+ private:
+  std::atomic<uint64_t> count_{0};
+  std::atomic<size_t> first_{SIZE_MAX};
+};
+
 // Closest or any hit: write(i, hit) for every ray i. Returns the rays the
 // walk refused (raise_for_refused names the first).
 template <class Target, class Write>
-uint64_t cast_hits(const Target& target, const RayArrays& rays, Query query, Cull cull, HitOutputs outputs,
+Refused cast_hits(const Target& target, const RayArrays& rays, Query query, Cull cull, HitOutputs outputs,
                    uint32_t threads, const Write& write) {
   using RayRecord = typename Target::RayRecord;
   using Record = typename Target::Record;
   const Chunks plan = plan_chunks(rays.count, threads);
-  std::atomic<uint64_t> refused{0};
+  RefusedTally refused;
   for_each_chunk(plan, threads, [&](size_t chunk) {
     // A thread's buffers, kept from chunk to chunk and call to call.
     static thread_local std::vector<RayRecord> packed;
@@ -68,10 +93,14 @@ uint64_t cast_hits(const Target& target, const RayArrays& rays, Query query, Cul
     target.pack(rays, begin, n, packed.data());
     const uint64_t r = target.trace(std::span<const RayRecord>(packed.data(), n), std::span<Record>(hits.data(), n),
                                     outputs, query, cull);
-    if (r) refused += r;
+    refused.add(r, begin, n, [&](size_t i) {
+      Record alone;
+      return target.trace(std::span<const RayRecord>(&packed[i], 1), std::span<Record>(&alone, 1), outputs, query,
+                          cull) != 0;
+    });
     for (size_t i = 0; i < n; ++i) write(begin + i, hits[i]);
   });
-  return refused.load();
+  return refused.result();
 }
 
 // Every hit: the rows of each chunk, in ray order, for the caller to
@@ -79,7 +108,7 @@ uint64_t cast_hits(const Target& target, const RayArrays& rays, Query query, Cul
 template <class Target>
 struct AllHits {
   std::vector<HitRows<typename Target::Record>> parts;
-  uint64_t refused = 0;
+  Refused refused;
   size_t hits() const {
     size_t total = 0;
     for (const auto& p : parts) total += p.hits.size();
@@ -112,7 +141,7 @@ AllHits<Target> cast_all(const Target& target, const RayArrays& rays, Cull cull,
   const Chunks plan = plan_chunks(rays.count, threads);
   AllHits<Target> all;
   all.parts.resize(plan.chunks);
-  std::atomic<uint64_t> refused{0};
+  RefusedTally refused;
   for_each_chunk(plan, threads, [&](size_t chunk) {
     static thread_local std::vector<RayRecord> packed;
     const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
@@ -121,9 +150,13 @@ AllHits<Target> cast_all(const Target& target, const RayArrays& rays, Cull cull,
     auto& rows = all.parts[chunk];
     rows.max_hits = max_hits;
     const uint64_t r = target.trace_all(std::span<const RayRecord>(packed.data(), n), rows, outputs, cull);
-    if (r) refused += r;
+    refused.add(r, begin, n, [&](size_t i) {
+      HitRows<typename Target::Record> alone;
+      alone.max_hits = 1;
+      return target.trace_all(std::span<const RayRecord>(&packed[i], 1), alone, outputs, cull) != 0;
+    });
   });
-  all.refused = refused.load();
+  all.refused = refused.result();
   return all;
 }
 

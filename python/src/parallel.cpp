@@ -4,7 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <map>
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -26,34 +26,38 @@ uint32_t thread_count(long long requested, const char* what) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-namespace {
-
-// One pool for each thread count asked for, made on first use and kept for
-// the process: a call's threads are its pool's, so calls of different
-// counts from several Python threads do not share one queue of a wrong
-// width. WorkerPool::run takes posts from any thread. A child forked from
-// the process (multiprocessing's default on Linux) has the pools but none
-// of their threads: it makes its own, and leaves the parent's alone
-// (joining threads it does not have would wait for ever).
-host::WorkerPool& pool_of(uint32_t threads) {
+// The process's one pool, as wide as the most threads a call has asked
+// for: a call of fewer threads runs that many of its workers (below), so
+// a sweep of thread counts keeps one pool, not one a count. A wider call
+// replaces the pool; the narrower one is joined once the calls still on it
+// return (each holds it). A child forked from the process
+// (multiprocessing's default on Linux) has the pool but none of its
+// threads: it makes its own and leaves the parent's alone (joining threads
+// it does not have would wait for ever).
+std::shared_ptr<host::WorkerPool> shared_pool(uint32_t threads) {
   static std::mutex mutex;
-  static std::map<uint32_t, std::unique_ptr<host::WorkerPool>> pools;
+  static std::shared_ptr<host::WorkerPool> pool;
   static pid_t owner = getpid();
   std::lock_guard<std::mutex> lock(mutex);
   if (owner != getpid()) {
-    for (auto& [count, pool] : pools) (void)pool.release();
-    pools.clear();
+    new std::shared_ptr<host::WorkerPool>(std::move(pool));  // the parent's, never destroyed here
     owner = getpid();
   }
-  std::unique_ptr<host::WorkerPool>& pool = pools[threads];
-  if (!pool) pool = std::make_unique<host::WorkerPool>(threads);
-  return *pool;
+  if (!pool || pool->threads() < threads) pool = std::make_shared<host::WorkerPool>(threads);
+  return pool;
 }
 
-}  // namespace
-
 void for_each_chunk(const Chunks& plan, uint32_t threads, const std::function<void(size_t)>& chunk) {
-  host::for_each_chunk(plan, threads > 1 ? &pool_of(threads) : nullptr, chunk);
+  if (threads <= 1 || plan.chunks <= 1) return host::for_each_chunk(plan, nullptr, chunk);
+  const std::shared_ptr<host::WorkerPool> pool = shared_pool(threads);
+  // `threads` runners on the pool, each taking the plan's chunks in turn:
+  // at most that many run at once, however wide the pool is.
+  Chunks runners;
+  runners.chunks = runners.count = std::min<size_t>(threads, plan.chunks);
+  std::atomic<size_t> next{0};
+  host::for_each_chunk(runners, pool.get(), [&](size_t) {
+    for (size_t c = next++; c < plan.chunks; c = next++) chunk(c);
+  });
 }
 
 }  // namespace meshcast::python

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cmath>
+#include <functional>
 #include <algorithm>
 #include <memory>
 #include <span>
@@ -18,6 +19,7 @@
 #include "meshcast/scene.h"
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
+#include "python/src/crossings.h"
 
 namespace meshcast::python {
 
@@ -80,50 +82,21 @@ void unpack_normal(const PackedNormal& p, float out[3]) {
   out[0] = float(x / length), out[1] = float(y / length), out[2] = float(z / length);
 }
 
-// A geometry's normals, and every geometry's as a cast sees them.
-using GeometryNormals = std::shared_ptr<const std::vector<PackedNormal>>;
-using Normals = std::vector<GeometryNormals>;
+// What a geometry keeps beside its blob (which the scene holds): its
+// triangles' normals, and their corners for the crossings (crossings.h).
+struct Geometry {
+  std::vector<PackedNormal> normals;
+  TriangleCorners corners;
+  Geometry(std::vector<PackedNormal> normals, std::span<const uint8_t> blob)
+      : normals(std::move(normals)), corners(blob) {}
+};
+// Every geometry, as a cast sees them.
+using Geometries = std::vector<std::shared_ptr<const Geometry>>;
+// A frame's geometries' corners, by geometry (crossings.h).
+using CornersOf = std::function<const TriangleCorners&(uint32_t geometry)>;
 
-// Where a ray crosses a mesh exactly on an edge or a vertex, the watertight
-// test reports every triangle there (its edge function is exactly 0 for
-// each), each at its own t, equal but for rounding. Open3D's users count
-// crossings (inside/outside tests by parity, the surfaces a LiDAR return
-// passed): hits of one geometry within 2^-20 of each other's t make one
-// crossing for each facing among them. Through an edge, or a convex
-// vertex, into a closed mesh the triangles all face the ray alike: one
-// crossing. A ray that only touches the mesh there (a silhouette edge)
-// meets a front face and a back face: two, in and out, and the parity
-// stays right. Not decided right: a ray exactly through a saddle vertex
-// (triangles around it facing both ways although the ray crosses once)
-// counts two; two surfaces of one geometry closer than 2^-20 of t count
-// one.
-// The geometry of a hit: a scene's instance, or 0 for the one geometry's
-// blob walked alone (RaycastingScene::Frame).
-inline uint32_t geometry_of(const SceneHit& h) { return h.instance; }
-inline uint32_t geometry_of(const Hit& h) { return h.triangle == kNoHit ? kNoHit : 0; }
 inline SceneHit scene_hit(const SceneHit& h) { return h; }
 inline SceneHit scene_hit(const Hit& h) { return {h.t, geometry_of(h), h.triangle, h.u, h.v}; }
-
-template <class Record, class Keep>
-void crossings(std::span<const Record> row, const float dir[3], const Normals& normals, const Keep& keep) {
-  for (size_t g = 0; g < row.size();) {
-    const float t0 = row[g].t;
-    const uint32_t geometry = geometry_of(row[g]);
-    const float tol = std::ldexp(std::fabs(t0), -20);
-    bool front = false, back = false;
-    size_t end = g;
-    do {  // the first hit always, so a group ends even on a NaN t
-      float n[3];
-      unpack_normal((*normals[geometry])[row[end].triangle], n);
-      const bool faces_back = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0;
-      bool& seen = faces_back ? back : front;
-      if (!seen) keep(row[end]);
-      seen = true;
-      ++end;
-    } while (end < row.size() && geometry_of(row[end]) == geometry && row[end].t - t0 <= tol);
-    g = end;
-  }
-}
 
 class RaycastingScene {
  public:
@@ -135,10 +108,10 @@ class RaycastingScene {
     std::string name;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      name = "geometry " + std::to_string(normals_.size());
+      name = "geometry " + std::to_string(geometries_.size());
     }
     Mesh mesh = mesh_from_arrays(vertices, triangles, centre);
-    auto normals = std::make_shared<std::vector<PackedNormal>>(mesh.triangle_count());
+    std::vector<PackedNormal> normals(mesh.triangle_count());
     std::vector<uint8_t> blob;
     {
       py::gil_scoped_release release;
@@ -154,7 +127,7 @@ class RaycastingScene {
         }
         const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                              e1[0] * e2[1] - e1[1] * e2[0]};
-        (*normals)[i] = pack_normal(n);
+        normals[i] = pack_normal(n);
       }
     }
     blob.shrink_to_fit();  // the builder's spare capacity would be memory the scene holds
@@ -163,7 +136,7 @@ class RaycastingScene {
     Transform placed;
     for (int k = 0; k < 3; ++k) placed.translation[k] = centre[k];
     const InstanceId id = scene_.add_instance(mesh_id, placed);
-    normals_.push_back(std::move(normals));
+    geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id)));
     if (id == 0) {  // the one geometry's blob (validated again: cheap beside its build)
       first_.emplace(scene_.mesh_blob(mesh_id), name);
       std::copy(centre, centre + 3, first_centre_);
@@ -185,7 +158,7 @@ class RaycastingScene {
     float* n_out = normals.mutable_data();
     uint32_t* g_out = geometry.mutable_data();
     uint32_t* p_out = primitive.mutable_data();
-    uint64_t refused;
+    Refused refused;
     {
       py::gil_scoped_release release;
       const Frame f = frame();
@@ -198,7 +171,7 @@ class RaycastingScene {
                            p_out[i] = h.triangle;
                            uv_out[2 * i] = h.u;
                            uv_out[2 * i + 1] = h.v;
-                           unpack_normal(geometry != kNoHit ? (*(*f.normals)[geometry])[h.triangle] : PackedNormal{},
+                           unpack_normal(geometry != kNoHit ? (*f.geometries)[geometry]->normals[h.triangle] : PackedNormal{},
                                          n_out + 3 * i);
                          });
       });
@@ -220,7 +193,7 @@ class RaycastingScene {
     const uint32_t threads = thread_count(nthreads);
     py::array_t<bool> occluded(rays.shape);
     bool* out = occluded.mutable_data();
-    uint64_t refused;
+    Refused refused;
     {
       py::gil_scoped_release release;
       refused = frame().visit([&](const auto& target) {
@@ -236,10 +209,10 @@ class RaycastingScene {
     const RayArrays rays = rays_from_six(rays_in);
     py::array_t<int32_t> counts(rays.shape);
     int32_t* out = counts.mutable_data();
-    every_hit(rays, HitOutputs::None, nthreads, [&](const auto& all, const Normals& normals) {
+    every_hit(rays, HitOutputs::None, nthreads, [&](const auto& all, const CornersOf& corners_of) {
       all.for_each_row([&](size_t i, uint32_t found, auto row) {
         uint64_t n = found - row.size();  // beyond the kept hits: each counted
-        crossings(row, rays.ray(i).dir, normals, [&n](const auto&) { ++n; });
+        crossings(row, rays.ray(i).dir, corners_of, [&n](const auto&) { ++n; });
         out[i] = int32_t(std::min<uint64_t>(n, INT32_MAX));
       });
     });
@@ -255,12 +228,12 @@ class RaycastingScene {
     std::vector<SceneHit> listed;
     std::vector<uint32_t> splits_of(rays.count + 1, 0);
     uint64_t dropped = 0;
-    every_hit(rays, HitOutputs::Uv, nthreads, [&](const auto& all, const Normals& normals) {
+    every_hit(rays, HitOutputs::Uv, nthreads, [&](const auto& all, const CornersOf& corners_of) {
       listed.reserve(all.hits());
       all.for_each_row([&](size_t i, uint32_t found, auto row) {
         splits_of[i] = uint32_t(listed.size());
         dropped += found - row.size();
-        crossings(row, rays.ray(i).dir, normals, [&listed](const auto& h) { listed.push_back(scene_hit(h)); });
+        crossings(row, rays.ray(i).dir, corners_of, [&listed](const auto& h) { listed.push_back(scene_hit(h)); });
       });
       splits_of[rays.count] = uint32_t(listed.size());
     });
@@ -307,12 +280,13 @@ class RaycastingScene {
     return answer;
   }
 
-  // The bytes the scene holds: every geometry's blob, its normals and the
-  // top level over the instances.
+  // The bytes the scene holds: every geometry's blob, its normals (and the
+  // corners' table, once a ray through an edge made it) and the top level
+  // over the instances.
   size_t nbytes() const {
     std::lock_guard<std::mutex> lock(mutex_);
     size_t bytes = scene_.owned_blob_bytes() + scene_.top_level_bytes();
-    for (const auto& n : normals_) bytes += n->capacity() * sizeof(PackedNormal);
+    for (const auto& g : geometries_) bytes += g->normals.capacity() * sizeof(PackedNormal) + g->corners.nbytes();
     return bytes;
   }
 
@@ -326,7 +300,7 @@ class RaycastingScene {
   // answers without the scene's top level and instance records.
   struct Frame {
     SceneTarget target;
-    std::shared_ptr<const Normals> normals;
+    std::shared_ptr<const Geometries> geometries;
     const BlobView* single = nullptr;
     const double* centre = nullptr;
     template <class Fn>
@@ -339,37 +313,39 @@ class RaycastingScene {
     std::lock_guard<std::mutex> lock(mutex_);
     if (changed_) {
       scene_.commit();
-      committed_normals_ = std::make_shared<const Normals>(normals_);
+      committed_ = std::make_shared<const Geometries>(geometries_);
       changed_ = false;
     }
-    Frame f{SceneTarget(scene_, 0xFF), committed_normals_};
-    if (committed_normals_->size() == 1) f.single = &*first_, f.centre = first_centre_;
+    Frame f{SceneTarget(scene_, 0xFF), committed_};
+    if (committed_->size() == 1) f.single = &*first_, f.centre = first_centre_;
     return f;
   }
   // Every hit of every ray (as many as a row keeps: kMaxHitsLimit; the
-  // rest counted), handed to use(all, normals) without the GIL, for the
-  // crossings to be told from with the normals of the frame they were
+  // rest counted), handed to use(all, corners_of) without the GIL, for the
+  // crossings to be told from with the corners of the frame they were
   // found in.
   template <class Use>
   void every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads, const Use& use) {
     const uint32_t threads = thread_count(nthreads);
-    uint64_t refused = 0;
+    Refused refused;
     {
       py::gil_scoped_release release;
       const Frame f = frame();
       f.visit([&](const auto& target) {
         const auto all = cast_all(target, rays, Cull::None, outputs, kMaxHitsLimit, threads);
         refused = all.refused;
-        if (refused == 0) use(all, *f.normals);
+        const Geometries& geometries = *f.geometries;
+        if (refused.count == 0) use(all, CornersOf([&geometries](uint32_t g) -> const TriangleCorners& { return geometries[g]->corners; }));
       });
     }
+    // Before any answer array reaches the caller: a refused ray has none.
     raise_for_refused(rays, refused, false);
   }
   const uint32_t build_threads_;  // BuildOptions::threads of add_triangles (0: every core)
   mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
-  Normals normals_;  // every geometry's, added so far
-  std::shared_ptr<const Normals> committed_normals_ = std::make_shared<const Normals>();
+  Geometries geometries_;  // every geometry's, added so far
+  std::shared_ptr<const Geometries> committed_ = std::make_shared<const Geometries>();
   std::optional<BlobView> first_;  // geometry 0's blob (in the scene), walked alone while it is the only one
   double first_centre_[3] = {0, 0, 0};
   bool changed_ = false;

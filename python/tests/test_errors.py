@@ -214,8 +214,9 @@ def test_corrupt_blob_file(grid, tmp_path, damage):
     else:
         data = bytearray(len(data))
     path.write_bytes(bytes(data))
-    with pytest.raises(ValueError):
-        meshcast.load(str(path))
+    for mmap in (False, True):
+        with pytest.raises(ValueError):
+            meshcast.load(str(path), mmap=mmap)
 
 
 def test_scene_bad_ids(grid):

@@ -31,10 +31,13 @@ def test_save_load_round_trip(sphere, tmp_path, layout):
     b.save(str(path))
     assert os.path.getsize(path) == b.nbytes
     loaded = meshcast.load(str(path))
-    assert loaded.mapped, "load maps the file"
-    assert loaded.layout == b.layout and loaded.triangle_count == b.triangle_count and loaded.nbytes == b.nbytes
-    for query in ("closest", "any", "all"):
-        same(b.cast(o, d, query=query, uv=True), loaded.cast(o, d, query=query, uv=True))
+    assert not loaded.mapped, "load reads the file into memory"
+    mapped = meshcast.load(str(path), mmap=True)
+    assert mapped.mapped, "load(mmap=True) maps the file"
+    for blob in (loaded, mapped):
+        assert blob.layout == b.layout and blob.triangle_count == b.triangle_count and blob.nbytes == b.nbytes
+        for query in ("closest", "any", "all"):
+            same(b.cast(o, d, query=query, uv=True), blob.cast(o, d, query=query, uv=True))
     # Saved again, the same bytes.
     loaded.save(str(tmp_path / "again.mcb"))
     assert (tmp_path / "again.mcb").read_bytes() == path.read_bytes()
@@ -52,7 +55,7 @@ def test_loaded_blob_outlives_its_file_name(sphere, tmp_path):
     b = meshcast.build(v, f)
     path = tmp_path / "gone.mcb"
     b.save(str(path))
-    loaded = meshcast.load(str(path))
+    loaded = meshcast.load(str(path), mmap=True)
     os.remove(path)
     same(b.cast(o, d), loaded.cast(o, d))
 

@@ -1,0 +1,89 @@
+// How RaycastingScene's count_intersections and list_intersections count
+// the hits of one ray: a crossing of a surface counts once, whether the ray
+// passes through a triangle's inside, a shared edge or a vertex, and
+// whichever way the triangles are wound.
+//
+// Where a ray meets a mesh exactly on an edge or a vertex, the watertight
+// test reports every triangle there (its edge function is exactly 0 for
+// each), each at its own t, equal but for rounding. Those hits of one
+// geometry within 2^-20 of each other's t make a group, and the group
+// counts the triangles that a ray moved off the point by an infinitely
+// small step, in a fixed direction across the ray, would pass through
+// inside: through an edge, the one of its two triangles on the step's
+// side; through a vertex, the triangles whose corner there holds the step
+// (simulation of simplicity). That count is what a ray in general position
+// counts: odd where the ray crosses a closed mesh, even (0 or 2) where it
+// only touches it (a silhouette edge, a saddle it grazes), whatever the
+// winding, so parity tells inside from outside on any closed mesh. It is
+// decided from the triangles' corners as the walker decoded them, never
+// from their facing.
+#pragma once
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <span>
+#include <vector>
+
+#include "meshcast/ray.h"
+#include "meshcast/scene.h"
+
+namespace meshcast::python {
+
+// A triangle's corners, in double.
+struct Corners {
+  double c[3][3];
+};
+
+// The corners of a geometry's triangles, as its blob's walker decodes them,
+// by the caller's triangle id. The table from an id to its leaf (8 bytes a
+// triangle) is made on first need: only rays through edges and vertices
+// need it.
+class TriangleCorners {
+ public:
+  explicit TriangleCorners(std::span<const uint8_t> blob) : blob_(blob) {}
+  Corners corners(uint32_t triangle) const;
+  size_t nbytes() const;  // of the table, once made
+
+ private:
+  std::span<const uint8_t> blob_;
+  mutable std::once_flag made_;
+  mutable std::vector<uint64_t> leaf_of_;  // the leaf block's offset << 8 | the triangle's lane
+};
+
+// The geometry of a hit: a scene's instance, or 0 for one geometry's blob
+// walked alone.
+inline uint32_t geometry_of(const SceneHit& h) { return h.instance; }
+inline uint32_t geometry_of(const Hit& h) { return h.triangle == kNoHit ? kNoHit : 0; }
+
+// Of the triangles of one group, each with its corners, which the ray
+// stepped off the point passes through: keep[k] for each.
+void crossing_triangles(std::span<const Corners> corners, const float dir[3], std::vector<bool>& keep);
+
+// Calls keep(hit) for each crossing of a ray's hits (nearest first, as
+// trace_all_hits rows them), each by one triangle. corners_of(geometry):
+// that geometry's TriangleCorners.
+template <class Record, class CornersOf, class Keep>
+void crossings(std::span<const Record> row, const float dir[3], const CornersOf& corners_of, const Keep& keep) {
+  static thread_local std::vector<Corners> corners;
+  static thread_local std::vector<bool> inside;
+  for (size_t g = 0; g < row.size();) {
+    const float t0 = row[g].t;
+    const uint32_t geometry = geometry_of(row[g]);
+    const float tol = std::ldexp(std::fabs(t0), -20);
+    size_t end = g + 1;  // the first hit always, so a group ends even on a NaN t
+    while (end < row.size() && geometry_of(row[end]) == geometry && row[end].t - t0 <= tol) ++end;
+    if (end - g == 1) {
+      keep(row[g]);
+    } else {
+      corners.resize(end - g);
+      const TriangleCorners& of = corners_of(geometry);
+      for (size_t k = g; k < end; ++k) corners[k - g] = of.corners(row[k].triangle);
+      crossing_triangles(corners, dir, inside);
+      for (size_t k = g; k < end; ++k)
+        if (inside[k - g]) keep(row[k]);
+    }
+    g = end;
+  }
+}
+
+}  // namespace meshcast::python

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <string>
 
 #include "builder/binary_tree.h"
 
@@ -41,17 +43,40 @@ void check_mesh(const Mesh& mesh, const std::string& name) {
     throw InputError(name + ": more than 2^32-2 triangles");
 }
 
+// The vertex stride as the caller gave it: in floats from the typed
+// constructors, in bytes by hand.
+static std::string stride_text(const MeshView& view) {
+  if (view.stride_in_floats) return "vertex stride " + std::to_string(*view.stride_in_floats) + " floats";
+  return "vertex stride " + std::to_string(view.vertex_stride) + " bytes";
+}
+
 Mesh copy_mesh(const MeshView& view, const std::string& name) {
+  // An enum read from memory filled in by hand may hold any value; read as
+  // 32-bit indices it would build a mesh of the wrong triangles.
+  if (view.index_type != IndexType::Uint16 && view.index_type != IndexType::Uint32)
+    throw InputError(name + ": index_type " + std::to_string(unsigned(view.index_type)) +
+                     " is neither IndexType::Uint16 (0) nor IndexType::Uint32 (1)");
   const size_t index_bytes = view.index_type == IndexType::Uint16 ? 2 : 4;
   const size_t triangle_stride = view.triangle_stride ? view.triangle_stride : 3 * index_bytes;
   if ((view.vertex_count && !view.positions) || (view.triangle_count && !view.indices))
     throw InputError(name + ": a null position or index array with a nonzero count");
-  if (view.vertex_stride < 3 * sizeof(float))
-    throw InputError(name + ": vertex stride " + std::to_string(view.vertex_stride) +
-                     " is shorter than a position (12 bytes: three floats)");
+  if (view.stride_in_floats ? *view.stride_in_floats < 3 : view.vertex_stride < 3 * sizeof(float))
+    throw InputError(name + ": " + stride_text(view) + " is shorter than a position (" +
+                     (view.stride_in_floats ? "3 floats)" : "12 bytes: three floats)"));
   if (triangle_stride < 3 * index_bytes)
     throw InputError(name + ": triangle stride " + std::to_string(triangle_stride) + " is shorter than three " +
                      std::to_string(8 * index_bytes) + "-bit indices");
+  // The reads below step count - 1 strides from the start: a stride whose
+  // product with its count overflows would wrap to memory it never meant.
+  const bool vertex_overflow =
+      view.vertex_count != 0 && (view.stride_in_floats ? *view.stride_in_floats > SIZE_MAX / sizeof(float) / view.vertex_count
+                                                       : view.vertex_stride > SIZE_MAX / view.vertex_count);
+  if (vertex_overflow)
+    throw InputError(name + ": " + stride_text(view) + " times " + std::to_string(view.vertex_count) +
+                     " vertices overflows the bytes memory addresses");
+  if (view.triangle_count && triangle_stride > SIZE_MAX / view.triangle_count)
+    throw InputError(name + ": triangle stride " + std::to_string(triangle_stride) + " bytes times " +
+                     std::to_string(view.triangle_count) + " triangles overflows the bytes memory addresses");
   // Where a view states its buffers' sizes (the typed constructors do), the
   // last vertex and triangle must lie inside them: a stride or index type
   // that does not match the data reads past them otherwise.
@@ -59,9 +84,10 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
     return bytes != 0 && count != 0 && (bytes < element || (count - 1) > (bytes - element) / stride);
   };
   if (past_end(view.vertex_count, view.vertex_stride, 12, view.positions_bytes))
-    throw InputError(name + ": the positions hold " + std::to_string(view.positions_bytes / sizeof(float)) +
-                     " floats, not " + std::to_string(view.vertex_count) + " vertices of 3 every " +
-                     std::to_string(view.vertex_stride / sizeof(float)) +
+    throw InputError(name + ": the positions hold " +
+                     (view.stride_in_floats ? std::to_string(view.positions_bytes / sizeof(float)) + " floats"
+                                            : std::to_string(view.positions_bytes) + " bytes") +
+                     ", not " + std::to_string(view.vertex_count) + " vertices at " + stride_text(view) +
                      " (the last vertex is cut short: check the stride and where the span starts)");
   if (past_end(view.triangle_count, triangle_stride, 3 * index_bytes, view.indices_bytes))
     throw InputError(name + ": the index buffer holds " + std::to_string(view.indices_bytes / index_bytes) + " " +
@@ -70,6 +96,9 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
                      " triangles (check the index type, and that the indices are whole triangles)");
   if (view.vertex_count > 0xFFFFFFFFu)
     throw InputError(name + ": " + std::to_string(view.vertex_count) + " vertices; 32-bit indices reach 2^32");
+  // check_mesh's limit, before the copy is allocated from the count.
+  if (view.triangle_count > 0xFFFFFFFEu)
+    throw InputError(name + ": " + std::to_string(view.triangle_count) + " triangles, more than 2^32-2");
   Mesh mesh;
   mesh.vertices.resize(view.vertex_count);
   const auto* positions = static_cast<const unsigned char*>(view.positions);
@@ -87,6 +116,19 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
         std::memcpy(&mesh.triangles[t][size_t(k)], at, 4);
       }
     }
+  // An index past the view's vertices, named with the stride that counted
+  // them: a stride given in bytes where floats were meant (or any stride
+  // too long) leaves fewer vertices than the indices use, which check_mesh
+  // would report without the stride.
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (uint32_t v : mesh.triangles[t])
+      if (v >= mesh.vertices.size())
+        throw InputError(name + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) +
+                         " but the view has only " + std::to_string(mesh.vertices.size()) + " vertices at " +
+                         stride_text(view) +
+                         (view.stride_in_floats ? " over " + std::to_string(view.positions_bytes / sizeof(float)) +
+                                                      " floats (check that the stride counts floats, not bytes)"
+                                                : " (vertex_count " + std::to_string(view.vertex_count) + ")"));
   check_mesh(mesh, name);
   return mesh;
 }

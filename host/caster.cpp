@@ -1,6 +1,7 @@
 #include "host/caster_impl.h"
 
 #include <algorithm>
+#include <atomic>
 #include <thread>
 
 #include "meshcast/errors.h"
@@ -16,6 +17,12 @@ const char* backend_name(Backend b) {
     case Backend::Automatic: return "automatic";
   }
   return "";
+}
+
+uint64_t Caster::Impl::new_identity() {
+  // From 1: a default Ticket (caster 0) is nobody's. 2^64 casters never wrap.
+  static std::atomic<uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
 }
 
 Caster::Impl::Impl(std::span<const uint8_t> blob, const std::string& name, CasterOptions options)
@@ -114,7 +121,7 @@ double Caster::Impl::time_measurement_batch(std::span<const Ray> rays, std::span
     slot.state = Slot::Running;
     slot.id = next_id_++;
     slot.query = {};  // the crossover is the closest hit's
-    t = {slot.id, slot.index};
+    t = {slot.id, slot.index, identity_};
   }
   start(slot, rays, backend);
   return collect(slot, t, hits, nullptr, false).latency_ms;

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -20,6 +21,7 @@
 
 #include "meshcast/blob.h"
 #include "meshcast/caster.h"
+#include "meshcast/errors.h"
 #include "host/crossover.h"
 #include "host/latency.h"
 
@@ -122,8 +124,17 @@ struct Caster::Impl {
   Slot& slot_of(const Ticket& t) const;  // UsageError for a slot out of range
   Slot& take_slot();  // a free game slot, Running; UsageError when none, or while the caster closes
   // A taken slot's batch of n rays under s.query: the clock started, room
-  // for its answers (scene hits or hits); UsageError beyond 2^32 - 1 rays.
-  void size_slot(Slot& s, size_t n, bool scene);
+  // for its answers (scene hits or hits); UsageError naming `who` beyond
+  // 2^32 - 1 rays, or when the machine's memory cannot hold the batch's
+  // rays and answers (allocating() below).
+  void size_slot(Slot& s, size_t n, bool scene, const char* who);
+  static uint64_t batch_bytes(const Slot& s, bool scene);  // the slot's rays and answers (size_slot's count)
+  // Runs `allocate`, which grows a slot's arrays for a batch of n rays
+  // (`bytes` in all), turning std::bad_alloc into UsageError naming `who`,
+  // the rays and the bytes: everything the caster throws is a
+  // meshcast::Error, and a bad_alloc says nothing of which call or size.
+  template <class Allocate>
+  static void allocating(const char* who, size_t n, uint64_t bytes, Allocate allocate);
   // Fills the slot with the rays and starts the batch on `backend` (the
   // CPU too when the GPU refuses it); collect() waits for it, copies its
   // hits and frees the slot, keeping its record if `record`.
@@ -202,6 +213,11 @@ struct Caster::Impl {
   std::vector<std::unique_ptr<Slot>> slots_;  // options.frames for the game, then the measurement's
   uint32_t game_slots_ = 0;
   uint64_t next_id_ = 1;
+  // This caster's number, which its tickets carry (Ticket::caster): one a
+  // caster, never given twice in the process, so a ticket of a caster
+  // destroyed and another made in its memory is still refused.
+  static uint64_t new_identity();  // host/caster.cpp
+  const uint64_t identity_ = new_identity();
   // Under mutex_, changed_ notified when it is known; its measurement's
   // thread is stopped first thing in the destructor.
   Crossover crossover_{mutex_, changed_};
@@ -227,6 +243,16 @@ struct Caster::Impl {
   bool stopping_ = false;
   std::thread completion_;
 };
+
+template <class Allocate>
+void Caster::Impl::allocating(const char* who, size_t n, uint64_t bytes, Allocate allocate) {
+  try {
+    allocate();
+  } catch (const std::bad_alloc&) {
+    throw UsageError(std::string(who) + ": a batch of " + std::to_string(n) + " rays needs " + std::to_string(bytes) +
+                     " bytes for its rays and answers, which could not be allocated; submit it in parts");
+  }
+}
 
 template <class Ready>
 bool Caster::Impl::block(std::unique_lock<std::mutex>& lock, Ready ready) {

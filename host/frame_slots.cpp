@@ -8,6 +8,8 @@
 #include <cstring>
 #include <exception>
 
+#include <unistd.h>
+
 #include "meshcast/errors.h"
 #include "gpu/method.h"
 #include "layout/queries.h"
@@ -18,6 +20,12 @@ namespace {
 
 double now_ms() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The machine's memory in bytes (0: not known).
+uint64_t machine_memory() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? uint64_t(pages) * uint64_t(page) : 0;
 }
 
 }  // namespace
@@ -36,7 +44,7 @@ Ticket Caster::Impl::submit(std::span<const Ray> rays, BatchQuery query) {
   Slot& s = take_slot();
   s.query = query;
   start(s, rays, choose(uint32_t(rays.size())));
-  return {s.id, s.index};
+  return {s.id, s.index, identity_};
 }
 
 Ticket Caster::Impl::submit(const Scene& scene, std::span<const RayD> rays, SceneBatchQuery query) {
@@ -47,8 +55,9 @@ Ticket Caster::Impl::submit(const Scene& scene, std::span<const RayD> rays, Scen
     s.scene = std::move(frame);
     s.scene_query = query;
     s.query = {query.query, query.cull, query.max_hits};
-    size_slot(s, rays.size(), true);
-    s.world.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+    size_slot(s, rays.size(), true, "Caster::submit");
+    // Keeps its capacity: no allocation once warm.
+    allocating("Caster::submit", s.n, batch_bytes(s, true), [&] { s.world.assign(rays.begin(), rays.end()); });
     if (s.n > 0 && scene_on_gpu(query, *s.scene)) {
       s.ran_on = Backend::Vulkan;
       {
@@ -63,7 +72,7 @@ Ticket Caster::Impl::submit(const Scene& scene, std::span<const RayD> rays, Scen
     free_slot(s);
     throw;
   }
-  return {s.id, s.index};
+  return {s.id, s.index, identity_};
 }
 
 Caster::Impl::Slot& Caster::Impl::take_slot() {
@@ -80,15 +89,38 @@ Caster::Impl::Slot& Caster::Impl::take_slot() {
                    " frames hold batches not yet collected; wait() for one before submitting more");
 }
 
-void Caster::Impl::size_slot(Slot& s, size_t n, bool scene) {
+// What a slot's arrays take for its batch: the rays' copy and a hit a ray
+// (Query::All's rows are the jobs' own, start_cpu, or the GPU method's, and
+// grow with the hits found).
+static uint64_t batch_bytes(uint64_t n, bool scene, bool all) {
+  const uint64_t answers = all ? 0 : n;
+  return scene ? n * sizeof(RayD) + answers * sizeof(SceneHit) : n * sizeof(Ray) + answers * sizeof(Hit);
+}
+
+uint64_t Caster::Impl::batch_bytes(const Slot& s, bool scene) {
+  return host::batch_bytes(s.n, scene, s.query.query == Query::All);
+}
+
+void Caster::Impl::size_slot(Slot& s, size_t n, bool scene, const char* who) {
   if (n > UINT32_MAX)
-    throw UsageError("Caster::submit: " + std::to_string(n) + " rays, more than a batch holds (2^32 - 1)");
+    throw UsageError(std::string(who) + ": " + std::to_string(n) + " rays, more than a batch holds (2^32 - 1)");
+  // Refused in words before anything is allocated when the machine could
+  // not hold it at all: an allocator may grant more than the memory and
+  // fail only as the pages are written, and a sanitizer's ends the process
+  // rather than throw. What is refused later still is allocating()'s.
+  const uint64_t bytes = host::batch_bytes(n, scene, s.query.query == Query::All);
+  static const uint64_t memory = machine_memory();
+  if (memory != 0 && bytes > memory)
+    throw UsageError(std::string(who) + ": a batch of " + std::to_string(n) + " rays needs " + std::to_string(bytes) +
+                     " bytes for its rays and answers, more than this machine's memory (" + std::to_string(memory) +
+                     " bytes); submit it in parts");
   s.submit_ms = now_ms();
   s.n = uint32_t(n);
-  // Query::All's rows are the jobs' own (start_cpu) or the GPU method's.
   const size_t answers = s.query.query == Query::All ? 0 : s.n;
-  if (scene) s.scene_hits.resize(answers);
-  else s.hits.resize(answers);
+  allocating(who, n, bytes, [&] {
+    if (scene) s.scene_hits.resize(answers);
+    else s.hits.resize(answers);
+  });
 }
 
 void Caster::Impl::free_slot(Slot& s) {
@@ -111,7 +143,7 @@ bool Caster::Impl::gpu_takes(const Slot& s, Backend backend) const {
 
 void Caster::Impl::start(Slot& s, std::span<const Ray> rays, Backend backend) {
   try {
-    size_slot(s, rays.size(), false);
+    size_slot(s, rays.size(), false, "Caster::submit");
     if (gpu_takes(s, backend)) {
       try {
         place_on_gpu(s);  // the rays go straight into the device's mapped memory
@@ -124,7 +156,8 @@ void Caster::Impl::start(Slot& s, std::span<const Ray> rays, Backend backend) {
         if (e.lost) gpu_failed(e.what());
       }
     }
-    s.rays.assign(rays.begin(), rays.end());  // keeps its capacity: no allocation once warm
+    // Keeps its capacity: no allocation once warm.
+    allocating("Caster::submit", s.n, batch_bytes(s, false), [&] { s.rays.assign(rays.begin(), rays.end()); });
     s.placed = s.rays;
     start_cpu(s);
   } catch (...) {
@@ -139,7 +172,7 @@ OpenBatch Caster::Impl::open(uint32_t rays, BatchQuery query) {
   Slot& s = take_slot();
   try {
     s.query = query;
-    size_slot(s, rays, false);
+    size_slot(s, rays, false, "Caster::open");
     bool on_gpu = false;
     if (gpu_takes(s, choose(rays))) {
       try {
@@ -150,7 +183,8 @@ OpenBatch Caster::Impl::open(uint32_t rays, BatchQuery query) {
       }
     }
     if (!on_gpu) {
-      s.rays.resize(rays);  // keeps its capacity: no allocation once warm
+      // Keeps its capacity (no allocation once warm) and the rays it held.
+      allocating("Caster::open", rays, batch_bytes(s, false), [&] { s.rays.resize(rays); });
       s.placed = s.rays;
     }
   } catch (...) {
@@ -161,7 +195,7 @@ OpenBatch Caster::Impl::open(uint32_t rays, BatchQuery query) {
     std::lock_guard<std::mutex> lock(mutex_);
     s.state = Slot::Open;
   }
-  return {{s.id, s.index}, s.placed};
+  return {{s.id, s.index, identity_}, s.placed};
 }
 
 Ticket Caster::Impl::submit(const OpenBatch& batch) {
@@ -172,9 +206,32 @@ Ticket Caster::Impl::submit(const OpenBatch& batch) {
     if (s.id != t.id || s.state != Slot::Open)
       throw UsageError("Caster::submit: ticket " + std::to_string(t.id) + " is not an open batch of this caster");
     if (closing_) throw UsageError("Caster::submit: the caster is being destroyed");
+    // The rays are the span's: the room open() gave, or the first part of
+    // it the caller narrowed the span to. Any other span would start rays
+    // the caller never wrote here (the room holds an earlier batch's).
+    if (batch.rays.data() != s.placed.data())
+      throw UsageError("Caster::submit: the rays of open batch " + std::to_string(t.id) +
+                       " do not start where open() put them; narrow the span with rays.first(k) to submit the first "
+                       "k rays written");
+    if (batch.rays.size() > s.n)
+      throw UsageError("Caster::submit: the rays of open batch " + std::to_string(t.id) + " are " +
+                       std::to_string(batch.rays.size()) + " rays, more than the " + std::to_string(s.n) + " opened");
     s.state = Slot::Running;
   }
   try {
+    if (batch.rays.size() < s.n) {
+      // Fewer rays written than opened: the batch, its hits and the
+      // device's batch cut to them (smaller: nothing is allocated).
+      s.n = uint32_t(batch.rays.size());
+      if (s.query.query != Query::All) s.hits.resize(s.n);
+      if (s.placed_on_gpu() && s.n > 0) {
+        std::lock_guard<std::mutex> lock(gpu_mutex_);
+        s.placed = s.method->rays(s.index, s.n);  // the same mapped memory, now s.n rays
+      } else {
+        s.rays.resize(s.placed_on_gpu() ? 0 : s.n);  // none written: the CPU answers the empty batch at once
+        s.placed = s.rays;
+      }
+    }
     if (s.placed_on_gpu()) {
       try {
         start_gpu(s);
@@ -204,6 +261,12 @@ void Caster::Impl::complete(Slot& s, Backend ran_on) {
 }
 
 Caster::Impl::Slot& Caster::Impl::slot_of(const Ticket& t) const {
+  // Every caster numbers its batches from 1: a ticket's id and slot alone
+  // would match another caster's batch.
+  if (t.caster != identity_)
+    throw UsageError("ticket " + std::to_string(t.id) +
+                     (t.caster ? " was issued by another caster" : " was issued by no caster (made up, or default)") +
+                     ": not a ticket of this caster");
   if (t.slot >= game_slots_)
     throw UsageError("ticket " + std::to_string(t.id) + " names frame slot " + std::to_string(t.slot) + " of " +
                      std::to_string(game_slots_) + ": not a ticket of this caster");

@@ -38,10 +38,24 @@ struct Scene::Edits {
   // snapshots copy.
   layout::TopLevel built;
   std::vector<uint32_t> order;
-  // The last two snapshots made. Once no batch holds the older one, the
+  // A snapshot's storage, and whether what snapshot() handed out of it is
+  // still held (by a trace, a caster's batch, or the scene as its last
+  // commit). The handed-out pointer's deleter clears `held` with release
+  // ordering once its last holder lets go, after that holder's last read;
+  // commit() loads it with acquire before writing into the storage again.
+  // The reference count of a shared_ptr cannot be read so (use_count() is
+  // a relaxed load), and a standalone fence after it, correct as it is,
+  // is an ordering ThreadSanitizer cannot see.
+  struct Frame {
+    SceneSnapshot snapshot;
+    std::atomic<bool> held{false};
+  };
+  // The last two snapshots made. Once nothing holds the older one, the
   // next commit writes into it: its arrays are reused, not allocated and
-  // faulted in again every frame.
-  std::shared_ptr<SceneSnapshot> current, previous;
+  // faulted in again every frame. Each frame also lives as long as what
+  // was handed out of it (the deleter keeps it), so a batch outlives the
+  // scene.
+  std::shared_ptr<Frame> current, previous;
   // What traces see: the last commit, read and replaced under the mutex
   // (traces may run on other threads than the one that commits).
   mutable std::mutex committed_mutex;
@@ -261,26 +275,32 @@ void Scene::commit() {
   }
   // The snapshot: what a walk reads, copied (the last one may still be
   // walked by a batch in flight).
-  std::shared_ptr<SceneSnapshot> next;
-  if (e.previous && e.previous.use_count() == 1) {
-    // Only this scene holds it: whoever walked it has let go (the fence
-    // orders their last reads, released with their reference, before the
-    // writes below).
-    std::atomic_thread_fence(std::memory_order_acquire);
-    next = std::move(e.previous);
+  std::shared_ptr<Edits::Frame> frame;
+  if (e.previous && !e.previous->held.load(std::memory_order_acquire)) {
+    // Nothing holds it: whoever walked it has let go, its last reads
+    // ordered before the writes below by the acquire.
+    frame = std::move(e.previous);
   } else {
-    next = std::make_shared<SceneSnapshot>();
+    frame = std::make_shared<Edits::Frame>();
   }
-  next->meshes = e.meshes;
-  next->top.placed.resize(e.order.size());
-  for (size_t k = 0; k < e.order.size(); ++k) next->top.placed[k] = e.instances[e.order[k]].placed;
-  next->top.wide.assign(e.built.wide.begin(), e.built.wide.end());
+  SceneSnapshot& next = frame->snapshot;
+  next.meshes = e.meshes;
+  next.top.placed.resize(e.order.size());
+  for (size_t k = 0; k < e.order.size(); ++k) next.top.placed[k] = e.instances[e.order[k]].placed;
+  next.top.wide.assign(e.built.wide.begin(), e.built.wide.end());
   for (int a = 0; a < 3; ++a)
-    next->top.anchor[a] = e.built.anchor[a], next->top.min[a] = e.built.min[a], next->top.max[a] = e.built.max[a];
+    next.top.anchor[a] = e.built.anchor[a], next.top.min[a] = e.built.min[a], next.top.max[a] = e.built.max[a];
+  // Handed out with a deleter of its own (one small control block a
+  // commit; the arrays are the frame's): its last holder marks the frame
+  // free. Marked held before the pointer exists, so no holder can clear
+  // the mark before it is set.
+  frame->held.store(true, std::memory_order_relaxed);
+  std::shared_ptr<const SceneSnapshot> handed(
+      &next, [keep = frame](const SceneSnapshot*) { keep->held.store(false, std::memory_order_release); });
   e.previous = std::move(e.current);
-  e.current = next;
+  e.current = std::move(frame);
   std::lock_guard<std::mutex> lock(e.committed_mutex);
-  e.committed = std::move(next);
+  e.committed = std::move(handed);
 }
 
 std::shared_ptr<const SceneSnapshot> Scene::snapshot() const {
@@ -298,8 +318,8 @@ size_t Scene::top_level_bytes() const {
   };
   size_t bytes = e.instances.capacity() * sizeof(Edits::Instance) + e.boxes.capacity() * sizeof(WorldBox) +
                  walked(e.built) + e.order.capacity() * sizeof(uint32_t);
-  for (const auto& s : {e.current, e.previous})
-    if (s) bytes += walked(s->top);
+  for (const auto& f : {e.current, e.previous})
+    if (f) bytes += walked(f->snapshot.top);
   return bytes;
 }
 

@@ -381,6 +381,63 @@ TEST(Build, TypedMeshViewsDeduceSizesAndRefuseWrongStrides) {
   EXPECT_EQ(build_blob(by_hand, {}, "grid"), expected);
 }
 
+// A typed view's stride is named as the caller gave it, in floats: one
+// under a position, one of bytes passed as floats (too few vertices for
+// the indices), one whose bytes overflow. A view filled in by hand names
+// its stride in bytes, refuses a stride whose product with the vertex
+// count overflows, and an index_type that is neither IndexType.
+TEST(Build, MeshViewsNameTheStrideAsGivenAndRefuseUnknownIndexTypes) {
+  auto refusal = [](const MeshView& view) {
+    try {
+      build_blob(view, {}, "level.mesh");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("built");
+  };
+  const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const std::vector<uint32_t> one = {0, 1, 2};
+  const std::string under = refusal(MeshView(xyz, 2, one));
+  EXPECT_NE(under.find("level.mesh: vertex stride 2 floats is shorter than a position (3 floats)"), std::string::npos)
+      << under;
+  const std::string bytes = refusal(MeshView(xyz, 12, one));
+  EXPECT_NE(bytes.find("triangle 0 uses vertex 1"), std::string::npos) << bytes;
+  EXPECT_NE(bytes.find("vertex stride 12 floats"), std::string::npos) << bytes;
+  EXPECT_NE(bytes.find("floats, not bytes"), std::string::npos) << bytes;
+  const std::string huge = refusal(MeshView(xyz, SIZE_MAX, one));
+  EXPECT_NE(huge.find("vertex stride " + std::to_string(SIZE_MAX) + " floats"), std::string::npos) << huge;
+  EXPECT_NE(huge.find("overflows"), std::string::npos) << huge;
+  EXPECT_EQ(refusal(MeshView(xyz, 3, one)), "built");
+
+  MeshView by_hand;
+  by_hand.positions = xyz.data(), by_hand.vertex_count = 3, by_hand.indices = one.data(), by_hand.triangle_count = 1;
+  by_hand.vertex_stride = 8;
+  const std::string short_bytes = refusal(by_hand);
+  EXPECT_NE(short_bytes.find("vertex stride 8 bytes is shorter than a position (12 bytes"), std::string::npos)
+      << short_bytes;
+  by_hand.vertex_stride = SIZE_MAX / 2;  // times 3 vertices: past what memory addresses
+  const std::string wraps = refusal(by_hand);
+  EXPECT_NE(wraps.find("vertex stride " + std::to_string(SIZE_MAX / 2) + " bytes times 3 vertices overflows"),
+            std::string::npos)
+      << wraps;
+  by_hand.vertex_stride = 12;
+  by_hand.triangle_stride = SIZE_MAX / 2, by_hand.triangle_count = 3;
+  EXPECT_NE(refusal(by_hand).find("triangle stride " + std::to_string(SIZE_MAX / 2) + " bytes times 3 triangles overflows"),
+            std::string::npos)
+      << refusal(by_hand);
+  by_hand.triangle_stride = 0, by_hand.triangle_count = SIZE_MAX / 64;  // refused before a copy is allocated
+  EXPECT_NE(refusal(by_hand).find(std::to_string(SIZE_MAX / 64) + " triangles, more than 2^32-2"), std::string::npos)
+      << refusal(by_hand);
+  by_hand.triangle_count = 1;
+  by_hand.index_type = IndexType(7);
+  const std::string unknown = refusal(by_hand);
+  EXPECT_NE(unknown.find("level.mesh: index_type 7 is neither IndexType::Uint16 (0) nor IndexType::Uint32 (1)"),
+            std::string::npos)
+      << unknown;
+  by_hand.index_type = IndexType::Uint32;
+  EXPECT_EQ(refusal(by_hand), "built");
+}
+
 // A mistyped layout name is answered with the few nearest names, not the
 // whole list of some 200.
 TEST(LayoutNames, AnUnknownNameOffersTheClosestFew) {

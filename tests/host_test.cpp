@@ -4,6 +4,7 @@
 // several threads submitting at once get their own answers (this suite also
 // runs under ThreadSanitizer in scripts/test.sh).
 #include <gtest/gtest.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -371,12 +372,52 @@ TEST(Host, MisuseIsAUsageError) {
   auto expect_usage = [](auto&& call, const std::string& words) { expect_throws<UsageError>(call, {words}); };
   expect_usage([&] { caster.poll(host::Ticket{12345, 7}); }, "not a ticket of this caster");
   expect_usage([&] { caster.wait(host::Ticket{12345, 7}, hits); }, "not a ticket of this caster");
-  expect_usage([&] { caster.wait(host::Ticket{12345, 0}, hits); }, "unknown or already collected");
+  expect_usage([&] { caster.wait(host::Ticket{12345, 0}, hits); }, "issued by no caster");
   const host::Ticket t = caster.submit(rays);
+  expect_usage([&] { caster.wait(host::Ticket{12345, 0, t.caster}, hits); }, "unknown or already collected");
   expect_usage([&] { caster.wait(t, short_hits); }, "needs room for 50 hits");
   caster.wait(t, hits);
   expect_usage([&] { caster.trace_now(rays, short_hits); }, "room for 49 hits");
   expect_usage([&] { BlobView(blob, "sphere").trace(rays, short_hits); }, "50 rays but room for 49 hits");
+}
+
+// Every caster numbers its batches from 1, so two casters issue tickets of
+// the same id and slot: each refuses the other's tickets and open batches,
+// and a destroyed caster's, even when a new caster takes its place, rather
+// than answer its own batch for them.
+TEST(Host, AnotherCastersTicketsAndOpenBatchesAreRefused) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 50, 3);
+  std::vector<Hit> hits(rays.size());
+  auto expect_refused = [](auto&& call) { expect_throws<UsageError>(call, {"another caster", "not a ticket of this caster"}); };
+  Caster a(blob, "sphere", options(Backend::Cpu, 2)), b(blob, "sphere", options(Backend::Cpu, 2));
+  const host::Ticket ta = a.submit(rays), tb = b.submit(rays);
+  ASSERT_TRUE(ta.id == tb.id && ta.slot == tb.slot);  // what the casters' own numbers cannot tell apart
+  EXPECT_NE(ta.caster, tb.caster);
+  expect_refused([&] { b.poll(ta); });
+  expect_refused([&] { b.wait(ta, hits); });
+  b.wait(tb, hits);  // b's own batch is still b's to collect
+  a.wait(ta, hits);
+  host::OpenBatch oa = a.open(10), ob = b.open(10);
+  ASSERT_TRUE(oa.ticket.id == ob.ticket.id && oa.ticket.slot == ob.ticket.slot);
+  std::copy(rays.begin(), rays.begin() + 10, oa.rays.begin());
+  std::copy(rays.begin(), rays.begin() + 10, ob.rays.begin());
+  expect_refused([&] { b.submit(oa); });
+  std::vector<Hit> ten(10);
+  b.wait(b.submit(ob), ten);  // still open, and b's own
+  a.wait(a.submit(oa), ten);
+  // A caster gone with its batch uncollected, and another made after it.
+  host::Ticket gone;
+  {
+    Caster c(blob, "sphere", options(Backend::Cpu, 2));
+    gone = c.submit(rays);
+  }
+  Caster d(blob, "sphere", options(Backend::Cpu, 2));
+  const host::Ticket td = d.submit(rays);
+  ASSERT_TRUE(gone.id == td.id && gone.slot == td.slot);
+  expect_refused([&] { d.wait(gone, hits); });
+  d.wait(td, hits);
 }
 
 // An engine's job system: here every run goes to a thread of its own, and
@@ -801,6 +842,109 @@ TEST(Host, OpenBatchesAreWrittenInPlace) {
   }
 }
 
+// An open batch's room holds the slot's earlier rays until written: a
+// caller that wrote k of them narrows the span to those (rays.first(k)),
+// and the batch is those k rays, on either backend, one hit a ray or every
+// hit; the rays the caller did not write are not answered. A span that
+// starts elsewhere or grew is refused, and the batch stays open.
+TEST(Host, AnOpenBatchSubmitsTheRaysWritten) {
+  Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(m, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "sphere");
+  const BlobView view(blob, "sphere");
+  const uint32_t n = 3000, k = 700;
+  const std::vector<Ray> earlier = make_rays(m, RayKind::Long, n, 5);
+  const std::vector<Ray> written = make_rays(m, RayKind::Radial, k, 6);
+  const std::vector<Hit> expected = trace_all(view, written);
+  const HitLists expected_rows = trace_lists(view, written, 4, Cull::None);
+  std::vector<Backend> backends = {Backend::Cpu};
+  if (!cpu_only()) backends.push_back(Backend::Vulkan);
+  for (Backend b : backends) {
+    Caster caster(blob, "sphere", options(b, 1));  // one slot: every batch in the same room
+    ASSERT_TRUE(b == Backend::Cpu || caster.gpu_available()) << caster.gpu_error();
+    const std::string on = host::backend_name(b);
+    for (const Query query : {Query::Closest, Query::All}) {
+      const host::BatchQuery q{query, Cull::None, 4};
+      host::OpenBatch first = caster.open(n, q);
+      std::copy(earlier.begin(), earlier.end(), first.rays.begin());
+      std::vector<Hit> hits(n);
+      HitLists lists;
+      if (query == Query::All) caster.wait(caster.submit(first), lists);
+      else caster.wait(caster.submit(first), hits);
+
+      host::OpenBatch next = caster.open(n, q);
+      std::copy(written.begin(), written.end(), next.rays.begin());
+      host::OpenBatch moved = next, grown = next;
+      moved.rays = next.rays.subspan(1, k);
+      grown.rays = std::span<Ray>(next.rays.data(), n + 1);  // never read: refused on its size
+      expect_throws<UsageError>([&] { caster.submit(moved); }, {"do not start where open() put them", "rays.first(k)"});
+      expect_throws<UsageError>([&] { caster.submit(grown); }, {"3001 rays, more than the 3000 opened"});
+      next.rays = next.rays.first(k);
+      const Hit untouched{-1.0f, 12345u};
+      std::fill(hits.begin(), hits.end(), untouched);
+      const host::Ticket t = caster.submit(next);
+      const host::BatchRecord r = query == Query::All ? caster.wait(t, lists) : caster.wait(t, hits);
+      EXPECT_EQ(r.rays, k) << on;
+      EXPECT_EQ(r.ran_on, b) << on;
+      if (query == Query::All) {
+        ASSERT_EQ(lists.rays(), k) << on;
+        for (size_t i = 0; i < k; ++i) ASSERT_EQ(lists.found[i], expected_rows.found[i]) << on << ", ray " << i;
+      } else {
+        for (size_t i = 0; i < k; ++i)
+          ASSERT_TRUE(hits[i].triangle == expected[i].triangle || hits[i].t == expected[i].t) << on << ", ray " << i;
+        for (size_t i = k; i < n; ++i) ASSERT_EQ(hits[i].triangle, 12345u) << on << ": ray " << i << " was not written";
+      }
+    }
+    // None written: a batch of no rays, answered at once.
+    host::OpenBatch none = caster.open(n);
+    none.rays = none.rays.first(0);
+    std::vector<Hit> no_hits;
+    EXPECT_EQ(caster.wait(caster.submit(none), no_hits).rays, 0u) << on;
+    EXPECT_EQ(caster.validation_messages(), 0u) << on;
+  }
+}
+
+// A batch the machine's memory cannot hold is refused as a UsageError
+// naming the rays and the bytes (not std::bad_alloc, which names nothing),
+// before anything is allocated or read: open() of 2^32 - 1 rays, and
+// submit() of spans that long (address space reserved, never readable: the
+// caster must refuse them on their size alone). The slots stay free.
+TEST(Host, ABatchBeyondMemoryIsAUsageError) {
+  const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");
+  const uint64_t memory = uint64_t(::sysconf(_SC_PHYS_PAGES)) * uint64_t(::sysconf(_SC_PAGESIZE));
+  const uint64_t most = UINT32_MAX;
+  if (memory >= most * sizeof(Ray)) GTEST_SKIP() << "this machine holds 2^32 - 1 rays";
+  Caster caster(blob, "sphere", options(Backend::Cpu, 1));
+  expect_throws<UsageError>([&] { caster.open(UINT32_MAX); },
+                            {"Caster::open: a batch of 4294967295 rays needs " + std::to_string(most * (sizeof(Ray) + sizeof(Hit))) + " bytes",
+                             "more than this machine's memory"});
+  expect_throws<UsageError>([&] { caster.open(UINT32_MAX, {Query::All, Cull::None, 4}); },
+                            {"4294967295 rays needs " + std::to_string(most * sizeof(Ray)) + " bytes"});
+  const size_t reserved = most * sizeof(RayD);
+  void* space = ::mmap(nullptr, reserved, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  if (space != MAP_FAILED) {
+    expect_throws<UsageError>([&] { caster.submit(std::span<const Ray>(static_cast<const Ray*>(space), most)); },
+                              {"Caster::submit: a batch of 4294967295 rays", "bytes"});
+    Scene scene;
+    scene.add_instance(scene.add_mesh(blob, "sphere"), Transform{});
+    scene.commit();
+    Caster scenes(options(Backend::Cpu, 1));
+    expect_throws<UsageError>(
+        [&] { scenes.submit(scene, std::span<const RayD>(static_cast<const RayD*>(space), most)); },
+        {"Caster::submit: a batch of 4294967295 rays needs " + std::to_string(most * (sizeof(RayD) + sizeof(SceneHit))) +
+         " bytes"});
+    ::munmap(space, reserved);
+    std::vector<RayD> world(10);
+    for (RayD& r : world) r = {{0, 0, 5}, {0, 0, -1}, INFINITY};
+    std::vector<SceneHit> scene_hits(world.size());
+    scenes.wait(scenes.submit(scene, world), scene_hits);
+    EXPECT_EQ(scene_hits[0].instance, 0u);
+  }
+  const std::vector<Ray> rays = make_rays(m, RayKind::Long, 50, 3);
+  std::vector<Hit> hits(rays.size());
+  EXPECT_EQ(caster.wait(caster.submit(rays), hits).rays, 50u);
+}
+
 TEST(Host, AnEnginesJobSystemRunsTheCpuWork) {
   Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
   std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3SOA4"), "sphere");
@@ -1192,6 +1336,84 @@ TEST(Host, SceneBatchesOnTheGpuSeeTheFrameTheySubmittedIn) {
   const std::map<Backend, int> refused = scene_frames(Backend::Vulkan, "AABBTree/Float3");
   EXPECT_EQ(refused.at(Backend::Cpu), 24);
   EXPECT_EQ(refused.count(Backend::Vulkan), 0u);
+}
+
+// Scene::commit() writes the next frame into the older snapshot once
+// nothing holds it, while other threads trace the scene (each trace holds
+// the snapshot it walks until it returns) and a caster's batches hold
+// theirs until collected. Every trace sees one committed frame whole, and
+// under ThreadSanitizer (scripts/test.sh) the reuse is seen to come after
+// the last reads of whoever let the snapshot go.
+TEST(Host, CommitsWhileOtherThreadsTrace) {
+  Scene scene;
+  const MeshId ball = scene.add_mesh(
+      build_blob(make_sphere(8, 12, 1, {0, 0, 0}), parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "ball"), "ball");
+  // A row of balls, raised together by a unit each frame.
+  constexpr int kBalls = 8, kFrames = 150, kRaysABall = 4;
+  auto at = [](int i, int frame) {
+    Transform t;
+    t.translation[0] = 4.0 * i, t.translation[2] = frame;
+    return t;
+  };
+  std::vector<InstanceId> balls;
+  for (int i = 0; i < kBalls; ++i) balls.push_back(scene.add_instance(ball, at(i, 0)));
+  scene.commit();
+  // Rays straight down onto each ball's top, a few to a ball: a frame's
+  // traces all meet their ball at the same height. Short traces, so that
+  // many begin on one frame and end before the commit after next.
+  std::vector<RayD> rays;
+  for (int i = 0; i < kBalls; ++i)
+    for (int k = 0; k < kRaysABall; ++k) rays.push_back({{4.0 * i, 0, 1000}, {0, 0, -1}, INFINITY});
+  std::vector<SceneHit> first(rays.size());
+  scene.trace(rays, first);
+  ASSERT_EQ(first[0].instance, 0u);
+  const float top = 1000 - first[0].t;  // the ball's top above its centre
+  std::atomic<bool> done{false};
+  std::atomic<int> traces{0}, torn{0};
+  auto tracer = [&] {
+    std::vector<SceneHit> hits(rays.size());
+    while (!done.load()) {
+      scene.trace(rays, hits);
+      const float frame = 1000 - hits[0].t - top;
+      bool whole = std::fabs(frame - std::round(frame)) < 1e-3f && frame > -0.5f && frame < kFrames + 0.5f;
+      for (size_t r = 0; r < rays.size(); ++r)
+        whole = whole && hits[r].instance == r / kRaysABall && hits[r].t == hits[0].t;
+      torn += !whole;
+      ++traces;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 3; ++k) threads.emplace_back(tracer);
+  CasterOptions o = options(Backend::Cpu, 2);
+  o.threads = 1;
+  Caster caster(o);
+  std::deque<std::pair<host::Ticket, int>> batches;  // and the frame each was submitted in
+  std::vector<SceneHit> batch_hits(rays.size());
+  int wrong_batches = 0;
+  for (int frame = 1; frame <= kFrames; ++frame) {
+    for (int i = 0; i < kBalls; ++i) scene.set_transform(balls[i], at(i, frame));
+    scene.commit();
+    // A pause for the traces of the frames before to end: the older
+    // snapshot is then free, and the next commit writes into it.
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (frame % 3 == 0) {  // a batch held over the next frames' commits
+      if (batches.size() == 2) {
+        caster.wait(batches.front().first, batch_hits);
+        wrong_batches += std::fabs(1000 - batch_hits[0].t - top - float(batches.front().second)) > 1e-3f;
+        batches.pop_front();
+      }
+      batches.emplace_back(caster.submit(scene, rays), frame);
+    }
+  }
+  done = true;
+  for (std::thread& t : threads) t.join();
+  for (const auto& [ticket, frame] : batches) {
+    caster.wait(ticket, batch_hits);
+    wrong_batches += std::fabs(1000 - batch_hits[0].t - top - float(frame)) > 1e-3f;
+  }
+  EXPECT_GT(traces.load(), 0);
+  EXPECT_EQ(torn.load(), 0) << "of " << traces.load() << " traces";
+  EXPECT_EQ(wrong_batches, 0);
 }
 
 // Scene batches over blobs the scene does not own: a mapped blob file

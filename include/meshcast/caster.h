@@ -56,12 +56,22 @@ namespace meshcast::host {
 enum class Backend { Cpu, Vulkan, Automatic };
 const char* backend_name(Backend b);
 
+// A batch's receipt. `caster` names the caster that issued it, a number no
+// other caster of the process ever has (not its address, which a later
+// caster may be given): every caster numbers its batches from 1, and
+// another caster's ticket is refused with UsageError, never taken for one
+// of its own.
 struct Ticket {
   uint64_t id = 0;
   uint32_t slot = 0;
+  uint64_t caster = 0;
 };
 
-// A batch open() gave: its ticket, and where its rays go.
+// A batch open() gave: its ticket, and where its rays go. The span holds
+// whatever the slot held before (an earlier batch's rays) until the caller
+// writes it. To send fewer rays than were opened, narrow it to the ones
+// written (`batch.rays = batch.rays.first(k)`): submit(batch) starts the
+// span's rays alone.
 struct OpenBatch {
   Ticket ticket;
   std::span<Ray> rays;
@@ -224,20 +234,27 @@ class Caster {
 
   // Copies the rays and starts the batch; returns at once (a GPU batch's
   // rays are copied once, into the device's mapped memory). Throws
-  // UsageError when all `frames` slots hold uncollected batches, or for a
-  // query out of range; what an engine's JobSystem::run() throws, as it
-  // threw it (the slot stays free).
+  // UsageError when all `frames` slots hold uncollected batches, for a
+  // query out of range, or for a batch whose copy of the rays and room for
+  // their hits the machine's memory cannot hold (naming the rays and the
+  // bytes); what an engine's JobSystem::run() throws, as it threw it (the
+  // slot stays free).
   Ticket submit(std::span<const Ray> rays, BatchQuery query = {});
   // Room for a batch of `rays` rays that the caller writes in place, then
   // starts with submit(batch): for a batch the GPU will answer, the
   // device's own mapped memory, read as written (no copy of the rays at
-  // all: what a batch of millions wants); else the slot's array. The batch
-  // holds a frame slot from now on; poll() and wait() refuse it until it is
-  // submitted. Write Ray records only into the span, and nothing after
-  // submit(). Throws as submit(rays).
+  // all: what a batch of millions wants); else the slot's array. The room
+  // is not cleared: it holds an earlier batch's rays until written. The
+  // batch holds a frame slot from now on; poll() and wait() refuse it
+  // until it is submitted. Write Ray records only into the span, and
+  // nothing after submit(). Throws as submit(rays).
   OpenBatch open(uint32_t rays, BatchQuery query = {});
-  // Starts a batch open() gave: UsageError for one not open (submitted
-  // already, or another caster's).
+  // Starts a batch open() gave, with the rays of batch.rays: the whole
+  // room, or its first k rays when the caller narrowed the span to the
+  // rays it wrote (the batch then has k rays, and wait() needs room for k
+  // hits). UsageError for a batch not open (submitted already, or another
+  // caster's), and for a span that no longer starts where open() put it or
+  // is longer than the rays opened (the batch stays open then).
   Ticket submit(const OpenBatch& batch);
   // A scene batch (see above): the scene's last commit, taken now; call it
   // from the thread that edits and commits the scene. The rays are copied.
@@ -250,7 +267,7 @@ class Caster {
   BatchRecord wait(const Ticket& t, SceneHitLists& lists);
 
   // Whether the batch is ready. UsageError for a ticket this caster did not
-  // issue or that was already collected.
+  // issue (another caster's, or made up) or that was already collected.
   bool poll(const Ticket& t);
   // Blocks until ready, copies the hits into `hits` (at least the batch's
   // size, else UsageError) and frees the slot; returns that batch's record.

@@ -28,7 +28,8 @@ struct OutputError : Error {
 };
 
 // A call the API does not allow: a hits span shorter than the rays, a ticket
-// this caster did not issue or already collected, every frame slot busy, an
+// this caster did not issue (another caster's) or already collected, every
+// frame slot busy, a batch larger than the machine's memory holds, an
 // engine's Vulkan objects that lack (or do not state) a version or feature
 // meshcast needs (caster.h, VulkanObjects).
 struct UsageError : Error {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -81,13 +82,14 @@ constexpr float kMaxCoordinate = 0x1p100f;
 // position is not first in a vertex) and `stride` counts floats from one
 // vertex's x to the next (3 when packed). Every stride's start in the span
 // is a vertex, and the span must hold the last one's three floats; the
-// indices must be a whole number of triangles. A stride under 3 floats is
-// refused.
+// indices must be a whole number of triangles. A stride under 3 floats, or
+// one so large that a vertex count times it overflows, is refused, and
+// every message names the stride as given, in floats.
 //
 // Filled in by hand (the raw pointers, for buffers that are not floats),
 // the sizes stay 0 (unknown) and only the strides can be checked: set
-// `index_type` to the buffer's own (it defaults to 32-bit), and
-// `vertex_stride` in bytes.
+// `index_type` to the buffer's own (it defaults to 32-bit; a value that is
+// neither IndexType is refused), and `vertex_stride` in bytes.
 enum class IndexType : uint8_t { Uint16, Uint32 };
 struct MeshView {
   const void* positions = nullptr;
@@ -100,6 +102,10 @@ struct MeshView {
   // The bytes `positions` and `indices` hold, where known (0: unknown):
   // copy_mesh refuses a view whose last vertex or triangle lies past them.
   size_t positions_bytes = 0, indices_bytes = 0;
+  // The typed constructors' stride as the caller gave it, in floats, which
+  // copy_mesh's messages name (`vertex_stride` holds it in bytes, SIZE_MAX
+  // where that overflows); unset for a view filled in by hand.
+  std::optional<size_t> stride_in_floats;
 
   MeshView() = default;
   MeshView(std::span<const float> positions, size_t stride, std::span<const uint32_t> indices)
@@ -119,13 +125,16 @@ struct MeshView {
         triangle_count(index_count / 3 + (index_count % 3 != 0)),
         index_type(type),
         positions_bytes(p.size() * sizeof(float)),
-        indices_bytes(index_count * (type == IndexType::Uint16 ? 2 : 4)) {}
+        indices_bytes(index_count * (type == IndexType::Uint16 ? 2 : 4)),
+        stride_in_floats(stride) {}
 };
 
 // The view's mesh, copied into a Mesh and checked (check_mesh), named
 // `name` in messages; InputError also for a null array with a count, a
-// stride shorter than its element, a last vertex or triangle past the bytes
-// a view states, or sizes beyond 2^32 vertices.
+// stride shorter than its element or whose product with its count
+// overflows, an index_type that is neither IndexType, a last vertex or
+// triangle past the bytes a view states, an index past the view's
+// vertices (naming the stride), or sizes beyond 2^32 vertices.
 Mesh copy_mesh(const MeshView& view, const std::string& name);
 
 // Checks what every layout relies on: at least one triangle, every index in

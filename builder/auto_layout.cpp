@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "builder/ray_sets.h"
+#include "layout/message_text.h"
 #include "meshcast/blob.h"
 
 namespace meshcast {
@@ -17,6 +18,23 @@ constexpr uint32_t kLeaf = 8;  // seed 000 §4.2's middle size, fastest in bench
 std::string format(const char* fmt, double a, double b) {
   char text[160];
   std::snprintf(text, sizeof text, fmt, a, b);
+  return text;
+}
+
+// A limit as the caller gave it: nine digits tell any two apart, where
+// "%.2f" made a limit of 0.001 "0.00" and 3.999 "4.00".
+std::string limit_text(double limit) { return number_text(limit); }
+std::string bytes_limit_text(double limit) { return limit_text(limit) + (limit == 1 ? " byte" : " bytes") + " a triangle"; }
+
+// A measured figure over `limit`, with the digits ("%.2f", "%.2g" at the
+// least) that show it over: 10.9141 against a limit of 10.914 is "10.9141",
+// never "10.91". A figure within its limit, or no limit (0): the fewest.
+std::string over_limit(double value, double limit, bool fixed) {
+  char text[64];
+  for (int digits = 2; digits < 17; ++digits) {
+    std::snprintf(text, sizeof text, fixed ? "%.*f" : "%.*g", digits, value);
+    if (!(limit > 0) || !(value > limit) || std::strtod(text, nullptr) > limit) break;
+  }
   return text;
 }
 
@@ -64,9 +82,11 @@ std::vector<uint8_t> judge(const Mesh& mesh, const MeshStats& s, const AutoLimit
   c.bytes_per_triangle = double(blob.size()) / double(s.triangles);
   c.error = relative_error_bound(blob, s.diagonal);
   if (l.max_bytes_per_triangle > 0 && c.bytes_per_triangle > l.max_bytes_per_triangle)
-    c.refused = format("%.2f bytes a triangle, over the limit of %.2f", c.bytes_per_triangle, l.max_bytes_per_triangle);
+    c.refused = over_limit(c.bytes_per_triangle, l.max_bytes_per_triangle, true) + " bytes a triangle, over the limit of " +
+                limit_text(l.max_bytes_per_triangle);
   else if (l.max_error > 0 && c.error > l.max_error)
-    c.refused = format("stated error %.2g of the diagonal, over the limit of %.2g", c.error, l.max_error);
+    c.refused = "stated error " + over_limit(c.error, l.max_error, false) + " of the diagonal, over the limit of " +
+                limit_text(l.max_error);
   if (!c.refused.empty()) return {};
   return blob;
 }
@@ -296,11 +316,15 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
     for (const AutoCandidate& c : out.candidates)
       if (c.built && c.bytes_per_triangle > 0) bytes = std::min(bytes, c.bytes_per_triangle), error = std::min(error, c.error);
     std::string set;
-    if (limits.max_bytes_per_triangle > 0) set += format("at most %.2f bytes a triangle", limits.max_bytes_per_triangle, 0);
-    if (limits.max_error > 0) set += (set.empty() ? "" : ", ") + format("error at most %.2g of the diagonal", limits.max_error, 0);
+    if (limits.max_bytes_per_triangle > 0) set += "at most " + bytes_limit_text(limits.max_bytes_per_triangle);
+    if (limits.max_error > 0) set += (set.empty() ? "" : ", ") + ("error at most " + limit_text(limits.max_error) + " of the diagonal");
     if (!limits.readers.empty()) set += std::string(set.empty() ? "" : ", ") + "read by the GPU too";
+    // What the nearest came to each limit, in whole words.
+    const std::string exact = error > 0 ? "states an error of " + over_limit(error, limits.max_error, false) + " of the diagonal"
+                                        : std::string("is exact (an error of 0)");
     throw InputError(name + ": no layout meets the limits (" + set + "); " +
-                     (bytes < 1e300 ? format("the smallest built takes %.2f bytes a triangle, the most exact states %.2g", bytes, error)
+                     (bytes < 1e300 ? "the smallest built takes " + over_limit(bytes, limits.max_bytes_per_triangle, true) +
+                                          " bytes a triangle and the most exact " + exact
                                     : std::string("no layout could be built")));
   }
   out.chosen = pick;
@@ -338,8 +362,8 @@ AutoLimits parse_auto_setting(const std::string& text) {
 
 std::string describe(const AutoLimits& limits) {
   std::string text = std::string(goal_name(limits.goal)) + " first, " + (limits.readers.empty() ? "CPU only" : "CPU and GPU");
-  text += limits.max_bytes_per_triangle > 0 ? format(", at most %.2f bytes a triangle", limits.max_bytes_per_triangle, 0) : "";
-  text += limits.max_error > 0 ? format(", error at most %.2g of the diagonal", limits.max_error, 0) : "";
+  text += limits.max_bytes_per_triangle > 0 ? ", at most " + bytes_limit_text(limits.max_bytes_per_triangle) : "";
+  text += limits.max_error > 0 ? ", error at most " + limit_text(limits.max_error) + " of the diagonal" : "";
   text += limits.trial_rays > 0 ? format(", a %.0f-ray trial", limits.trial_rays, 0) : "";
   return text;
 }

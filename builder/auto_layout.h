@@ -48,7 +48,7 @@ struct AutoLimits {
 // of ",trial=RAYS", ",bytes=B" (bytes a triangle), ",error=E" (of the
 // diagonal). InputError naming the part it cannot read.
 AutoLimits parse_auto_setting(const std::string& text);
-// "speed first, CPU only, at most 20.00 bytes a triangle, ...".
+// "speed first, CPU only, at most 20 bytes a triangle, ...": each limit as given.
 std::string describe(const AutoLimits& limits);
 
 struct AutoCandidate {

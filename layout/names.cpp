@@ -91,6 +91,14 @@ size_t part_distance(const std::string& typed, const std::string& real) {
   return edit_distance(t, r);
 }
 
+// "A, B or C": the first `count` names.
+std::string listed(const std::vector<std::string>& names, size_t count) {
+  std::string out;
+  const size_t n = std::min(count, names.size());
+  for (size_t i = 0; i < n; ++i) out += (i == 0 ? "" : i + 1 == n ? " or " : ", ") + names[i];
+  return out;
+}
+
 }  // namespace
 
 std::string closest_layouts(const std::string& text) {
@@ -115,11 +123,17 @@ std::string closest_layouts(const std::string& text) {
   std::stable_sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) {
     return a.first != b.first ? a.first < b.first : a.second < b.second;
   });
-  constexpr size_t kSuggestions = 3;
-  std::string out;
-  for (size_t i = 0; i < kSuggestions && i < scored.size(); ++i)
-    out += (i == 0 ? "" : i + 1 == kSuggestions ? " or " : ", ") + scored[i].name;
-  return out;
+  std::vector<std::string> names;
+  for (const Scored& s : scored) names.push_back(s.name);
+  return listed(names, 3);
+}
+
+std::string closest_names(const std::string& text, const std::vector<std::string>& names, size_t count) {
+  std::vector<std::string> sorted = names;
+  std::stable_sort(sorted.begin(), sorted.end(), [&](const std::string& a, const std::string& b) {
+    return part_distance(text, a) < part_distance(text, b);
+  });
+  return listed(sorted, count);
 }
 
 }  // namespace meshcast

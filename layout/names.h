@@ -18,5 +18,9 @@ std::vector<std::string> layout_names();
 // The three layout names nearest `text` ("A, B or C"): a tree or triangle
 // format typed in part ("OctTree") counts as near its whole name.
 std::string closest_layouts(const std::string& text);
+// The same for any list of names (the generated meshes'): the `count`
+// nearest `text`, nearest first, case folded, a name typed in part near
+// its whole, as "A, B or C".
+std::string closest_names(const std::string& text, const std::vector<std::string>& names, size_t count = 3);
 
 }  // namespace meshcast

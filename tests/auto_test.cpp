@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 
 #include "check/generate.h"
 #include "layout/blob_format.h"
@@ -107,6 +109,51 @@ TEST(AutoLayout, ImpossibleLimitsAndReaders) {
     const std::string chosen = layout_name(h.tree_format, h.triangle_format);
     EXPECT_TRUE(chosen == "AABBTree/Float3" || chosen == "SKDTree/Float3") << chosen;
   }
+}
+
+// The refusal names each limit as it was given (0.001, not "0.00"; 1.25e-30,
+// not "1.2e-30"), ends in whole words on what the nearest
+// came to (the smallest's bytes, the most exact's error), and never shows a
+// figure at or under the limit it is over.
+TEST(AutoLayout, RefusalNamesTheLimitsAsGiven) {
+  const Mesh sphere = make_sphere(12, 24, 1.0f, {});
+  auto refusal = [&](const AutoLimits& l) -> std::string {
+    try {
+      choose_layout(sphere, l, "sphere");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "the limits were met";
+    return "";
+  };
+  AutoLimits bytes;
+  bytes.max_bytes_per_triangle = 0.001;
+  const std::string b = refusal(bytes);
+  EXPECT_NE(b.find("(at most 0.001 bytes a triangle)"), std::string::npos) << b;
+  // The exact layouts (Float3) are among those built: the most exact is exact.
+  EXPECT_TRUE(b.ends_with(" bytes a triangle and the most exact is exact (an error of 0)")) << b;
+
+  // Only a quantized layout: the most exact states an error above 0.
+  AutoLimits error;
+  error.readers = {parse_layout_name("QuadTreeHalfFloat/Indexed8BitPackSOA4")};
+  error.max_error = 1.25e-30;
+  const std::string e = refusal(error);
+  EXPECT_NE(e.find("(error at most 1.25e-30 of the diagonal, read by the GPU too)"), std::string::npos) << e;
+  const size_t states = e.find("the most exact states an error of ");
+  ASSERT_NE(states, std::string::npos) << e;
+  EXPECT_TRUE(e.ends_with(" of the diagonal")) << e;
+  EXPECT_GT(std::strtod(e.c_str() + states + std::strlen("the most exact states an error of "), nullptr), 1.25e-30) << e;
+
+  // A limit a hair under the smallest blob: the figure shown is over it.
+  AutoLimits memory;
+  memory.goal = AutoGoal::Memory;
+  const double smallest = choose_layout(sphere, memory, "sphere").choice().bytes_per_triangle;
+  AutoLimits hair;
+  hair.max_bytes_per_triangle = smallest * (1 - 1e-6);
+  const std::string h = refusal(hair);
+  const size_t takes = h.find("the smallest built takes ");
+  ASSERT_NE(takes, std::string::npos) << h;
+  EXPECT_GT(std::strtod(h.c_str() + takes + std::strlen("the smallest built takes "), nullptr), hair.max_bytes_per_triangle) << h;
 }
 
 // Without the remap (BuildOptions::triangle_ids false) every layout walks

@@ -85,6 +85,22 @@ check generate 0 "131072 triangles" -- "$meshcast" generate terrain_66k --out "$
 "$meshcast" rays terrain_66k --kind probe --count 300 --out "$work/tg.rays" >/dev/null
 cmp "$work/tf.rays" "$work/tg.rays" || { echo "FAIL: the generated OFF did not read back as the generated mesh"; exit 1; }
 check generate-unknown 2 "terrain_2M" -- "$meshcast" generate mountain --out "$work/x.off"
+# A generated mesh's name mistyped is answered with the names, nearest
+# first, by every command that takes a mesh (as a mistyped layout is); a
+# path that is no file is not (it is no name).
+for command in "rays:--out $work/x.rays" "info:" "build:--out $work/x.blob" "trace:--rays $work/r.rays --out $work/x.hits" \
+               "render:--png $work/x.png" "demo:" "bench encodings:--out-dir $work" "bench latency:--out-dir $work"; do
+  IFS=: read -r name options <<<"$command"
+  # shellcheck disable=SC2086 # the command's words and options split
+  check "mistyped-generated-${name// /-}" 2 "terrain_66K: cannot open the file .*; nor is it a generated mesh: did you mean terrain_66k, terrain_2M or city_1M\?" -- "$meshcast" $name terrain_66K $options
+done
+check mistyped-generated-generate 2 '"terrain_66K" is not a generated mesh; did you mean terrain_66k, terrain_2M or city_1M\?' -- "$meshcast" generate terrain_66K --out "$work/x.off"
+check missing-path-no-names 2 "nope.off: cannot open the file \([^)]*\)$" -- "$meshcast" info "$work/nope.off"
+# ... and the names offered are taken by each of them.
+check generated-info 0 '"triangles":131072' -- "$meshcast" info terrain_66k --json
+check generated-trace 0 "^terrain_66k: OctTreeCompressed/ClusterBitPackSOA8" -- "$meshcast" trace terrain_66k --rays "$work/tg.rays" --out "$work/tg.hits" --repeat 1
+printf '{"meshes": {"t": "terrain_66k"}, "instances": [{"mesh": "t"}]}' >"$work/generated.json"
+check generated-scene 0 "1 instances" -- "$meshcast" render "$work/generated.json" --png "$work/g.png" --width 16 --height 16
 check trace-query-unknown 2 "query" -- "$meshcast" trace "$mesh" --query nearest --rays "$work/r.rays" --out "$work/hx.hits"
 check trace-all 0 '"query":"all","cull":"back"' -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --query all --max-hits 4 --cull back --rays "$work/r.rays" --out "$work/hn.hitc" --json
 # HITC: magic, 500 rays, N, 500 counts, then the kept records alone: 12 + 500
@@ -156,8 +172,15 @@ if ! diff <(od -An -tu4 -v -w8 -j8 "$work/tmin.hits" | awk '{print $1, ($2 == 42
           <(od -An -tu4 -v -w12 -j8 "$work/tmin.hiti" | awk '{print $1, ($2 == 4294967295 ? "miss" : $2), $3}') >/dev/null; then
   echo "FAIL trace-scene-t-min: the scene's hits with --t-min differ from the mesh's"; failures=$((failures + 1))
 fi
-check trace-t-min-negative 2 "--t-min -0.5: a finite number at least 0" -- "$meshcast" trace "$mesh" --t-min -0.5 --rays "$work/r.rays" --out "$work/hx.hits"
-check trace-t-min-nan 2 "--t-min nan: a finite number at least 0" -- "$meshcast" trace "$mesh" --t-min nan --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-t-min-negative 2 "--t-min: -0.5 is not in 0\.\.3\.40282347e\+38" -- "$meshcast" trace "$mesh" --t-min -0.5 --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-t-min-nan 2 '--t-min: "nan" is not a number' -- "$meshcast" trace "$mesh" --t-min nan --rays "$work/r.rays" --out "$work/hx.hits"
+# Every refusal names the value as it was written, not as it was read: a
+# --t-min past a float's range is not "inf", one nearer 0 than a float
+# holds is not taken as 0.
+check trace-t-min-huge 2 "--t-min: 1e39 is not in 0\.\.3\.40282347e\+38" -- "$meshcast" trace "$mesh" --t-min 1e39 --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-t-min-huge-negative 2 "--t-min: -1e39 is not in" -- "$meshcast" trace "$mesh" --t-min -1e39 --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-t-min-tiny 2 "--t-min: 1e-50 is nearer 0 than the least float above 0 \(1\.40129846e-45\)" -- "$meshcast" trace "$mesh" --t-min 1e-50 --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-t-min-scene-huge 2 "--t-min: 1e39 is not in" -- "$meshcast" trace "$work/one.json" --t-min 1e39 --rays "$work/r.rays" --out "$work/hx.hiti"
 # The Vulkan scene method (lavapipe in CI) on the same scene, culled: the
 # CPU's t bits and instances (the triangle may be the other one of an edge
 # both meet at the same t, as gpu_test allows).
@@ -256,7 +279,9 @@ check auto-memory 0 "the fewest bytes that meet the limits" -- "$meshcast" info 
 check auto-trial 0 "fastest in the trial" -- "$meshcast" build "$mesh" --layout auto --trial 64 --out "$work/auto2.blob"
 check auto-gpu 0 "CPU and GPU" -- "$meshcast" info "$mesh" --layout auto --gpu --goal memory
 check auto-json 0 '^\{"input"' -- "$meshcast" info "$mesh" --layout auto --json
-check auto-impossible 2 "no layout meets the limits \(at most 1.00 bytes" -- "$meshcast" info "$mesh" --layout auto --max-bytes 1
+check auto-impossible 2 "no layout meets the limits \(at most 1 byte a triangle\); the smallest built takes [0-9.]+ bytes a triangle and the most exact is exact \(an error of 0\)$" -- "$meshcast" info "$mesh" --layout auto --max-bytes 1
+check auto-impossible-small 2 "no layout meets the limits \(at most 0\.001 bytes a triangle\)" -- "$meshcast" info "$mesh" --layout auto --max-bytes 0.001
+check auto-error-given 0 "error at most 1\.25e-07 of the diagonal" -- "$meshcast" info "$mesh" --layout auto --max-error 1.25e-7
 check auto-goal 2 "valid goals: speed memory" -- "$meshcast" info "$mesh" --layout auto --goal fast
 check no-triangle-ids 0 "remap: none" -- "$meshcast" info "$mesh" --layout QuadTree/Float3SOA4 --no-triangle-ids
 check pairing 0 "of triangles paired" -- "$meshcast" info "$mesh" --layout AABBTree/Float3SOA4 --pairing
@@ -295,7 +320,34 @@ check render-cpu 0 "device: CPU" -- "$meshcast" render "$mesh" --png "$work/rc.p
 check render-vulkan 0 "device: " -- "$meshcast" render "$mesh" --backend vulkan --png "$work/rv.png" --width 160 --height 120
 # The same bytes walked on the GPU give the same picture.
 cmp -s "$work/rc.png" "$work/rv.png" || { echo "FAIL the Vulkan picture differs from the CPU's"; failures=$((failures + 1)); }
-check vulkan-wrong-layout 2 "reads BruteForce/BitPackSOA128 or BruteForce/Float3SOA128 blobs, not AABBTree/Float3" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
+check vulkan-wrong-layout 2 "reads BruteForce/BitPackSOA128 or BruteForce/Float3SOA128 blobs, not AABBTree/Float3" -- "$meshcast" trace "$mesh" --layout AABBTree/Float3 --backend vulkan --method bruteforce --rays "$work/r.rays" --out "$work/hx.hits"
+# --method defaults to the method that reads the blob's layout (trace --help
+# says so, as render does): a mesh in the default layout, and a saved blob
+# of every layout a GPU method reads (the list trace --help gives, from the
+# one table), each cast on the GPU without --method answers as the CPU
+# does on the same blob, byte for byte.
+check trace-vulkan-default 0 "device: " -- "$meshcast" trace "$mesh" --backend vulkan --rays "$work/r.rays" --out "$work/hvd.hits" --repeat 1
+"$meshcast" trace "$mesh" --rays "$work/r.rays" --out "$work/hcd.hits" --repeat 1 >/dev/null
+cmp -s "$work/hvd.hits" "$work/hcd.hits" || { echo "FAIL trace-vulkan-default: the GPU's hits differ from the CPU's"; failures=$((failures + 1)); }
+gpu_layouts=$("$meshcast" trace --help | grep -- '--method' | grep -oE '[A-Za-z0-9]+/[A-Za-z0-9]+' | sort -u)
+if (( $(wc -w <<<"$gpu_layouts") < 10 )); then
+  echo "FAIL trace-vulkan-layouts: trace --help names only these layouts a GPU method reads: $gpu_layouts"; failures=$((failures + 1))
+fi
+for gpu_layout in $gpu_layouts; do
+  blob=$work/gpu-${gpu_layout//\//-}.blob
+  "$meshcast" build "$mesh" --layout "$gpu_layout" --out "$blob" >/dev/null
+  "$meshcast" trace "$blob" --rays "$work/r.rays" --out "$blob.cpu.hits" --repeat 1 >/dev/null
+  check "trace-vulkan-default-$gpu_layout" 0 "\"layout\":\"$gpu_layout\",\"device\":\"[^C]" -- "$meshcast" trace "$blob" --backend vulkan --rays "$work/r.rays" --out "$blob.gpu.hits" --repeat 1 --json
+  cmp -s "$blob.cpu.hits" "$blob.gpu.hits" || { echo "FAIL trace-vulkan-default-$gpu_layout: the GPU's hits differ from the CPU's"; failures=$((failures + 1)); }
+done
+# --layout auto with a method named keeps to the layouts that method reads
+# (not a layout of another method, the named one dropped).
+check trace-vulkan-auto-method 0 '"layout":"StacklessLBVH/Float3"' -- "$meshcast" trace "$mesh" --layout auto --backend vulkan --method lbvh --rays "$work/r.rays" --out "$work/hx.hits" --repeat 1 --json
+# A layout no GPU method reads, and a method that does not exist, are
+# refused naming them and what the methods read (not "GPU method ''").
+check trace-vulkan-no-method 2 "no GPU method reads QuadTree/Float3SOA4 blobs.*octtree \(OctTreeCompressed/ClusterBitPackSOA8\)" -- "$meshcast" trace "$mesh" --layout QuadTree/Float3SOA4 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
+check render-vulkan-no-method 2 "no GPU method reads QuadTree/Float3SOA4 blobs" -- "$meshcast" render "$mesh" --layout QuadTree/Float3SOA4 --backend vulkan --png "$work/x.png" --width 16 --height 16
+check trace-vulkan-unknown-method 2 "--method octree: no such GPU method; the methods: aabbtree" -- "$meshcast" trace "$mesh" --backend vulkan --method octree --rays "$work/r.rays" --out "$work/hx.hits"
 check trace-help-methods 0 "octtree \(OctTreeCompressed/ClusterBitPackSOA8\), aabblist \(AABBList/Float3SOA128 or AABBList/BitPackSOA128\)" -- "$meshcast" trace --help
 check vulkan-no-device 3 "no device matches" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --device nonesuch --rays "$work/r.rays" --out "$work/hx.hits"
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
@@ -370,8 +422,19 @@ head -c 150 "$work/tiny_bin.stl" >"$work/cut.stl" 2>/dev/null
 check truncated-stl 2 "cut.stl: malformed file: binary STL truncated.*2 facets" -- "$meshcast" info "$work/cut.stl"
 { printf 'solid exported by a binary writer'; head -c 47 /dev/zero; printf '\x02\x00\x00\x00'; head -c 66 /dev/zero; } >"$work/cut_solid.stl"
 check truncated-stl-solid 2 "cut_solid.stl: malformed file: binary STL truncated.*2 facets" -- "$meshcast" info "$work/cut_solid.stl"
-check max-bytes-nan 2 "--max-bytes nan: a finite number" -- "$meshcast" info "$mesh" --layout auto --max-bytes nan
-check max-error-nan 2 "--max-error nan: a finite number" -- "$meshcast" info "$mesh" --layout auto --max-error nan
+check max-bytes-nan 2 '--max-bytes: "nan" is not a number \(a finite number at least 0\)' -- "$meshcast" info "$mesh" --layout auto --max-bytes nan
+check max-error-nan 2 '--max-error: "nan" is not a number \(a finite number at least 0\)' -- "$meshcast" info "$mesh" --layout auto --max-error nan
+check max-bytes-minus-nan 2 '--max-bytes: "-nan" is not a number' -- "$meshcast" info "$mesh" --layout auto --max-bytes -nan
+check max-bytes-huge 2 "--max-bytes: 1e400 is not a finite number at least 0$" -- "$meshcast" info "$mesh" --layout auto --max-bytes 1e400
+check max-error-negative 2 "--max-error: -inf is not a finite number at least 0$" -- "$meshcast" info "$mesh" --layout auto --max-error -inf
+# Integers: a negative or 65-bit seed was taken wrapped; leading zeros are
+# the number they spell; an unchecked count took -1 as 2^64 - 1.
+check rays-seed-negative 2 '--seed: "-1" is not an integer \(0\.\.18446744073709551615\)' -- "$meshcast" rays "$mesh" --count 5 --seed -1 --out "$work/x.rays"
+check rays-seed-huge 2 "--seed: 18446744073709551616 is not in 0\.\.18446744073709551615" -- "$meshcast" rays "$mesh" --count 5 --seed 18446744073709551616 --out "$work/x.rays"
+check rays-seed-largest 0 "5 long rays" -- "$meshcast" rays "$mesh" --count 5 --seed 18446744073709551615 --out "$work/x.rays"
+check rays-count-zeros 0 "5 long rays" -- "$meshcast" rays "$mesh" --count 000000000000000000005 --out "$work/x.rays"
+check demo-gpu-count-negative 2 '--gpu-count: "-1" is not an integer \(0\.\.10000000\)' -- timeout 60 "$meshcast" demo "$mesh" --gpu-count -1 --count 1 --png "$work/x.png"
+check bench-frame-ms-nan 2 '--frame-ms: "nan" is not a number \(0\.\.1000\)' -- timeout 60 "$meshcast" bench latency "$mesh" --frame-ms nan --out-dir "$work"
 check blob-leaf 2 "m.blob: is a blob.*--leaf applies only to a mesh" -- "$meshcast" info "$work/m.blob" --leaf 4
 check blob-layout 2 "m.blob: is a blob.*--layout applies only" -- "$meshcast" trace "$work/m.blob" --layout AABBTree/Float3 --rays "$work/r.rays" --out "$work/x.hits"
 check blob-pairing 2 "m.blob: is a blob.*--pairing" -- "$meshcast" info "$work/m.blob" --pairing

@@ -6,6 +6,7 @@
 #include <map>
 #include <cmath>
 #include <algorithm>
+#include <optional>
 
 #include "cpu/counters.h"
 #include "check/ray_files.h"
@@ -19,6 +20,7 @@
 #include "bench/robustness.h"
 #include "bench/trees.h"
 #include "check/generate.h"
+#include "layout/names.h"
 #include "meshcast/read.h"
 #include "tools/progress.h"
 #include "tools/commands.h"
@@ -26,11 +28,44 @@
 
 namespace meshcast::tools {
 
+const std::vector<std::string>& generated_mesh_names() {
+  static const std::vector<std::string> names = {"terrain_2M", "terrain_66k", "city_1M"};
+  return names;
+}
+
+bool is_generated_mesh(const std::string& name) {
+  const std::vector<std::string>& names = generated_mesh_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::optional<Mesh> generated_mesh(const std::string& name) {
+  if (name == "terrain_2M") return make_terrain(1024, 1024, 5);
+  if (name == "terrain_66k") return make_terrain(256, 256, 5);
+  if (name == "city_1M") return make_city(1000000, 7);
+  return std::nullopt;
+}
+
+std::string generated_mesh_offer(const std::string& name) {
+  return "did you mean " + closest_names(name, generated_mesh_names()) + "?";
+}
+
+void refuse_missing_mesh(const std::string& input, const InputError& e) {
+  // A word with no folder and no extension that is no file may be a
+  // generated mesh's name mistyped ("terrain_66K"): the names are offered,
+  // nearest first, as a mistyped layout's are.
+  std::error_code ec;
+  if (input.find_first_of("/.") == std::string::npos && !std::filesystem::exists(std::filesystem::symlink_status(input, ec)))
+    throw InputError(std::string(e.what()) + "; nor is it a generated mesh: " + generated_mesh_offer(input));
+  throw;  // as it was: its own type, its own words
+}
+
 Mesh bench_mesh(const std::string& input) {
-  if (input == "terrain_2M") return make_terrain(1024, 1024, 5);
-  if (input == "terrain_66k") return make_terrain(256, 256, 5);
-  if (input == "city_1M") return make_city(1000000, 7);
-  return read_mesh(input);
+  if (std::optional<Mesh> generated = generated_mesh(input)) return std::move(*generated);
+  try {
+    return read_mesh(input);
+  } catch (const InputError& e) {
+    refuse_missing_mesh(input, e);
+  }
 }
 
 namespace {
@@ -271,7 +306,7 @@ void add_bench_latency(CLI::App* bench) {
   CLI::App* lat = bench->add_subcommand("latency", "the host layer: batch latency from 1 to 65,536 rays, CPU and Vulkan");
   lat->add_option("mesh", largs->input, "mesh file, or terrain_2M (default data/bunny00.off)");
   lat->add_option("--device", lopts->first, "Vulkan device: index or part of its name");
-  lat->add_option("--frame-ms", lopts->second, "the frame of other work in the frame-ahead columns")->check(CLI::Range(0.0, 1000.0));
+  lat->add_option("--frame-ms", lopts->second, "the frame of other work in the frame-ahead columns")->check(number_in(0, 1000));
   lat->add_option("--out-dir", largs->out_dir, "where the CSV and the plot go");
   lat->callback([largs, lopts] {
     Mesh mesh = bench_mesh(largs->input);

@@ -32,18 +32,19 @@ void add_demo(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("demo", "the main job: three layouts, three ray kinds, oracle, picture");
-  cmd->add_option("input", args->input, "mesh file")->required();
+  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
   cmd->add_option("--count", args->count, "rays of each kind")->check(integer_in(1, 10000000));
   cmd->add_option("--repeat", args->repeat, "timed rounds (each casts every CPU row and ray kind once); the median is reported")->check(integer_in(1, 100));
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf (default: each layout's own)")->check(integer_in(1, 31));
   cmd->add_option("--png", args->png, "picture to write");
-  cmd->add_option("--gpu-count", args->gpu_count, "rays of each kind for the Vulkan row (0: no GPU row)");
+  cmd->add_option("--gpu-count", args->gpu_count, "rays of each kind for the Vulkan row (0: no GPU row)")
+      ->check(integer_in(0, 10000000));
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->add_option("--width", args->width)->check(integer_in(16, 8192));
   cmd->add_option("--height", args->height)->check(integer_in(16, 8192));
   cmd->callback([args] {
     auto t0 = std::chrono::steady_clock::now();
-    Mesh mesh = read_mesh(args->input);
+    Mesh mesh = bench_mesh(args->input);
     double load_ms = ms_since(t0);
     std::printf("%s: %zu triangles, %zu vertices, read in %.0f ms\n", args->input.c_str(), mesh.triangles.size(),
                 mesh.vertices.size(), load_ms);

@@ -1,9 +1,11 @@
 // meshcast rays MESH --kind long|probe|radial --count N --seed S --out R.rays
 // meshcast generate terrain_2M|terrain_66k|city_1M --out MESH.off
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 
 #include "check/ray_files.h"
+#include "layout/message_text.h"
 #include "meshcast/read.h"
 #include "tools/commands.h"
 #include "tools/common.h"
@@ -21,7 +23,7 @@ void add_rays(CLI::App& app) {
   cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
   cmd->add_option("--kind", args->kind, "long, probe or radial")->check(CLI::IsMember({"long", "probe", "radial"}));
   cmd->add_option("--count", args->count, "number of rays, at most 2^27")->check(integer_in(1, kMaxRayCount));
-  cmd->add_option("--seed", args->seed, "random seed");
+  cmd->add_option("--seed", args->seed, "random seed")->check(integer_in(0, UINT64_MAX));
   cmd->add_option("--out", args->out, "rays file to write")->required();
   cmd->callback([args] {
     Mesh mesh = bench_mesh(args->input);
@@ -43,7 +45,11 @@ void add_generate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("generate", "write a generated benchmark mesh (terrain_2M, terrain_66k, city_1M) as OFF");
   cmd->add_option("name", args->name, "terrain_2M, terrain_66k or city_1M")
       ->required()
-      ->check(CLI::IsMember({"terrain_2M", "terrain_66k", "city_1M"}));
+      ->check(CLI::Validator(
+          [](std::string& name) -> std::string {
+            return is_generated_mesh(name) ? std::string() : "\"" + shown_text(name) + "\" is not a generated mesh; " + generated_mesh_offer(name);
+          },
+          "NAME"));
   cmd->add_option("--out", args->out, "OFF file to write")->required();
   cmd->callback([args] {
     const Mesh mesh = bench_mesh(args->name);

@@ -30,7 +30,7 @@ struct TraceArgs {
   LayoutArgs layout;
   uint32_t repeat = 5;
   bool json = false;
-  std::string backend = "cpu", method = "bruteforce", device, query = "closest", cull = "none";
+  std::string backend = "cpu", method, device, query = "closest", cull = "none";  // method "": the blob's
   uint32_t max_hits = 16;
   float t_min = 0;
   uint32_t threads = 1;  // the CPU backend's, on a blob (0: every core)
@@ -113,7 +113,7 @@ void trace_scene(TraceArgs a) {
 void add_trace(CLI::App& app) {
   auto args = std::make_shared<TraceArgs>();
   CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh, blob or scene (.json), write a hits file");
-  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), blob or scene file (.json: RAYD or RAYS rays in, HITI hits out)")->required();
+  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), generated mesh (terrain_2M, terrain_66k, city_1M), blob or scene file (.json: RAYD or RAYS rays in, HITI hits out)")->required();
   cmd->add_option("--rays", args->rays, "rays file")->required();
   cmd->add_option("--out", args->out, "hits file to write")->required();
   add_layout_options(cmd, args->layout);
@@ -134,16 +134,16 @@ void add_trace(CLI::App& app) {
       ->check(CLI::IsMember({"none", "back", "front"}));
   cmd->add_option("--t-min", args->t_min,
                   "the nearest t a hit may have, on every ray read (a hit needs t-min <= t <= t_max; default 0): "
-                  "secondary rays from a surface skip it. A ray whose t_max is below it is an invalid ray (a miss)");
+                  "secondary rays from a surface skip it. A ray whose t_max is below it is an invalid ray (a miss)")
+      ->check(number_in(0, INFINITY, true));
   cmd->add_option("--backend", args->backend, "cpu (one thread, or --threads) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
   cmd->add_option("--threads", args->threads,
                   "cpu, a mesh or blob: the threads the batch is split over, in chunks of rays (0: every core; default 1)")
       ->check(integer_in(0, 1024));
   // The methods and what each reads, from the one table (gpu/method_table.cpp).
-  std::string methods = "GPU method (default: the one that reads the blob's layout):";
-  for (const std::string& m : gpu::method_names()) methods += " " + m + " (" + gpu::layouts_read_by(m) + "),";
-  methods.back() = '.';
-  cmd->add_option("--method", args->method, methods);
+  cmd->add_option("--method", args->method,
+                  "GPU method (default: the one that reads the blob's layout; with --layout auto, a layout the named "
+                  "method reads): " + gpu_methods_text() + ".");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name (default $MESHCAST_VK_DEVICE, "
                                             "else the first discrete GPU)");
   cmd->callback([args, max_hits] {
@@ -153,22 +153,13 @@ void add_trace(CLI::App& app) {
     // Given with a query that keeps one hit a ray, it would be ignored.
     if (max_hits->count() > 0 && query != Query::All)
       throw InputError("trace: --max-hits is for --query all (every hit); --query " + args->query + " keeps one hit a ray");
-    if (!(args->t_min >= 0) || std::isinf(args->t_min)) {
-      char shown[32];
-      std::snprintf(shown, sizeof shown, "%g", double(args->t_min));
-      throw InputError(std::string("trace: --t-min ") + shown + ": a finite number at least 0 (the nearest t a hit may have)");
-    }
     if (args->threads != 1 && (args->backend != "cpu" || is_scene_file(args->input)))
       throw InputError("trace: --threads is for --backend cpu on a mesh or blob (scene files are cast on one thread)");
     if (is_scene_file(args->input)) {
       trace_scene(*args);
       return;
     }
-    // --layout auto for the Vulkan backend: a layout a method reads, and that method.
-    const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
-    if (vulkan_auto) args->layout.gpu = true;
-    Loaded in = load_input(args->input, args->layout);
-    if (vulkan_auto) args->method = gpu::method_reading(in.blob);
+    Loaded in = load_input_for(args->input, args->layout, args->backend, args->method);
     std::vector<Ray> rays = read_rays(args->rays);
     apply_t_min(rays, args->t_min);
     std::vector<Hit> hits(rays.size());
@@ -287,13 +278,13 @@ void add_render(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("render", "a depth-shaded picture of a mesh, blob or scene, one primary ray a pixel");
-  cmd->add_option("input", args->input, "mesh file, blob or scene file (.json)")->required();
+  cmd->add_option("input", args->input, "mesh file, generated mesh, blob or scene file (.json)")->required();
   add_layout_options(cmd, args->layout);
   cmd->add_option("--png", args->png, "picture to write");
   cmd->add_option("--width", args->width)->check(integer_in(16, 8192));
   cmd->add_option("--height", args->height)->check(integer_in(16, 8192));
   cmd->add_option("--backend", args->backend, "cpu (one thread) or vulkan")->check(CLI::IsMember({"cpu", "vulkan"}));
-  cmd->add_option("--method", args->method, "GPU method (see trace --help; default: the one that reads the layout)");
+  cmd->add_option("--method", args->method, "GPU method (see trace --help; default: the one that reads the blob's layout)");
   cmd->add_option("--device", args->device, "Vulkan device: index or part of its name");
   cmd->callback([args] {
     if (is_scene_file(args->input)) {
@@ -305,10 +296,7 @@ void add_render(CLI::App& app) {
                   file.instances, file.mesh_names.size(), p.width, p.height, p.ns_per_ray, args->png.c_str());
       return;
     }
-    const bool vulkan_auto = args->backend == "vulkan" && args->layout.layout == "auto";
-    if (vulkan_auto) args->layout.gpu = true;
-    Loaded in = load_input(args->input, args->layout);
-    if (vulkan_auto || args->method.empty()) args->method = gpu::method_reading(in.blob);
+    Loaded in = load_input_for(args->input, args->layout, args->backend, args->method);
     std::string device = "CPU, one thread";
     Picture p;
     if (args->backend == "vulkan") {
@@ -335,7 +323,7 @@ void add_build(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("build", "build a mesh into a blob file");
-  cmd->add_option("input", args->input, "mesh file")->required();
+  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
   cmd->add_option("--out", args->out, "blob file to write")->required();
   add_layout_options(cmd, args->layout);
   cmd->callback([args] {

@@ -3,10 +3,13 @@
 #include "tools/commands.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "builder/auto_layout.h"
@@ -23,17 +26,25 @@ namespace meshcast::tools {
 Loaded load_mesh_or_blob(const std::string& path, const MeshBuilder& build) {
   Loaded out;
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<uint8_t> head = read_file(path);
-  uint32_t magic = 0;
-  if (head.size() >= 4) std::memcpy(&magic, head.data(), 4);
-  if (magic == MC_BLOB_MAGIC) {
-    std::string why = layout::validate(head);
-    if (!why.empty()) throw InputError(path + ": " + why);
-    out.blob = std::move(head);
-    out.load_ms = ms_since(t0);
-    return out;
+  out.mesh = generated_mesh(path);
+  if (!out.mesh) {
+    std::vector<uint8_t> head;
+    try {
+      head = read_file(path);
+    } catch (const InputError& e) {
+      refuse_missing_mesh(path, e);
+    }
+    uint32_t magic = 0;
+    if (head.size() >= 4) std::memcpy(&magic, head.data(), 4);
+    if (magic == MC_BLOB_MAGIC) {
+      std::string why = layout::validate(head);
+      if (!why.empty()) throw InputError(path + ": " + why);
+      out.blob = std::move(head);
+      out.load_ms = ms_since(t0);
+      return out;
+    }
+    out.mesh = read_mesh(path);
   }
-  out.mesh = read_mesh(path);
   out.load_ms = ms_since(t0);
   auto t1 = std::chrono::steady_clock::now();
   {
@@ -52,29 +63,43 @@ BuildOptions layout_options(const std::string& layout, uint32_t leaf, const std:
   return o;
 }
 
-namespace {
-
-// NaN passes CLI11's NonNegativeNumber; "no limit" is 0, so NaN and
-// infinity are refused.
-void check_limit(const char* option, double value) {
-  if (!std::isfinite(value))
-    throw InputError(std::string(option) + " " + (std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf") +
-                     ": a finite number at least 0 (0: no limit)");
-}
-
-}  // namespace
-
 CLI::Validator integer_in(uint64_t lo, uint64_t hi) {
   const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
   return CLI::Validator(
       [lo, hi, range](std::string& text) -> std::string {
         const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
         if (!digits) return "\"" + shown_text(text) + "\" is not an integer (" + range + ")";
-        // Past 19 digits a number is past 64 bits, and past any range here.
-        if (text.size() > 19 || std::stoull(text) < lo || std::stoull(text) > hi) return shown_text(text) + " is not in " + range;
+        // Past 64 bits is past any range here; leading zeros are read as such.
+        uint64_t value = 0;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+        if (error != std::errc() || value < lo || value > hi) return shown_text(text) + " is not in " + range;
         return {};
       },
       "INT in " + range);
+}
+
+CLI::Validator number_in(double lo, double hi, bool single) {
+  // A float option's range is a float's too: past it the value would be
+  // read as inf, and a nonzero one nearer 0 than a float holds as 0.
+  if (single) hi = std::min(hi, double(std::numeric_limits<float>::max()));
+  const std::string span = number_text(lo) + ".." + number_text(hi);
+  const std::string range = std::isinf(hi) ? "a finite number at least " + number_text(lo) : "in " + span;
+  const double least = single ? double(std::numeric_limits<float>::denorm_min()) : std::numeric_limits<double>::denorm_min();
+  return CLI::Validator(
+      [lo, hi, single, span, range, least](std::string& text) -> std::string {
+        errno = 0;
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size() || std::isnan(value))
+          return "\"" + shown_text(text) + "\" is not a number (" + (std::isinf(hi) ? range : span) + ")";
+        // 1e400 is read as inf: past every range here.
+        if (!std::isfinite(value) || value < lo || value > hi) return shown_text(text) + " is not " + range;
+        if ((value == 0 && errno == ERANGE) || (single && value != 0 && float(value) == 0))
+          return shown_text(text) + " is nearer 0 than the least " + (single ? "float" : "double") + " above 0 (" +
+                 number_text(least) + ")";
+        return {};
+      },
+      std::isinf(hi) ? "NUMBER >= " + number_text(lo) : "NUMBER in " + span);
 }
 
 void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
@@ -82,10 +107,10 @@ void add_layout_options(CLI::App* cmd, LayoutArgs& a) {
   cmd->add_option("--layout", a.layout, "TREE/TRIANGLES when building from a mesh, or auto (chosen for the mesh)");
   cmd->add_option("--goal", a.goal, "auto: speed (fastest) or memory (fewest bytes)");
   cmd->add_option("--max-bytes", a.max_bytes, "auto: at most this many blob bytes a triangle (0: no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_in(0));
   cmd->add_option("--max-error", a.max_error,
                   "auto: stated error bound at most this fraction of the mesh diagonal (0: no limit; bench error)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_in(0));
   cmd->add_flag("--gpu", a.gpu, "auto: only layouts a Vulkan method reads as well (CPU and GPU)");
   cmd->add_option("--trial", a.trial, "auto, speed first: time the candidates on this many rays (0: rules only)")
       ->check(integer_in(0, 1u << 20));
@@ -134,7 +159,8 @@ static Loaded load_as_asked(const std::string& path, const LayoutArgs& a, std::F
   limits.goal = parse_goal(a.goal);
   limits.max_bytes_per_triangle = a.max_bytes, limits.max_error = a.max_error;
   if (a.gpu)
-    for (const gpu::MethodLayout& m : gpu::method_layouts()) limits.readers.push_back(m.layout);
+    for (const gpu::MethodLayout& m : gpu::method_layouts())
+      if (a.gpu_method.empty() || a.gpu_method == m.method) limits.readers.push_back(m.layout);
   limits.trial_rays = a.trial;
   limits.triangle_ids = !a.no_triangle_ids;
   limits.build_threads = a.build_threads;
@@ -147,8 +173,6 @@ static Loaded load_as_asked(const std::string& path, const LayoutArgs& a, std::F
 }
 
 Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* report) {
-  check_limit("--max-bytes", a.max_bytes);
-  check_limit("--max-error", a.max_error);
   Loaded in = load_as_asked(path, a, report);
   // A blob's layout was fixed when it was built.
   if (!in.mesh)
@@ -156,6 +180,31 @@ Loaded load_input(const std::string& path, const LayoutArgs& a, std::FILE* repor
       if (option->count() > 0)
         throw InputError(path + ": is a blob, whose layout was fixed when it was built; " + option->get_name() +
                          " applies only to a mesh input");
+  return in;
+}
+
+std::string gpu_methods_text() {
+  std::string text;
+  for (const std::string& m : gpu::method_names()) text += (text.empty() ? "" : ", ") + m + " (" + gpu::layouts_read_by(m) + ")";
+  return text;
+}
+
+Loaded load_input_for(const std::string& path, LayoutArgs& layout, const std::string& backend, std::string& method,
+                      std::FILE* report) {
+  if (backend != "vulkan") return load_input(path, layout, report);
+  const std::vector<std::string> names = gpu::method_names();
+  if (!method.empty() && std::find(names.begin(), names.end(), method) == names.end())
+    throw InputError("--method " + shown_text(method) + ": no such GPU method; the methods: " + gpu_methods_text());
+  // --layout auto: a layout a GPU method reads (the named one's, when named).
+  if (layout.layout == "auto") layout.gpu = true, layout.gpu_method = method;
+  Loaded in = load_input(path, layout, report);
+  if (method.empty()) {
+    method = gpu::method_reading(in.blob);
+    const layout::BlobHeader& h = layout::header_of(in.blob.data());
+    if (method.empty())
+      throw InputError(path + ": no GPU method reads " + layout_name(h.tree_format, h.triangle_format) +
+                       " blobs (--layout auto chooses one that a method reads); the methods: " + gpu_methods_text());
+  }
   return in;
 }
 

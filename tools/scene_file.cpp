@@ -88,7 +88,9 @@ SceneFile load_scene_file(const std::string& path, const LayoutArgs& layout, std
     if (file.get<std::string>().size() > PATH_MAX)
       throw InputError(where + ": the file name \"" + shown_text(file.get<std::string>()) + "\" is longer than a path may be (" +
                        std::to_string(PATH_MAX) + " bytes)");
-    const std::string mesh_path = (folder / file.get<std::string>()).string();
+    // A generated mesh's name is that mesh wherever the scene file lies, as on the command line.
+    const std::string mesh_path =
+        is_generated_mesh(file.get<std::string>()) ? file.get<std::string>() : (folder / file.get<std::string>()).string();
     try {  // the mesh file's own message, and where the scene names it
       Loaded mesh = load_input(mesh_path, layout, report);
       out.blob_bytes += mesh.blob.size();

@@ -6,7 +6,8 @@
 // where rotation_scale (default the identity), translation (default 0),
 // mask (default 255), enabled (default true) and flip_facing (default
 // false: the instance faces as its mesh, Scene::add_instance) may be left
-// out, and a mesh's path is taken relative to the scene file's folder.
+// out, and a mesh's path is taken relative to the scene file's folder (a
+// generated mesh's name, terrain_2M, terrain_66k or city_1M, is that mesh).
 #pragma once
 #include <cstdio>
 #include <string>

@@ -31,7 +31,12 @@ with ``ValueError`` naming it (Open3D answers such a ray as a miss).
 Arrays: float32 or float64 (other real types are converted once); C-
 contiguous arrays are read where they lie. Every cast releases the GIL and
 splits the batch over meshcast's own threads (``nthreads``: 0 for every
-core). Bad input raises ``ValueError``, files ``OSError``.
+core): one pool for the process, as wide as the most threads a call has
+asked for, a call of fewer using that many of them. A child forked from
+the process (``multiprocessing`` on Linux) casts on threads and Vulkan
+devices of its own, whatever its parent cast. Bad input raises
+``ValueError``, files ``OSError``; a thread or device the system refuses,
+``RuntimeError`` saying so.
 """
 
 import os as _os

@@ -65,7 +65,7 @@ def build(vertices, triangles, layout="auto", max_bytes=0, leaf_size=0, threads=
     leaf_size: a named layout's largest leaf (0: its own). threads: the
     build's threads (0: every core); the bytes are the same on any number.
     """
-    return _meshcast._build(vertices, triangles, layout, float(max_bytes), leaf_size, threads, name)
+    return _meshcast._build(vertices, triangles, layout, max_bytes, leaf_size, threads, name)
 
 
 def load(path, mmap=False):

@@ -120,14 +120,16 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
 }
 
 std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,
-                              double max_bytes, long long leaf_size, long long threads, const std::string& name) {
+                              const py::object& max_bytes_given, long long leaf_size, long long threads,
+                              const std::string& name) {
   if (leaf_size < 0 || leaf_size > 31)
     throw py::value_error("leaf_size " + std::to_string(leaf_size) + ": from 1 to 31 (0: the layout's own)");
   const uint32_t build_threads = threads == 0 ? 0 : thread_count(threads, "threads");
   const double no_centre[3] = {0, 0, 0};
   const Mesh mesh = mesh_from_arrays(vertices, triangles, no_centre);
-  // The value as Python writes it (nan, 1e+39, 1000.5), as the caller gave it.
-  const std::string max_bytes_text = py::repr(py::float_(max_bytes)).cast<std::string>();
+  // The value as the caller gave it (1000, nan, 1e+39, 1000.5), as Python writes it.
+  const std::string max_bytes_text = py::str(max_bytes_given).cast<std::string>();
+  const double max_bytes = py::float_(max_bytes_given);
   if (std::isnan(max_bytes)) throw py::value_error("max_bytes: " + max_bytes_text + " is not a number of bytes");
   if (max_bytes < 0) throw py::value_error("max_bytes: " + max_bytes_text + " is negative");
   std::vector<uint8_t> bytes;
@@ -138,7 +140,14 @@ std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& tria
       limits.max_bytes_per_triangle = max_bytes / double(std::max<size_t>(1, mesh.triangle_count()));
       limits.build_threads = build_threads;
       if (leaf_size) throw InputError(name + ": leaf_size is the automatic layout's to choose (name a layout to set it)");
-      bytes = choose_layout(mesh, limits, name).blob;
+      try {
+        bytes = choose_layout(mesh, limits, name).blob;
+      } catch (const InputError& e) {
+        if (!(max_bytes > 0)) throw;
+        // The automatic layout speaks of bytes a triangle: say what the caller's whole-blob limit became.
+        throw InputError("max_bytes " + max_bytes_text + " over " + std::to_string(mesh.triangle_count()) +
+                         " triangles: " + e.what());
+      }
     } else {
       BuildOptions options;
       options.layout = parse_layout_name(layout);
@@ -196,7 +205,7 @@ Python threads may cast through one Blob at once.)")
       });
 
   m.def("_build", &build, py::arg("vertices"), py::arg("triangles"), py::arg("layout") = "auto",
-        py::arg("max_bytes") = 0.0, py::arg("leaf_size") = 0, py::arg("threads") = 0, py::arg("name") = "mesh");
+        py::arg("max_bytes") = 0, py::arg("leaf_size") = 0, py::arg("threads") = 0, py::arg("name") = "mesh");
   m.def(
       "_load",
       [](const std::string& path, bool mmap) {

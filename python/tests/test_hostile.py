@@ -200,6 +200,9 @@ def test_values_are_named_as_written():
         meshcast.build(v, f, max_bytes=-1.5)
     with pytest.raises(ValueError, match=r"above max_bytes 100\.5"):
         meshcast.build(v, f, layout=DEFAULT_LAYOUT, max_bytes=100.5)
+    # The automatic layout's limit is a triangle's share: the caller's own figure is named too.
+    with pytest.raises(ValueError, match=r"max_bytes 24 over 12 triangles: .*at most 2 bytes a triangle"):
+        meshcast.build(v, f, max_bytes=24)
     bad = f.astype(np.uint64)
     bad[3, 1] = np.uint64(2**64 - 1)
     with pytest.raises(ValueError, match=r"triangles\[3, 1\] = 18446744073709551615: "):

@@ -327,6 +327,16 @@ TEST(Build, BadMeshesAreRefusedWithTheirNameAndProblem) {
   EXPECT_THROW(build_blob(ok, big_leaf, "grid"), InputError);
 }
 
+// What building a view of "level.mesh" is refused with, or "built".
+std::string refusal(const MeshView& view) {
+  try {
+    build_blob(view, {}, "level.mesh");
+  } catch (const InputError& e) {
+    return std::string(e.what());
+  }
+  return std::string("built");
+}
+
 // A mesh from typed spans: interleaved vertices (position, normal, uv: 8
 // floats) and 16-bit indices build the same blob as the packed mesh, and a
 // stride or index buffer that does not fit the data is refused by name.
@@ -349,14 +359,6 @@ TEST(Build, TypedMeshViewsDeduceSizesAndRefuseWrongStrides) {
   for (const Vec3& v : m.vertices) normal_first.insert(normal_first.end(), {0, 0, 1, v.x, v.y, v.z, 0.5f, 0.5f});
   EXPECT_EQ(build_blob(MeshView(std::span<const float>(normal_first).subspan(3), 8, indices), {}, "grid"), expected);
 
-  auto refusal = [](const MeshView& view) {
-    try {
-      build_blob(view, {}, "level.mesh");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("built");
-  };
   // A stride under 3 floats, a last vertex cut short, indices that are not
   // whole triangles.
   const std::string under = refusal(MeshView(interleaved, 2, short_indices));
@@ -387,14 +389,6 @@ TEST(Build, TypedMeshViewsDeduceSizesAndRefuseWrongStrides) {
 // its stride in bytes, refuses a stride whose product with the vertex
 // count overflows, and an index_type that is neither IndexType.
 TEST(Build, MeshViewsNameTheStrideAsGivenAndRefuseUnknownIndexTypes) {
-  auto refusal = [](const MeshView& view) {
-    try {
-      build_blob(view, {}, "level.mesh");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("built");
-  };
   const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const std::vector<uint32_t> one = {0, 1, 2};
   const std::string under = refusal(MeshView(xyz, 2, one));

@@ -60,7 +60,9 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
   const size_t triangle_stride = view.triangle_stride ? view.triangle_stride : 3 * index_bytes;
   if ((view.vertex_count && !view.positions) || (view.triangle_count && !view.indices))
     throw InputError(name + ": a null position or index array with a nonzero count");
-  if (view.stride_in_floats ? *view.stride_in_floats < 3 : view.vertex_stride < 3 * sizeof(float))
+  // The byte stride is the one the reads take (a typed view's too): the
+  // floats only word the message.
+  if (view.vertex_stride < 3 * sizeof(float))
     throw InputError(name + ": " + stride_text(view) + " is shorter than a position (" +
                      (view.stride_in_floats ? "3 floats)" : "12 bytes: three floats)"));
   if (triangle_stride < 3 * index_bytes)
@@ -68,9 +70,10 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
                      std::to_string(8 * index_bytes) + "-bit indices");
   // The reads below step count - 1 strides from the start: a stride whose
   // product with its count overflows would wrap to memory it never meant.
+  // A typed view's stride in floats may overflow as bytes by itself.
   const bool vertex_overflow =
-      view.vertex_count != 0 && (view.stride_in_floats ? *view.stride_in_floats > SIZE_MAX / sizeof(float) / view.vertex_count
-                                                       : view.vertex_stride > SIZE_MAX / view.vertex_count);
+      view.vertex_count != 0 && ((view.stride_in_floats && *view.stride_in_floats > SIZE_MAX / sizeof(float)) ||
+                                 view.vertex_stride > SIZE_MAX / view.vertex_count);
   if (vertex_overflow)
     throw InputError(name + ": " + stride_text(view) + " times " + std::to_string(view.vertex_count) +
                      " vertices overflows the bytes memory addresses");

@@ -22,6 +22,9 @@ WorkerPool::WorkerPool(uint32_t threads) {
     throw Error("meshcast: the system refused to start worker thread " + std::to_string(started + 1) + " of " +
                 std::to_string(threads) + " (" + e.what() +
                 "): ask for fewer threads, or raise the process's limits on threads and address space");
+  } catch (...) {  // std::bad_alloc (a thread's own state, the vector growing): the same joining first
+    stop();
+    throw;
   }
 }
 

@@ -427,12 +427,13 @@ check max-error-nan 2 '--max-error: "nan" is not a number \(a finite number at l
 check max-bytes-minus-nan 2 '--max-bytes: "-nan" is not a number' -- "$meshcast" info "$mesh" --layout auto --max-bytes -nan
 check max-bytes-huge 2 "--max-bytes: 1e400 is not a finite number at least 0$" -- "$meshcast" info "$mesh" --layout auto --max-bytes 1e400
 check max-error-negative 2 "--max-error: -inf is not a finite number at least 0$" -- "$meshcast" info "$mesh" --layout auto --max-error -inf
-# Integers: a negative or 65-bit seed was taken wrapped; leading zeros are
-# the number they spell; an unchecked count took -1 as 2^64 - 1.
+# Integers: a negative or 65-bit seed was taken wrapped; a leading zero made
+# CLI11 read octal (010 as eight); an unchecked count took -1 as 2^64 - 1.
 check rays-seed-negative 2 '--seed: "-1" is not an integer \(0\.\.18446744073709551615\)' -- "$meshcast" rays "$mesh" --count 5 --seed -1 --out "$work/x.rays"
 check rays-seed-huge 2 "--seed: 18446744073709551616 is not in 0\.\.18446744073709551615" -- "$meshcast" rays "$mesh" --count 5 --seed 18446744073709551616 --out "$work/x.rays"
 check rays-seed-largest 0 "5 long rays" -- "$meshcast" rays "$mesh" --count 5 --seed 18446744073709551615 --out "$work/x.rays"
-check rays-count-zeros 0 "5 long rays" -- "$meshcast" rays "$mesh" --count 000000000000000000005 --out "$work/x.rays"
+check rays-count-zeros 2 "--count: 010 has a leading zero" -- "$meshcast" rays "$mesh" --count 010 --out "$work/x.rays"
+check rays-seed-zero 0 "5 long rays" -- "$meshcast" rays "$mesh" --count 5 --seed 0 --out "$work/x.rays"
 check demo-gpu-count-negative 2 '--gpu-count: "-1" is not an integer \(0\.\.10000000\)' -- timeout 60 "$meshcast" demo "$mesh" --gpu-count -1 --count 1 --png "$work/x.png"
 check bench-frame-ms-nan 2 '--frame-ms: "nan" is not a number \(0\.\.1000\)' -- timeout 60 "$meshcast" bench latency "$mesh" --frame-ms nan --out-dir "$work"
 check blob-leaf 2 "m.blob: is a blob.*--leaf applies only to a mesh" -- "$meshcast" info "$work/m.blob" --leaf 4

@@ -69,7 +69,11 @@ CLI::Validator integer_in(uint64_t lo, uint64_t hi) {
       [lo, hi, range](std::string& text) -> std::string {
         const bool digits = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
         if (!digits) return "\"" + shown_text(text) + "\" is not an integer (" + range + ")";
-        // Past 64 bits is past any range here; leading zeros are read as such.
+        // CLI11 converts the text with base 0, where a leading zero means
+        // octal: 010 would pass here as ten and be taken as eight.
+        if (text.size() > 1 && text[0] == '0')
+          return shown_text(text) + " has a leading zero (written without it, in decimal; " + range + ")";
+        // Past 64 bits is past any range here.
         uint64_t value = 0;
         const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
         if (error != std::errc() || value < lo || value > hi) return shown_text(text) + " is not in " + range;

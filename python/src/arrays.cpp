@@ -192,7 +192,10 @@ std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
 
 void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin) {
   if (refused.count == 0) return;
-  const size_t i = std::min(refused.first, rays.count - 1);
+  if (refused.first >= rays.count)  // a walk counted a ray that, walked alone, it took: never expected
+    throw py::value_error(std::to_string(refused.count) + " of " + std::to_string(rays.count) +
+                          " rays refused by the walk (none of them when cast alone)");
+  const size_t i = refused.first;
   std::string why = refusal(rays, i, float_origin);
   if (why.empty()) {
     // The ray is fine in the world but not in the frame of a geometry it

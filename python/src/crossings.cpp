@@ -17,6 +17,7 @@ Corners TriangleCorners::corners(uint32_t triangle) const {
       for (uint32_t i = 0; i < count; ++i)
         leaf_of_[layout::remap_entry(blob, h, layout::slot_of(h, block, i))] = uint64_t(block) << 8 | i;
     });
+    table_bytes_.store(leaf_of_.capacity() * sizeof(uint64_t), std::memory_order_release);
   });
   float v[3][3];
   const uint64_t at = leaf_of_[triangle];
@@ -26,8 +27,6 @@ Corners TriangleCorners::corners(uint32_t triangle) const {
     for (int k = 0; k < 3; ++k) out.c[c][k] = v[c][k];
   return out;
 }
-
-size_t TriangleCorners::nbytes() const { return leaf_of_.capacity() * sizeof(uint64_t); }
 
 namespace {
 

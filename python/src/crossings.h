@@ -18,6 +18,7 @@
 // decided from the triangles' corners as the walker decoded them, never
 // from their facing.
 #pragma once
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <mutex>
@@ -42,12 +43,13 @@ class TriangleCorners {
  public:
   explicit TriangleCorners(std::span<const uint8_t> blob) : blob_(blob) {}
   Corners corners(uint32_t triangle) const;
-  size_t nbytes() const;  // of the table, once made
+  size_t nbytes() const { return table_bytes_.load(std::memory_order_acquire); }  // of the table, once made
 
  private:
   std::span<const uint8_t> blob_;
   mutable std::once_flag made_;
   mutable std::vector<uint64_t> leaf_of_;  // the leaf block's offset << 8 | the triangle's lane
+  mutable std::atomic<size_t> table_bytes_{0};  // read by nbytes() while another thread may be making the table
 };
 
 // The geometry of a hit: a scene's instance, or 0 for one geometry's blob
@@ -66,22 +68,41 @@ template <class Record, class CornersOf, class Keep>
 void crossings(std::span<const Record> row, const float dir[3], const CornersOf& corners_of, const Keep& keep) {
   static thread_local std::vector<Corners> corners;
   static thread_local std::vector<bool> inside;
+  static thread_local std::vector<size_t> members;
+  static thread_local std::vector<bool> kept, done;
   for (size_t g = 0; g < row.size();) {
+    // The window of hits within 2^-20 of the first's t, of any geometry:
+    // each geometry's t carries its own frame's rounding, so two meeting
+    // at a point may sort interleaved (t, then instance).
     const float t0 = row[g].t;
-    const uint32_t geometry = geometry_of(row[g]);
     const float tol = std::ldexp(std::fabs(t0), -20);
-    size_t end = g + 1;  // the first hit always, so a group ends even on a NaN t
-    while (end < row.size() && geometry_of(row[end]) == geometry && row[end].t - t0 <= tol) ++end;
+    size_t end = g + 1;  // the first hit always, so a window ends even on a NaN t
+    while (end < row.size() && row[end].t - t0 <= tol) ++end;
     if (end - g == 1) {
       keep(row[g]);
-    } else {
-      corners.resize(end - g);
-      const TriangleCorners& of = corners_of(geometry);
-      for (size_t k = g; k < end; ++k) corners[k - g] = of.corners(row[k].triangle);
-      crossing_triangles(corners, dir, inside);
-      for (size_t k = g; k < end; ++k)
-        if (inside[k - g]) keep(row[k]);
+      g = end;
+      continue;
     }
+    kept.assign(end - g, false);
+    done.assign(end - g, false);
+    for (size_t first = g; first < end; ++first) {  // each geometry's group of the window
+      if (done[first - g]) continue;
+      const uint32_t geometry = geometry_of(row[first]);
+      members.clear();
+      for (size_t k = first; k < end; ++k)
+        if (!done[k - g] && geometry_of(row[k]) == geometry) members.push_back(k), done[k - g] = true;
+      if (members.size() == 1) {
+        kept[first - g] = true;
+        continue;
+      }
+      corners.resize(members.size());
+      const TriangleCorners& of = corners_of(geometry);
+      for (size_t m = 0; m < members.size(); ++m) corners[m] = of.corners(row[members[m]].triangle);
+      crossing_triangles(corners, dir, inside);
+      for (size_t m = 0; m < members.size(); ++m) kept[members[m] - g] = inside[m];
+    }
+    for (size_t k = g; k < end; ++k)
+      if (kept[k - g]) keep(row[k]);
     g = end;
   }
 }

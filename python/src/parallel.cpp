@@ -1,5 +1,6 @@
 #include "python/src/parallel.h"
 
+#include <pthread.h>
 #include <sched.h>
 #include <unistd.h>
 
@@ -34,11 +35,26 @@ uint32_t thread_count(long long requested, const char* what) {
 // (multiprocessing's default on Linux) has the pool but none of its
 // threads: it makes its own and leaves the parent's alone (joining threads
 // it does not have would wait for ever).
-std::shared_ptr<host::WorkerPool> shared_pool(uint32_t threads) {
+namespace {
+
+// The pool's lock, held across a fork (pthread_atfork) so that a child
+// never inherits it locked by a thread it does not have.
+std::mutex& pool_mutex() {
   static std::mutex mutex;
+  static const bool held_across_forks = [] {
+    pthread_atfork([] { pool_mutex().lock(); }, [] { pool_mutex().unlock(); }, [] { pool_mutex().unlock(); });
+    return true;
+  }();
+  (void)held_across_forks;
+  return mutex;
+}
+
+}  // namespace
+
+std::shared_ptr<host::WorkerPool> shared_pool(uint32_t threads) {
   static std::shared_ptr<host::WorkerPool> pool;
   static pid_t owner = getpid();
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<std::mutex> lock(pool_mutex());
   if (owner != getpid()) {
     new std::shared_ptr<host::WorkerPool>(std::move(pool));  // the parent's, never destroyed here
     owner = getpid();

@@ -275,3 +275,12 @@ def test_parity_through_edges_and_vertices_of_any_winding(winding):
                              f"counts {counts[wrong[0]]}, inside {inside[wrong[0]]}")
     listed = scene.list_intersections(rays)
     np.testing.assert_array_equal(np.diff(listed["ray_splits"].numpy()), counts)
+    # A second geometry through the same points (the solid moved by one
+    # voxel along x, stored about another centre): each counts its own.
+    moved = v + [1.0, 0.0, 0.0]
+    alone, both = meshcast.RaycastingScene(), meshcast.RaycastingScene()
+    alone.add_triangles(moved, f)
+    both.add_triangles(v, f)
+    both.add_triangles(moved, f)
+    np.testing.assert_array_equal(both.count_intersections(rays).numpy(),
+                                  counts + alone.count_intersections(rays).numpy())

@@ -28,8 +28,27 @@
 
 namespace meshcast::tools {
 
+namespace {
+
+// The generated meshes: each name once, with the mesh it makes.
+struct GeneratedMesh {
+  const char* name;
+  Mesh (*make)();
+};
+constexpr GeneratedMesh kGeneratedMeshes[] = {
+    {"terrain_2M", [] { return make_terrain(1024, 1024, 5); }},
+    {"terrain_66k", [] { return make_terrain(256, 256, 5); }},
+    {"city_1M", [] { return make_city(1000000, 7); }},
+};
+
+}  // namespace
+
 const std::vector<std::string>& generated_mesh_names() {
-  static const std::vector<std::string> names = {"terrain_2M", "terrain_66k", "city_1M"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const GeneratedMesh& g : kGeneratedMeshes) out.push_back(g.name);
+    return out;
+  }();
   return names;
 }
 
@@ -39,9 +58,8 @@ bool is_generated_mesh(const std::string& name) {
 }
 
 std::optional<Mesh> generated_mesh(const std::string& name) {
-  if (name == "terrain_2M") return make_terrain(1024, 1024, 5);
-  if (name == "terrain_66k") return make_terrain(256, 256, 5);
-  if (name == "city_1M") return make_city(1000000, 7);
+  for (const GeneratedMesh& g : kGeneratedMeshes)
+    if (name == g.name) return g.make();
   return std::nullopt;
 }
 

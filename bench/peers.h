@@ -41,7 +41,7 @@ struct CoreRow {
 
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
-  std::vector<std::string> kinds = {"long", "probe", "radial"};  // ray kinds measured
+  std::vector<std::string> kinds = {"long", "probe", "radial", "segment"};  // ray kinds measured
   std::vector<std::string> queries = {"closest", "any"};          // each kind under each query (see PeerRow)
   size_t rays = 10000;               // a set, for each kind
   uint32_t rounds = 7;

@@ -36,7 +36,8 @@ RayKind parse_ray_kind(const std::string& name) {
   if (name == "long") return RayKind::Long;
   if (name == "probe") return RayKind::Probe;
   if (name == "radial") return RayKind::Radial;
-  throw InputError("unknown ray kind '" + name + "'; valid kinds: long, probe, radial");
+  if (name == "segment") return RayKind::Segment;
+  throw InputError("unknown ray kind '" + name + "'; valid kinds: long, probe, radial, segment");
 }
 
 RaySource::RaySource(const Mesh& mesh, RayKind kind, uint64_t seed)
@@ -47,6 +48,22 @@ void RaySource::fill(std::span<Ray> rays) {
   Rng rng{state_};
   const Vec3 c = box_.centre();
   const double diag = diagonal_;
+  // A point of a random triangle moved off it along its normal, to either
+  // side, by 10^-4 of the diagonal.
+  auto off_surface = [&](Rng& g) {
+    size_t t = size_t(g.uniform() * mesh_.triangles.size());
+    double a = g.uniform(), b = g.uniform();
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    Vec3 p0 = mesh_.corner(t, 0), p1 = mesh_.corner(t, 1), p2 = mesh_.corner(t, 2);
+    double e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; ++k) e1[k] = double(p1[k]) - p0[k], e2[k] = double(p2[k]) - p0[k];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double side = g.uniform() < 0.5 ? -1 : 1, off = 1e-4 * diag * side / (len > 0 ? len : 1);
+    Vec3 o;
+    for (int k = 0; k < 3; ++k) o[k] = float(p0[k] + a * e1[k] + b * e2[k] + (len > 0 ? n[k] * off : 0));
+    return o;
+  };
   for (Ray& r : rays) {
     Vec3 o, d;
     float tmax = INFINITY;
@@ -58,19 +75,15 @@ void RaySource::fill(std::span<Ray> rays) {
     } else if (kind_ == RayKind::Radial) {
       o = c;
       d = rng.unit();
-    } else {
-      size_t t = size_t(rng.uniform() * mesh_.triangles.size());
-      double a = rng.uniform(), b = rng.uniform();
-      if (a + b > 1) a = 1 - a, b = 1 - b;
-      Vec3 p0 = mesh_.corner(t, 0), p1 = mesh_.corner(t, 1), p2 = mesh_.corner(t, 2);
-      double e1[3], e2[3], n[3];
-      for (int k = 0; k < 3; ++k) e1[k] = double(p1[k]) - p0[k], e2[k] = double(p2[k]) - p0[k];
-      n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-      double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      double side = rng.uniform() < 0.5 ? -1 : 1, off = 1e-4 * diag * side / (len > 0 ? len : 1);
-      for (int k = 0; k < 3; ++k) o[k] = float(p0[k] + a * e1[k] + b * e2[k] + (len > 0 ? n[k] * off : 0));
+    } else if (kind_ == RayKind::Probe) {
+      o = off_surface(rng);
       d = rng.unit();
       tmax = float(0.05 * diag);
+    } else {
+      o = off_surface(rng);
+      const Vec3 p = off_surface(rng);
+      d = {p.x - o.x, p.y - o.y, p.z - o.z};
+      tmax = 1.0f;
     }
     r = {{o.x, o.y, o.z}, {d.x, d.y, d.z}, tmax};
   }

@@ -1,4 +1,4 @@
-// Ray sets for measuring and checking: deterministic rays of three kinds
+// Ray sets for measuring and checking: deterministic rays of four kinds
 // around a mesh. The automatic layout times its candidates on them; the
 // tests, benchmarks and the `meshcast rays` command cast them too.
 #pragma once
@@ -13,7 +13,7 @@
 
 namespace meshcast {
 
-enum class RayKind { Long, Probe, Radial };
+enum class RayKind { Long, Probe, Radial, Segment };
 
 // Throws InputError for an unknown name, listing the valid ones.
 RayKind parse_ray_kind(const std::string& name);
@@ -24,6 +24,9 @@ RayKind parse_ray_kind(const std::string& name);
 //  Probe:  short rays (t_max = 5% of the diagonal) from just off a random
 //          point of a random triangle, in random directions.
 //  Radial: from the centre of the box in random directions; t_max infinite.
+//  Segment: line of sight between two points just off random points of
+//          random triangles (as Probe's origins): the direction is the
+//          second point less the first, t_max 1.
 std::vector<Ray> make_rays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed);
 
 // The same rays a part at a time: fill() writes the next rays of the set

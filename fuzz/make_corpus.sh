@@ -40,7 +40,9 @@ printf '3solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nve
 { printf '3'; head -c 80 /dev/zero; printf '\x01\x00\x00\x00'; head -c 12 /dev/zero
   printf '\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x00\x00\x00\x00'; } > corpus/mesh/binary.stl
 
-for layout in $("$meshcast" build --layout list "$tmp/sphere.off" --out /dev/null 2>&1 | sed -n 's|^  \([A-Za-z0-9]*/[A-Za-z0-9]*\)$|\1|p'); do
+layouts=$("$meshcast" layouts)
+[[ -n $layouts ]] || { echo "make_corpus.sh: '$meshcast layouts' listed no layout" >&2; exit 1; }
+for layout in $layouts; do
   name=${layout/\//_}
   leaf=4
   [[ $layout == *SOA128 ]] && leaf=31  # 128-lane blocks: few leaves keep the seed small

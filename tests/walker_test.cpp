@@ -110,7 +110,10 @@ void check_layout(const std::string& layout_name_, bool large) {
     // 5,000 a kind in Release (10,000 took half of the CPU suites' time, and
     // the whole test run past CI's 30 minutes in a slow spell).
     size_t count = uint32_t(options.layout.tree) == MC_TREE_BRUTEFORCE ? 400 : quick() ? 2000 : 5000;
-    for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial}) {
+    for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial, RayKind::Segment}) {
+      // Line-of-sight segments: on the layouts that cover every tree and
+      // triangle format, which is every walker's code.
+      if (kind == RayKind::Segment && !covering) continue;
       const std::vector<Ray>& rays = test_rays(m, kind, count);
       const std::vector<OracleHit>& oracle = oracle_answers(reference, kind, rays);
       std::vector<Hit> hits = trace_all(view, rays);

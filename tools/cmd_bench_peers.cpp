@@ -24,7 +24,7 @@ void add_bench_peers(CLI::App* bench) {
   struct Args {
     std::string meshes = "data/bunny00.off,data/armadillo.off,data/refined_elephant.off,data/ChineseDragon-10kv.off,"
                          "terrain_2M,city_1M";
-    std::string layouts, kinds = "long,probe,radial", queries = "closest,any", out_dir = "out";
+    std::string layouts, kinds = "long,probe,radial,segment", queries = "closest,any", out_dir = "out";
     size_t rays = 10000;
     uint32_t rounds = 7;
     bool no_cores = false;
@@ -33,12 +33,12 @@ void add_bench_peers(CLI::App* bench) {
   CLI::App* cmd = bench->add_subcommand("peers", "meshcast's layouts beside Embree's default, high-quality, robust and compact builds");
   cmd->add_option("--meshes", args->meshes, "comma-separated mesh files, terrain_2M or city_1M (default: all six)");
   cmd->add_option("--layouts", args->layouts, "comma-separated meshcast layouts (default: the OctTree and QuadTree ones)");
-  cmd->add_option("--kinds", args->kinds, "comma-separated ray kinds: long, probe, radial (default: all three)");
+  cmd->add_option("--kinds", args->kinds, "comma-separated ray kinds: long, probe, radial, segment (default: all four)");
   cmd->add_option("--queries", args->queries,
                   "comma-separated queries: closest, any (Embree: rtcOccluded1), all (every hit, rows of 16), "
                   "each with a culling as in closest-back or any-front; Embree answers closest and any "
                   "(default: closest,any)");
-  cmd->add_option("--rays", args->rays, "rays a set (long, probe, radial)")->check(integer_in(100, 1000000));
+  cmd->add_option("--rays", args->rays, "rays a set (each ray kind)")->check(integer_in(100, 1000000));
   cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(integer_in(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where peers.csv, cores.csv and peers.png go");
   cmd->add_flag("--no-cores", args->no_cores,

@@ -112,9 +112,11 @@ void check_layout(const std::string& layout_name_, bool large) {
     size_t count = uint32_t(options.layout.tree) == MC_TREE_BRUTEFORCE ? 400 : quick() ? 2000 : 5000;
     for (RayKind kind : {RayKind::Long, RayKind::Probe, RayKind::Radial, RayKind::Segment}) {
       // Line-of-sight segments: on the layouts that cover every tree and
-      // triangle format, which is every walker's code.
+      // triangle format, which is every walker's code, and fewer of them
+      // (the oracle's double-precision walk is most of this test's time).
       if (kind == RayKind::Segment && !covering) continue;
-      const std::vector<Ray>& rays = test_rays(m, kind, count);
+      const size_t kind_count = kind == RayKind::Segment ? std::min<size_t>(count, 1000) : count;
+      const std::vector<Ray>& rays = test_rays(m, kind, kind_count);
       const std::vector<OracleHit>& oracle = oracle_answers(reference, kind, rays);
       std::vector<Hit> hits = trace_all(view, rays);
       Agreement a = compare(*reference.mesh, rays, hits, oracle, tolerance);
@@ -125,7 +127,7 @@ void check_layout(const std::string& layout_name_, bool large) {
       for (const Hit& h : hits) hit_count += h.triangle != MC_NO_HIT;
       // A ray set that never hits proves nothing: every kind must hit often.
       EXPECT_GT(hit_count, rays.size() / 20) << m.name << " kind " << int(kind);
-      EXPECT_EQ(a.rays, count);
+      EXPECT_EQ(a.rays, kind_count);
       // The other queries: in the quick runs on the covering layouts only.
       if (quick() && !covering) continue;
       check_queries(view, reference, kind, rays, tolerance,

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "builder/ray_sets.h"
 #include "meshcast/mesh.h"
 
 namespace meshcast::bench {
@@ -41,7 +42,7 @@ struct CoreRow {
 
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
-  std::vector<std::string> kinds = {"long", "probe", "radial", "segment"};  // ray kinds measured
+  std::vector<std::string> kinds = ray_kind_names();  // ray kinds measured
   std::vector<std::string> queries = {"closest", "any"};          // each kind under each query (see PeerRow)
   size_t rays = 10000;               // a set, for each kind
   uint32_t rounds = 7;

@@ -32,12 +32,19 @@ Vec3 lerp_box(const Box3& b, Rng& rng) {
 
 }  // namespace
 
+const std::vector<std::string>& ray_kind_names() {
+  static const std::vector<std::string> names = {"long", "probe", "radial", "segment"};
+  return names;
+}
+
 RayKind parse_ray_kind(const std::string& name) {
-  if (name == "long") return RayKind::Long;
-  if (name == "probe") return RayKind::Probe;
-  if (name == "radial") return RayKind::Radial;
-  if (name == "segment") return RayKind::Segment;
-  throw InputError("unknown ray kind '" + name + "'; valid kinds: long, probe, radial, segment");
+  const std::vector<std::string>& names = ray_kind_names();
+  std::string valid;
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (name == names[k]) return RayKind(k);
+    valid += (k ? ", " : "") + names[k];
+  }
+  throw InputError("unknown ray kind '" + name + "'; valid kinds: " + valid);
 }
 
 RaySource::RaySource(const Mesh& mesh, RayKind kind, uint64_t seed)

@@ -15,6 +15,8 @@ namespace meshcast {
 
 enum class RayKind { Long, Probe, Radial, Segment };
 
+// The kinds' names in RayKind's order: long, probe, radial, segment.
+const std::vector<std::string>& ray_kind_names();
 // Throws InputError for an unknown name, listing the valid ones.
 RayKind parse_ray_kind(const std::string& name);
 

@@ -24,7 +24,7 @@ void add_bench_peers(CLI::App* bench) {
   struct Args {
     std::string meshes = "data/bunny00.off,data/armadillo.off,data/refined_elephant.off,data/ChineseDragon-10kv.off,"
                          "terrain_2M,city_1M";
-    std::string layouts, kinds = "long,probe,radial,segment", queries = "closest,any", out_dir = "out";
+    std::string layouts, kinds, queries = "closest,any", out_dir = "out";
     size_t rays = 10000;
     uint32_t rounds = 7;
     bool no_cores = false;
@@ -47,7 +47,7 @@ void add_bench_peers(CLI::App* bench) {
   cmd->callback([args] {
     bench::PeersOptions o;
     o.layouts = args->layouts.empty() ? bench::default_peer_layouts() : split(args->layouts);
-    o.kinds = split(args->kinds);
+    if (!args->kinds.empty()) o.kinds = split(args->kinds);
     o.queries = split(args->queries);
     for (const std::string& q : o.queries) layout::query_spec_named(q, "--queries");  // refused before any build
     o.rays = args->rays, o.rounds = args->rounds;

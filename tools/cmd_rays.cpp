@@ -21,7 +21,7 @@ void add_rays(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("rays", "write a rays file for a mesh");
   cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
-  cmd->add_option("--kind", args->kind, "long, probe, radial or segment")->check(CLI::IsMember({"long", "probe", "radial", "segment"}));
+  cmd->add_option("--kind", args->kind, "long, probe, radial or segment")->check(CLI::IsMember(ray_kind_names()));
   cmd->add_option("--count", args->count, "number of rays, at most 2^27")->check(integer_in(1, kMaxRayCount));
   cmd->add_option("--seed", args->seed, "random seed")->check(integer_in(0, UINT64_MAX));
   cmd->add_option("--out", args->out, "rays file to write")->required();

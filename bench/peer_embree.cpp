@@ -92,6 +92,34 @@ class Embree final : public Peer {
       });
     });
   }
+  void trace_packets(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query) const override {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // the caller's rays come sorted by direction
+    for (size_t begin = 0; begin < rays.size(); begin += 16) {
+      const size_t n = std::min<size_t>(16, rays.size() - begin);
+      alignas(64) int valid[16];
+      alignas(64) RTCRayHit16 rh{};
+      for (size_t k = 0; k < 16; ++k) {
+        valid[k] = k < n ? -1 : 0;
+        const Ray& r = rays[begin + std::min(k, n - 1)];
+        rh.ray.org_x[k] = r.org[0], rh.ray.org_y[k] = r.org[1], rh.ray.org_z[k] = r.org[2];
+        rh.ray.dir_x[k] = r.dir[0], rh.ray.dir_y[k] = r.dir[1], rh.ray.dir_z[k] = r.dir[2];
+        rh.ray.tnear[k] = r.tmin, rh.ray.tfar[k] = r.tmax, rh.ray.mask[k] = ~0u;
+        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      }
+      if (query == Query::Any) {
+        rtcOccluded16(valid, scene_, &context, &rh.ray);
+        for (size_t k = 0; k < n; ++k) hits[begin + k] = rh.ray.tfar[k] < 0 ? Hit{0.0f, 0} : Hit{};
+      } else {
+        rtcIntersect16(valid, scene_, &context, &rh);
+        for (size_t k = 0; k < n; ++k)
+          hits[begin + k] = rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID
+                                ? Hit{}
+                                : Hit{rh.ray.tfar[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]};
+      }
+    }
+  }
 
  private:
   void trace_range(const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query, size_t begin, size_t end) const {

@@ -13,6 +13,7 @@
 #include "bench/peer.h"
 #include "builder/layout_names.h"
 #include "builder/ray_sets.h"
+#include "cpu/common_origin.h"
 #include "cpu/counters.h"
 #include "layout/queries.h"
 #include "meshcast/blob.h"
@@ -36,8 +37,11 @@ struct Contender {
   double bytes, build_one, build_all;
   // False for a query the contender has no answer to (Embree: all hits,
   // culling, which its build takes only at compile time).
-  std::function<bool(const std::vector<Ray>&, std::vector<Hit>&, QuerySpec)> trace;
+  // `sorted`: a set of one origin's rays sorted by direction, which
+  // meshcast walks as packets; every other set one ray at a time.
+  std::function<bool(const std::vector<Ray>&, std::vector<Hit>&, QuerySpec, bool sorted)> trace;
   std::vector<std::vector<double>> ns;  // per set (ray kind and query), one a round
+  bool packets_peer = false;  // Embree's 16-wide packets, on the sorted sets alone
 };
 
 }  // namespace
@@ -49,6 +53,22 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   for (const std::string& k : o.kinds) kinds.push_back(parse_ray_kind(k));
   std::vector<std::vector<Ray>> rays;
   for (RayKind k : kinds) rays.push_back(make_rays(mesh, k, o.rays, 19));
+  // A kind whose rays share one origin (radial) again, sorted by direction:
+  // a set of its own (KIND sorted), on which meshcast walks packets and
+  // Embree is timed both one ray at a time and in 16-wide packets, so that
+  // a packet's gain is never read as a single ray's.
+  std::vector<std::string> set_names = o.kinds;
+  std::vector<bool> sorted(kinds.size(), false);
+  for (size_t k = 0; k < kinds.size(); ++k) {
+    if (!o.packets || !share_one_origin(rays[k])) continue;
+    std::vector<uint32_t> order(rays[k].size());
+    order_by_direction(rays[k], order);
+    std::vector<Ray> by_direction;
+    for (uint32_t i : order) by_direction.push_back(rays[k][i]);
+    rays.push_back(std::move(by_direction));
+    set_names.push_back(o.kinds[k] + " sorted");
+    sorted.push_back(true);
+  }
 
   std::vector<Contender> all;
   std::vector<std::vector<uint8_t>> blobs;  // kept alive for the views
@@ -75,12 +95,22 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     const BlobView* view = views.back().get();
     auto lists = std::make_shared<HitLists>();  // Query::All's rows, kept from pass to pass as a game would
     all.push_back({layout, false, double(blobs.back().size()) / triangles, 0, 0,
-                   [view, lists](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
+                   [view, lists](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool) {
                      if (q.query == Query::All) view->trace_all_hits(r, *lists, HitOutputs::None, q.cull);
-                     else view->trace(r, h, HitOutputs::None, q.query, q.cull);
+                     else view->trace(r, h, HitOutputs::None, q.query, q.cull, Packets::Off);
                      return true;
                    },
                    {}});
+    // The same layout's packets, on the sorted sets alone (where the
+    // layout's walker has none, its single rays again).
+    if (o.packets)
+      all.push_back({layout + ", packets", false, double(blobs.back().size()) / triangles, 0, 0,
+                     [view](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool sorted) {
+                       if (!sorted || q.query == Query::All) return false;
+                       view->trace(r, h, HitOutputs::None, q.query, q.cull, Packets::Auto);
+                       return true;
+                     },
+                     {}});
   }
   std::vector<std::unique_ptr<Peer>> peers;
   std::vector<EmbreeMode> modes;
@@ -90,7 +120,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     if (!peer) break;  // built without Embree
     const Peer* p = peer.get();
     all.push_back({peer->name(), true, double(peer->bytes()) / triangles, 0, 0,
-                   [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q) {
+                   [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool) {
                      if (q.query == Query::All || q.cull != Cull::None) return false;
                      p->trace(r, h, q.query);
                      return true;
@@ -99,6 +129,18 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     peers.push_back(std::move(peer));
     modes.push_back(mode);
   }
+  // Embree default's 16-wide packets (rtcIntersect16 / rtcOccluded16) on
+  // the sorted sets: the peer's own packets on the rays meshcast packs.
+  if (!peers.empty() && o.packets) {
+    const Peer* p = peers[0].get();
+    all.push_back({p->name() + ", 16-wide packets", true, double(p->bytes()) / triangles, 0, 0,
+                   [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool sorted) {
+                     if (!sorted || q.query == Query::All || q.cull != Cull::None) return false;
+                     p->trace_packets(r, h, q.query);
+                     return true;
+                   },
+                   {}, true});
+  }
 
   // Build times: every contender built again in interleaved rounds, on one
   // thread and on every core, the median of each (a first build pays for
@@ -106,18 +148,20 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   {
     const uint32_t build_rounds = std::max(3u, o.rounds);
     std::vector<std::vector<double>> one(all.size()), every(all.size());
+    // A layout's packets and Embree's 16-wide packets walk the build
+    // before them in `all` (the layout's own, Embree default's).
+    const size_t layout_twins = o.packets ? 2 : 1;
     for (uint32_t round = 0; round < build_rounds; ++round) {
       size_t c = 0;
-      for (const std::string& layout : o.layouts) {
+      for (size_t l = 0; l < o.layouts.size(); ++l, c += layout_twins) {
         for (uint32_t threads : {1u, 0u}) {
           const auto t0 = std::chrono::steady_clock::now();
-          const std::vector<uint8_t> again = build_blob(mesh, options_of(layout, threads), name);
+          const std::vector<uint8_t> again = build_blob(mesh, options_of(o.layouts[l], threads), name);
           (threads == 1 ? one : every)[c].push_back(ms_since(t0));
-          if (again != blobs[c])
-            throw std::runtime_error(name + ": " + layout + " built to other bytes on " +
+          if (again != blobs[l])
+            throw std::runtime_error(name + ": " + o.layouts[l] + " built to other bytes on " +
                                      (threads == 1 ? "one thread" : "every core") + " than on one thread before");
         }
-        ++c;
       }
       for (EmbreeMode mode : modes) {
         one[c].push_back(make_embree(mesh, mode, 1)->build_ms());
@@ -125,6 +169,11 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
         ++c;
       }
     }
+    for (size_t c = 0; c < all.size(); ++c)
+      if (one[c].empty()) {  // a twin: the build it walks
+        const size_t of = all[c].packets_peer ? o.layouts.size() * layout_twins : c - 1;
+        one[c] = one[of], every[c] = every[of];
+      }
     for (size_t c = 0; c < all.size(); ++c) all[c].build_one = median(one[c]), all[c].build_all = median(every[c]);
   }
 
@@ -133,7 +182,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   for (const std::string& q : o.queries) queries.push_back(layout::query_spec_named(q, "--queries"));
   struct Set { size_t kind; size_t query; };
   std::vector<Set> sets;
-  for (size_t k = 0; k < kinds.size(); ++k)
+  for (size_t k = 0; k < rays.size(); ++k)
     for (size_t q = 0; q < queries.size(); ++q) sets.push_back({k, q});
 
   // Rounds: every contender on every set once a round, so a slow spell of
@@ -144,7 +193,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     for (Contender& c : all)
       for (size_t s = 0; s < sets.size(); ++s) {
         const auto t0 = std::chrono::steady_clock::now();
-        if (!c.trace(rays[sets[s].kind], hits, queries[sets[s].query])) continue;  // no such query: no row
+        if (!c.trace(rays[sets[s].kind], hits, queries[sets[s].query], sorted[sets[s].kind])) continue;  // no row
         const double ns = ms_since(t0) * 1e6 / double(o.rays);
         if (round > 0) c.ns[s].push_back(ns);  // round 0 warms the caches
       }
@@ -168,7 +217,9 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
       casters.push_back(std::make_unique<host::Caster>(std::span<const uint8_t>(aligned[0].get(), blobs[0].size()), name, co));
       host::Caster* c = casters.back().get();
       runners.push_back({o.layouts[0] + " (Caster, CPU)", [c](const std::vector<Ray>& r, std::vector<Hit>& h, Query q) {
-                           c->wait(c->submit(r, host::BatchQuery{q}), h);
+                           host::BatchQuery query{q};
+                           query.packets = Packets::Off;  // rays one at a time, as the single-thread rows
+                           c->wait(c->submit(r, query), h);
                          }});
     }
     // Embree on a device of every core: a device of one thread (the
@@ -225,32 +276,34 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     for (Contender& c : all)
       for (size_t s = 0; s < sets.size() && !c.is_peer; ++s) {
         test_counts = {};
-        c.trace(rays[sets[s].kind], hits, queries[sets[s].query]);
+        if (!c.trace(rays[sets[s].kind], hits, queries[sets[s].query], sorted[sets[s].kind])) continue;
         std::fprintf(stderr, "  %s %s %s %s: %.1f box tests, %.1f triangle tests a ray\n", name.c_str(),
-                     o.kinds[sets[s].kind].c_str(), o.queries[sets[s].query].c_str(), c.name.c_str(),
+                     set_names[sets[s].kind].c_str(), o.queries[sets[s].query].c_str(), c.name.c_str(),
                      double(test_counts.boxes) / double(o.rays), double(test_counts.triangles) / double(o.rays));
       }
 
   std::vector<PeerRow> rows;
   for (size_t s = 0; s < sets.size(); ++s) {
-    double embree_default = 0, embree_high = 0;
+    double embree_default = 0, embree_high = 0, embree_packets = 0;
     std::vector<PeerRow> set_rows;
     for (Contender& c : all) {
       if (c.ns[s].empty()) continue;  // a query the contender does not answer
-      PeerRow r{name, o.kinds[sets[s].kind], c.name, c.is_peer, median(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
+      PeerRow r{name, set_names[sets[s].kind], c.name, c.is_peer, median(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
       r.query = o.queries[sets[s].query];
       // The same contender's closest hit on the same rays, when measured.
       for (size_t t = 0; t < sets.size(); ++t)
         if (sets[t].kind == sets[s].kind && o.queries[sets[t].query] == "closest")
           r.to_closest = r.ns_per_ray / median(c.ns[t]);
       // The first peer is the default build, the second the high-quality one.
-      if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;
+      if (c.packets_peer) embree_packets = r.ns_per_ray;
+      else if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;
       else if (c.is_peer && embree_high == 0) embree_high = r.ns_per_ray;
       set_rows.push_back(r);
     }
     for (PeerRow& r : set_rows) {
       r.ratio = embree_default > 0 ? r.ns_per_ray / embree_default : 0;
       r.ratio_high = embree_high > 0 ? r.ns_per_ray / embree_high : 0;
+      r.ratio_packets = embree_packets > 0 ? r.ns_per_ray / embree_packets : 0;
       rows.push_back(r);
     }
   }

@@ -1,4 +1,4 @@
-// `meshcast bench peers` (issue 19): meshcast's layouts beside Embree's
+// `meshcast bench peers`: meshcast's layouts beside Embree's
 // default, robust and compact builds on the same rays in one run: rounds
 // interleave every contender and ray kind, the median of the rounds is
 // reported, tracing on one thread.
@@ -25,6 +25,9 @@ struct PeerRow {
   std::string query = "closest";
   double to_closest = 0;          // time / the same contender's closest-hit time on the same rays (0: not measured)
   double ratio_high = 0;          // to Embree's high-quality build (RTC_BUILD_QUALITY_HIGH), as `ratio`
+  // A sorted set (KIND sorted: one origin's rays by direction): to Embree
+  // default's 16-wide packets on the same rays (0 elsewhere).
+  double ratio_packets = 0;
 };
 
 // A multi-core row: rays a second on one thread and on every core, the
@@ -47,6 +50,9 @@ struct PeersOptions {
   size_t rays = 10000;               // a set, for each kind
   uint32_t rounds = 7;
   bool cores = true;                 // the multi-core rows (the first layout and Embree default)
+  // A kind whose rays share one origin (radial) timed again sorted by
+  // direction: meshcast's packets, Embree's single rays and 16-wide packets.
+  bool packets = true;
 };
 
 // The meshcast layouts `bench peers` measures unless told otherwise.

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cpu/common_origin.h"
 #include "cpu/scratch.h"
 #include "cpu/walk_table.h"
 #include "layout/blob_format.h"
@@ -19,6 +20,7 @@ BlobView::BlobView(std::span<const uint8_t> bytes, const std::string& name) : by
   const layout::BlobHeader& h = layout::header_of(bytes.data());
   walk_ = walker_for(h.tree_format, h.triangle_format);
   if (!walk_) throw InputError(name + ": no walker for this layout");
+  walks_packets_ = h.tree_format == uint32_t(TreeFormat::OctTreeCompressed);
 }
 
 namespace {
@@ -30,18 +32,42 @@ uint32_t flags_of(const char* who, HitOutputs outputs, Query query, Cull cull) {
   return (uint32_t(outputs) & (MC_HIT_UV | MC_HIT_POINT)) | layout::query_bits(query, cull);
 }
 
+// The fewest rays of one origin worth sorting into packets.
+constexpr size_t kLeastPacketBatch = 32;
+constexpr size_t kPacketPiece = 65536;
+
 }  // namespace
 
 uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs, Query query,
-                         Cull cull) const {
+                         Cull cull, Packets packets) const {
   if (hits.size() < rays.size())
     throw UsageError("BlobView::trace: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(hits.size()) + " hits; the hits span must hold one hit a ray");
   if (query == Query::All)
     throw UsageError("BlobView::trace: Query::All has a list of hits a ray: BlobView::trace_all_hits answers it");
+  if (packets != Packets::Auto && packets != Packets::Off)
+    throw UsageError("BlobView::trace: packets " + std::to_string(uint32_t(packets)) + " is neither Auto nor Off");
   WalkRequest request{flags_of("BlobView::trace", outputs, query, cull)};
   uint64_t skipped = 0;
-  walk_(bytes_.data(), rays.data(), hits.data(), rays.size(), &skipped, request);
+  const size_t n = rays.size();
+  if (packets == Packets::Auto && walks_packets_ && n >= kLeastPacketBatch && share_one_origin(rays)) {
+    // The rays by direction, walked as packets, the hits put back in place;
+    // a piece of the batch at a time, so the thread's scratch stays small
+    // (a piece of 65,536 rays of one origin is dense enough in directions).
+    request.packets = true;
+    for (size_t begin = 0; begin < n; begin += kPacketPiece) {
+      const size_t m = std::min(kPacketPiece, n - begin);
+      const std::span<uint32_t> order = thread_scratch<uint32_t>(m);
+      const std::span<Ray> sorted = thread_scratch<Ray>(m);
+      const std::span<Hit> sorted_hits = thread_scratch<Hit>(m);
+      order_by_direction(rays.subspan(begin, m), order);
+      for (size_t k = 0; k < m; ++k) sorted[k] = rays[begin + order[k]];
+      walk_(bytes_.data(), sorted.data(), sorted_hits.data(), m, &skipped, request);
+      for (size_t k = 0; k < m; ++k) hits[begin + order[k]] = sorted_hits[k];
+    }
+    return skipped;
+  }
+  walk_(bytes_.data(), rays.data(), hits.data(), n, &skipped, request);
   return skipped;
 }
 

@@ -63,7 +63,13 @@ struct Closest {
         list->add(lanes.t[i], slot_of(uint32_t(i)), lanes.u[i], lanes.v[i]);
       }
     } else if (h.lane >= 0 && h.t <= t) {
-      take(h.t, slot_of(uint32_t(h.lane)), h.u, h.v);
+      // Equal t (a ray through an edge both triangles share): the lower
+      // slot, whichever the walk met first, so a ray's answer does not
+      // depend on the order its walk takes the leaves in (a packet walk
+      // takes them in another). Within one test the lowest lane, the lowest
+      // slot, already wins.
+      const uint32_t s = slot_of(uint32_t(h.lane));
+      if (h.t < t || s < slot) take(h.t, s, h.u, h.v);
     }
   }
 };
@@ -262,10 +268,39 @@ inline uint64_t test_pair_leaf(const uint8_t* blob, const RayPre& r, uint32_t bl
   return at;
 }
 
-// Cluster leaves (layout/triangles/cluster.h): each cluster's 16 vertices decoded into
-// registers once, a row of 8 corners permuted out of them per corner and
-// axis, 8 triangles a test. The leaf's triangles are numbered cluster by
-// cluster. Returns the leaf's bytes (what the decode read, padded to 4).
+// One cluster's triangles against one ray, 8 a test: a row of 8 corners
+// permuted out of the decoded vertices (`corner_axis`, in the ray's axis
+// order) per corner and axis; `slot` is the cluster's first triangle's.
+template <TriangleTest kTest>
+[[gnu::always_inline]] inline void test_cluster_triangles(const RayPre& r, Closest& c, const simd::V16* const corner_axis[3],
+                                                          const uint8_t* index, uint32_t triangles, uint32_t slot) {
+  for (uint32_t first = 0; first < triangles && c.t >= 0; first += 8, index += MC_CLUSTER_INDEX_BLOCK_BYTES) {
+    simd::F8 v[3][3];
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t nibbles = layout::load<uint32_t>(index + 4 * k);
+      for (int j = 0; j < 3; ++j) v[k][j] = simd::cluster_pick(*corner_axis[j], nibbles);
+    }
+    LaneSet lanes;
+    LaneHit hit = triangle_test<kTest>(r, v, simd::lanes_below8(triangles - first), c.t, c.every(lanes));
+    c.offer(hit, lanes, [&](uint32_t lane) { return slot + first + lane; });
+  }
+}
+
+// A cluster's vertices along axis `a`, decoded into registers.
+template <class Codec>
+[[gnu::always_inline]] inline simd::V16 decode_cluster_axis(const uint8_t* blob, const layout::BlobHeader& h, uint32_t at, int a) {
+  const uint64_t origin = layout::load<uint64_t>(blob + at);
+  const uint32_t vertices = Codec::vertex_count(blob, at);
+  const bool wide = Codec::wide(blob, at);
+  const uint32_t row_bytes = (wide ? 4 : 2) * vertices;
+  return simd::cluster_decode(blob + Codec::rows_at(blob, at) + uint32_t(a) * row_bytes, vertices, wide,
+                              layout::bitpack_component(origin, a), h.quant_scale[a], h.quant_offset[a]);
+}
+
+// Cluster leaves (layout/triangles/cluster.h): each cluster's 16 vertices
+// decoded into registers once (in the ray's axis order), then its
+// triangles 8 a test. The leaf's triangles are numbered cluster by cluster.
+// Returns the leaf's bytes (what the decode read, padded to 4).
 template <class Codec, TriangleTest kTest>
 inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                               Closest& c) {
@@ -274,31 +309,42 @@ inline uint64_t test_cluster_leaf(const uint8_t* blob, const RayPre& r, uint32_t
   // c.t below 0: an any-hit query has its hit, the rest of the leaf is moot
   // (not even decoded).
   while (made < count && c.t >= 0) {
-    const uint64_t origin = layout::load<uint64_t>(blob + at);
-    const uint32_t vertices = Codec::vertex_count(blob, at), triangles = Codec::triangle_count(blob, at);
-    const bool wide = Codec::wide(blob, at);
-    const uint32_t rows = Codec::rows_at(blob, at), row_bytes = (wide ? 4 : 2) * vertices;
-    simd::V16 corner_axis[3];  // vertex coordinates in the ray's axis order
-    for (int j = 0; j < 3; ++j) {
-      const int a = r.axis[j];
-      corner_axis[j] = simd::cluster_decode(blob + rows + uint32_t(a) * row_bytes, vertices, wide, layout::bitpack_component(origin, a),
-                                            h.quant_scale[a], h.quant_offset[a]);
-    }
-    const uint8_t* index = blob + Codec::index_at(at);
-    for (uint32_t first = 0; first < triangles && c.t >= 0; first += 8, index += MC_CLUSTER_INDEX_BLOCK_BYTES) {
-      simd::F8 v[3][3];
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t nibbles = layout::load<uint32_t>(index + 4 * k);
-        for (int j = 0; j < 3; ++j) v[k][j] = simd::cluster_pick(corner_axis[j], nibbles);
-      }
-      LaneSet lanes;
-      LaneHit hit = triangle_test<kTest>(r, v, simd::lanes_below8(triangles - first), c.t, c.every(lanes));
-      c.offer(hit, lanes, [&](uint32_t lane) { return slot0 + made + first + lane; });
-    }
+    const simd::V16 x = decode_cluster_axis<Codec>(blob, h, at, r.axis[0]), y = decode_cluster_axis<Codec>(blob, h, at, r.axis[1]),
+                    z = decode_cluster_axis<Codec>(blob, h, at, r.axis[2]);
+    const simd::V16* const corner_axis[3] = {&x, &y, &z};
+    const uint32_t triangles = Codec::triangle_count(blob, at);
+    test_cluster_triangles<kTest>(r, c, corner_axis, blob + Codec::index_at(at), triangles, slot0 + made);
     made += triangles;
     at += Codec::bytes_of(blob, at);
   }
   return (at - block + 3) / 4 * 4;
+}
+
+// The same leaf for the rays of a packet (bit i of `rays`: pre[i] and
+// c[i]): each cluster decoded once for all of them, on every axis; each
+// ray takes the axes in its own order. Each ray's answer is what
+// test_cluster_leaf gives it alone.
+template <class Codec, TriangleTest kTest>
+inline void test_cluster_leaf_rays(const uint8_t* blob, const RayPre* pre, Closest* c, uint32_t rays, uint32_t block,
+                                   uint32_t count, uint32_t slot0) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  uint32_t at = block, made = 0;
+  while (made < count) {
+    for (uint32_t m = rays; m; m &= m - 1)  // an any-hit ray with its hit is done
+      if (c[__builtin_ctz(m)].t < 0) rays &= ~(1u << __builtin_ctz(m));
+    if (!rays) return;
+    const simd::V16 axes[3] = {decode_cluster_axis<Codec>(blob, h, at, 0), decode_cluster_axis<Codec>(blob, h, at, 1),
+                               decode_cluster_axis<Codec>(blob, h, at, 2)};
+    const uint32_t triangles = Codec::triangle_count(blob, at);
+    const uint8_t* index = blob + Codec::index_at(at);
+    for (uint32_t m = rays; m; m &= m - 1) {
+      const int i = __builtin_ctz(m);
+      const simd::V16* const corner_axis[3] = {&axes[pre[i].axis[0]], &axes[pre[i].axis[1]], &axes[pre[i].axis[2]]};
+      test_cluster_triangles<kTest>(pre[i], c[i], corner_axis, index, triangles, slot0 + made);
+    }
+    made += triangles;
+    at += Codec::bytes_of(blob, at);
+  }
 }
 
 // Tests the `count` triangles of the block at blob offset `block`, the
@@ -335,6 +381,22 @@ inline uint64_t test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, 
     }
     if constexpr (requires { Codec::block_bytes(count); }) return Codec::block_bytes(count);
     else return 0;
+  }
+}
+
+// The leaf for several rays (a packet; bit i of `rays`: pre[i] and c[i]):
+// a cluster leaf decoded once for all of them, any other leaf tested ray by
+// ray. Each ray's answer is what test_leaf gives it alone.
+template <class Codec, TriangleTest kTest>
+inline void test_leaf_rays(const uint8_t* blob, const RayPre* pre, Closest* c, uint32_t rays, uint32_t block,
+                           uint32_t count, uint32_t slot0) {
+  if constexpr (requires { Codec::kClusters; }) {
+    test_cluster_leaf_rays<Codec, kTest>(blob, pre, c, rays, block, count, slot0);
+  } else {
+    for (uint32_t m = rays; m; m &= m - 1) {
+      const int i = __builtin_ctz(m);
+      test_leaf<Codec, kTest>(blob, pre[i], block, count, slot0, c[i]);
+    }
   }
 }
 

@@ -29,6 +29,11 @@ struct WalkRequest {
   // written). A scene walks an instance one ray at a time: it looks the
   // slots up afterwards, many rays side by side, as finish_hits does.
   bool keep_slots = false;
+  // The rays share one origin and come sorted by direction (BlobView::trace,
+  // cpu/common_origin.h): a walker with a packet walk (OctTreeCompressed)
+  // takes them in groups, each node decoded once for a group; the others
+  // walk them one by one as ever. The answers are the same either way.
+  bool packets = false;
 };
 
 MC_ISA_BEGIN

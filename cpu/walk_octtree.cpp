@@ -1,4 +1,4 @@
-// OctTreeCompressed walker (issue 19): the 8 child boxes of a node tested
+// OctTreeCompressed walker: the 8 child boxes of a node tested
 // at once, one fma a plane (the fused form below; the exact decode where a
 // ray needs it), near and far planes picked by the ray's direction signs;
 // one hit child is walked next without touching the stack, several are
@@ -6,6 +6,7 @@
 // skipped once the closest hit is nearer. Every hit child's first lines are
 // asked for when its parent is tested.
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <cmath>
 
@@ -216,23 +217,183 @@ inline void walk_ray(const uint8_t* blob, const layout::BlobHeader& h, const Ray
   }
 }
 
+// One ray's walk, in the node test's fused form where it applies.
+template <class Codec, TriangleTest kTest>
+inline void walk_one(const uint8_t* blob, const layout::BlobHeader& h, const RayPre& r, Closest& c) {
+  const OctFused fused(r, h, OctFused::blob_fits(h));
+  if (c.any) {
+    if (fused.applies) walk_ray<Codec, kTest, true, true>(blob, h, r, fused, c);
+    else walk_ray<Codec, kTest, false, true>(blob, h, r, fused, c);
+  } else {
+    if (fused.applies) walk_ray<Codec, kTest, true, false>(blob, h, r, fused, c);
+    else walk_ray<Codec, kTest, false, false>(blob, h, r, fused, c);
+  }
+}
+
+// Packets: up to kPacketRays rays of one origin walked together, each node
+// decoded once for all of them. Where the rays share their origin, a child
+// plane's distance along each ray is (plane - o) / d: the decode and the
+// subtraction are the packet's, one multiply a plane is each ray's. That is
+// the exact form's arithmetic operation for operation, so each ray's hit
+// children are those its exact test finds (conservative, as the fused
+// form's). The packet walks the children any of its rays hits, nearest first
+// by the least entry among them, each with the mask of those rays; a leaf is
+// tested for those rays alone, each with its own cut, by the leaf test a
+// single walk makes. A ray thus tests every triangle its single walk would
+// need to and answers the same: the closest hit, ties to the lower slot
+// (Closest::offer), whatever order the leaves come in.
+constexpr int kPacketRays = 8;
+
+// Bit j of byte i to bit i of byte j: the packet's rays' hit children to
+// each child's rays.
+inline uint64_t transpose_bits8x8(uint64_t x) {
+  uint64_t t;
+  t = (x ^ (x >> 7)) & 0x00AA00AA00AA00AAull;
+  x ^= t ^ (t << 7);
+  t = (x ^ (x >> 14)) & 0x0000CCCC0000CCCCull;
+  x ^= t ^ (t << 14);
+  t = (x ^ (x >> 28)) & 0x00000000F0F0F0F0ull;
+  x ^= t ^ (t << 28);
+  return x;
+}
+
+template <class Codec, TriangleTest kTest>
+void walk_packet(const uint8_t* blob, const layout::BlobHeader& h, const RayPre* pre, Closest* c, int n) {
+  using simd::F8;
+  const uint8_t* tree = blob + h.tree_offset;
+  struct Entry {
+    uint32_t properties;
+    uint32_t rays;
+    float entry;  // the least of its rays' entries
+  };
+  Entry stack[kStackSize];
+  int top = 0;
+  const F8 zero = F8::splat(0.0f), inf = F8::splat(INFINITY), scale_far = F8::splat(kFarScale);
+  F8 origin_of[3];
+  for (int a = 0; a < 3; ++a) origin_of[a] = F8::splat(pre[0].org[a]);
+  uint32_t properties = h.root, rays = (1u << n) - 1;
+  for (;;) {
+    const uint32_t count = layout::oct_count(properties), offset = layout::oct_offset(properties);
+    if (count == 0) {
+      const uint8_t* node = tree + offset;
+      F8 lo[3], hi[3];
+      for (int a = 0; a < 3; ++a) {
+        const F8 origin = F8::splat(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a));
+        const F8 scale = F8::splat(layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));
+        lo[a] = simd::fma(simd::from_u8x8(node + MC_OCT_QLO_AT + 8 * a), scale, origin) - origin_of[a];
+        hi[a] = simd::fma(simd::from_u8x8(node + MC_OCT_QHI_AT + 8 * a), scale, origin) - origin_of[a];
+      }
+      const int used = simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT);
+      uint64_t hit_rows = 0;  // byte i: ray i's hit children
+      F8 least = inf;         // each child's least entry among the rays that hit it
+      for (uint32_t m = rays; m; m &= m - 1) {
+        const int i = __builtin_ctz(m);
+        const RayPre& r = pre[i];
+        count_boxes(8);
+        F8 tn[3], tf[3];
+        const F8 cut = F8::splat(c[i].t);
+        for (int a = 0; a < 3; ++a) {
+          const F8 inv = F8::splat(r.inv[a]);
+          tn[a] = simd::max((r.near_is_max[a] ? hi[a] : lo[a]) * inv, zero);
+          tf[a] = simd::min((r.near_is_max[a] ? lo[a] : hi[a]) * inv, cut);
+        }
+        const F8 entry = simd::max(simd::max(tn[0], tn[1]), tn[2]);
+        const F8 exit = simd::min(simd::min(tf[0], tf[1]), tf[2]) * scale_far;
+        const simd::M8 hit = (entry <= exit) & (entry < inf);
+        const int bits = simd::bits(hit) & used;
+        hit_rows |= uint64_t(uint32_t(bits)) << (8 * i);
+        least = simd::select(hit, simd::min(least, entry), least);
+      }
+      if (hit_rows) {
+        const uint64_t by_child = transpose_bits8x8(hit_rows);  // byte k: the rays that hit child k
+        float entries[8];
+        least.store(entries);
+        // The hit children, farthest first (at most 8: insertion sort).
+        Entry hit[8];
+        int k = 0;
+        for (int child = 0; child < 8; ++child) {
+          const uint32_t child_rays = uint32_t(by_child >> (8 * child)) & 0xFF;
+          if (!child_rays) continue;
+          const Entry e{layout::oct_child_properties(node, child), child_rays, entries[child]};
+          prefetch_child(tree + layout::oct_offset(e.properties));
+          int at = k++;
+          for (; at > 0 && hit[at - 1].entry < e.entry; --at) hit[at] = hit[at - 1];
+          hit[at] = e;
+        }
+        for (int j = 0; j + 1 < k; ++j) stack[top++] = hit[j];
+        properties = hit[k - 1].properties, rays = hit[k - 1].rays;
+        continue;
+      }
+    } else {
+      test_leaf_rays<Codec, kTest>(blob, pre, c, rays, h.tree_offset + offset, count, layout::slot_of(h, offset, 0));
+    }
+    // The next entry that some of its rays may still find a hit in (an
+    // any-hit ray that has one has a cut below 0, and drops out here).
+    for (;;) {
+      if (top == 0) return;
+      const Entry& e = stack[--top];
+      rays = 0;
+      for (uint32_t m = e.rays; m; m &= m - 1) {
+        const int i = __builtin_ctz(m);
+        if (e.entry <= c[i].t * kFarScale) rays |= 1u << i;
+      }
+      if (rays) {
+        properties = e.properties;
+        break;
+      }
+    }
+  }
+}
+
+// A request's packets: rays in groups of kPacketRays as they come (the
+// caller has sorted them by direction), a group walked as a packet when its
+// rays share one origin, else one by one.
+template <class Codec, TriangleTest kTest>
+void walk_packets(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
+                  const WalkRequest& request) {
+  const layout::BlobHeader& h = layout::header_of(blob);
+  const uint32_t outputs = request.flags;
+  const bool any = (outputs & MC_QUERY_ANY) != 0;
+  alignas(32) uint8_t pre_bytes[kPacketRays * sizeof(RayPre)];
+  RayPre* pre = reinterpret_cast<RayPre*>(pre_bytes);
+  Closest c[kPacketRays];
+  int walked[kPacketRays];
+  for (size_t begin = 0; begin < n; begin += kPacketRays) {
+    const size_t end = std::min(n, begin + kPacketRays);
+    int k = 0;
+    for (size_t i = begin; i < end; ++i) {
+      hits[i] = Hit{};
+      if (!ray_is_walkable(rays[i])) {
+        ++*skipped;
+        continue;
+      }
+      new (&pre[k]) RayPre(rays[i], outputs);
+      c[k] = Closest{rays[i].tmax};
+      c[k].any = any;
+      walked[k++] = int(i - begin);
+    }
+    bool one_origin = true;
+    for (int j = 1; j < k; ++j)
+      for (int a = 0; a < 3; ++a) one_origin &= std::bit_cast<uint32_t>(pre[j].org[a]) == std::bit_cast<uint32_t>(pre[0].org[a]);
+    if (k > 0 && one_origin) {
+      walk_packet<Codec, kTest>(blob, h, pre, c, k);
+    } else {
+      for (int j = 0; j < k; ++j) walk_one<Codec, kTest>(blob, h, pre[j], c[j]);
+    }
+    for (int j = 0; j < k; ++j) keep_slot(hits[begin + size_t(walked[j])], c[j], outputs);
+    if (!request.keep_slots) finish_hits(blob, rays, hits, begin, end, outputs);
+  }
+}
+
 }  // namespace
 
 template <class Codec, TriangleTest kTest>
 void walk(layout::tree::OctTreeCompressed, const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
           const WalkRequest& request) {
+  if (request.packets && !(request.flags & MC_QUERY_ALL)) return walk_packets<Codec, kTest>(blob, rays, hits, n, skipped, request);
   const layout::BlobHeader& h = layout::header_of(blob);
-  const bool blob_fits = OctFused::blob_fits(h);
-  for_each_ray(blob, rays, hits, n, skipped, request, [&](const RayPre& r, Closest& c) {
-    const OctFused fused(r, h, blob_fits);
-    if (c.any) {
-      if (fused.applies) walk_ray<Codec, kTest, true, true>(blob, h, r, fused, c);
-      else walk_ray<Codec, kTest, false, true>(blob, h, r, fused, c);
-    } else {
-      if (fused.applies) walk_ray<Codec, kTest, true, false>(blob, h, r, fused, c);
-      else walk_ray<Codec, kTest, false, false>(blob, h, r, fused, c);
-    }
-  });
+  for_each_ray(blob, rays, hits, n, skipped, request,
+               [&](const RayPre& r, Closest& c) { walk_one<Codec, kTest>(blob, h, r, c); });
 }
 
 #define MC_INSTANTIATE(Codec, name) \

@@ -191,7 +191,7 @@ std::string Caster::Impl::why(uint32_t rays) const {
 }
 
 void Caster::Impl::trace_now(std::span<const Ray> rays, std::span<Hit> hits, BatchQuery query) const {
-  blob("Caster::trace_now").trace(rays, hits, options_.hit_outputs, query.query, query.cull);
+  blob("Caster::trace_now").trace(rays, hits, options_.hit_outputs, query.query, query.cull, query.packets);
 }
 
 void Caster::Impl::trace_now(std::span<const Ray> rays, HitLists& lists, Cull cull) const {

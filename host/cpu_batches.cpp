@@ -39,7 +39,7 @@ void Caster::Impl::walk_job(Slot& s, uint32_t job) {
       rows.max_hits = q.max_hits;
       view_->trace_all_hits(rays, rows, options_.hit_outputs, q.cull);
     } else {
-      view_->trace(rays, std::span<Hit>(s.hits).subspan(first, count), options_.hit_outputs, q.query, q.cull);
+      view_->trace(rays, std::span<Hit>(s.hits).subspan(first, count), options_.hit_outputs, q.query, q.cull, q.packets);
     }
   } catch (...) {
     std::lock_guard<std::mutex> lock(mutex_);

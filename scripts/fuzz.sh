@@ -17,16 +17,7 @@ seed=${MESHCAST_FUZZ_SEED:-1}
 # under CI's 30 minutes with the Python package's stages.
 declare -A runs=([blob]=75000 [mesh]=10000)
 
-source scripts/packages.sh
-install_missing clang libclang-rt-14-dev
-
-source scripts/isa.sh
-# The widest walker set alone, and line tables only (-g1): full debug info
-# of the walkers' templates is most of a build's time; reports keep their
-# files, lines and functions.
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
-      -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DMESHCAST_FUZZ=ON "-DMESHCAST_ISAS=$(widest_isa)" >/dev/null
-cmake --build build-fuzz -j"$(nproc)" --target blob_fuzz mesh_fuzz
+bash scripts/sanitizer_build.sh blob_fuzz mesh_fuzz
 
 for target in blob mesh; do
   echo "== fuzz: ${target}_fuzz, ${runs[$target]} inputs (seed $seed, at most ${seconds} s) from fuzz/corpus/${target}"

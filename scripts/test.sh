@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The whole test suite (README.md lists the stages and their time): the
-# Release build (its walkers on every instruction set the processor has),
-# every CPU suite under AddressSanitizer/UBSan, the host layer under
-# ThreadSanitizer, the installed package, and last the fuzz targets under
-# libFuzzer for a bounded time (scripts/fuzz.sh).
+# The whole test suite (docs/testing.md lists the stages and their time):
+# the Release build (its walkers on every instruction set the processor
+# has), the CPU suites that read hostile input and walk under
+# AddressSanitizer/UBSan with the fuzz targets under libFuzzer for a bounded
+# time (scripts/fuzz.sh) in the same build, the host layer under
+# ThreadSanitizer, and the installed package.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -49,7 +50,7 @@ run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
           { echo "  $item: FAILED"; tail -50 "$dir/$item.log"; exit 1; }' "$dir" {}
 }
 stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
-# The sanitizer builds: -O1 with line tables only (-g1): reports keep their
+# The ThreadSanitizer build: -O1 with line tables only (-g1): reports keep their
 # files, lines and functions; full debug info of the walkers' templates
 # doubled these builds' time, and -O2 took 5.8 min to build the ASan stage
 # where -O1 takes 4.4 (its suites ran 3.3 min either way).
@@ -79,20 +80,19 @@ ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 stage "Python: the package (build/python) against its own double-precision brute force (pytest)"
 PYTHONPATH="$PWD/build/python" MESHCAST_DATA="$PWD/data" /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests
 
-stage "AddressSanitizer + UBSan ($widest walkers), the test counters compiled in, without the Vulkan backend: the CPU suites of asan_suites and the CPU host layer"
-# The Vulkan suites stay out of this build: lavapipe and the loader are not
-# instrumented (their own allocations would read as leaks); they run in the
-# Release build above and the host layer under TSan below.
-# The fuzz corpora replay under clang's ASan and UBSan at the start of the
-# libFuzzer stage (and without sanitizers in Release's CTest).
-# Built without the Vulkan backend (MESHCAST_VULKAN=OFF): every CPU suite
-# and the CPU-only host layer pass there too.
-# The test counters (MESHCAST_COUNT_TESTS) are compiled in here: the
-# suites' counted-test checks run in this build alone.
-cmake -S . -B build-asan "${sanitizer_flags[@]}" "-DMESHCAST_ISAS=$widest" -DMESHCAST_SANITIZE=ON -DMESHCAST_COUNT_TESTS=ON \
-      -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
-cmake --build build-asan -j"$jobs" --target "${asan_suites[@]}" host_test
-run_suites build-asan quick "${asan_suites[@]}" host_test
+stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters compiled in, without the Vulkan backend: the CPU suites of asan_suites and the CPU host layer, then the fuzz targets"
+# One sanitizer build (scripts/sanitizer_build.sh, build-fuzz/) serves the
+# suites and the libFuzzer targets: the walkers' templates, most of a
+# build's time, are compiled once for both. The Vulkan suites stay out of
+# it: lavapipe and the loader are not instrumented (their own allocations
+# would read as leaks); they run in the Release build above and the host
+# layer under TSan below. The test counters (MESHCAST_COUNT_TESTS) are
+# compiled in there: the suites' counted-test checks run in that build
+# alone. The fuzz corpora replay under ASan and UBSan at the start of each
+# fuzz target's run (and without sanitizers in Release's CTest).
+bash scripts/sanitizer_build.sh "${asan_suites[@]}" host_test
+run_suites build-fuzz quick "${asan_suites[@]}" host_test
+bash scripts/fuzz.sh
 
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
@@ -107,7 +107,4 @@ MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 TSAN_OPTIONS="halt_on_error=1 se
 
 stage "The package: installed and used by the examples (CMake and pkg-config), and as a subproject"
 bash scripts/package_test.sh
-
-stage "libFuzzer: the blob validator + walker and the mesh reader + builder"
-bash scripts/fuzz.sh
 stage "done"

@@ -557,3 +557,81 @@ TEST(TMin, SecondaryRaysFromHitPointsMissTheirOwnTriangle) {
 }
 }  // namespace
 }  // namespace meshcast::testing
+
+// Batches of one origin (a sensor, a point's visibility) walk as packets
+// on the octtree: each ray answers exactly as it does walked alone
+// (Packets::Off): the same t, triangle, u and v bits for the closest hit,
+// culled or not, with or without t_min; the same hit or miss for any hit.
+// From inside, from outside and from just off the surface, on every
+// octtree triangle format (covering ones in quick runs); against the
+// oracle too.
+namespace meshcast::testing {
+namespace {
+TEST(Packets, CommonOriginBatchesAnswerAsSingleRays) {
+  std::vector<std::string> octtree;
+  for (const std::string& name : layout_names())
+    if (name.rfind("OctTreeCompressed/", 0) == 0) octtree.push_back(name);
+  if (quick()) octtree = {"OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/Float3"};
+  std::mt19937 rng(7);
+  std::normal_distribution<float> gauss;
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  size_t packets_hit = 0;
+  for (const NamedMesh& m : test_meshes(false)) {
+    const Box3 box = m.mesh->bounds();
+    const Vec3 centre = box.centre(), extent = box.extent();
+    const double size = std::sqrt(double(extent.x) * extent.x + double(extent.y) * extent.y + double(extent.z) * extent.z);
+    // Just off triangle 0's centroid along its normal, by 1e-3 of the mesh.
+    const Vec3 a = m.mesh->corner(0, 0), b = m.mesh->corner(0, 1), c = m.mesh->corner(0, 2);
+    const double e1[3] = {b.x - a.x, b.y - a.y, b.z - a.z}, e2[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const double off = 1e-3 * size / std::max(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1e-300);
+    Vec3 surface;
+    for (int k = 0; k < 3; ++k) surface[k] = float((double(a[k]) + b[k] + c[k]) / 3 + n[k] * off);
+    Vec3 outside;
+    for (int k = 0; k < 3; ++k) outside[k] = centre[k] + 1.5f * extent[k];
+    const Vec3 origins[3] = {centre, outside, surface};
+    const size_t count = quick() ? 600 : 3000;
+    for (const std::string& name : octtree) {
+      const std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(name), m.name);
+      const BlobView view(blob, m.name);
+      for (int o = 0; o < 3; ++o) {
+        std::vector<Ray> rays(count);
+        for (size_t i = 0; i < count; ++i) {
+          Ray& r = rays[i];
+          for (int k = 0; k < 3; ++k) r.org[k] = origins[o][k], r.dir[k] = gauss(rng);
+          r.tmax = INFINITY;
+          // A third of the rays start a little way out (t_min), as the
+          // secondary rays of a hit point do.
+          r.tmin = i % 3 == 0 ? unit(rng) * 0.2f * float(size) : 0.0f;
+        }
+        const std::string what = name + " on " + m.name + " from origin " + std::to_string(o);
+        for (Cull cull : {Cull::None, Cull::Back}) {
+          std::vector<Hit> alone(count), packed(count);
+          view.trace(rays, alone, HitOutputs::Uv, Query::Closest, cull, Packets::Off);
+          view.trace(rays, packed, HitOutputs::Uv, Query::Closest, cull, Packets::Auto);
+          for (size_t i = 0; i < count; ++i) {
+            ASSERT_EQ(packed[i].triangle, alone[i].triangle) << what << ", ray " << i;
+            ASSERT_EQ(std::bit_cast<uint32_t>(packed[i].t), std::bit_cast<uint32_t>(alone[i].t)) << what << ", ray " << i;
+            ASSERT_EQ(std::bit_cast<uint32_t>(packed[i].u), std::bit_cast<uint32_t>(alone[i].u)) << what << ", ray " << i;
+            ASSERT_EQ(std::bit_cast<uint32_t>(packed[i].v), std::bit_cast<uint32_t>(alone[i].v)) << what << ", ray " << i;
+            packets_hit += packed[i].triangle != kNoHit;
+          }
+          view.trace(rays, alone, HitOutputs::None, Query::Any, cull, Packets::Off);
+          view.trace(rays, packed, HitOutputs::None, Query::Any, cull, Packets::Auto);
+          for (size_t i = 0; i < count; ++i)
+            ASSERT_EQ(packed[i].triangle == kNoHit, alone[i].triangle == kNoHit) << what << ", any hit, ray " << i;
+        }
+        if (o == 0 && name == octtree[0]) {
+          std::vector<Ray> from_zero = rays;
+          for (Ray& r : from_zero) r.tmin = 0;
+          std::vector<Hit> packed(count);
+          view.trace(from_zero, packed, HitOutputs::None, Query::Closest, Cull::None, Packets::Auto);
+          expect_oracle(*m.mesh, blob, from_zero, packed, what + " against the oracle");
+        }
+      }
+    }
+  }
+  EXPECT_GT(packets_hit, 0u);
+}
+}  // namespace
+}  // namespace meshcast::testing

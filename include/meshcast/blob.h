@@ -36,10 +36,12 @@ class BlobView {
   // The closest hit of each ray (or with Query::Any, any hit), written to
   // hits[i]; returns how many rays were not walkable (ray_is_walkable:
   // answered as misses). `outputs`: what else each hit carries; `cull`:
-  // which faces the rays see. UsageError when hits is shorter than rays, or
-  // for Query::All (trace_all_hits answers it).
+  // which faces the rays see; `packets`: whether a batch of rays of one
+  // origin may walk as packets (meshcast/ray.h; the same answers). UsageError
+  // when hits is shorter than rays, or for Query::All (trace_all_hits
+  // answers it).
   uint64_t trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutputs outputs = HitOutputs::None,
-                 Query query = Query::Closest, Cull cull = Cull::None) const;
+                 Query query = Query::Closest, Cull cull = Cull::None, Packets packets = Packets::Auto) const;
 
   // Query::All: every hit of each ray along its segment into `lists`,
   // compact rows (meshcast/ray.h: cleared, then a row a ray holding its
@@ -59,6 +61,7 @@ class BlobView {
   std::span<const uint8_t> bytes_;
   using Walk = void (*)(const uint8_t*, const Ray*, Hit*, size_t, uint64_t*, const WalkRequest&);
   Walk walk_ = nullptr;
+  bool walks_packets_ = false;  // the layout's walker has a packet walk
 };
 
 // The instruction set the CPU walkers run on, chosen once per process: the

@@ -87,6 +87,9 @@ struct BatchQuery {
   Query query = Query::Closest;
   Cull cull = Cull::None;
   uint32_t max_hits = 16;
+  // The CPU's packets for rays of one origin (ray.h; the same answers); the
+  // GPU walks every ray alone.
+  Packets packets = Packets::Auto;
 };
 
 // A scene batch's question: BatchQuery's, and the rays' mask (an instance

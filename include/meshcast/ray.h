@@ -148,6 +148,16 @@ constexpr uint32_t kMaxHitsLimit = 4096;
 // back face hits the one it keeps.
 enum class Cull : uint32_t { None = 0, Back = 1, Front = 2 };
 
+// Whether a batch whose rays all start at one point (a sensor, a probe, a
+// point's visibility) is walked as packets: the rays sorted by direction
+// and walked a few at a time, each node decoded once for them, on the
+// layouts whose walker has packets (OctTreeCompressed). Auto finds such a
+// batch by itself; Off walks every ray alone. The answers are the same bit
+// for bit either way (a tie between triangles at one t goes to the lower
+// one in the blob's order, whatever the walk's order); only the time
+// differs.
+enum class Packets : uint32_t { Auto = 0, Off = 1 };
+
 // The largest direction component a ray may have.
 constexpr float kMaxDirection = 0x1p126f;
 

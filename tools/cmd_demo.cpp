@@ -95,7 +95,11 @@ void add_demo(CLI::App& app) {
       SectionBytes s = section_bytes(*blobs.back());
       const BlobView* view = views.back().get();
       cpu.push_back({Row{name, report.build_ms, s.walked() / n, s.remap / n, {}, 0},
-                     [view](const std::vector<Ray>& r, std::vector<Hit>& h) { view->trace(r, h); },
+                     // One ray at a time, as the peer's rows: the radial rays share an
+                     // origin, which would otherwise walk as packets.
+                     [view](const std::vector<Ray>& r, std::vector<Hit>& h) {
+                       view->trace(r, h, HitOutputs::None, Query::Closest, Cull::None, Packets::Off);
+                     },
                      [&, judged_mesh, judged_tree](int k, const std::vector<Hit>& hits) {
                        if (!judged_tree) return compare(*judged_mesh, rays[k], hits, oracle[k], tolerance);
                        std::vector<OracleHit> answers(rays[k].size());

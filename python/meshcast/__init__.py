@@ -37,6 +37,11 @@ the process (``multiprocessing`` on Linux) casts on threads and Vulkan
 devices of its own, whatever its parent cast. Bad input raises
 ``ValueError``, files ``OSError``; a thread or device the system refuses,
 ``RuntimeError`` saying so.
+
+A blob's cast whose rays all start at one point (a sensor, a probe) walks
+them as packets on the recommended layout: sorted by direction, 8 at a
+time, each node decoded once for them; the answers are the same bits as
+one ray at a time (``packets="off"``), only the time differs.
 """
 
 import os as _os

@@ -106,8 +106,11 @@ py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery
 py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::handle& directions,
                    const py::handle& t_min, const py::handle& t_max, const std::string& query_name,
                    const std::string& cull_name, long long max_hits, bool uv, const py::object& out,
-                   const std::string& backend, long long nthreads) {
+                   const std::string& backend, long long nthreads, const std::string& packets_name) {
   const Query query = parse_query(query_name);
+  if (packets_name != "auto" && packets_name != "off")
+    throw py::value_error("packets \"" + packets_name + "\": auto or off");
+  const Packets packets = packets_name == "off" ? Packets::Off : Packets::Auto;
   const Cull cull = parse_cull(cull_name);
   if (backend != "cpu" && backend != "vulkan") throw py::value_error("backend \"" + backend + "\": cpu or vulkan");
   const uint32_t kept = checked_max_hits(max_hits);
@@ -116,7 +119,7 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
   if (backend == "vulkan") return cast_on_gpu(const_cast<PyBlob&>(blob), rays, {query, cull, kept}, outputs, out);
-  return cast_answer(BlobTarget{blob.view()}, rays, query, cull, outputs, kept, threads, out, true);
+  return cast_answer(BlobTarget{blob.view(), nullptr, packets}, rays, query, cull, outputs, kept, threads, out, true);
 }
 
 std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,
@@ -197,7 +200,7 @@ Python threads may cast through one Blob at once.)")
       .def("cast", &cast_blob, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
            py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",
            py::arg("max_hits") = 16, py::arg("uv") = false, py::arg("out") = py::none(), py::arg("backend") = "cpu",
-           py::arg("nthreads") = 0, "See the package's documentation (help(meshcast)).")
+           py::arg("nthreads") = 0, py::arg("packets") = "auto", "See the package's documentation (help(meshcast)).")
       .def("__repr__", [](const PyBlob& b) {
         return "<meshcast.Blob " + b.name() + ": " + layout_name(b.view().layout()) + ", " +
                std::to_string(b.view().triangle_count()) + " triangles, " + std::to_string(b.view().bytes().size()) +

@@ -23,9 +23,10 @@ struct BlobTarget {
   using Record = Hit;
   const BlobView& view;
   const double* offset = nullptr;  // subtracted from every origin first (a geometry's centre)
+  Packets packets = Packets::Auto;  // rays of one origin as packets (meshcast/ray.h)
   void pack(const RayArrays& rays, size_t begin, size_t n, Ray* out) const { rays.pack(begin, n, out, offset); }
   uint64_t trace(std::span<const Ray> r, std::span<Hit> h, HitOutputs o, Query q, Cull c) const {
-    return view.trace(r, h, o, q, c);
+    return view.trace(r, h, o, q, c, packets);
   }
   uint64_t trace_all(std::span<const Ray> r, HitLists& lists, HitOutputs o, Cull c) const {
     return view.trace_all_hits(r, lists, o, c);

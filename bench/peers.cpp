@@ -61,8 +61,9 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   std::vector<bool> sorted(kinds.size(), false);
   for (size_t k = 0; k < kinds.size(); ++k) {
     if (!o.packets || !share_one_origin(rays[k])) continue;
-    std::vector<uint32_t> order(rays[k].size());
-    order_by_direction(rays[k], order);
+    std::vector<uint32_t> order(rays[k].size()), scratch(rays[k].size());
+    std::vector<uint16_t> keys(rays[k].size());
+    order_by_direction(rays[k], order, keys, scratch);
     std::vector<Ray> by_direction;
     for (uint32_t i : order) by_direction.push_back(rays[k][i]);
     rays.push_back(std::move(by_direction));

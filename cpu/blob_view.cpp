@@ -57,10 +57,11 @@ uint64_t BlobView::trace(std::span<const Ray> rays, std::span<Hit> hits, HitOutp
     request.packets = true;
     for (size_t begin = 0; begin < n; begin += kPacketPiece) {
       const size_t m = std::min(kPacketPiece, n - begin);
-      const std::span<uint32_t> order = thread_scratch<uint32_t>(m);
+      const std::span<uint32_t> orders = thread_scratch<uint32_t>(2 * m);  // the order, and the sort's own
+      const std::span<uint32_t> order = orders.first(m);
       const std::span<Ray> sorted = thread_scratch<Ray>(m);
       const std::span<Hit> sorted_hits = thread_scratch<Hit>(m);
-      order_by_direction(rays.subspan(begin, m), order);
+      order_by_direction(rays.subspan(begin, m), order, thread_scratch<uint16_t>(m), orders.subspan(m));
       for (size_t k = 0; k < m; ++k) sorted[k] = rays[begin + order[k]];
       walk_(bytes_.data(), sorted.data(), sorted_hits.data(), m, &skipped, request);
       for (size_t k = 0; k < m; ++k) hits[begin + order[k]] = sorted_hits[k];

@@ -3,7 +3,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <vector>
 
 namespace meshcast {
 
@@ -43,11 +42,11 @@ uint32_t direction_key(const Ray& r) {
 
 }  // namespace
 
-void order_by_direction(std::span<const Ray> rays, std::span<uint32_t> order) {
+void order_by_direction(std::span<const Ray> rays, std::span<uint32_t> order, std::span<uint16_t> keys,
+                        std::span<uint32_t> scratch) {
   const size_t n = rays.size();
-  std::vector<uint16_t> keys(n);
   for (size_t i = 0; i < n; ++i) keys[i] = uint16_t(direction_key(rays[i]));
-  std::vector<uint32_t> low(n);
+  const std::span<uint32_t> low = scratch;  // the order by the low byte
   // Low byte first, then the high byte, each pass stable.
   for (int pass = 0; pass < 2; ++pass) {
     const int shift = 8 * pass;

@@ -18,7 +18,10 @@ bool share_one_origin(std::span<const Ray> rays);
 // square (Meyer et al.'s octahedral map), 256 x 256 cells in Morton order,
 // so neighbouring keys are neighbouring directions; rays of one cell keep
 // their order. Two passes of a byte-wise counting sort. A direction that is
-// not finite or is zero goes first (it is not walked anyway).
-void order_by_direction(std::span<const Ray> rays, std::span<uint32_t> order);
+// not finite or is zero goes first (it is not walked anyway). `keys` and
+// `scratch` (as many as the rays) are the caller's, so a caller that keeps
+// them allocates nothing.
+void order_by_direction(std::span<const Ray> rays, std::span<uint32_t> order, std::span<uint16_t> keys,
+                        std::span<uint32_t> scratch);
 
 }  // namespace meshcast

@@ -346,8 +346,8 @@ void walk_packet(const uint8_t* blob, const layout::BlobHeader& h, const RayPre*
 }
 
 // A request's packets: rays in groups of kPacketRays as they come (the
-// caller has sorted them by direction), a group walked as a packet when its
-// rays share one origin, else one by one.
+// caller has found that they share one origin and sorted them by
+// direction: WalkRequest::packets).
 template <class Codec, TriangleTest kTest>
 void walk_packets(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uint64_t* skipped,
                   const WalkRequest& request) {
@@ -372,14 +372,7 @@ void walk_packets(const uint8_t* blob, const Ray* rays, Hit* hits, size_t n, uin
       c[k].any = any;
       walked[k++] = int(i - begin);
     }
-    bool one_origin = true;
-    for (int j = 1; j < k; ++j)
-      for (int a = 0; a < 3; ++a) one_origin &= std::bit_cast<uint32_t>(pre[j].org[a]) == std::bit_cast<uint32_t>(pre[0].org[a]);
-    if (k > 0 && one_origin) {
-      walk_packet<Codec, kTest>(blob, h, pre, c, k);
-    } else {
-      for (int j = 0; j < k; ++j) walk_one<Codec, kTest>(blob, h, pre[j], c[j]);
-    }
+    if (k > 0) walk_packet<Codec, kTest>(blob, h, pre, c, k);
     for (int j = 0; j < k; ++j) keep_slot(hits[begin + size_t(walked[j])], c[j], outputs);
     if (!request.keep_slots) finish_hits(blob, rays, hits, begin, end, outputs);
   }

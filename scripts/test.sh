@@ -54,7 +54,7 @@ stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
 # files, lines and functions; full debug info of the walkers' templates
 # doubled these builds' time, and -O2 took 5.8 min to build the ASan stage
 # where -O1 takes 4.4 (its suites ran 3.3 min either way).
-sanitizer_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG")
+tsan_flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG")
 
 # The walkers' instruction sets (cpu/isa.h): the Release build has them all
 # and runs the widest this processor has, then the suites that walk again
@@ -97,7 +97,7 @@ bash scripts/fuzz.sh
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
 # (uninstrumented) threads ever make TSan report what it cannot see.
-cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
+cmake -S . -B build-tsan "${tsan_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test build_test
 # tests/tsan.supp leaves out races inside the Vulkan validation layer's own threads.
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \

@@ -1,4 +1,4 @@
-// `meshcast bench auto`: issue 9's check of the automatic layout. On each
+// `meshcast bench auto`: the check of the automatic layout. On each
 // mesh every layout of the combos table is measured, then the layout `auto`
 // chooses under each setting, in the same run on the same rays; the choice
 // is set against the best combos layout that meets the setting's limits

@@ -1,4 +1,4 @@
-// `meshcast bench error` (issue 8): error against run time. For every tree x
+// `meshcast bench error`: error against run time. For every tree x
 // encoding (and, with a Vulkan device, every GPU method) on each mesh: time a
 // ray and bytes a triangle against the error measured against the
 // double-precision oracle over the input mesh:

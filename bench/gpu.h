@@ -13,7 +13,7 @@ struct GpuRow {
   double device_us = 0, wall_us = 0;  // per ray: GPU timestamps; submission to read-back (CPU row: one thread)
   double bytes = 0;                   // walked bytes per triangle
   uint64_t disagreements = 0;
-  // Issue 20: each query's time on the same rays against the closest hit's
+  // Each query's time on the same rays against the closest hit's
   // (device time where the device has timestamps, else wall): any hit, and
   // every hit (rows of 16). 0 for the CPU row.
   double any_to_closest = 0, all_to_closest = 0;

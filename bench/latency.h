@@ -1,4 +1,4 @@
-// `meshcast bench latency` (issue 6): the host layer's batches from 1 to
+// `meshcast bench latency`: the host layer's batches from 1 to
 // 65,536 rays on the CPU (one thread, every thread) and on the Vulkan
 // device, latency percentiles, rays a second, frame-ahead throughput, and
 // the crossover the automatic backend measures.

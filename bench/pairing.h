@@ -1,4 +1,4 @@
-// `meshcast bench pairing` (issue 7, seed 003's results table): per mesh the
+// `meshcast bench pairing` (seed 003's results table): per mesh the
 // pairing pass's time, the paired share before (input order, window N = 2)
 // and after, and what pairs as the builder's unit change in bytes per
 // triangle, time per ray and (in a counting build, cpu/counters.h) box and

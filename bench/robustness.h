@@ -1,4 +1,4 @@
-// `meshcast bench robustness` (issue 8): what the watertight test costs. The
+// `meshcast bench robustness`: what the watertight test costs. The
 // same layouts walked with the watertight test (the default) and with the
 // plain Möller–Trumbore test, alternately in one run: time a ray on long
 // rays through the mesh, their disagreements with the oracle, and leaks:

@@ -1,4 +1,4 @@
-// `meshcast bench scenes` (issue 21): a generated level of placed copies of
+// `meshcast bench scenes`: a generated level of placed copies of
 // the test meshes, rotated, scaled and mirrored, spread over 10 km, beside
 // Embree's instancing in one run: ns a ray (interleaved rounds, medians,
 // one thread), bytes (blobs and top level against Embree's scenes and the

@@ -35,7 +35,7 @@ std::vector<TreeRow> bench_order(const Mesh& mesh, const std::string& name, size
 std::vector<TreeRow> bench_combos(const Mesh& mesh, const std::string& name, size_t rays, uint32_t repeat,
                                   const std::string& only = "");
 
-// Issue 4's offset test: QuadTreeHalfFloat (and its peers in this format
+// The offset test: QuadTreeHalfFloat (and its peers in this format
 // family) on a mesh at the origin and the same mesh moved far away.
 struct OffsetRow {
   std::string layout, mesh;  // "0.15 units at 1000" etc.

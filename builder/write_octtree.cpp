@@ -1,4 +1,4 @@
-// OctTreeCompressed (issue 19): the binary SAH tree with the caller's leaves;
+// OctTreeCompressed: the binary SAH tree with the caller's leaves;
 // the wide plan gives every node up to 8 children (the collapse by table
 // of builder/wide_plan.h), which sit in the slots that order them for the
 // rays of each octant. An SAH collapse that chose the leaves again, counting

@@ -43,7 +43,7 @@ HitLists read_hit_lists(const std::string& path);
 // A HITC file. InputError beyond kMaxRayCount rays; UsageError for rows
 // that do not keep min(found, max_hits) records each.
 void write_hit_lists(const std::string& path, const HitLists& lists);
-// Scenes' files (issue 21), with read_rays' refusals.
+// Scenes' files, with read_rays' refusals.
 std::vector<RayD> read_scene_rays(const std::string& path);
 void write_scene_rays(const std::string& path, const std::vector<RayD>& rays);
 std::vector<SceneHit> read_scene_hits(const std::string& path);

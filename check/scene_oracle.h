@@ -1,4 +1,4 @@
-// The double-precision oracle for scenes (issue 21): every instance's
+// The double-precision oracle for scenes: every instance's
 // triangles moved into the world in double (rotation_scale as exact
 // doubles, the translation added in double), the world ray in double, the
 // oracle's watertight test; no top level, no float anywhere. Ties: the

@@ -1,4 +1,4 @@
-// The Vulkan scene method (issue 21): shaders/scene_octtree.comp walks a
+// The Vulkan scene method: shaders/scene_octtree.comp walks a
 // snapshot's top level and then each instance's blob, reading the bytes
 // Scene::commit() made (the placed records and wide nodes, copied
 // unchanged) and the blobs the CPU walks. Every mesh must be in the

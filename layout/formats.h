@@ -10,12 +10,12 @@
 #define MC_BLOB_VERSION 2u
 #define MC_BLOB_HEADER_BYTES 160u
 
-// Per-hit outputs a trace may ask for beyond t and the triangle (issue 9);
+// Per-hit outputs a trace may ask for beyond t and the triangle;
 // what is not asked for is not computed and reads 0. The CPU walkers take
 // them with each batch, the Vulkan methods as specialization constant 0.
 #define MC_HIT_UV 1u     // barycentrics u, v of the hit in its triangle
 #define MC_HIT_POINT 2u  // the hit point: org + t * dir, in float
-// The query a trace answers, in the same word as the outputs (issue 20):
+// The query a trace answers, in the same word as the outputs:
 // without a query bit the closest hit; MC_QUERY_ANY any hit in [t_min, t_max],
 // the walk ending at the first triangle it takes; MC_QUERY_ALL every hit
 // along the segment. Face culling rides there too: MC_CULL_BACK keeps the
@@ -62,7 +62,7 @@
 #define MC_TREE_AABBLIST 10u           // §7: 256-triangle batches, one box each
 #define MC_TREE_ZEROBYTE 11u           // seed 004: the index buffer is the tree
 #define MC_TREE_ZEROBYTEHYBRID 12u     // seed 004's future work: AABBTree nodes over zero-byte leaves
-#define MC_TREE_OCTTREECOMPRESSED 13u  // issue 19: 8 children a node, 8-bit boxes on power-of-two scales
+#define MC_TREE_OCTTREECOMPRESSED 13u  // 8 children a node, 8-bit boxes on power-of-two scales
 
 // BruteForce: the tree section is a run of records, [count (uint32)][block],
 // each block holding the next brute_chunk(lanes) triangles in input order
@@ -105,9 +105,9 @@
 #define MC_TRI_COMPRESSEDSTRIP 16u     // §3.10
 #define MC_TRI_FLOAT3PAIRSOA4 18u      // seed 003: triangle pairs, the shared edge stored once
 #define MC_TRI_INDEXED24 17u           // seed 004: 32-bit index words, 24 bits of vertex index, 8 of tree
-#define MC_TRI_CLUSTERBITPACKSOA8 19u  // issue 19: clusters of mesh-grid vertices stored once, 4-bit indices
+#define MC_TRI_CLUSTERBITPACKSOA8 19u  // clusters of mesh-grid vertices stored once, 4-bit indices
 
-// ClusterBitPackSOA8 (issue 19): a leaf is a run of clusters, each
+// ClusterBitPackSOA8: a leaf is a run of clusters, each
 //   Origin     uint64 BitPack word: the mesh-grid codes (18 bits used of
 //              each 21-bit field) of the cluster's smallest corner
 //   Vertices   byte: the cluster's vertex count (1..16); bit 7: wide offsets
@@ -241,7 +241,7 @@
 #define MC_QUADHALF_PROPERTIES_AT 48u  // in a QuadTreeHalfFloat node
 // Offsets are relative to the start of the tree section.
 
-// OctTreeCompressed (issue 19; the 8-wide sibling of QuadTree, named like it
+// OctTreeCompressed (the 8-wide sibling of QuadTree, named like it
 // for its branching, not a spatial octree): 96-byte nodes of 8 children,
 // each child box coded in 8 bits an axis against the node's frame, as
 // Ylitie, Karras and Laine 2017 code CWBVH's:

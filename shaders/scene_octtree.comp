@@ -1,4 +1,4 @@
-// A scene (issue 21), one world ray a thread: cpu/scene_trace.cpp's walk on
+// A scene, one world ray a thread: cpu/scene_trace.cpp's walk on
 // the bytes a Scene::commit() made. The top level's 8-wide nodes of float
 // boxes near the anchor (layout/tree/top_level.h), each instance the ray reaches
 // walked in its OctTreeCompressed/ClusterBitPackSOA8 blob

@@ -1,4 +1,4 @@
-// The automatic layout (issue 9): what it measures of a mesh, the rules it
+// The automatic layout: what it measures of a mesh, the rules it
 // shortlists by, that its choice meets the caller's limits, and that every
 // blob it chooses returns the double-precision oracle's answers on a
 // surface within the error it states. (The stiff suite runs its choices

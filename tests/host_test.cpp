@@ -208,7 +208,7 @@ TEST(Host, HitOutputsOnBothBackends) {
   }
 }
 
-// The query is per batch (issue 20): any hit, culled closest hits and
+// The query is per batch: any hit, culled closest hits and
 // every hit, in flight at once beside closest-hit batches, on both
 // backends: each batch the BlobView's own answer to its query. Asking for
 // the other kind of answer than the batch's is a UsageError.
@@ -1139,7 +1139,7 @@ TEST(Host, AutomaticChoiceOnProfilesItCannotUse) {
 }  // namespace
 }  // namespace meshcast::testing
 
-// Scene batches (issue 21): the game moves, hides, shows, adds and removes
+// Scene batches: the game moves, hides, shows, adds and removes
 // instances and commits a frame while up to three batches are in flight;
 // every batch, collected frames later, is the scene as it was when it was
 // submitted (the same answers as walking that frame's snapshot), and the

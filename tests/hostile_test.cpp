@@ -1,4 +1,4 @@
-// Hostile input (issue 17): what an adversarial run found, one test per
+// Hostile input: what an adversarial run found, one test per
 // defect, each on files the test makes itself. The wrong answers at large
 // coordinates are probed on every layout and every Vulkan method by the
 // stiff suite (robustness_test.cpp: ExtremeMagnitudesAndDirectionLengths,

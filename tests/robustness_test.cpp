@@ -55,6 +55,12 @@ class Robustness : public ::testing::TestWithParam<std::string> {
   // "auto:SETTING" (builder/auto_layout.h parse_auto_setting) builds the layout the automatic
   // layout chooses for each probe mesh; anything else the named layout.
   bool automatic() const { return GetParam().rfind("auto:", 0) == 0; }
+  // A walk whose time grows with rays times triangles: the brute force and
+  // AABBList, on the CPU or on the GPU.
+  bool tests_every_triangle() const {
+    if (!method().empty()) return method() == "bruteforce" || method() == "aabblist";
+    return layout().rfind("BruteForce/", 0) == 0 || layout().rfind("AABBList/", 0) == 0;
+  }
   std::vector<uint8_t> build(const Mesh& mesh, const char* what) const {
     if (!automatic()) return build_blob(mesh, options(), what);
     AutoLimits limits = parse_auto_setting(layout().substr(5));
@@ -77,7 +83,7 @@ class Robustness : public ::testing::TestWithParam<std::string> {
     return trace_all(blob, rays, skipped, outputs);
 #endif
   }
-  // A query (issue 20) on either side: the CPU walker, or a GPU method
+  // A query on either side: the CPU walker, or a GPU method
   // made for it (its specialization constants).
   std::vector<Hit> trace_query(const std::vector<uint8_t>& blob, const std::vector<Ray>& rays, Query query, Cull cull) {
 #ifdef MESHCAST_TEST_GPU
@@ -123,9 +129,14 @@ class Robustness : public ::testing::TestWithParam<std::string> {
 
 // Closed sphere, welded and unwelded: rays from inside must all hit; rays
 // aimed at its vertices and edge midpoints from the centre must all hit.
+// The walks that test every triangle (or every batch) for every ray take a
+// sphere of a quarter of the triangles, so half the rays: on the finer one
+// they took 130 s of the CPU suites' work and 139 s of lavapipe's, for the
+// same watertight test at the same kind of shared edges and vertices.
 TEST_P(Robustness, ClosedSphereNeverLeaks) {
+  const bool linear = tests_every_triangle();
   for (bool soup : {false, true}) {
-  Mesh s = make_sphere(24, 48, 1.0f, {0.1f, 0.2f, 0.3f});
+  Mesh s = linear ? make_sphere(12, 24, 1.0f, {0.1f, 0.2f, 0.3f}) : make_sphere(24, 48, 1.0f, {0.1f, 0.2f, 0.3f});
   if (soup) s = unwelded(s);
   std::vector<uint8_t> blob = build(s, "sphere");
   std::vector<Ray> rays;
@@ -144,7 +155,7 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
   size_t leaks = 0;
   for (const Hit& h : hits) leaks += h.triangle == MC_NO_HIT;
   EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded");
-  // Query::Any leaks no ray either (issue 20).
+  // Query::Any leaks no ray either.
   leaks = 0;
   for (const Hit& h : trace_query(blob, rays, Query::Any, Cull::None)) leaks += h.triangle == MC_NO_HIT;
   EXPECT_EQ(leaks, 0u) << (soup ? "unwelded" : "welded") << ", Query::Any";
@@ -153,7 +164,7 @@ TEST_P(Robustness, ClosedSphereNeverLeaks) {
   // GPU, every 16th for the methods that test every triangle (or every
   // batch) for every ray (7 passes of 19,000 rays took them 10-13 s each
   // on lavapipe).
-  const size_t stride = method() == "bruteforce" || method() == "aabblist" ? 16 : method().empty() && !quick() ? 1 : 4;
+  const size_t stride = !method().empty() && linear ? 16 : method().empty() && !quick() ? 1 : 4;
   std::vector<Ray> some;
   for (size_t i = 0; i < rays.size(); i += stride) some.push_back(rays[i]);
   // Query::All: every ray from inside finds at least one hit.
@@ -254,7 +265,7 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
   expect_answers(g, rays, "grid");
 }
 
-// Per-hit outputs (issue 9) are computed only when asked: u, v and the
+// Per-hit outputs are computed only when asked: u, v and the
 // point read 0 otherwise, and asking changes neither t nor the triangle.
 // The point is org + t * dir; u, v name that point in the stored triangle.
 TEST_P(Robustness, PerHitOutputsOnlyWhenAsked) {
@@ -327,7 +338,7 @@ TEST_P(Robustness, FarTinyAndHugeMeshes) {
   }
 }
 
-// Issue 17: coordinates from 1e-30 to 1e30 (the +-2^100 limit) and direction
+// Coordinates from 1e-30 to 1e30 (the +-2^100 limit) and direction
 // lengths scaled by 2^-130 .. 2^100 (those with a component beyond 2^126 or
 // all below FLT_MIN are counted misses, as the oracle has them). The float
 // test overflows (det, T) or underflows there, and at 1e19 det passes 2^126;
@@ -418,7 +429,7 @@ TEST_P(Robustness, MeshesUnderAGridsLeastExtent) {
   }
 }
 
-// The adversarial run's case (issue 17): two triangles with corners (0,0),
+// The adversarial run's case: two triangles with corners (0,0),
 // (1e13,0), (0,1e13) at z = -1e13 and at z = 0. From (1e12, 1e12, 1e13)
 // straight down the ray must hit the upper one (triangle 1) at t = 1e13;
 // float's T overflowed, giving t = inf and triangle 0, and with t_max 3e13

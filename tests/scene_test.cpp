@@ -1,4 +1,4 @@
-// Scenes (issue 21): generated levels of placed, rotated, scaled and
+// Scenes: generated levels of placed, rotated, scaled and
 // mirrored instances, at the origin and 10^6 and 10^7 units from it,
 // against the double-precision scene oracle (check/scene_oracle.h); the
 // closed sphere and the grid far away; edits and commits; bad input.

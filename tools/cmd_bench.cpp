@@ -317,7 +317,7 @@ void add_bench_gpu(CLI::App* bench) {
   });
 }
 
-// Issue 6: the host layer's latency against batch size.
+// The host layer's latency against batch size.
 void add_bench_latency(CLI::App* bench) {
   auto largs = std::make_shared<BenchArgs>();
   auto lopts = std::make_shared<std::pair<std::string, double>>("", 16.7);  // device, frame ms
@@ -368,7 +368,7 @@ void add_bench_latency(CLI::App* bench) {
   });
 }
 
-// Issue 8: error against run time and bytes.
+// Error against run time and bytes.
 void add_bench_error(CLI::App* bench) {
   auto eargs = std::make_shared<BenchArgs>();
   auto emeshes = std::make_shared<std::vector<std::string>>();
@@ -446,7 +446,7 @@ void add_bench_error(CLI::App* bench) {
   });
 }
 
-// Issue 8: the watertight test against Moller-Trumbore.
+// The watertight test against Moller-Trumbore.
 void add_bench_robustness(CLI::App* bench) {
   auto rargs = std::make_shared<BenchArgs>();
   CLI::App* rob = bench->add_subcommand("robustness", "the watertight test against plain Moller-Trumbore, time and leaks");
@@ -532,7 +532,7 @@ void add_bench_pairing(CLI::App* bench) {
   });
 }
 
-// Issue 4: the half-float tree far from the origin.
+// The half-float tree far from the origin.
 void add_bench_offset(CLI::App* bench) {
   auto oargs = std::make_shared<BenchArgs>();
   CLI::App* off = bench->add_subcommand("offset", "QuadTreeHalfFloat far from the origin: 0.15 units at 1000, 150 at 30000");

@@ -1,4 +1,4 @@
-// A scene's top level (issue 21): the records one Scene::commit() makes and
+// A scene's top level: the records one Scene::commit() makes and
 // every trace of that frame reads: the instances that are walked (enabled at
 // the commit) in the tree's order, and 8-wide nodes over their world boxes
 // (scene/build_top_level.h builds them from boxes in double: worlds far from the

@@ -1,4 +1,4 @@
-// ClusterBitPackSOA8 (issue 19; formats.h gives the bytes): a leaf's
+// ClusterBitPackSOA8 (formats.h gives the bytes): a leaf's
 // triangles in clusters of at most 16 triangles over at most 16 vertices,
 // each vertex stored once a cluster as offsets from the cluster's origin on
 // the mesh grid (kGridPowerOfTwo, as BitPack), corners as 4-bit vertex

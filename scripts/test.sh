@@ -19,7 +19,7 @@ jobs=$(nproc)
 # suite prints its log; xargs waits for the others and fails the pipeline.
 # The longest first; walker_test and robustness_test (every layout) in two
 # shards each, so the two cores finish together.
-cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test scene_test
+cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test scene_test point_test
             hostile_test oracle_test io_test)
 # Under AddressSanitizer: the suites that read hostile input, walk, place
 # instances and allocate per frame. The layouts' own suites (layout_test,
@@ -30,7 +30,7 @@ cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_
 # their encoders are the builds the suites below make, and the fuzz
 # targets' ASan builds read, build and walk every layout on arbitrary
 # bytes and rays again.
-asan_suites=(walker_test limits_test zerobyte_test scene_test hostile_test io_test)
+asan_suites=(walker_test limits_test zerobyte_test scene_test hostile_test io_test point_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
 walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...

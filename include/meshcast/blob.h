@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "meshcast/build.h"
+#include "meshcast/closest_point.h"
 #include "meshcast/ray.h"
 
 namespace meshcast {
@@ -52,6 +53,18 @@ class BlobView {
   // walkable, as trace() does. UsageError for max_hits out of range.
   uint64_t trace_all_hits(std::span<const Ray> rays, HitLists& lists, HitOutputs outputs = HitOutputs::None,
                           Cull cull = Cull::None) const;
+
+  // Point queries (meshcast/closest_point.h): the nearest point of the
+  // stored mesh to each of `points`, no farther than `max_distance` (the
+  // limit included), written to out[i]; a point with none that near gets
+  // ClosestPoint{} (distance INFINITY, triangle kNoHit). At one distance
+  // the lower triangle number. Returns how many points had a NaN or
+  // infinite coordinate (answered as none found). Walks OctTreeCompressed
+  // blobs: the recommended layout and the exact one the automatic layout
+  // picks under an error limit; UsageError naming any other layout, when
+  // out is shorter than points, or for a negative or NaN max_distance.
+  uint64_t closest_points(std::span<const Vec3> points, std::span<ClosestPoint> out,
+                          float max_distance = INFINITY) const;
 
   std::span<const uint8_t> bytes() const { return bytes_; }
   Layout layout() const;

@@ -115,6 +115,24 @@ void ClusterBitPackSOA8::decode(const uint8_t* blob, uint32_t block, uint32_t i,
   }
 }
 
+void ClusterBitPackSOA8::decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]) {
+  const BlobHeader& h = header_of(blob);
+  uint32_t at = block, made = 0;
+  while (made < count) {
+    const uint32_t v = vertex_count(blob, at), t = std::min(triangle_count(blob, at), count - made);
+    float vertex[MC_CLUSTER_MAX_VERTICES][3];
+    for (uint32_t k = 0; k < v; ++k)
+      for (int a = 0; a < 3; ++a) vertex[k][a] = std::fma(float(code(blob, at, k, a)), h.quant_scale[a], h.quant_offset[a]);
+    for (uint32_t i = 0; i < t; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t k = corner(blob, at, i, c);
+        for (int a = 0; a < 3; ++a) out[made + i][c][a] = vertex[k][a];
+      }
+    made += t;
+    at += bytes_of(blob, at);
+  }
+}
+
 bool ClusterBitPackSOA8::check(const uint8_t* blob, uint32_t block, uint32_t count, std::string* why) {
   uint32_t at = block, made = 0;
   while (made < count) {

@@ -96,6 +96,8 @@ struct ClusterBitPackSOA8 {
   // do not hold exactly `count` triangles, or end past `limit`.
   static uint64_t stored_bytes(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit);
   static void decode(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]);
+  // The leaf's `count` triangles, each cluster's vertices decoded once.
+  static void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]);
   // Every corner number of every lane (padding too: walkers decode them)
   // names a vertex of its cluster, and every code stays on the 21-bit grid.
   static bool check(const uint8_t* blob, uint32_t block, uint32_t count, std::string* why);

@@ -8,21 +8,15 @@
 
 namespace meshcast::python {
 
-namespace {
-
-std::string shape_text(const py::array& a) {
-  std::string s = "(";
-  for (py::ssize_t d = 0; d < a.ndim(); ++d) s += (d ? ", " : "") + std::to_string(a.shape(d));
-  return s + (a.ndim() == 1 ? ",)" : ")");
-}
-
 std::string shape_text(const std::vector<py::ssize_t>& shape) {
   std::string s = "(";
   for (size_t d = 0; d < shape.size(); ++d) s += (d ? ", " : "") + std::to_string(shape[d]);
   return s + (shape.size() == 1 ? ",)" : ")");
 }
 
-bool is_double(const py::array& a) { return a.dtype().itemsize() == 8; }
+std::string shape_text(const py::array& a) {
+  return shape_text(std::vector<py::ssize_t>(a.shape(), a.shape() + a.ndim()));
+}
 
 double read_real(const uint8_t* p, bool is_double_value) {
   if (is_double_value) {
@@ -34,6 +28,10 @@ double read_real(const uint8_t* p, bool is_double_value) {
   std::memcpy(&f, p, 4);
   return f;
 }
+
+namespace {
+
+bool is_double(const py::array& a) { return a.dtype().itemsize() == 8; }
 
 std::string triple(const double v[3]) {
   std::ostringstream s;

@@ -25,6 +25,16 @@ namespace py = pybind11;
 // float16 converted to float32. ValueError naming `what` for complex,
 // boolean, object and string arrays.
 py::array real_array(const py::handle& input, const char* what);
+// `shape` with one more axis of n: an answer of n values a ray or point.
+inline std::vector<py::ssize_t> shape_with(std::vector<py::ssize_t> shape, py::ssize_t n) {
+  shape.push_back(n);
+  return shape;
+}
+// An array's shape as Python writes it: "(4, 3)", "(3,)".
+std::string shape_text(const py::array& a);
+std::string shape_text(const std::vector<py::ssize_t>& shape);
+// A float32 or float64 value at p (numpy may hand over unaligned memory).
+double read_real(const uint8_t* p, bool is_double_value);
 
 // Rays as the caller gave them: origins and directions (...,3) each, or
 // one (...,6) array whose first three columns are the origin. The leading

@@ -13,6 +13,7 @@
 #include "python/src/answers.h"
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
+#include "python/src/points.h"
 #if MESHCAST_READER
 #include "meshcast/read.h"
 #endif
@@ -122,6 +123,37 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
   return cast_answer(BlobTarget{blob.view(), nullptr, packets}, rays, query, cull, outputs, kept, threads, out, true);
 }
 
+// The nearest point of the stored mesh to each query point.
+py::dict closest_points_blob(const PyBlob& blob, const py::handle& points_in, double max_distance, long long nthreads) {
+  const PointArrays points = points_from_array(points_in, "points");
+  const float limit = checked_max_distance(max_distance);
+  const uint32_t threads = thread_count(nthreads);
+  py::array_t<float> point(shape_with(points.shape, 3)), distance(points.shape), uv(shape_with(points.shape, 2));
+  py::array_t<uint32_t> triangle(points.shape);
+  float* p_out = point.mutable_data();
+  float* d_out = distance.mutable_data();
+  float* uv_out = uv.mutable_data();
+  uint32_t* t_out = triangle.mutable_data();
+  {
+    py::gil_scoped_release release;
+    std::vector<ClosestPoint> found;
+    nearest_points(blob.view(), nullptr, points, limit, threads, found);
+    for (size_t i = 0; i < found.size(); ++i) {
+      const ClosestPoint& c = found[i];
+      for (int k = 0; k < 3; ++k) p_out[3 * i + k] = c.triangle == kNoHit ? NAN : c.point[k];
+      d_out[i] = c.distance;
+      t_out[i] = c.triangle;
+      uv_out[2 * i] = c.u, uv_out[2 * i + 1] = c.v;
+    }
+  }
+  py::dict answer;
+  answer["point"] = point;
+  answer["distance"] = distance;
+  answer["triangle"] = triangle;
+  answer["uv"] = uv;
+  return answer;
+}
+
 std::shared_ptr<PyBlob> build(const py::handle& vertices, const py::handle& triangles, const std::string& layout,
                               const py::object& max_bytes_given, long long leaf_size, long long threads,
                               const std::string& name) {
@@ -201,6 +233,18 @@ Python threads may cast through one Blob at once.)")
            py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",
            py::arg("max_hits") = 16, py::arg("uv") = false, py::arg("out") = py::none(), py::arg("backend") = "cpu",
            py::arg("nthreads") = 0, py::arg("packets") = "auto", "See the package's documentation (help(meshcast)).")
+      .def("closest_points", &closest_points_blob, py::arg("points"), py::arg("max_distance") = INFINITY,
+           py::arg("nthreads") = 0, R"(The nearest point of the mesh to each query point.
+
+points: (..., 3) float32 or float64. max_distance: points with nothing
+that near get triangle NO_HIT, distance inf and a NaN point. Answers a
+dict of arrays shaped like the points: point (..., 3) float32, distance
+float32, triangle uint32, uv (..., 2) float32 (point = (1 - u - v) a +
+u b + v c of the stored corners). Worked out in double from the stored
+triangles: exact on an exact layout, within the layout's stated bound of
+the input mesh on a quantized one. The recommended layout and
+OctTreeCompressed/Float3SOA8 take point queries; another layout raises
+ValueError naming it.)")
       .def("__repr__", [](const PyBlob& b) {
         return "<meshcast.Blob " + b.name() + ": " + layout_name(b.view().layout()) + ", " +
                std::to_string(b.view().triangle_count()) + " triangles, " + std::to_string(b.view().bytes().size()) +

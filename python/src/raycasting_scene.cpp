@@ -20,6 +20,7 @@
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
 #include "python/src/crossings.h"
+#include "python/src/points.h"
 
 namespace meshcast::python {
 
@@ -84,11 +85,16 @@ void unpack_normal(const PackedNormal& p, float out[3]) {
 
 // What a geometry keeps beside its blob (which the scene holds): its
 // triangles' normals, and their corners for the crossings (crossings.h).
+// Its blob's view and float64 centre serve the point queries, which walk
+// each geometry's blob with the point in its frame.
 struct Geometry {
   std::vector<PackedNormal> normals;
   TriangleCorners corners;
-  Geometry(std::vector<PackedNormal> normals, std::span<const uint8_t> blob)
-      : normals(std::move(normals)), corners(blob) {}
+  BlobView view;
+  double centre[3];
+  Geometry(std::vector<PackedNormal> normals, std::span<const uint8_t> blob, const std::string& name,
+           const double at[3])
+      : normals(std::move(normals)), corners(blob), view(blob, name), centre{at[0], at[1], at[2]} {}
 };
 // Every geometry, as a cast sees them.
 using Geometries = std::vector<std::shared_ptr<const Geometry>>;
@@ -97,6 +103,38 @@ using CornersOf = std::function<const TriangleCorners&(uint32_t geometry)>;
 
 inline SceneHit scene_hit(const SceneHit& h) { return h; }
 inline SceneHit scene_hit(const Hit& h) { return {h.t, geometry_of(h), h.triangle, h.u, h.v}; }
+
+// The arrays an answer names its primitives with, Open3D's keys:
+// geometry_ids, primitive_ids, primitive_uvs and primitive_normals, in the
+// shape of the rays or points asked about.
+struct PrimitiveArrays {
+  py::array_t<uint32_t> geometry, primitive;
+  py::array_t<float> uvs, normals;
+  uint32_t* g_out;
+  uint32_t* p_out;
+  float* uv_out;
+  float* n_out;
+  explicit PrimitiveArrays(const std::vector<py::ssize_t>& shape)
+      : geometry(shape), primitive(shape), uvs(shape_with(shape, 2)), normals(shape_with(shape, 3)),
+        g_out(geometry.mutable_data()), p_out(primitive.mutable_data()), uv_out(uvs.mutable_data()),
+        n_out(normals.mutable_data()) {}
+  // Answer i: geometry (kInvalidId: none), its triangle, u and v, and that
+  // triangle's normal from `geometries` (no GIL needed).
+  template <class Geometries>
+  void write(size_t i, uint32_t geometry_id, uint32_t triangle, float u, float v, const Geometries& geometries) {
+    const bool found = geometry_id != kInvalidId;
+    g_out[i] = geometry_id;
+    p_out[i] = found ? triangle : kInvalidId;
+    uv_out[2 * i] = u, uv_out[2 * i + 1] = v;
+    unpack_normal(found ? geometries[geometry_id]->normals[triangle] : PackedNormal{}, n_out + 3 * i);
+  }
+  void add_to(py::dict& answer) const {
+    answer["geometry_ids"] = geometry;
+    answer["primitive_ids"] = primitive;
+    answer["primitive_uvs"] = uvs;
+    answer["primitive_normals"] = normals;
+  }
+};
 
 class RaycastingScene {
  public:
@@ -136,7 +174,7 @@ class RaycastingScene {
     Transform placed;
     for (int k = 0; k < 3; ++k) placed.translation[k] = centre[k];
     const InstanceId id = scene_.add_instance(mesh_id, placed);
-    geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id)));
+    geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id), name, centre));
     if (id == 0) {  // the one geometry's blob (validated again: cheap beside its build)
       first_.emplace(scene_.mesh_blob(mesh_id), name);
       std::copy(centre, centre + 3, first_centre_);
@@ -148,16 +186,9 @@ class RaycastingScene {
   py::dict cast_rays(const py::handle& rays_in, long long nthreads) {
     RayArrays rays = rays_from_six(rays_in);
     const uint32_t threads = thread_count(nthreads);
-    std::vector<py::ssize_t> shape2 = rays.shape, shape3 = rays.shape;
-    shape2.push_back(2);
-    shape3.push_back(3);
-    py::array_t<float> t(rays.shape), uvs(shape2), normals(shape3);
-    py::array_t<uint32_t> geometry(rays.shape), primitive(rays.shape);
+    py::array_t<float> t(rays.shape);
     float* t_out = t.mutable_data();
-    float* uv_out = uvs.mutable_data();
-    float* n_out = normals.mutable_data();
-    uint32_t* g_out = geometry.mutable_data();
-    uint32_t* p_out = primitive.mutable_data();
+    PrimitiveArrays primitives(rays.shape);
     Refused refused;
     {
       py::gil_scoped_release release;
@@ -165,24 +196,15 @@ class RaycastingScene {
       refused = f.visit([&](const auto& target) {
         return cast_hits(target, rays, Query::Closest, Cull::None, HitOutputs::Uv, threads,
                          [&](size_t i, const auto& h) {
-                           const uint32_t geometry = geometry_of(h);
                            t_out[i] = h.t;
-                           g_out[i] = geometry;
-                           p_out[i] = h.triangle;
-                           uv_out[2 * i] = h.u;
-                           uv_out[2 * i + 1] = h.v;
-                           unpack_normal(geometry != kNoHit ? (*f.geometries)[geometry]->normals[h.triangle] : PackedNormal{},
-                                         n_out + 3 * i);
+                           primitives.write(i, geometry_of(h), h.triangle, h.u, h.v, *f.geometries);
                          });
       });
     }
     raise_for_refused(rays, refused, false);
     py::dict answer;
     answer["t_hit"] = t;
-    answer["geometry_ids"] = geometry;
-    answer["primitive_ids"] = primitive;
-    answer["primitive_uvs"] = uvs;
-    answer["primitive_normals"] = normals;
+    primitives.add_to(answer);
     return answer;
   }
 
@@ -280,6 +302,44 @@ class RaycastingScene {
     return answer;
   }
 
+  // The nearest point of every geometry to each query point (Open3D's
+  // compute_closest_points): each geometry's blob walked with the points
+  // in its frame, the nearest kept, at one distance the lower geometry id.
+  py::dict compute_closest_points(const py::handle& points_in, long long nthreads) {
+    const PointArrays points = points_from_array(points_in, "query_points");
+    py::array_t<float> point(shape_with(points.shape, 3));
+    float* p_out = point.mutable_data();
+    PrimitiveArrays primitives(points.shape);
+    {
+      py::gil_scoped_release release;
+      const Frame f = frame();
+      nearest_of_all(*f.geometries, points, thread_count(nthreads), [&](size_t i, uint32_t g, const ClosestPoint& c) {
+        for (int k = 0; k < 3; ++k)
+          p_out[3 * i + k] = g == kInvalidId ? NAN : float(double(c.point[k]) + (*f.geometries)[g]->centre[k]);
+        primitives.write(i, g, c.triangle, c.u, c.v, *f.geometries);
+      });
+    }
+    py::dict answer;
+    answer["points"] = point;
+    primitives.add_to(answer);
+    return answer;
+  }
+
+  // The distance to the nearest point of any geometry (float32; inf for a
+  // scene without geometry).
+  py::array compute_distance(const py::handle& points_in, long long nthreads) {
+    const PointArrays points = points_from_array(points_in, "query_points");
+    py::array_t<float> distance(points.shape);
+    float* out = distance.mutable_data();
+    {
+      py::gil_scoped_release release;
+      const Frame f = frame();
+      nearest_of_all(*f.geometries, points, thread_count(nthreads),
+                     [&](size_t i, uint32_t, const ClosestPoint& c) { out[i] = c.distance; });
+    }
+    return distance;
+  }
+
   // The bytes the scene holds: every geometry's blob, its normals (and the
   // corners' table, once a ray through an edge made it) and the top level
   // over the instances.
@@ -341,6 +401,20 @@ class RaycastingScene {
     // Before any answer array reaches the caller: a refused ray has none.
     raise_for_refused(rays, refused, false);
   }
+  // Each point's nearest over the geometries, handed to use(i, geometry,
+  // answer) (geometry kInvalidId: none). Without the GIL.
+  template <class Use>
+  static void nearest_of_all(const Geometries& geometries, const PointArrays& points, uint32_t threads, const Use& use) {
+    std::vector<ClosestPoint> best(points.count), found;
+    std::vector<uint32_t> best_geometry(points.count, kInvalidId);
+    for (uint32_t g = 0; g < geometries.size(); ++g) {
+      nearest_points(geometries[g]->view, geometries[g]->centre, points, INFINITY, threads, found);
+      for (size_t i = 0; i < points.count; ++i)
+        if (found[i].triangle != kNoHit && found[i].distance < best[i].distance)
+          best[i] = found[i], best_geometry[i] = g;
+    }
+    for (size_t i = 0; i < points.count; ++i) use(i, best_geometry[i], best[i]);
+  }
   const uint32_t build_threads_;  // BuildOptions::threads of add_triangles (0: every core)
   mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
@@ -366,6 +440,9 @@ void register_raycasting_scene(py::module_& m) {
            py::arg("tfar") = INFINITY, py::arg("nthreads") = 0)
       .def("count_intersections", &RaycastingScene::count_intersections, py::arg("rays"), py::arg("nthreads") = 0)
       .def("list_intersections", &RaycastingScene::list_intersections, py::arg("rays"), py::arg("nthreads") = 0)
+      .def("compute_closest_points", &RaycastingScene::compute_closest_points, py::arg("query_points"),
+           py::arg("nthreads") = 0)
+      .def("compute_distance", &RaycastingScene::compute_distance, py::arg("query_points"), py::arg("nthreads") = 0)
       .def_property_readonly("nbytes", &RaycastingScene::nbytes);
   m.attr("INVALID_ID") = kInvalidId;
 }

@@ -1,0 +1,212 @@
+// Point queries (BlobView::closest_points) against the double-precision
+// oracle of check/point_oracle.h, every triangle tried: on the recommended
+// layout (quantized: judged on the mesh it stores, and against the input
+// mesh within its stated bound) and on the exact OctTreeCompressed/Float3SOA8.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "check/generate.h"
+#include "check/point_oracle.h"
+#include "tests/testing.h"
+
+namespace meshcast::testing {
+namespace {
+
+const char* const kPointLayouts[] = {"OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/Float3SOA8"};
+
+// Points of every kind a user asks about: scattered through the mesh's box
+// grown by a fifth, just off the surface (a triangle's point moved along
+// its normal by 10^-4 of the diagonal, either side), on corners and edge
+// midpoints exactly, and far out (ten diagonals).
+std::vector<Vec3> query_points(const Mesh& mesh, size_t count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  const Box3 box = mesh.bounds();
+  const double diagonal = box.diagonal();
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Vec3> points;
+  for (size_t i = 0; i < count; ++i) {
+    const size_t t = size_t(unit(rng) * double(mesh.triangles.size())) % mesh.triangles.size();
+    const Vec3 a = mesh.corner(t, 0), b = mesh.corner(t, 1), c = mesh.corner(t, 2);
+    Vec3 p;
+    switch (i % 4) {
+      case 0:
+        for (int k = 0; k < 3; ++k) {
+          const double grow = 0.2 * (box.max[k] - box.min[k]);
+          p[k] = float(box.min[k] - grow + unit(rng) * (box.max[k] - box.min[k] + 2 * grow));
+        }
+        break;
+      case 1: {
+        double u = unit(rng), v = unit(rng);
+        if (u + v > 1) u = 1 - u, v = 1 - v;
+        double n[3] = {(double(b.y) - a.y) * (double(c.z) - a.z) - (double(b.z) - a.z) * (double(c.y) - a.y),
+                       (double(b.z) - a.z) * (double(c.x) - a.x) - (double(b.x) - a.x) * (double(c.z) - a.z),
+                       (double(b.x) - a.x) * (double(c.y) - a.y) - (double(b.y) - a.y) * (double(c.x) - a.x)};
+        const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const double off = (i % 8 == 1 ? 1e-4 : -1e-4) * diagonal / (length > 0 ? length : 1);
+        for (int k = 0; k < 3; ++k) p[k] = float(a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]) + off * n[k]);
+        break;
+      }
+      case 2:
+        p = i % 8 == 2 ? a : Vec3{0.5f * (a.x + b.x), 0.5f * (a.y + b.y), 0.5f * (a.z + b.z)};
+        break;
+      default:
+        for (int k = 0; k < 3; ++k) p[k] = float(0.5 * (box.min[k] + box.max[k]) + 10 * diagonal * (2 * unit(rng) - 1));
+    }
+    points.push_back(p);
+  }
+  return points;
+}
+
+// float rounding of the answer (a few ulps of the distance) and of the
+// double arithmetic on coordinates of magnitude `scale`.
+double tolerance(double distance, double scale) { return 0x1p-21 * distance + 0x1p-40 * scale; }
+
+// Each answer against the oracle over `reference` (the stored mesh): the
+// least distance, a triangle at that distance, its point on that triangle
+// and as far from the query point as said, the barycentrics naming it.
+void expect_oracle(const Mesh& reference, const std::vector<Vec3>& points, const std::vector<ClosestPoint>& got,
+                   const std::string& what) {
+  const Box3 box = reference.bounds();
+  size_t wrong = 0;
+  std::string first;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double p[3] = {points[i].x, points[i].y, points[i].z};
+    const OraclePoint want = oracle_closest_point(reference, p);
+    double scale = 0;
+    for (int k = 0; k < 3; ++k) scale = std::fmax(scale, std::fmax(std::fabs(p[k]), std::fmax(std::fabs(box.min[k]), std::fabs(box.max[k]))));
+    const double tol = tolerance(want.distance, scale);
+    const ClosestPoint& g = got[i];
+    std::string problem;
+    if (g.triangle >= reference.triangles.size()) {
+      problem = "no triangle";
+    } else {
+      double near[3];
+      const double own = oracle_point_triangle(p, reference.corner(g.triangle, 0), reference.corner(g.triangle, 1),
+                                               reference.corner(g.triangle, 2), near);
+      double from_point = 0, from_uv = 0;
+      for (int k = 0; k < 3; ++k) {
+        from_point += (double(g.point[k]) - p[k]) * (double(g.point[k]) - p[k]);
+        const double uv = (1.0 - g.u - g.v) * reference.corner(g.triangle, 0)[k] + double(g.u) * reference.corner(g.triangle, 1)[k] +
+                          double(g.v) * reference.corner(g.triangle, 2)[k];
+        from_uv = std::fmax(from_uv, std::fabs(uv - g.point[k]));
+      }
+      if (std::fabs(g.distance - want.distance) > tol)
+        problem = "distance " + std::to_string(g.distance) + ", the oracle's " + std::to_string(want.distance);
+      else if (std::fabs(own - want.distance) > tol)
+        problem = "triangle " + std::to_string(g.triangle) + " lies " + std::to_string(own) + " away, the nearest " +
+                  std::to_string(want.distance);
+      else if (std::fabs(std::sqrt(from_point) - g.distance) > tol + 0x1p-22 * scale)
+        problem = "the point lies " + std::to_string(std::sqrt(from_point)) + " away, not " + std::to_string(g.distance);
+      else if (from_uv > 0x1p-20 * scale)
+        problem = "u, v name a point " + std::to_string(from_uv) + " off the one given";
+    }
+    if (!problem.empty() && wrong++ == 0) first = "point " + std::to_string(i) + ": " + problem;
+  }
+  EXPECT_EQ(wrong, 0u) << what << ": " << first;
+}
+
+TEST(ClosestPoints, AgreeWithTheOracleOnEveryTestMesh) {
+  for (const char* layout : kPointLayouts)
+    for (const NamedMesh& m : test_meshes(false)) {
+      if (m.name == "armadillo" || m.name == "refined_elephant") continue;  // bunny00 and the dragon suffice
+      const std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout), m.name);
+      const BlobView view(blob, m.name);
+      const Mesh reference = stored_mesh(blob);
+      const std::vector<Vec3> points = query_points(*m.mesh, quick() ? 150 : 300, 7);
+      std::vector<ClosestPoint> got(points.size());
+      EXPECT_EQ(view.closest_points(points, got), 0u);
+      expect_oracle(reference, points, got, std::string(layout) + " on " + m.name);
+    }
+}
+
+// The quantized layout's distances are the input mesh's within its stated
+// bound (a fraction of the diagonal), as its rays' are.
+TEST(ClosestPoints, QuantizedDistancesWithinTheStatedBound) {
+  for (const NamedMesh& m : test_meshes(false)) {
+    if (!is_chosen_public_mesh(m.name) && m.name != "sphere") continue;
+    const std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(kPointLayouts[0]), m.name);
+    const double diagonal = m.mesh->bounds().diagonal();
+    const double bound = relative_error_bound(blob, diagonal) * diagonal;
+    EXPECT_GT(bound, 0) << m.name;
+    const std::vector<Vec3> points = query_points(*m.mesh, 200, 11);
+    std::vector<ClosestPoint> got(points.size());
+    BlobView(blob, m.name).closest_points(points, got);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const double p[3] = {points[i].x, points[i].y, points[i].z};
+      const double exact = oracle_closest_point(*m.mesh, p).distance;
+      EXPECT_LE(std::fabs(got[i].distance - exact), bound + tolerance(exact, 10 * diagonal)) << m.name << ", point " << i;
+    }
+  }
+}
+
+TEST(ClosestPoints, TheLimitIncludedAndNothingBeyondIt) {
+  const Mesh grid = make_grid_plane(2, 2);  // z = 0 over [0, 2] x [0, 2]
+  const std::vector<uint8_t> blob = build_blob(grid, parse_layout(kPointLayouts[1]), "grid");
+  const BlobView view(blob, "grid");
+  const std::vector<Vec3> points = {{1, 1, 0.5f}, {1, 1, 0.25f}, {1, 1, 0}, {3, 1, 0}, {1, 1, -0.75f}};
+  std::vector<ClosestPoint> got(points.size());
+  view.closest_points(points, got, 0.5f);
+  EXPECT_EQ(got[0].distance, 0.5f);  // exactly at the limit: found
+  EXPECT_EQ(got[1].distance, 0.25f);
+  EXPECT_EQ(got[2].distance, 0.0f);
+  EXPECT_EQ(got[3].triangle, kNoHit);  // 1 away
+  EXPECT_EQ(got[3].distance, INFINITY);
+  EXPECT_EQ(got[4].triangle, kNoHit);
+  view.closest_points(points, got, 0.0f);
+  EXPECT_EQ(got[2].distance, 0.0f);
+  EXPECT_EQ(got[0].triangle, kNoHit);
+}
+
+TEST(ClosestPoints, RefusesWhatItCannotAnswer) {
+  const Mesh sphere = make_sphere(8, 16, 1, {0, 0, 0});
+  const std::vector<uint8_t> other = build_blob(sphere, parse_layout("AABBTree/Float3"), "sphere");
+  std::vector<Vec3> points = {{0, 0, 0}, {NAN, 0, 0}, {0, INFINITY, 0}, {2, 0, 0}};
+  std::vector<ClosestPoint> got(points.size());
+  try {
+    BlobView(other, "sphere").closest_points(points, got);
+    FAIL() << "another tree format was walked";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("AABBTree/Float3"), std::string::npos) << e.what();
+  }
+  const std::vector<uint8_t> blob = build_blob(sphere, parse_layout(kPointLayouts[0]), "sphere");
+  const BlobView view(blob, "sphere");
+  std::vector<ClosestPoint> short_out(3);
+  EXPECT_THROW(view.closest_points(points, short_out), UsageError);
+  EXPECT_THROW(view.closest_points(points, got, NAN), UsageError);
+  EXPECT_THROW(view.closest_points(points, got, -1.0f), UsageError);
+  EXPECT_EQ(view.closest_points(points, got), 2u);  // NaN and infinity: counted, answered as none
+  EXPECT_EQ(got[1].triangle, kNoHit);
+  EXPECT_EQ(got[2].distance, INFINITY);
+  EXPECT_NEAR(got[0].distance, 1.0, 0.05);
+  EXPECT_NEAR(got[3].distance, 1.0, 0.05);
+}
+
+// Triangles of no area (corners on a line, or at one point) have their
+// nearest point on their edges; a triangle twice over answers with the
+// lower number; far from the origin the distances stay the stored mesh's.
+TEST(ClosestPoints, DegenerateRepeatedAndFarOutTriangles) {
+  Mesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {5, 5, 5}, {0, 0, 3}, {1, 0, 3}, {0, 1, 3}};
+  m.triangles = {{0, 1, 2}, {4, 4, 4}, {0, 1, 3}, {5, 6, 7}, {5, 6, 7}};
+  for (const char* layout : kPointLayouts) {
+    for (float shift : {0.0f, 1e4f}) {
+      Mesh moved = m;
+      for (Vec3& v : moved.vertices) v.x += shift, v.y -= shift;
+      const std::vector<uint8_t> blob = build_blob(moved, parse_layout(layout), "degenerate");
+      const BlobView view(blob, "degenerate");
+      const std::vector<Vec3> points = {{3 + shift, 0 - shift, 0},   {5 + shift, 6 - shift, 5}, {0.2f + shift, 0.2f - shift, 2},
+                                        {1.5f + shift, -1 - shift, 0}, {0.25f + shift, 0.25f - shift, 0.5f}};
+      std::vector<ClosestPoint> got(points.size());
+      view.closest_points(points, got);
+      const std::string what = std::string(layout) + ", shifted " + std::to_string(shift);
+      expect_oracle(stored_mesh(blob), points, got, what);
+      EXPECT_EQ(got[2].triangle, 3u) << what << ": the lower of the two copies";
+      EXPECT_EQ(got[1].triangle, 1u) << what << ": the triangle at one point";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace meshcast::testing

@@ -125,6 +125,10 @@ class Tensor(_np.ndarray):
     def numpy(self):
         return self.view(_np.ndarray)
 
+    def isfinite(self):
+        """Element-wise: neither inf nor NaN (bool), as Open3D's ``Tensor.isfinite``."""
+        return _np.isfinite(self.view(_np.ndarray)).view(Tensor)
+
 
 def _tensors(answer):
     if isinstance(answer, dict):
@@ -160,14 +164,31 @@ class RaycastingScene:
     def _threads(self, nthreads):
         return nthreads if nthreads else self._nthreads
 
-    def add_triangles(self, vertex_positions, triangle_indices=None):
-        """Adds a mesh: (V, 3) vertices and (T, 3) triangles, or an object
-        with ``.vertex.positions`` and ``.triangle.indices`` (Open3D's
-        ``t.geometry.TriangleMesh``). Returns its geometry id (0, 1, ...)."""
-        if triangle_indices is None:
+    def add_triangles(self, vertex_positions=None, triangle_indices=None, mesh=None):
+        """Adds a mesh: (V, 3) vertices and (T, 3) triangles, or ``mesh=`` (or
+        the first argument) an object with ``.vertex.positions`` and
+        ``.triangle.indices`` (Open3D's ``t.geometry.TriangleMesh``). Returns
+        its geometry id (0, 1, ...)."""
+        if mesh is None and triangle_indices is None:
             mesh = vertex_positions
+        if mesh is not None:
+            if vertex_positions is not None and vertex_positions is not mesh or triangle_indices is not None:
+                raise TypeError("add_triangles: a mesh, or vertex_positions and triangle_indices, not both")
             vertex_positions, triangle_indices = mesh.vertex.positions, mesh.triangle.indices
+        if vertex_positions is None:
+            raise TypeError("add_triangles: vertex_positions and triangle_indices, or a mesh")
         return self._scene.add_triangles(_array(vertex_positions), _array(triangle_indices))
+
+    def __copy__(self):
+        """A scene of the same geometries (their structures copied): adding to
+        one leaves the other as it was."""
+        twin = RaycastingScene.__new__(RaycastingScene)
+        twin._scene = self._scene.copy()
+        twin._nthreads = self._nthreads
+        return twin
+
+    def __deepcopy__(self, memo):
+        return self.__copy__()
 
     def cast_rays(self, rays, nthreads=0):
         """The closest hit of each ray: t_hit, geometry_ids, primitive_ids,
@@ -208,8 +229,107 @@ class RaycastingScene:
         of the scene's meshes (float32)."""
         return _tensors(self._scene.compute_distance(_array(query_points), self._threads(nthreads)))
 
+    def _inside(self, query_points, nsamples, nthreads):
+        # Parity of the crossings of rays from each point: exact on a closed
+        # mesh (a crossing through an edge or vertex counts once), so one ray
+        # decides; nsamples rays vote, as Open3D's do.
+        if not isinstance(nsamples, (int, _np.integer)) or nsamples < 1 or nsamples % 2 == 0:
+            raise ValueError(f"nsamples: {nsamples!r} is not an odd number of rays (1, 3, 5, ...)")
+        points = _np.asarray(_array(query_points))
+        if points.ndim < 1 or points.shape[-1] != 3:
+            raise ValueError(f"query_points: shape {points.shape} is not (..., 3): each point is x, y, z")
+        dtype = _np.float64 if points.dtype == _np.float64 else _np.float32
+        flat = points.reshape(-1, 3).astype(dtype, copy=False)
+        votes = _np.zeros(len(flat), _np.int32)
+        for direction in _SIGN_DIRECTIONS[:nsamples] if nsamples <= len(_SIGN_DIRECTIONS) else _sign_directions(nsamples):
+            rays = _np.empty((len(flat), 6), dtype)
+            rays[:, :3] = flat
+            rays[:, 3:] = direction
+            votes += self._scene.count_intersections(rays, self._threads(nthreads)) % 2
+        return (2 * votes > nsamples).reshape(points.shape[:-1])
+
+    def compute_signed_distance(self, query_points, nthreads=0, nsamples=1):
+        """compute_distance, negative inside: inside is an odd number of
+        crossings of a ray from the point (exact on a closed mesh, wound
+        either way: a crossing through an edge or vertex counts once), the
+        majority of ``nsamples`` rays (odd) in fixed directions."""
+        distance = self.compute_distance(query_points, nthreads).numpy()
+        inside = self._inside(query_points, nsamples, nthreads)
+        return _tensors(_np.where(inside, -distance, distance).astype(_np.float32))
+
+    def compute_occupancy(self, query_points, nthreads=0, nsamples=1):
+        """1.0 inside, 0.0 outside (float32), decided as the sign of
+        compute_signed_distance is."""
+        return _tensors(self._inside(query_points, nsamples, nthreads).astype(_np.float32))
+
+    @staticmethod
+    def create_rays_pinhole(*args, **kwargs):
+        """Rays of a pinhole camera, Open3D's two forms, (height_px,
+        width_px, 6) float32, one ray a pixel through its centre:
+
+        ``create_rays_pinhole(intrinsic_matrix, extrinsic_matrix, width_px,
+        height_px)``: the 3x3 intrinsic matrix K and the 4x4 world-to-camera
+        matrix [R t]; each ray starts at the camera's centre -R^T t, its
+        direction R^T K^-1 (x + 0.5, y + 0.5, 1).
+
+        ``create_rays_pinhole(fov_deg, center, eye, up, width_px,
+        height_px)``: a horizontal field of view in degrees, the camera at
+        ``eye`` looking at ``center``, ``up`` the up vector, made into K and
+        [R t] as Open3D makes them."""
+        names = ("intrinsic_matrix", "extrinsic_matrix", "width_px", "height_px")
+        if "fov_deg" in kwargs or (args and _np.ndim(_array(args[0])) == 0):
+            given = dict(zip(("fov_deg", "center", "eye", "up", "width_px", "height_px"), args), **kwargs)
+            return _pinhole_rays(*_look_at(**given))
+        given = dict(zip(names, args), **kwargs)
+        return _pinhole_rays(_array(given["intrinsic_matrix"]), _array(given["extrinsic_matrix"]),
+                             given["width_px"], given["height_px"])
+
     @property
     def nbytes(self):
         """The memory the scene's structures hold: every geometry's blob, its
         normals and the top level."""
         return self._scene.nbytes
+
+
+def _sign_directions(n):
+    # Fixed directions for the inside test's rays: none along an axis or a
+    # diagonal (a mesh's edges often are), the same on every call.
+    rng = _np.random.default_rng(20261129)
+    d = rng.normal(size=(n, 3))
+    return d / _np.linalg.norm(d, axis=1, keepdims=True)
+
+
+_SIGN_DIRECTIONS = _sign_directions(9)
+
+
+def _pinhole_rays(intrinsic, extrinsic, width_px, height_px):
+    width, height = int(width_px), int(height_px)
+    if width < 1 or height < 1:
+        raise ValueError(f"create_rays_pinhole: {width} x {height} pixels")
+    k = _np.asarray(intrinsic, _np.float64)
+    e = _np.asarray(extrinsic, _np.float64)
+    if k.shape != (3, 3) or e.shape != (4, 4):
+        raise ValueError(f"create_rays_pinhole: intrinsic_matrix {k.shape} and extrinsic_matrix {e.shape}, "
+                         "not (3, 3) and (4, 4)")
+    r_t = e[:3, :3].T
+    to_world = r_t @ _np.linalg.inv(k)
+    x, y = _np.meshgrid(_np.arange(width) + 0.5, _np.arange(height) + 0.5)
+    pixels = _np.stack([x, y, _np.ones_like(x)], axis=-1)
+    rays = _np.empty((height, width, 6), _np.float32)
+    rays[..., :3] = -r_t @ e[:3, 3]
+    rays[..., 3:] = pixels @ to_world.T
+    return rays.view(Tensor)
+
+
+def _look_at(fov_deg, center, eye, up, width_px, height_px):
+    center, eye, up = (_np.asarray(_array(v), _np.float64).reshape(3) for v in (center, eye, up))
+    focal = 0.5 * width_px / _np.tan(_np.radians(0.5 * fov_deg))
+    k = _np.array([[focal, 0, 0.5 * width_px], [0, focal, 0.5 * height_px], [0, 0, 1]])
+    front = (center - eye) / _np.linalg.norm(center - eye)
+    right = _np.cross(up / _np.linalg.norm(up), front)
+    right /= _np.linalg.norm(right)
+    r = _np.stack([right, _np.cross(front, right), front])
+    e = _np.eye(4)
+    e[:3, :3] = r
+    e[:3, 3] = -r @ eye
+    return k, e, width_px, height_px

@@ -170,17 +170,21 @@ class RaycastingScene {
     }
     blob.shrink_to_fit();  // the builder's spare capacity would be memory the scene holds
     std::lock_guard<std::mutex> lock(mutex_);
-    const MeshId mesh_id = scene_.add_mesh(std::move(blob), name);
-    Transform placed;
-    for (int k = 0; k < 3; ++k) placed.translation[k] = centre[k];
-    const InstanceId id = scene_.add_instance(mesh_id, placed);
-    geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id), name, centre));
-    if (id == 0) {  // the one geometry's blob (validated again: cheap beside its build)
-      first_.emplace(scene_.mesh_blob(mesh_id), name);
-      std::copy(centre, centre + 3, first_centre_);
+    return add_geometry(std::move(blob), std::move(normals), centre, name);
+  }
+
+  // A scene of the same geometries, each blob and its normals copied (copy
+  // and deepcopy in Python): adding to one leaves the other as it was.
+  std::unique_ptr<RaycastingScene> copy() const {
+    auto twin = std::make_unique<RaycastingScene>(build_threads_);
+    std::lock_guard<std::mutex> lock(mutex_), twin_lock(twin->mutex_);
+    for (size_t g = 0; g < geometries_.size(); ++g) {
+      const Geometry& from = *geometries_[g];
+      const std::span<const uint8_t> bytes = from.view.bytes();
+      twin->add_geometry(std::vector<uint8_t>(bytes.begin(), bytes.end()), from.normals, from.centre,
+                         "geometry " + std::to_string(g));
     }
-    changed_ = true;
-    return id;
+    return twin;
   }
 
   py::dict cast_rays(const py::handle& rays_in, long long nthreads) {
@@ -401,6 +405,22 @@ class RaycastingScene {
     // Before any answer array reaches the caller: a refused ray has none.
     raise_for_refused(rays, refused, false);
   }
+  // The scene's next geometry and its instance, placed at `centre`; the
+  // caller holds the lock.
+  uint32_t add_geometry(std::vector<uint8_t> blob, std::vector<PackedNormal> normals, const double centre[3],
+                        const std::string& name) {
+    const MeshId mesh_id = scene_.add_mesh(std::move(blob), name);
+    Transform placed;
+    for (int k = 0; k < 3; ++k) placed.translation[k] = centre[k];
+    const InstanceId id = scene_.add_instance(mesh_id, placed);
+    geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id), name, centre));
+    if (id == 0) {  // the one geometry's blob (validated again: cheap beside its build)
+      first_.emplace(scene_.mesh_blob(mesh_id), name);
+      std::copy(centre, centre + 3, first_centre_);
+    }
+    changed_ = true;
+    return id;
+  }
   // Each point's nearest over the geometries, handed to use(i, geometry,
   // answer) (geometry kInvalidId: none). Without the GIL.
   template <class Use>
@@ -443,6 +463,7 @@ void register_raycasting_scene(py::module_& m) {
       .def("compute_closest_points", &RaycastingScene::compute_closest_points, py::arg("query_points"),
            py::arg("nthreads") = 0)
       .def("compute_distance", &RaycastingScene::compute_distance, py::arg("query_points"), py::arg("nthreads") = 0)
+      .def("copy", &RaycastingScene::copy)
       .def_property_readonly("nbytes", &RaycastingScene::nbytes);
   m.attr("INVALID_ID") = kInvalidId;
 }

@@ -367,6 +367,28 @@ head -c 30 "$work/r.rays" >"$work/cut.rays"
 check truncated-rays 2 "cut.rays" -- "$meshcast" trace "$work/m.blob" --rays "$work/cut.rays" --out "$work/x.hits"
 
 
+# Distances: a unit cube's signed distance on a grid (cell centres at
+# -0.375 + 0.25 k over the box grown by half its extent: 4 of 8 a side
+# fall inside, 64 in all) and at three points read from a .npy file whose
+# distances are known: the centre (-0.5 inside), 2 above the top face, 1
+# beside a side face.
+printf 'OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n3 0 2 1\n3 0 3 2\n3 4 5 6\n3 4 6 7\n3 0 1 5\n3 0 5 4\n3 1 2 6\n3 1 6 5\n3 2 3 7\n3 2 7 6\n3 3 0 4\n3 3 4 7\n' >"$work/cube.off"
+check distance-grid 0 '"points":512,"signed":true,"inside":64' -- "$meshcast" distance "$work/cube.off" --grid 8 --margin 0.5 --signed --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8
+[[ $(stat -c %s "$work/grid.npy") == 2176 ]] || { echo "FAIL distance-grid: grid.npy is not 128 header bytes and 512 float32"; failures=$((failures + 1)); }
+python3 -c 'import struct, sys
+h = "{\x27descr\x27: \x27<f8\x27, \x27fortran_order\x27: False, \x27shape\x27: (3, 3), }"
+h += " " * ((64 - (10 + len(h) + 1) % 64) % 64) + "\n"
+pts = [0.5, 0.5, 0.5, 0.5, 0.5, 3.0, 2.0, 0.5, 0.5]
+open(sys.argv[1], "wb").write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(h)) + h.encode() + struct.pack("<9d", *pts))' "$work/p.npy"
+check distance-points 0 "1 inside \(negative\), 2 outside" -- "$meshcast" distance "$work/cube.off" --points "$work/p.npy" --signed --out "$work/d.npy" --triangles "$work/t.npy"
+got=$(python3 -c 'import struct, sys
+b = open(sys.argv[1], "rb").read(); n = struct.unpack("<H", b[8:10])[0]
+print(*struct.unpack("<3f", b[10 + n:]))' "$work/d.npy")
+[[ $got == "-0.5 2.0 1.0" ]] || { echo "FAIL distance-points: distances $got, not -0.5 2.0 1.0"; failures=$((failures + 1)); }
+check distance-both 2 "--points FILE.npy or --grid N, one of them" -- "$meshcast" distance "$work/cube.off" --grid 4 --points "$work/p.npy" --out "$work/x.npy"
+check distance-not-npy 2 "cube.off: not a .npy file" -- "$meshcast" distance "$work/cube.off" --points "$work/cube.off" --out "$work/x.npy"
+check distance-layout 2 "point queries walk OctTreeCompressed layouts.*AABBTree/Float3" -- "$meshcast" distance "$work/cube.off" --grid 4 --layout AABBTree/Float3 --out "$work/x.npy"
+
 # Hostile input through the command line.
 # Every --json output parses as JSON, a path with quotes, backslashes and a
 # byte that is not UTF-8 included; NaN is null, not a bare nan.

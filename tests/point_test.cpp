@@ -9,6 +9,7 @@
 
 #include "check/generate.h"
 #include "check/point_oracle.h"
+#include "cpu/crossings.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -205,6 +206,56 @@ TEST(ClosestPoints, DegenerateRepeatedAndFarOutTriangles) {
       EXPECT_EQ(got[2].triangle, 3u) << what << ": the lower of the two copies";
       EXPECT_EQ(got[1].triangle, 1u) << what << ": the triangle at one point";
     }
+  }
+}
+
+}  // namespace
+}  // namespace meshcast::testing
+
+namespace meshcast::testing {
+namespace {
+
+// The crossings behind signed distances: odd from inside a closed mesh,
+// even from outside, on rays through the triangles' insides, through
+// shared vertices and, from outside, in at one vertex and out at its
+// opposite; the winding either way.
+TEST(Crossings, ParityTellsInsideFromOutsideThroughVertices) {
+  const Vec3 centre{0.25f, -0.5f, 1.0f};
+  Mesh sphere = make_sphere(8, 16, 2.0f, centre);
+  for (bool flip : {false, true}) {
+    if (flip)
+      for (Triangle& t : sphere.triangles) std::swap(t[1], t[2]);
+    const std::vector<uint8_t> blob = build_blob(sphere, parse_layout(kPointLayouts[0]), "sphere");
+    const BlobView view(blob, "sphere");
+    std::vector<Ray> rays;
+    std::vector<uint32_t> want;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> unit(-1, 1);
+    for (int i = 0; i < 400; ++i) {
+      const float scale = i % 2 ? 1.5f : 3.0f;  // inside (within the inscribed sphere) or out beyond it
+      const Vec3 o{centre.x + scale * unit(rng), centre.y + scale * unit(rng), centre.z + scale * unit(rng)};
+      const double r = std::sqrt(double(o.x - centre.x) * (o.x - centre.x) + double(o.y - centre.y) * (o.y - centre.y) +
+                                 double(o.z - centre.z) * (o.z - centre.z));
+      if (r > 1.5 && r < 2.05) continue;  // between the inscribed and circumscribed spheres: either
+      rays.push_back({{o.x, o.y, o.z}, {unit(rng), unit(rng), unit(rng)}, INFINITY});
+      want.push_back(r < 1.5 ? 1 : 0);
+    }
+    for (size_t v = 0; v < sphere.vertices.size(); ++v) {
+      const Vec3 p = sphere.vertices[v];
+      const float d[3] = {p.x - centre.x, p.y - centre.y, p.z - centre.z};
+      rays.push_back({{centre.x, centre.y, centre.z}, {d[0], d[1], d[2]}, INFINITY});  // out through the vertex
+      want.push_back(1);
+      rays.push_back({{centre.x + 2 * d[0], centre.y + 2 * d[1], centre.z + 2 * d[2]}, {-d[0], -d[1], -d[2]}, INFINITY});
+      want.push_back(0);  // in at the vertex, out at its opposite
+    }
+    std::vector<uint32_t> counts(rays.size());
+    EXPECT_EQ(count_crossings(view, rays, counts), 0u);
+    size_t wrong = 0;
+    std::string first;
+    for (size_t i = 0; i < rays.size(); ++i)
+      if (counts[i] % 2 != want[i] && wrong++ == 0) first = "ray " + std::to_string(i) + ": " + std::to_string(counts[i]);
+    EXPECT_EQ(wrong, 0u) << (flip ? "wound inward: " : "wound outward: ") << first;
+    EXPECT_THROW(count_crossings(view, rays, std::span(counts).first(1)), UsageError);
   }
 }
 

@@ -21,6 +21,7 @@ void add_generate(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_bench(CLI::App& app);
 void add_render(CLI::App& app);
+void add_distance(CLI::App& app);
 void add_bench_auto(CLI::App* bench);   // `meshcast bench auto`, under `bench`
 void add_bench_peers(CLI::App* bench);  // `meshcast bench peers`
 void add_bench_scenes(CLI::App* bench);  // `meshcast bench scenes`

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   meshcast::tools::add_demo(app);
   meshcast::tools::add_bench(app);
   meshcast::tools::add_render(app);
+  meshcast::tools::add_distance(app);
   // Exit codes (README): 2 the input, 3 no Vulkan or no such device, 4 an
   // output not written, 1 anything else.
   auto report = [](const std::exception& e, int code) {

@@ -19,7 +19,7 @@
 #include "meshcast/scene.h"
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
-#include "python/src/crossings.h"
+#include "cpu/crossings.h"
 #include "python/src/points.h"
 
 namespace meshcast::python {

@@ -1,11 +1,13 @@
-#include "python/src/crossings.h"
+#include "cpu/crossings.h"
 
+#include <algorithm>
 #include <array>
+#include <string>
 
 #include "layout/blob_format.h"
 #include "layout/tree/leaves.h"
 
-namespace meshcast::python {
+namespace meshcast {
 
 Corners TriangleCorners::corners(uint32_t triangle) const {
   const uint8_t* blob = blob_.data();
@@ -82,4 +84,28 @@ void crossing_triangles(std::span<const Corners> corners, const float dir[3], st
   }
 }
 
-}  // namespace meshcast::python
+uint64_t count_crossings(const BlobView& view, std::span<const Ray> rays, std::span<uint32_t> counts) {
+  if (counts.size() < rays.size())
+    throw UsageError("count_crossings: " + std::to_string(rays.size()) + " rays but room for " +
+                     std::to_string(counts.size()) + " counts");
+  const TriangleCorners corners(view.bytes());
+  const auto corners_of = [&corners](uint32_t) -> const TriangleCorners& { return corners; };
+  HitLists lists;
+  lists.max_hits = kMaxHitsLimit;
+  uint64_t skipped = 0;
+  // A few rays at a time: every-hit rows take memory as the hits come.
+  constexpr size_t kPiece = 256;
+  for (size_t begin = 0; begin < rays.size(); begin += kPiece) {
+    const size_t n = std::min(kPiece, rays.size() - begin);
+    skipped += view.trace_all_hits(rays.subspan(begin, n), lists);
+    for (size_t i = 0; i < n; ++i) {
+      const auto row = lists.row(i);
+      uint64_t count = lists.found[i] - row.size();
+      crossings(row, rays[begin + i].dir, corners_of, [&count](const Hit&) { ++count; });
+      counts[begin + i] = uint32_t(std::min<uint64_t>(count, UINT32_MAX));
+    }
+  }
+  return skipped;
+}
+
+}  // namespace meshcast

@@ -1,7 +1,8 @@
-// How RaycastingScene's count_intersections and list_intersections count
-// the hits of one ray: a crossing of a surface counts once, whether the ray
-// passes through a triangle's inside, a shared edge or a vertex, and
-// whichever way the triangles are wound.
+// How the crossings of a ray with a mesh are counted (the Python
+// package's count_intersections and list_intersections, the signed
+// distances' inside test): a crossing of a surface counts once, whether
+// the ray passes through a triangle's inside, a shared edge or a vertex,
+// and whichever way the triangles are wound.
 //
 // Where a ray meets a mesh exactly on an edge or a vertex, the watertight
 // test reports every triangle there (its edge function is exactly 0 for
@@ -25,10 +26,11 @@
 #include <span>
 #include <vector>
 
+#include "meshcast/blob.h"
 #include "meshcast/ray.h"
 #include "meshcast/scene.h"
 
-namespace meshcast::python {
+namespace meshcast {
 
 // A triangle's corners, in double.
 struct Corners {
@@ -107,4 +109,11 @@ void crossings(std::span<const Record> row, const float dir[3], const CornersOf&
   }
 }
 
-}  // namespace meshcast::python
+// The crossings of each ray with the blob's mesh along [tmin, tmax], counted
+// as above: every hit found (Query::All, rows of kMaxHitsLimit; hits beyond
+// a row counted one each), through a shared edge or vertex once. Parity
+// tells inside from outside of a closed mesh. Returns the rays not walkable
+// (counted 0). counts must hold one a ray.
+uint64_t count_crossings(const BlobView& view, std::span<const Ray> rays, std::span<uint32_t> counts);
+
+}  // namespace meshcast

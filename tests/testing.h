@@ -52,6 +52,8 @@ bool quick();
 // once, the trees on different formats where the names allow: each
 // walker's node code and each codec's leaf code run, not every pairing.
 std::vector<std::string> covering_layouts(const std::vector<std::string>& names);
+// That covering few whether quick or not.
+std::vector<std::string> covering_subset(const std::vector<std::string>& names);
 
 // Oracle answers (tree oracle) for a ray set, cached per (mesh, kind, set
 // size, culling): the closest hits, and Query::All's sets.

@@ -12,7 +12,9 @@ alone: Blob.closest_points), and Open3D's RaycastingScene where
 ``import open3d`` works (Debian 12: python3-open3d). Each is checked
 against the exact blob first (distances within 1e-5 of the diagonal; the
 signs' disagreements counted), then timed in interleaved rounds (the order
-rotated each round), one thread and every core, medians. Memory: bytes a
+rotated each round), one thread and every core, medians. Open3D runs with
+bench.py's Embree ray-mask shim preloaded (Debian's Open3D would miss every
+ray of its inside test). Memory: bytes a
 triangle, meshcast's structures by their nbytes, Open3D's by the growth
 of the process's resident memory across add_triangles and a first query.
 Writes DIR/points.csv and prints a Markdown table.
@@ -44,6 +46,18 @@ def main():
     ap.add_argument("--data", default=os.path.join(REPO, "data"))
     ap.add_argument("--out", default=os.path.join(REPO, "bench", "results", "point_queries"))
     a = ap.parse_args()
+    # Debian's Open3D hands Embree rays of mask 0, which its Embree honours:
+    # every ray misses, so every sign would be positive. The ray-mask shim
+    # bench.py builds sets the mask; this process runs again with it.
+    if "MESHCAST_POINTS_SHIM" not in os.environ:
+        sys.path.insert(0, HERE)
+        from bench import compile_shim
+        import tempfile
+        so, why = compile_shim(tempfile.mkdtemp())
+        if so:
+            env = dict(os.environ, MESHCAST_POINTS_SHIM="1", LD_PRELOAD=so)
+            os.execve(sys.executable, [sys.executable] + sys.argv, env)
+        print(f"Open3D's signs without the ray-mask shim ({why}): every ray misses", file=sys.stderr)
     sys.path.insert(0, os.path.join(a.build_dir, "python"))
     import meshcast
     try:

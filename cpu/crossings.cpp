@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <string>
 
 #include "layout/blob_format.h"
@@ -84,11 +85,14 @@ void crossing_triangles(std::span<const Corners> corners, const float dir[3], st
   }
 }
 
-uint64_t count_crossings(const BlobView& view, std::span<const Ray> rays, std::span<uint32_t> counts) {
+uint64_t count_crossings(const BlobView& view, std::span<const Ray> rays, std::span<uint32_t> counts,
+                         const TriangleCorners* given) {
   if (counts.size() < rays.size())
     throw UsageError("count_crossings: " + std::to_string(rays.size()) + " rays but room for " +
                      std::to_string(counts.size()) + " counts");
-  const TriangleCorners corners(view.bytes());
+  std::optional<TriangleCorners> own;
+  if (!given) own.emplace(view.bytes());
+  const TriangleCorners& corners = given ? *given : *own;
   const auto corners_of = [&corners](uint32_t) -> const TriangleCorners& { return corners; };
   HitLists lists;
   lists.max_hits = kMaxHitsLimit;

@@ -114,6 +114,10 @@ void crossings(std::span<const Record> row, const float dir[3], const CornersOf&
 // a row counted one each), through a shared edge or vertex once. Parity
 // tells inside from outside of a closed mesh. Returns the rays not walkable
 // (counted 0). counts must hold one a ray.
-uint64_t count_crossings(const BlobView& view, std::span<const Ray> rays, std::span<uint32_t> counts);
+// `corners`: the blob's TriangleCorners, made once by a caller that counts
+// batch after batch (its table is made on first need: a whole-mesh pass);
+// null: one made for this call.
+uint64_t count_crossings(const BlobView& view, std::span<const Ray> rays, std::span<uint32_t> counts,
+                         const TriangleCorners* corners = nullptr);
 
 }  // namespace meshcast

@@ -3,6 +3,7 @@
 // from a .npy file or laid on a grid over the mesh's box, the answers
 // written as .npy files numpy reads directly.
 #include <chrono>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -55,7 +56,7 @@ void run(const DistanceArgs& a) {
     for (size_t i = 0; i < points.size(); ++i)
       for (int k = 0; k < 3; ++k) {
         const double v = read.values[3 * i + size_t(k)];
-        if (!std::isfinite(v) || std::fabs(v) > 3.4e38)
+        if (!std::isfinite(v) || std::fabs(v) > FLT_MAX)
           throw InputError(a.points + ": point " + std::to_string(i) + " has coordinate " + std::to_string(k) + " " +
                            std::to_string(v) + ", not a finite float");
         points[i][k] = float(v);
@@ -83,6 +84,7 @@ void run(const DistanceArgs& a) {
   t0 = std::chrono::steady_clock::now();
   std::vector<ClosestPoint> found(points.size());
   std::vector<uint32_t> crossings(a.signed_distance ? points.size() : 0);
+  const TriangleCorners corners(view.bytes());  // one table for every chunk's inside test
   host::WorkerPool pool(a.threads);
   const host::Chunks plan = host::plan_chunks(points.size(), pool.threads());
   host::for_each_chunk(plan, &pool, [&](size_t c) {
@@ -93,7 +95,7 @@ void run(const DistanceArgs& a) {
     for (size_t i = 0; i < n; ++i)
       rays[i] = Ray{{points[begin + i].x, points[begin + i].y, points[begin + i].z},
                     {kInsideDirection[0], kInsideDirection[1], kInsideDirection[2]}, INFINITY};
-    count_crossings(view, rays, std::span(crossings).subspan(begin, n));
+    count_crossings(view, rays, std::span(crossings).subspan(begin, n), &corners);
   });
   const double query_ms = ms_since(t0);
   std::vector<float> distance(points.size());
@@ -131,8 +133,9 @@ void add_distance(CLI::App& app) {
       "distance", "distances (or signed distances) from points or a grid to a mesh's nearest point, as .npy files");
   cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), generated mesh or blob file")->required();
   cmd->add_option("--points", args->points, "query points: a .npy file of shape (..., 3), float32 or float64");
-  cmd->add_option("--grid", args->grid, "or an N x N x N grid of cell centres over the mesh's box (grown by --margin)")
-      ->check(integer_in(1, 2048));
+  cmd->add_option("--grid", args->grid,
+                  "or an N x N x N grid of cell centres over the mesh's box (grown by --margin), N up to 512")
+      ->check(integer_in(1, 512));
   cmd->add_option("--margin", args->margin, "--grid: the box grown by this fraction of its extent on every side")
       ->check(number_in(0, 1000));
   cmd->add_option("--out", args->out, "the distances (float32 .npy, the points' shape; a grid's [x][y][z])")->required();

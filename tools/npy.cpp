@@ -93,8 +93,9 @@ NpyReals read_npy_reals(const std::string& path) {
       d = d * 10 + uint64_t(dim[k] - '0');
     }
     out.shape.push_back(d);
+    if (d != 0 && count > (uint64_t(1) << 36) / d)
+      throw InputError(path + ": shape " + shape_text + " is beyond what is read (2^36 values)");
     count *= d;
-    if (count > (uint64_t(1) << 36)) throw InputError(path + ": shape " + shape_text + " is beyond what is read (2^36 values)");
   }
   const size_t size = is_double ? 8 : 4, data = at + length;
   if (bytes.size() - data < count * size)

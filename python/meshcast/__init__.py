@@ -182,7 +182,7 @@ class RaycastingScene:
     def __copy__(self):
         """A scene of the same geometries (their structures copied): adding to
         one leaves the other as it was."""
-        twin = RaycastingScene.__new__(RaycastingScene)
+        twin = type(self).__new__(type(self))
         twin._scene = self._scene.copy()
         twin._nthreads = self._nthreads
         return twin
@@ -240,6 +240,9 @@ class RaycastingScene:
             raise ValueError(f"query_points: shape {points.shape} is not (..., 3): each point is x, y, z")
         dtype = _np.float64 if points.dtype == _np.float64 else _np.float32
         flat = points.reshape(-1, 3).astype(dtype, copy=False)
+        bad = _np.flatnonzero(~_np.isfinite(flat).all(axis=1))
+        if len(bad):
+            raise ValueError(f"query_points[{bad[0]}]: {flat[bad[0]].tolist()} is not a finite point")
         votes = _np.zeros(len(flat), _np.int32)
         for direction in _SIGN_DIRECTIONS[:nsamples] if nsamples <= len(_SIGN_DIRECTIONS) else _sign_directions(nsamples):
             rays = _np.empty((len(flat), 6), dtype)

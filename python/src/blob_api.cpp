@@ -127,6 +127,10 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
 py::dict closest_points_blob(const PyBlob& blob, const py::handle& points_in, double max_distance, long long nthreads) {
   const PointArrays points = points_from_array(points_in, "points");
   const float limit = checked_max_distance(max_distance);
+  // Refused by name even for no points (the walk checks it a chunk).
+  if (blob.view().layout().tree != TreeFormat::OctTreeCompressed)
+    throw py::value_error("closest_points: point queries walk OctTreeCompressed blobs (the recommended layout, and "
+                          "the exact OctTreeCompressed/Float3SOA8); this blob is " + layout_name(blob.view().layout()));
   const uint32_t threads = thread_count(nthreads);
   py::array_t<float> point(shape_with(points.shape, 3)), distance(points.shape), uv(shape_with(points.shape, 2));
   py::array_t<uint32_t> triangle(points.shape);

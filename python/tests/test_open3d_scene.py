@@ -62,6 +62,8 @@ def test_nsamples_must_be_odd_and_points_three_wide():
             scene.compute_occupancy(np.zeros((1, 3)), nsamples=bad)
     with pytest.raises(ValueError, match=r"\(\.\.\., 3\)"):
         scene.compute_signed_distance(np.zeros((2, 4)))
+    with pytest.raises(ValueError, match=r"query_points\[1\]"):
+        scene.compute_occupancy(np.array([[0, 0, 0], [np.nan, 0, 0]]))
 
 
 def test_pinhole_rays_from_matrices_reproject_to_their_pixels():
@@ -107,6 +109,12 @@ def test_pinhole_rays_from_a_look_at_camera():
     left, right = row[0] / np.linalg.norm(row[0]), row[-1] / np.linalg.norm(row[-1])
     spread = np.degrees(np.arccos(np.clip(left @ right, -1, 1)))
     assert abs(spread - fov) < 4 * half_pixel
+    # Open3D's orientation: the first column looks towards up x front, the
+    # first row away from up (its images come out turned half a turn)
+    right = np.cross(up, front)
+    upward = up - (up @ front) * front  # the camera's up, across its view
+    assert rays[height // 2, 0, 3:] @ right < 0 < rays[height // 2, -1, 3:] @ right
+    assert rays[0, width // 2, 3:] @ upward < 0 < rays[-1, width // 2, 3:] @ upward
     # the image's columns run along the camera's horizontal, rows along up
     assert abs((row[-1] - row[0]) @ up) < 1e-6
     assert abs((rays[-1, width // 2, 3:] - rays[0, width // 2, 3:]).astype(np.float64) @ np.cross(up, front)) < 1e-6

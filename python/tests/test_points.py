@@ -104,6 +104,9 @@ def test_bad_input_is_refused_by_name():
     other = meshcast.build(v, t, layout="AABBTree/Float3")
     with pytest.raises(ValueError, match="AABBTree/Float3"):
         other.closest_points(np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="AABBTree/Float3"):
+        other.closest_points(np.zeros((0, 3)))
+    assert blob.closest_points(np.zeros((0, 3)))["distance"].shape == (0,)
     with pytest.raises(ValueError, match="beyond float"):
         blob.closest_points(np.array([[1e39, 0, 0]]))
 

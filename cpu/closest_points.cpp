@@ -35,8 +35,10 @@ struct Best {
   uint32_t triangle = kNoHit;
 };
 
-// The squared distance from p to the box [lo, hi] (0 inside).
-inline double box_d2(const double p[3], const float lo[3], const float hi[3]) {
+// The squared distance from p to the box [lo, hi] (0 inside): a leaf's
+// triangles' corner boxes (float) and a node's decoded child boxes (double).
+template <class Bound>
+inline double box_d2(const double p[3], const Bound lo[3], const Bound hi[3]) {
   double d2 = 0;
   for (int a = 0; a < 3; ++a) {
     const double below = double(lo[a]) - p[a], above = p[a] - double(hi[a]);
@@ -106,14 +108,12 @@ void walk_point(const uint8_t* blob, const layout::BlobHeader& h, const double p
     for (int k = 0; k < 8; ++k) {
       const uint32_t child = layout::oct_child_properties(node, k);
       if (child == 0) continue;
-      double d2 = 0;
+      double lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
-        const double lo = origin[a] + node[MC_OCT_QLO_AT + 8 * a + k] * scale[a];
-        const double hi = origin[a] + node[MC_OCT_QHI_AT + 8 * a + k] * scale[a];
-        const double below = lo - p[a], above = p[a] - hi;
-        const double d = below > 0 ? below : above > 0 ? above : 0;
-        d2 += d * d;
+        lo[a] = origin[a] + node[MC_OCT_QLO_AT + 8 * a + k] * scale[a];
+        hi[a] = origin[a] + node[MC_OCT_QHI_AT + 8 * a + k] * scale[a];
       }
+      const double d2 = box_d2(p, lo, hi);
       if (d2 * kBoxSlack > best.d2) continue;
       heap.push_back({d2, child});
       std::push_heap(heap.begin(), heap.end(), farther);

@@ -2,6 +2,7 @@
 #include "check/point_oracle.h"
 
 #include <cmath>
+#include <numbers>
 
 namespace meshcast {
 
@@ -76,6 +77,43 @@ OraclePoint oracle_closest_point(const Mesh& mesh, const double p[3]) {
     }
   }
   return best;
+}
+
+namespace {
+
+// The angle at corner A of the spherical triangle A B C: between the great
+// circles A-B and A-C, the angle between the normals of their planes.
+double corner_angle(const double a[3], const double b[3], const double c[3]) {
+  double ab[3], ac[3], both[3];
+  cross(a, b, ab);
+  cross(a, c, ac);
+  cross(ab, ac, both);
+  return std::atan2(std::sqrt(dot(both, both)), dot(ab, ac));
+}
+
+}  // namespace
+
+double oracle_winding_number(const Mesh& mesh, const double p[3]) {
+  double sum = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    double u[3][3];
+    bool degenerate = false;
+    for (int corner = 0; corner < 3; ++corner) {
+      for (int k = 0; k < 3; ++k) u[corner][k] = double(mesh.corner(t, corner)[k]) - p[k];
+      const double length = std::sqrt(dot(u[corner], u[corner]));
+      if (!(length > 0)) degenerate = true;
+      for (int k = 0; k < 3; ++k) u[corner][k] /= length;
+    }
+    if (degenerate) continue;  // p on a corner: that triangle sees no area
+    double bc[3];
+    cross(u[1], u[2], bc);
+    const double det = dot(u[0], bc);
+    if (det == 0) continue;  // p in the triangle's plane
+    const double excess = corner_angle(u[0], u[1], u[2]) + corner_angle(u[1], u[2], u[0]) +
+                          corner_angle(u[2], u[0], u[1]) - std::numbers::pi;
+    sum += det > 0 ? excess : -excess;
+  }
+  return sum / (4 * std::numbers::pi);
 }
 
 }  // namespace meshcast

@@ -23,4 +23,11 @@ double oracle_point_triangle(const double p[3], const Vec3& a, const Vec3& b, co
 // Every triangle of the mesh, in input order.
 OraclePoint oracle_closest_point(const Mesh& mesh, const double p[3]);
 
+// The generalized winding number of the mesh at p: each triangle's signed
+// solid angle over 4 pi, by Girard's theorem (the spherical triangle's
+// angle excess, its corners projected onto the unit sphere about p), apart
+// from the library's Van Oosterom and Strackee formula; positive where the
+// normal (b - a) x (c - a) points away from p.
+double oracle_winding_number(const Mesh& mesh, const double p[3]);
+
 }  // namespace meshcast

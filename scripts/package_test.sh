@@ -17,7 +17,7 @@
 #     but the core's disabled (configuring fails if it reaches for one);
 #  5. the Python package: imported from where step 1's cmake --install put
 #     it; the README's install lines (a venv, pip install ./python) and its
-#     Python example run in that venv.
+#     Python examples (a scan, a signed-distance grid) run in that venv.
 # The library-only build compiles the scalar walkers alone: what it checks
 # is configuration, installation and targets (the installed package of
 # step 1 has every instruction set), at a third of the time.
@@ -173,21 +173,30 @@ echo "  add_subdirectory: configured with only the core's packages; meshcast::me
 # 5. Python: the README's install lines as written (a venv that sees
 # Debian's numpy, pip without build isolation, offline), step 3's scalar
 # walkers and no Vulkan passed through MESHCAST_CMAKE_ARGS (the reader is
-# built: Assimp is installed); then the README's Python example run in the
-# venv on bunny00, its PNG checked.
+# built: Assimp is installed); then the README's Python examples run in the
+# venv on bunny00, their PNGs and the distance grid checked.
 awk '/<!-- python install begins/ {on = 1; next} /<!-- python install ends/ {on = 0} on && !/^```/' README.md > "$tmp/install.sh"
 awk '/<!-- python example begins/ {on = 1; next} /<!-- python example ends/ {on = 0} on && !/^```/' README.md > "$tmp/scan.py"
-[[ $(wc -l < "$tmp/install.sh") -ge 3 && $(wc -l < "$tmp/scan.py") -ge 10 ]] ||
-  { echo "FAIL: no Python install lines or example between the README's markers"; exit 1; }
+awk '/<!-- python distance example begins/ {on = 1; next} /<!-- python distance example ends/ {on = 0} on && !/^```/' \
+  README.md > "$tmp/sdf.py"
+[[ $(wc -l < "$tmp/install.sh") -ge 3 && $(wc -l < "$tmp/scan.py") -ge 10 && $(wc -l < "$tmp/sdf.py") -ge 10 ]] ||
+  { echo "FAIL: no Python install lines or examples between the README's markers"; exit 1; }
 # The venv in the scratch folder, not the repository's .venv (a
-# developer's own, perhaps).
-sed -i "s|\.venv|$tmp/venv|g" "$tmp/install.sh"
+# developer's own, perhaps); the Debian packages the lines install are
+# setup.sh's, installed already.
+sed -i "s|\.venv|$tmp/venv|g; /^apt-get /d" "$tmp/install.sh"
 MESHCAST_CMAKE_ARGS="-DMESHCAST_ISAS=scalar -DMESHCAST_VULKAN=OFF ${launcher[*]}" bash -e "$tmp/install.sh" > "$tmp/pip.log" 2>&1 ||
   { echo "FAIL: the README's Python install lines"; tail -40 "$tmp/pip.log"; exit 1; }
 echo "  pip install ./python into a venv: $(tail -1 "$tmp/pip.log")"
 mkdir -p "$tmp/scan" && ln -s "$PWD/data" "$tmp/scan/data"
-(cd "$tmp/scan" && "$tmp/venv/bin/python" "$tmp/scan.py" > out.txt 2>&1) ||
-  { echo "FAIL: the README's Python example"; cat "$tmp/scan/out.txt"; exit 1; }
-[[ $(head -c 8 "$tmp/scan/scan.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] ||
-  { echo "FAIL: the README's Python example wrote no PNG"; exit 1; }
-echo "  the README's Python example: $(tail -1 "$tmp/scan/out.txt")"
+for example in scan sdf; do
+  (cd "$tmp/scan" && "$tmp/venv/bin/python" "$tmp/$example.py" > $example.txt 2>&1) ||
+    { echo "FAIL: the README's Python example $example.py"; cat "$tmp/scan/$example.txt"; exit 1; }
+  echo "  the README's Python example $example.py: $(tail -1 "$tmp/scan/$example.txt")"
+done
+for png in scan.png bunny_sdf.png; do
+  [[ $(head -c 8 "$tmp/scan/out/$png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]] ||
+    { echo "FAIL: the README's Python examples wrote no out/$png"; exit 1; }
+done
+"$tmp/venv/bin/python" -c "import numpy; assert numpy.load('$tmp/scan/out/bunny_sdf.npy').shape == (96, 96, 96)" ||
+  { echo "FAIL: the README's distance example saved no 96^3 grid"; exit 1; }

@@ -18,21 +18,8 @@ PACKAGES+=(ccache)
 source scripts/packages.sh
 install_missing "${PACKAGES[@]}"
 
-# Public meshes: data/meshes/*.off of CGAL's demo data (libcgal-demo).
-if [[ ! -f data/bunny00.off ]]; then
-  echo "setup: fetching the public meshes from libcgal-demo"
-  tmp=$(mktemp -d)
-  trap 'rm -rf "$tmp"' EXIT
-  (cd "$tmp" && apt-get download libcgal-demo >/dev/null 2>&1 ||
-     { apt-get update -qq && apt-get download libcgal-demo >/dev/null; })
-  dpkg-deb -x "$tmp"/libcgal-demo_*.deb "$tmp/x"
-  mkdir -p data
-  tar -xzf "$tmp/x/usr/share/doc/libcgal-dev/data.tar.gz" -C "$tmp" --wildcards 'data/meshes/*.off'
-  mv "$tmp"/data/meshes/*.off data/
-fi
-for m in bunny00 armadillo refined_elephant ChineseDragon-10kv; do
-  [[ -f data/$m.off ]] || { echo "setup: data/$m.off is missing after the fetch" >&2; exit 1; }
-done
+# Public meshes: data/*.off of CGAL's demo data (libcgal-demo).
+bash scripts/fetch_meshes.sh
 
 jobs=$(nproc)
 # Debian's interpreter, the one its numpy and pytest belong to (python3 on

@@ -10,6 +10,7 @@
 #include "check/generate.h"
 #include "check/point_oracle.h"
 #include "cpu/crossings.h"
+#include "meshcast/winding_number.h"
 #include "tests/testing.h"
 
 namespace meshcast::testing {
@@ -257,6 +258,71 @@ TEST(Crossings, ParityTellsInsideFromOutsideThroughVertices) {
     EXPECT_EQ(wrong, 0u) << (flip ? "wound inward: " : "wound outward: ") << first;
     EXPECT_THROW(count_crossings(view, rays, std::span(counts).first(1)), UsageError);
   }
+}
+
+// Winding numbers: within their stated bound of the oracle's exact sum
+// over the stored triangles (Girard's formula, every triangle), on a
+// closed sphere, an open grid and a public mesh in both point layouts;
+// and the inside test equal to the oracle's |w| > 1/2 wherever that is not
+// within rounding of 1/2.
+TEST(WindingNumbers, WithinTheirBoundOfTheOracle) {
+  for (const char* layout : kPointLayouts)
+    for (const NamedMesh& m : test_meshes(false)) {
+      if (m.name != "sphere" && m.name != "grid_plane" && !is_chosen_public_mesh(m.name)) continue;
+      const std::vector<uint8_t> blob = build_blob(*m.mesh, parse_layout(layout), m.name);
+      const BlobView view(blob, m.name);
+      const Mesh reference = stored_mesh(blob);
+      const WindingNumbers winding(view);
+      const std::vector<Vec3> points = query_points(*m.mesh, is_chosen_public_mesh(m.name) ? 60 : 200, 9);
+      std::vector<WindingNumbers::Answer> got(points.size());
+      std::vector<uint8_t> inside(points.size());
+      winding.evaluate(points, got);
+      winding.inside(points, inside);
+      const double diagonal = reference.bounds().diagonal();
+      size_t wrong = 0, expanded = 0;
+      std::string first;
+      for (size_t i = 0; i < points.size(); ++i) {
+        const double p[3] = {points[i].x, points[i].y, points[i].z};
+        // On the surface (a corner, an edge's midpoint) a winding number
+        // is any of the values about it.
+        if (oracle_closest_point(reference, p).distance < 1e-6 * diagonal) continue;
+        const double want = oracle_winding_number(reference, p);
+        // Double's rounding of two sums of solid angles, each within a few
+        // ulps of pi a triangle.
+        const double rounding = 1e-14 * double(reference.triangles.size());
+        expanded += got[i].bound > 0;
+        std::string problem;
+        if (!(std::fabs(got[i].w - want) <= got[i].bound + rounding))
+          problem = "w " + std::to_string(got[i].w) + " +- " + std::to_string(got[i].bound) + ", the oracle's " +
+                    std::to_string(want);
+        else if (std::fabs(std::fabs(want) - 0.5) > rounding && inside[i] != (std::fabs(want) > 0.5))
+          problem = "inside " + std::to_string(inside[i]) + " where the oracle's w is " + std::to_string(want);
+        else if (std::fabs(winding.exact(points[i]) - want) > rounding)
+          problem = "the exact sum " + std::to_string(winding.exact(points[i])) + ", the oracle's " + std::to_string(want);
+        if (!problem.empty() && wrong++ == 0) first = "point " + std::to_string(i) + ": " + problem;
+      }
+      EXPECT_EQ(wrong, 0u) << layout << " on " << m.name << ": " << first;
+      // The far points (a quarter of them) are the expansion's.
+      EXPECT_GE(expanded, points.size() / 5) << layout << " on " << m.name;
+    }
+}
+
+TEST(WindingNumbers, RefusesWhatItCannotAnswer) {
+  const Mesh sphere = make_sphere(6, 8, 1.0f, Vec3{0, 0, 0});
+  const std::vector<uint8_t> other = build_blob(sphere, parse_layout("AABBTree/Float3"), "sphere");
+  EXPECT_THROW(WindingNumbers(BlobView(other, "sphere")), UsageError);
+  const std::vector<uint8_t> blob = build_blob(sphere, parse_layout(kPointLayouts[0]), "sphere");
+  const BlobView view(blob, "sphere");
+  EXPECT_THROW(WindingNumbers(view, 0.0), UsageError);
+  EXPECT_THROW(WindingNumbers(view, NAN), UsageError);
+  const WindingNumbers winding(view);
+  const std::vector<Vec3> points = {{0, 0, 0}, {NAN, 0, 0}};
+  std::vector<WindingNumbers::Answer> got(1);
+  EXPECT_THROW(winding.evaluate(points, got), UsageError);
+  got.resize(2);
+  winding.evaluate(points, got);
+  EXPECT_NEAR(got[0].w, 1.0, 1e-9);  // the centre of a closed sphere wound outward
+  EXPECT_TRUE(std::isnan(got[1].w));
 }
 
 }  // namespace

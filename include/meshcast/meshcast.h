@@ -10,3 +10,4 @@
 #include "meshcast/mesh.h"
 #include "meshcast/ray.h"
 #include "meshcast/scene.h"
+#include "meshcast/winding_number.h"

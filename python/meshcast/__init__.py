@@ -26,7 +26,9 @@ crosses, twice or not at all where it only touches a closed mesh (a
 silhouette edge or vertex), so parity tells inside from outside on any
 closed mesh, wound one way, the other or both. A ray with a
 NaN or infinite component, a zero direction or ``t_min > t_max`` is refused
-with ``ValueError`` naming it (Open3D answers such a ray as a miss).
+with ``ValueError`` naming it by ``Blob.cast`` and ``Scene.cast``
+(``invalid="miss"`` answers it as a miss instead); RaycastingScene answers
+it as a miss, as Open3D does.
 
 Arrays: float32 or float64 (other real types are converted once); C-
 contiguous arrays are read where they lie. Every cast releases the GIL and
@@ -59,8 +61,10 @@ from .images import write_png  # noqa: F401
 from ._meshcast import (NO_HIT, Blob, Scene, __version__, features, layouts,  # noqa: F401
                         walker_isa)
 
+# Tensor, the answers' type, is left out: help(meshcast) would repeat
+# numpy.ndarray's whole documentation under it.
 __all__ = ["Blob", "Scene", "RaycastingScene", "build", "load", "read_mesh", "layouts", "features",
-           "walker_isa", "write_png", "from_bytes", "Tensor", "NO_HIT", "__version__"]
+           "walker_isa", "write_png", "from_bytes", "NO_HIT", "__version__"]
 
 
 def build(vertices, triangles, layout="auto", max_bytes=0, leaf_size=0, threads=0, name="mesh"):
@@ -146,8 +150,9 @@ class RaycastingScene:
     """Open3D's ``open3d.t.geometry.RaycastingScene``, on meshcast.
 
     Port with a rename: the methods, argument names, result keys, dtypes and
-    sentinels are Open3D's (``t_hit`` inf and ``INVALID_ID`` on a miss); a
-    NaN ray raises ValueError where Open3D answers a miss. Rays
+    sentinels are Open3D's (``t_hit`` inf and ``INVALID_ID`` on a miss; a
+    ray with a NaN or infinite component or a zero direction is a miss, as
+    padded pixels of a camera's rays are in Open3D). Rays
     are (..., 6) arrays, [ox, oy, oz, dx, dy, dz], float32 or float64: float64
     origins keep their precision, and each geometry is stored about its own
     float64 centre, so scenes far from the origin answer as at the origin.
@@ -165,10 +170,11 @@ class RaycastingScene:
         return nthreads if nthreads else self._nthreads
 
     def add_triangles(self, vertex_positions=None, triangle_indices=None, mesh=None):
-        """Adds a mesh: (V, 3) vertices and (T, 3) triangles, or ``mesh=`` (or
-        the first argument) an object with ``.vertex.positions`` and
-        ``.triangle.indices`` (Open3D's ``t.geometry.TriangleMesh``). Returns
-        its geometry id (0, 1, ...)."""
+        """Adds a mesh: vertex_positions (V, 3) float32 or float64 and
+        triangle_indices (T, 3) integers, or ``mesh=`` (or the first
+        argument) an object with ``.vertex.positions`` and
+        ``.triangle.indices`` (Open3D's ``t.geometry.TriangleMesh``).
+        Returns its geometry id (0, 1, ...)."""
         if mesh is None and triangle_indices is None:
             mesh = vertex_positions
         if mesh is not None:
@@ -190,49 +196,82 @@ class RaycastingScene:
     def __deepcopy__(self, memo):
         return self.__copy__()
 
-    def cast_rays(self, rays, nthreads=0):
-        """The closest hit of each ray: t_hit, geometry_ids, primitive_ids,
-        primitive_uvs (barycentrics of corners 1 and 2), primitive_normals
-        (the unit normal (b - a) x (c - a))."""
-        return _tensors(self._scene.cast_rays(_array(rays), self._threads(nthreads)))
+    def cast_rays(self, rays, nthreads=0, *, uvs=True, normals=True, out=None, backend="cpu"):
+        """The closest hit of each ray.
 
-    def test_occlusions(self, rays, tnear=0.0, tfar=float("inf"), nthreads=0):
-        """Whether anything lies on each ray between tnear and tfar (bool)."""
-        return _tensors(self._scene.test_occlusions(_array(rays), tnear, tfar, self._threads(nthreads)))
+        rays: (..., 6) float32 or float64, [ox, oy, oz, dx, dy, dz]; t is in
+        units of the direction. nthreads: the cast's threads (0: the scene's).
+        uvs, normals: False leaves primitive_uvs, primitive_normals out (and
+        their work). out: a dict of arrays to write the answer into, keyed as
+        below (C-contiguous, the answer's dtype and shape); the others are
+        made. backend: "cpu" or "vulkan" (the GPU; RuntimeError where the
+        machine has none), the same answers.
+
+        Returns (Tensors in the rays' shape): t_hit (float32, inf on a miss),
+        geometry_ids, primitive_ids (uint32, INVALID_ID on a miss),
+        primitive_uvs (..., 2) float32, the barycentrics of corners 1 and 2,
+        primitive_normals (..., 3) float32, the unit normal (b - a) x (c - a)
+        (within 6e-5 radians; zeros on a miss)."""
+        return _tensors(self._scene.cast_rays(_array(rays), self._threads(nthreads), uvs, normals, out, backend))
+
+    def test_occlusions(self, rays, tnear=0.0, tfar=float("inf"), nthreads=0, *, out=None, backend="cpu"):
+        """Whether anything lies on each ray with tnear <= t <= tfar: a bool
+        Tensor in the rays' shape. rays: (..., 6), as cast_rays. tnear, tfar:
+        numbers or arrays of the rays' shape. nthreads: the cast's threads (0:
+        the scene's). out: a bool array to write into. backend: "cpu" or
+        "vulkan"."""
+        return _tensors(self._scene.test_occlusions(_array(rays), tnear, tfar, self._threads(nthreads), out, backend))
 
     def count_intersections(self, rays, nthreads=0):
-        """How many times each ray crosses the meshes for t >= 0 (int32): a
-        crossing through a shared edge or a vertex counts once, whichever
-        way the triangles are wound, so the parity tells inside from
-        outside of a closed mesh."""
+        """How many times each ray crosses the meshes for t >= 0: an int32
+        Tensor in the rays' shape. rays: (..., 6), as cast_rays; nthreads:
+        the call's threads (0: the scene's). A crossing
+        through a shared edge or a vertex counts once, whichever way the
+        triangles are wound, so the parity tells inside from outside of a
+        closed mesh; every crossing is counted, however many."""
         return _tensors(self._scene.count_intersections(_array(rays), self._threads(nthreads)))
 
     def list_intersections(self, rays, nthreads=0):
-        """Every crossing of every ray, Open3D 0.18's layout: ray i's are
-        [ray_splits[i], ray_splits[i + 1]) of ray_ids, geometry_ids,
-        primitive_ids, primitive_uvs and t_hit, nearest first; a crossing
-        through an edge or vertex is listed as count_intersections counts
-        it, by one of its triangles. At most 4096 hits a ray are looked at
-        (a RuntimeWarning says how many were left out)."""
+        """Every crossing of every ray (rays: (..., 6), as cast_rays; nthreads:
+        the call's threads, 0: the scene's), Open3D 0.18's layout: ray i's are [ray_splits[i], ray_splits[i + 1]) of
+        ray_ids, geometry_ids, primitive_ids (uint32), primitive_uvs (H, 2)
+        and t_hit (float32), nearest first; ray_splits has one entry more
+        than the rays. A crossing through an edge or vertex is listed as
+        count_intersections counts it, by one of its triangles. Every
+        crossing is listed, however many a ray has (only beyond 4096 of one
+        ray at one t would some be left out, with a RuntimeWarning)."""
         return _tensors(self._scene.list_intersections(_array(rays), self._threads(nthreads)))
 
     def compute_closest_points(self, query_points, nthreads=0):
-        """The nearest point of the scene's meshes to each (..., 3) query
-        point: points, geometry_ids, primitive_ids, primitive_uvs and
-        primitive_normals, Open3D's keys. Worked out in double from each
-        triangle as stored (the recommended layout's corners lie within its
-        stated bound of the mesh's, a few millionths of its diagonal)."""
+        """The nearest point of the scene's meshes to each query point.
+
+        query_points: (..., 3) float32 or float64 (finite). nthreads: the
+        call's threads (0: the scene's). Returns Tensors in the points'
+        shape: points (..., 3) float32, geometry_ids and primitive_ids
+        (uint32), primitive_uvs (..., 2) (the barycentrics of corners 1 and
+        2 of the nearest point), primitive_normals (..., 3) (the triangle's
+        unit normal), Open3D's keys; for a scene without geometry, NaN
+        points and INVALID_ID. Worked out in double from each triangle as
+        stored (the recommended layout's corners lie within its stated
+        bound of the mesh's, a few millionths of its diagonal); at one
+        distance the lower geometry id, then the lower triangle."""
         return _tensors(self._scene.compute_closest_points(_array(query_points), self._threads(nthreads)))
 
     def compute_distance(self, query_points, nthreads=0):
-        """The distance from each (..., 3) query point to the nearest point
-        of the scene's meshes (float32)."""
+        """The distance from each query point to the nearest point of the
+        scene's meshes: a float32 Tensor in the points' shape (inf for a
+        scene without geometry). query_points: (..., 3) float32 or float64;
+        nthreads: the call's threads (0: the scene's)."""
         return _tensors(self._scene.compute_distance(_array(query_points), self._threads(nthreads)))
 
-    def _inside(self, query_points, nsamples, nthreads):
+    def _inside(self, query_points, nsamples, nthreads, sign="parity"):
         # Parity of the crossings of rays from each point: exact on a closed
         # mesh (a crossing through an edge or vertex counts once), so one ray
-        # decides; nsamples rays vote, as Open3D's do.
+        # decides; nsamples rays vote, as Open3D's do. Or the winding number.
+        if sign == "winding":
+            return self._scene.winding_numbers(_array(query_points), self._threads(nthreads), True)
+        if sign != "parity":
+            raise ValueError(f"sign: {sign!r} is neither \"parity\" nor \"winding\"")
         if not isinstance(nsamples, (int, _np.integer)) or nsamples < 1 or nsamples % 2 == 0:
             raise ValueError(f"nsamples: {nsamples!r} is not an odd number of rays (1, 3, 5, ...)")
         points = _np.asarray(_array(query_points))
@@ -251,19 +290,50 @@ class RaycastingScene:
             votes += self._scene.count_intersections(rays, self._threads(nthreads)) % 2
         return (2 * votes > nsamples).reshape(points.shape[:-1])
 
-    def compute_signed_distance(self, query_points, nthreads=0, nsamples=1):
-        """compute_distance, negative inside: inside is an odd number of
-        crossings of a ray from the point (exact on a closed mesh, wound
-        either way: a crossing through an edge or vertex counts once), the
-        majority of ``nsamples`` rays (odd) in fixed directions."""
+    def compute_signed_distance(self, query_points, nthreads=0, nsamples=1, sign="parity"):
+        """compute_distance, negative inside: a float32 Tensor in the points'
+        shape. query_points: (..., 3) float32 or float64 (finite); nthreads:
+        the call's threads (0: the scene's); nsamples: how many rays (odd)
+        decide inside, by majority.
+
+        sign="parity" (Open3D's way): inside is an odd number of crossings of
+        a ray from the point, exact on a closed mesh wound either way (a
+        crossing through an edge or vertex counts once, never missed); on a
+        mesh with holes the rays may disagree, and more of them vote.
+
+        sign="winding": inside is a generalized winding number above 1/2 in
+        magnitude (compute_winding_number), right on meshes with holes, gaps
+        and self-intersections where parity and votes are not; decided on
+        the exact sum wherever the expansion's bound leaves it in doubt, so
+        the sign is the exact winding number's. nsamples is not used."""
         distance = self.compute_distance(query_points, nthreads).numpy()
-        inside = self._inside(query_points, nsamples, nthreads)
+        inside = self._inside(query_points, nsamples, nthreads, sign)
         return _tensors(_np.where(inside, -distance, distance).astype(_np.float32))
 
-    def compute_occupancy(self, query_points, nthreads=0, nsamples=1):
-        """1.0 inside, 0.0 outside (float32), decided as the sign of
-        compute_signed_distance is."""
-        return _tensors(self._inside(query_points, nsamples, nthreads).astype(_np.float32))
+    def compute_occupancy(self, query_points, nthreads=0, nsamples=1, sign="parity"):
+        """1.0 inside, 0.0 outside: a float32 Tensor in the points' shape,
+        decided as the sign of compute_signed_distance is, with the same
+        query_points, nthreads, nsamples and sign."""
+        return _tensors(self._inside(query_points, nsamples, nthreads, sign).astype(_np.float32))
+
+    def compute_winding_number(self, query_points, nthreads=0):
+        """The generalized winding number of the scene's meshes at each point
+        (Jacobson et al. 2013; every geometry's summed): 1 inside a closed
+        mesh wound outward, -1 wound inward, 0 outside, in between near
+        holes. Evaluated on each geometry's tree with Barill et al.'s
+        second-order far-field expansion (2018).
+
+        query_points: (..., 3) float32 or float64 (finite), each rounded to
+        float in its geometry's frame as for distances. nthreads: the call's
+        threads (0: the scene's). Returns float64 Tensors in the points'
+        shape: winding_number, and bound, such that |winding_number - exact|
+        <= bound, where exact is the sum of every stored triangle's solid
+        angle (Van Oosterom and Strackee) over 4 pi, seen from the point. A
+        cluster of triangles is expanded only where its error is at most 1%
+        of the most it could add, so the bound is at most 1% of the sum of
+        those (a few hundredths for a point seeing a closed mesh from
+        outside)."""
+        return _tensors(self._scene.winding_numbers(_array(query_points), self._threads(nthreads), False))
 
     @staticmethod
     def create_rays_pinhole(*args, **kwargs):

@@ -112,10 +112,11 @@ inline void refuse_out_for_all(Query query, const py::object& out) {
 // A cast on the library's threads answered as Blob.cast and Scene.cast
 // answer: one hit a ray (into out= where given) or every hit's rows.
 // `float_origin`: the walk rounds origins to float (a blob), for the
-// refusal's message.
+// refusal's message; `invalid`: what a ray that is not one gets.
 template <class Target>
 py::dict cast_answer(const Target& target, const RayArrays& rays, Query query, Cull cull, HitOutputs outputs,
-                     uint32_t max_hits, uint32_t threads, const py::object& out, bool float_origin) {
+                     uint32_t max_hits, uint32_t threads, const py::object& out, bool float_origin,
+                     Invalid invalid) {
   using Record = typename Target::Record;
   const bool uv = has(outputs, HitOutputs::Uv);
   refuse_out_for_all(query, out);
@@ -125,7 +126,7 @@ py::dict cast_answer(const Target& target, const RayArrays& rays, Query query, C
       py::gil_scoped_release release;
       all = cast_all(target, rays, cull, outputs, max_hits, threads);
     }
-    raise_for_refused(rays, all.refused, float_origin);
+    raise_for_refused(rays, all.refused, float_origin, invalid);
     return all_hits_answer(all, rays.count, uv);
   }
   const OneHitAnswer<Record> a(out, rays.shape, uv);
@@ -134,7 +135,7 @@ py::dict cast_answer(const Target& target, const RayArrays& rays, Query query, C
     py::gil_scoped_release release;
     refused = cast_hits(target, rays, query, cull, outputs, threads, [&a](size_t i, const Record& h) { a.write(i, h); });
   }
-  raise_for_refused(rays, refused, float_origin);
+  raise_for_refused(rays, refused, float_origin, invalid);
   return a.dict();
 }
 

@@ -162,7 +162,10 @@ std::string number(double x) {
 
 }  // namespace
 
-std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
+namespace {
+
+// Why ray i is not a ray the walkers take, without its index, or "".
+std::string refusal_reason(const RayArrays& rays, size_t i, bool float_origin) {
   RayD r = rays.ray_d(i);
   double o[3], d[3];
   for (int k = 0; k < 3; ++k) {
@@ -170,31 +173,56 @@ std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
     o[k] = float_origin ? double(float(r.org[k])) : r.org[k];
     d[k] = read_real(rays.dir + i * rays.dir_stride + k * (rays.dir_double ? 8 : 4), rays.dir_double);
   }
-  const std::string at = "rays[" + std::to_string(i) + "]: ";
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(o[k])) return at + "origin " + triple(o) + " is not finite";
+    if (!std::isfinite(o[k])) return "origin " + triple(o) + " is not finite";
   for (int k = 0; k < 3; ++k)
-    if (std::fabs(o[k]) > kMaxCoordinate) return at + "origin " + triple(o) + " lies beyond 2^100 on an axis";
+    if (std::fabs(o[k]) > kMaxCoordinate) return "origin " + triple(o) + " lies beyond 2^100 on an axis";
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(d[k]) || !std::isfinite(r.dir[k]))
-      return at + "direction " + triple(d) + " is not finite (in float)";
+    if (!std::isfinite(d[k]) || !std::isfinite(r.dir[k])) return "direction " + triple(d) + " is not finite (in float)";
   for (int k = 0; k < 3; ++k)
-    if (std::fabs(r.dir[k]) > kMaxDirection) return at + "direction " + triple(d) + " has a component beyond 2^126";
+    if (std::fabs(r.dir[k]) > kMaxDirection) return "direction " + triple(d) + " has a component beyond 2^126";
   if (std::fabs(r.dir[0]) < FLT_MIN && std::fabs(r.dir[1]) < FLT_MIN && std::fabs(r.dir[2]) < FLT_MIN)
-    return at + "direction " + triple(d) + " is zero (every component below FLT_MIN)";
-  if (std::isnan(r.tmax) || r.tmax < 0) return at + "t_max " + number(r.tmax) + " is NaN or negative";
-  if (std::isnan(r.tmin) || r.tmin < 0) return at + "t_min " + number(r.tmin) + " is NaN or negative";
-  if (r.tmin > r.tmax) return at + "t_min " + number(r.tmin) + " is above t_max " + number(r.tmax);
+    return "direction " + triple(d) + " is zero (every component below FLT_MIN)";
+  if (std::isnan(r.tmax) || r.tmax < 0) return "t_max " + number(r.tmax) + " is NaN or negative";
+  if (std::isnan(r.tmin) || r.tmin < 0) return "t_min " + number(r.tmin) + " is NaN or negative";
+  if (r.tmin > r.tmax) return "t_min " + number(r.tmin) + " is above t_max " + number(r.tmax);
   return "";
 }
 
-void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin) {
+}  // namespace
+
+std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
+  std::string why = refusal_reason(rays, i, float_origin);
+  return why.empty() ? why : "rays[" + std::to_string(i) + "]: " + why;
+}
+
+Invalid parse_invalid(const std::string& name) {
+  if (name == "raise") return Invalid::Raise;
+  if (name == "miss") return Invalid::Miss;
+  throw py::value_error("invalid \"" + name + "\": raise or miss");
+}
+
+void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin, Invalid invalid) {
   if (refused.count == 0) return;
   if (refused.first >= rays.count)  // a walk counted a ray that, walked alone, it took: never expected
     throw py::value_error(std::to_string(refused.count) + " of " + std::to_string(rays.count) +
                           " rays refused by the walk (none of them when cast alone)");
   const size_t i = refused.first;
   std::string why = refusal(rays, i, float_origin);
+  if (invalid == Invalid::Miss) {
+    // The walk answered every refused ray as a miss. That is the answer
+    // the caller asked for where the ray is not a ray; one fine in the
+    // world that some geometry's frame could not take (below) is not, and
+    // is still raised.
+    uint64_t not_rays = 0;
+    for (size_t j = i; j < rays.count; ++j) not_rays += !refusal_reason(rays, j, float_origin).empty();
+    if (not_rays == refused.count) return;
+    if (!why.empty())
+      throw py::value_error(std::to_string(refused.count - not_rays) + " of " + std::to_string(rays.count) +
+                            " rays cannot be walked in the frame of a geometry they pass: their origins lie beyond "
+                            "2^100 of that geometry's position (or its scale takes a direction beyond 2^126); cast "
+                            "them from nearer the geometry");
+  }
   if (why.empty()) {
     // The ray is fine in the world but not in the frame of a geometry it
     // passes: that frame's rounding would answer it wrongly, so it is not

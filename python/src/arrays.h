@@ -125,12 +125,21 @@ struct Refused {
   size_t first = SIZE_MAX;
 };
 
+// What a cast does with a ray that is not one (refusal() says why: a NaN,
+// an infinity, a zero direction, t_min above t_max): raise ValueError
+// naming it, or answer it as a miss (Open3D's way; padded pixels of a
+// camera's rays are common). "raise" or "miss": ValueError otherwise.
+enum class Invalid { Raise, Miss };
+Invalid parse_invalid(const std::string& name);
+
 // After a batch that refused rays: ValueError naming the first of them,
 // with its refusal(), or, for a ray fine in the world that the frame of
 // some geometry cannot take (a translation puts its origin beyond the
-// walkers' range there), saying so. A refused ray is never answered as a
-// miss: the geometry it cannot see may lie on it.
-void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin);
+// walkers' range there), saying so. With Invalid::Miss the rays that are
+// not rays keep the miss the walk answered; a ray fine in the world is
+// never answered as a miss: the geometry it cannot see may lie on it.
+void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float_origin,
+                       Invalid invalid = Invalid::Raise);
 
 // A mesh from (V,3) vertices and (T,3) triangles: indices int32, uint32 or
 // int64 (any integer dtype is read), each checked against the vertex count;

@@ -3,8 +3,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <optional>
 
@@ -29,39 +27,11 @@ PyBlob::PyBlob(std::shared_ptr<const MappedBlob> file, std::string name)
   view_.emplace(mapped_->bytes(), name_);
 }
 
-PyBlob::~PyBlob() {
-  GpuCasters* gpu = gpu_.load();
-  if (gpu && gpu->process == getpid()) delete gpu;  // a parent's casters are left alone (gpu_casters())
-}
-
-PyBlob::GpuCasters& PyBlob::gpu_casters() {
-  const pid_t process = getpid();
-  GpuCasters* gpu = gpu_.load();
-  while (!gpu || gpu->process != process) {
-    auto* made = new GpuCasters;
-    made->process = process;
-    if (gpu_.compare_exchange_strong(gpu, made)) return *made;  // a parent's set, if any, is dropped unread
-    delete made;  // another thread of this process made one first: `gpu` is that one now
-  }
-  return *gpu;
-}
-
 host::Caster& PyBlob::vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& lock) {
-  GpuCasters& gpu = gpu_casters();
-  lock = std::unique_lock<std::mutex>(gpu.mutex);
-  std::unique_ptr<host::Caster>& caster = gpu.casters[uint32_t(outputs)];
-  if (!caster) {
-    host::CasterOptions options;
-    options.backend = host::Backend::Vulkan;
-    options.frames = 1;  // one batch at a time, under the lock
-    options.hit_outputs = outputs;
-    // The process's pool, not one more of every core's threads a blob.
-    if (!gpu.pool) gpu.pool = shared_pool(thread_count(0));
-    options.jobs = gpu.pool.get();
-    caster = std::make_unique<host::Caster>(view_->bytes(), name_, options);
-  }
-  if (!caster->gpu_available()) throw GpuError("backend \"vulkan\": " + caster->gpu_error());
-  return *caster;
+  return gpu_.get(
+      outputs,
+      [this](const host::CasterOptions& options) { return std::make_unique<host::Caster>(view_->bytes(), name_, options); },
+      lock);
 }
 
 namespace {
@@ -69,7 +39,7 @@ namespace {
 // backend="vulkan": the batch through the blob's Vulkan caster (the host
 // layer's GPU method for its layout), answered as the CPU's casts are.
 py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery& query, HitOutputs outputs,
-                     const py::object& out) {
+                     const py::object& out, Invalid invalid) {
   const bool uv = has(outputs, HitOutputs::Uv);
   refuse_out_for_all(query.query, out);
   std::optional<OneHitAnswer<Hit>> one;
@@ -100,15 +70,17 @@ py::dict cast_on_gpu(PyBlob& blob, const RayArrays& rays, const host::BatchQuery
       caster.wait(ticket, all.parts[0]);
     }
   }
-  raise_for_refused(rays, all.refused, true);
+  raise_for_refused(rays, all.refused, true, invalid);
   return one ? one->dict() : all_hits_answer(all, rays.count, uv);
 }
 
 py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::handle& directions,
                    const py::handle& t_min, const py::handle& t_max, const std::string& query_name,
                    const std::string& cull_name, long long max_hits, bool uv, const py::object& out,
-                   const std::string& backend, long long nthreads, const std::string& packets_name) {
+                   const std::string& backend, long long nthreads, const std::string& packets_name,
+                   const std::string& invalid_name) {
   const Query query = parse_query(query_name);
+  const Invalid invalid = parse_invalid(invalid_name);
   if (packets_name != "auto" && packets_name != "off")
     throw py::value_error("packets \"" + packets_name + "\": auto or off");
   const Packets packets = packets_name == "off" ? Packets::Off : Packets::Auto;
@@ -119,8 +91,9 @@ py::dict cast_blob(const PyBlob& blob, const py::handle& origins, const py::hand
   set_segment(rays, t_min, t_max);
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
-  if (backend == "vulkan") return cast_on_gpu(const_cast<PyBlob&>(blob), rays, {query, cull, kept}, outputs, out);
-  return cast_answer(BlobTarget{blob.view(), nullptr, packets}, rays, query, cull, outputs, kept, threads, out, true);
+  if (backend == "vulkan") return cast_on_gpu(const_cast<PyBlob&>(blob), rays, {query, cull, kept}, outputs, out, invalid);
+  return cast_answer(BlobTarget{blob.view(), nullptr, packets}, rays, query, cull, outputs, kept, threads, out, true,
+                     invalid);
 }
 
 // The nearest point of the stored mesh to each query point.
@@ -236,7 +209,37 @@ Python threads may cast through one Blob at once.)")
       .def("cast", &cast_blob, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
            py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",
            py::arg("max_hits") = 16, py::arg("uv") = false, py::arg("out") = py::none(), py::arg("backend") = "cpu",
-           py::arg("nthreads") = 0, py::arg("packets") = "auto", "See the package's documentation (help(meshcast)).")
+           py::arg("nthreads") = 0, py::arg("packets") = "auto", py::arg("invalid") = "raise",
+           R"(Casts rays against the mesh.
+
+origins: (..., 3) float32 or float64 (rounded to float32: the blob's
+frame), or one (3,) origin for every ray. directions: (..., 3), need not
+be normalized; t is in their units.
+t_min, t_max: None (0 and inf), a number, or an array of the rays' shape;
+a hit needs t_min <= t <= t_max.
+query: "closest" (the nearest hit), "any" (a hit, the first found:
+occlusion) or "all" (every hit, nearest first).
+cull: "none" (two-sided), "back" or "front" (the front face's corners
+run counter-clockwise seen from the ray's origin).
+max_hits: query="all" keeps the nearest max_hits of each ray (1 to 4096;
+"found" counts them all).
+uv: also answer each hit's barycentrics of corners 1 and 2.
+out: a dict of arrays to write the answer into (keys as below, C-
+contiguous, the answer's dtype and shape; closest and any only).
+backend: "cpu" (meshcast's threads) or "vulkan" (the GPU; RuntimeError
+where the machine has none). The answers are the same.
+nthreads: the cast's threads (0: every core).
+packets: "auto" walks rays of one origin 8 at a time, "off" one by one
+(the same answers).
+invalid: "raise" (ValueError naming the first ray with a NaN or
+infinite component, a zero direction or t_min above t_max) or "miss"
+(such a ray answered as a miss).
+
+Returns a dict of arrays in the rays' shape: "t" (float32, inf on a miss)
+and "triangle" (uint32, NO_HIT on a miss), with uv=True "uv" (..., 2).
+query="all": "found" (N,) uint32, "offsets" (N + 1,) int64, and "t",
+"triangle" (and "uv") of the kept hits, ray i's from offsets[i] to
+offsets[i + 1].)")
       .def("closest_points", &closest_points_blob, py::arg("points"), py::arg("max_distance") = INFINITY,
            py::arg("nthreads") = 0, R"(The nearest point of the mesh to each query point.
 

@@ -6,8 +6,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <atomic>
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <algorithm>
 #include <memory>
 #include <span>
@@ -17,10 +19,12 @@
 
 #include "meshcast/build.h"
 #include "meshcast/scene.h"
+#include "meshcast/winding_number.h"
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
 #include "cpu/crossings.h"
 #include "python/src/points.h"
+#include "python/src/vulkan_casters.h"
 
 namespace meshcast::python {
 
@@ -95,6 +99,20 @@ struct Geometry {
   Geometry(std::vector<PackedNormal> normals, std::span<const uint8_t> blob, const std::string& name,
            const double at[3])
       : normals(std::move(normals)), corners(blob), view(blob, name), centre{at[0], at[1], at[2]} {}
+  // The winding numbers' clusters, made by the first call that asks for them.
+  const WindingNumbers& winding() const {
+    std::call_once(winding_made_, [this] {
+      winding_ = std::make_unique<const WindingNumbers>(view);
+      winding_ready_ = true;
+    });
+    return *winding_;
+  }
+  size_t winding_bytes() const { return winding_ready_ ? winding_->nbytes() : 0; }
+
+ private:
+  mutable std::once_flag winding_made_;
+  mutable std::unique_ptr<const WindingNumbers> winding_;
+  mutable std::atomic<bool> winding_ready_{false};
 };
 // Every geometry, as a cast sees them.
 using Geometries = std::vector<std::shared_ptr<const Geometry>>;
@@ -104,20 +122,42 @@ using CornersOf = std::function<const TriangleCorners&(uint32_t geometry)>;
 inline SceneHit scene_hit(const SceneHit& h) { return h; }
 inline SceneHit scene_hit(const Hit& h) { return {h.t, geometry_of(h), h.triangle, h.u, h.v}; }
 
+// out= of a RaycastingScene call: None, or a dict of arrays keyed as the
+// answer is (ValueError naming a key the answer has not).
+void check_out(const py::object& out, std::initializer_list<const char*> keys) {
+  if (out.is_none()) return;
+  if (!py::isinstance<py::dict>(out)) throw py::value_error("out: a dict of arrays (keyed as the answer's) expected");
+  for (auto item : out.cast<py::dict>()) {
+    const std::string key = py::str(item.first);
+    if (std::none_of(keys.begin(), keys.end(), [&key](const char* k) { return key == k; })) {
+      std::string known;
+      for (const char* k : keys) known += (known.empty() ? "" : ", ") + std::string(k);
+      throw py::value_error("out[\"" + key + "\"]: the answer has no such array (" + known + ")");
+    }
+  }
+}
+
 // The arrays an answer names its primitives with, Open3D's keys:
-// geometry_ids, primitive_ids, primitive_uvs and primitive_normals, in the
-// shape of the rays or points asked about.
+// geometry_ids, primitive_ids, and where asked for primitive_uvs and
+// primitive_normals, in the shape of the rays or points asked about; each
+// the caller's out[key] where given.
 struct PrimitiveArrays {
   py::array_t<uint32_t> geometry, primitive;
   py::array_t<float> uvs, normals;
   uint32_t* g_out;
   uint32_t* p_out;
-  float* uv_out;
-  float* n_out;
-  explicit PrimitiveArrays(const std::vector<py::ssize_t>& shape)
-      : geometry(shape), primitive(shape), uvs(shape_with(shape, 2)), normals(shape_with(shape, 3)),
-        g_out(geometry.mutable_data()), p_out(primitive.mutable_data()), uv_out(uvs.mutable_data()),
-        n_out(normals.mutable_data()) {}
+  float* uv_out = nullptr;
+  float* n_out = nullptr;
+  PrimitiveArrays(const std::vector<py::ssize_t>& shape, const py::object& out, bool with_uvs, bool with_normals)
+      : geometry(answer_array<uint32_t>(out, "geometry_ids", shape)),
+        primitive(answer_array<uint32_t>(out, "primitive_ids", shape)),
+        g_out(geometry.mutable_data()),
+        p_out(primitive.mutable_data()) {
+    if (with_uvs) uvs = answer_array<float>(out, "primitive_uvs", shape_with(shape, 2)), uv_out = uvs.mutable_data();
+    if (with_normals)
+      normals = answer_array<float>(out, "primitive_normals", shape_with(shape, 3)), n_out = normals.mutable_data();
+  }
+  explicit PrimitiveArrays(const std::vector<py::ssize_t>& shape) : PrimitiveArrays(shape, py::none(), true, true) {}
   // Answer i: geometry (kInvalidId: none), its triangle, u and v, and that
   // triangle's normal from `geometries` (no GIL needed).
   template <class Geometries>
@@ -125,16 +165,57 @@ struct PrimitiveArrays {
     const bool found = geometry_id != kInvalidId;
     g_out[i] = geometry_id;
     p_out[i] = found ? triangle : kInvalidId;
-    uv_out[2 * i] = u, uv_out[2 * i + 1] = v;
-    unpack_normal(found ? geometries[geometry_id]->normals[triangle] : PackedNormal{}, n_out + 3 * i);
+    if (uv_out) uv_out[2 * i] = u, uv_out[2 * i + 1] = v;
+    if (n_out) unpack_normal(found ? geometries[geometry_id]->normals[triangle] : PackedNormal{}, n_out + 3 * i);
   }
   void add_to(py::dict& answer) const {
     answer["geometry_ids"] = geometry;
     answer["primitive_ids"] = primitive;
-    answer["primitive_uvs"] = uvs;
-    answer["primitive_normals"] = normals;
+    if (uv_out) answer["primitive_uvs"] = uvs;
+    if (n_out) answer["primitive_normals"] = normals;
   }
 };
+
+// backend="cpu" or "vulkan" (ValueError otherwise): whether the GPU casts.
+bool on_gpu(const std::string& backend) {
+  if (backend != "cpu" && backend != "vulkan") throw py::value_error("backend \"" + backend + "\": cpu or vulkan");
+  return backend == "vulkan";
+}
+
+// A ray's every hit where the first walk kept the nearest kMaxHitsLimit of
+// `found`: walked again from the farthest t kept, as often as it takes.
+// The hits at that t are taken from the new walk alone (which of them a
+// full row kept is the walk's choice), so each hit is listed once. Returns
+// the row; `dropped` counts what is left out when more than kMaxHitsLimit
+// hits lie at one t (no later walk could get past them).
+template <class Target, class Record>
+std::vector<Record> whole_row(const Target& target, const RayArrays& rays, size_t i, std::span<const Record> kept,
+                              uint32_t found, uint64_t& dropped) {
+  using RayRecord = typename Target::RayRecord;
+  std::vector<Record> row(kept.begin(), kept.end());
+  RayRecord ray;
+  target.pack(rays, i, 1, &ray);
+  HitRows<Record> more;
+  more.max_hits = kMaxHitsLimit;
+  while (found > kMaxHitsLimit) {
+    const float from = row.back().t;
+    const size_t before = row.size();
+    while (!row.empty() && row.back().t == from) row.pop_back();
+    const bool stuck = row.size() + kMaxHitsLimit <= before;  // a whole row at one t
+    ray.tmin = from;
+    more.clear();
+    target.trace_all(std::span<const RayRecord>(&ray, 1), more, HitOutputs::Uv, Cull::None);
+    const std::span<const Record> next = more.row(0);
+    row.insert(row.end(), next.begin(), next.end());
+    found = more.found[0];
+    if (stuck && found > kMaxHitsLimit) {
+      dropped += found - kMaxHitsLimit;
+      break;
+    }
+  }
+  return row;
+}
+
 
 class RaycastingScene {
  public:
@@ -187,25 +268,35 @@ class RaycastingScene {
     return twin;
   }
 
-  py::dict cast_rays(const py::handle& rays_in, long long nthreads) {
+  py::dict cast_rays(const py::handle& rays_in, long long nthreads, bool uvs, bool normals, const py::object& out,
+                     const std::string& backend) {
     RayArrays rays = rays_from_six(rays_in);
     const uint32_t threads = thread_count(nthreads);
-    py::array_t<float> t(rays.shape);
+    const bool gpu = on_gpu(backend);
+    check_out(out, {"t_hit", "geometry_ids", "primitive_ids", "primitive_uvs", "primitive_normals"});
+    py::array_t<float> t = answer_array<float>(out, "t_hit", rays.shape);
     float* t_out = t.mutable_data();
-    PrimitiveArrays primitives(rays.shape);
+    PrimitiveArrays primitives(rays.shape, out, uvs, normals);
+    const HitOutputs outputs = uvs ? HitOutputs::Uv : HitOutputs::None;
     Refused refused;
     {
       py::gil_scoped_release release;
-      const Frame f = frame();
-      refused = f.visit([&](const auto& target) {
-        return cast_hits(target, rays, Query::Closest, Cull::None, HitOutputs::Uv, threads,
-                         [&](size_t i, const auto& h) {
-                           t_out[i] = h.t;
-                           primitives.write(i, geometry_of(h), h.triangle, h.u, h.v, *f.geometries);
-                         });
-      });
+      const auto write = [&](const Geometries& geometries) {
+        return [&, of = &geometries](size_t i, const auto& h) {
+          t_out[i] = h.t;
+          primitives.write(i, geometry_of(h), h.triangle, h.u, h.v, *of);
+        };
+      };
+      if (gpu) {
+        cast_on_gpu(rays, Query::Closest, outputs, write);
+      } else {
+        const Frame f = frame();
+        refused = f.visit([&](const auto& target) {
+          return cast_hits(target, rays, Query::Closest, Cull::None, outputs, threads, write(*f.geometries));
+        });
+      }
     }
-    raise_for_refused(rays, refused, false);
+    raise_for_refused(rays, refused, false, Invalid::Miss);
     py::dict answer;
     answer["t_hit"] = t;
     primitives.add_to(answer);
@@ -213,21 +304,29 @@ class RaycastingScene {
   }
 
   py::array test_occlusions(const py::handle& rays_in, const py::handle& tnear, const py::handle& tfar,
-                            long long nthreads) {
+                            long long nthreads, const py::object& out_array, const std::string& backend) {
     RayArrays rays = rays_from_six(rays_in);
     set_segment(rays, tnear, tfar);
     const uint32_t threads = thread_count(nthreads);
-    py::array_t<bool> occluded(rays.shape);
-    bool* out = occluded.mutable_data();
+    const bool gpu = on_gpu(backend);
+    py::dict out;
+    if (!out_array.is_none()) out["out"] = out_array;
+    py::array_t<bool> occluded = answer_array<bool>(out, "out", rays.shape);
+    bool* answer = occluded.mutable_data();
+    const auto write = [answer](const Geometries&) {
+      return [answer](size_t i, const auto& h) { answer[i] = h.triangle != kNoHit; };
+    };
     Refused refused;
     {
       py::gil_scoped_release release;
-      refused = frame().visit([&](const auto& target) {
-        return cast_hits(target, rays, Query::Any, Cull::None, HitOutputs::None, threads,
-                         [out](size_t i, const auto& h) { out[i] = h.triangle != kNoHit; });
-      });
+      if (gpu)
+        cast_on_gpu(rays, Query::Any, HitOutputs::None, write);
+      else
+        refused = frame().visit([&](const auto& target) {
+          return cast_hits(target, rays, Query::Any, Cull::None, HitOutputs::None, threads, write({}));
+        });
     }
-    raise_for_refused(rays, refused, false);
+    raise_for_refused(rays, refused, false, Invalid::Miss);
     return occluded;
   }
 
@@ -235,9 +334,9 @@ class RaycastingScene {
     const RayArrays rays = rays_from_six(rays_in);
     py::array_t<int32_t> counts(rays.shape);
     int32_t* out = counts.mutable_data();
-    every_hit(rays, HitOutputs::None, nthreads, [&](const auto& all, const CornersOf& corners_of) {
-      all.for_each_row([&](size_t i, uint32_t found, auto row) {
-        uint64_t n = found - row.size();  // beyond the kept hits: each counted
+    every_hit(rays, HitOutputs::None, nthreads, [&](const auto& for_each_row, const CornersOf& corners_of) {
+      for_each_row([&](size_t i, uint64_t dropped, auto row) {
+        uint64_t n = dropped;  // left out of the row (at one t): each counted
         crossings(row, rays.ray(i).dir, corners_of, [&n](const auto&) { ++n; });
         out[i] = int32_t(std::min<uint64_t>(n, INT32_MAX));
       });
@@ -254,14 +353,14 @@ class RaycastingScene {
     std::vector<SceneHit> listed;
     std::vector<uint32_t> splits_of(rays.count + 1, 0);
     uint64_t dropped = 0;
-    every_hit(rays, HitOutputs::Uv, nthreads, [&](const auto& all, const CornersOf& corners_of) {
-      listed.reserve(all.hits());
-      all.for_each_row([&](size_t i, uint32_t found, auto row) {
+    every_hit(rays, HitOutputs::Uv, nthreads, [&](const auto& for_each_row, const CornersOf& corners_of) {
+      for_each_row([&](size_t i, uint64_t row_dropped, auto row) {
+        if (listed.size() > UINT32_MAX) return;  // raised below
         splits_of[i] = uint32_t(listed.size());
-        dropped += found - row.size();
+        dropped += row_dropped;
         crossings(row, rays.ray(i).dir, corners_of, [&listed](const auto& h) { listed.push_back(scene_hit(h)); });
       });
-      splits_of[rays.count] = uint32_t(listed.size());
+      splits_of[rays.count] = uint32_t(std::min<size_t>(listed.size(), UINT32_MAX));
     });
     if (listed.size() > UINT32_MAX)
       throw py::value_error("list_intersections: " + std::to_string(listed.size()) +
@@ -291,8 +390,8 @@ class RaycastingScene {
     }
     // A warning the caller's filter turns into an error raises it.
     if (dropped && PyErr_WarnEx(PyExc_RuntimeWarning,
-                                ("list_intersections: " + std::to_string(dropped) + " hits beyond " +
-                                 std::to_string(kMaxHitsLimit) + " a ray were left out (count_intersections counts them)")
+                                ("list_intersections: " + std::to_string(dropped) + " hits were left out: more than " +
+                                 std::to_string(kMaxHitsLimit) + " of one ray at one t (count_intersections counts them)")
                                     .c_str(),
                                 1) < 0)
       throw py::error_already_set();
@@ -344,13 +443,66 @@ class RaycastingScene {
     return distance;
   }
 
+  // The scene's generalized winding number at each point: every
+  // geometry's, summed (WindingNumbers, in each geometry's frame), and
+  // the bound on its error. With `inside`, whether |w| > 1/2 instead,
+  // decided on the exact sums wherever the bound leaves it in doubt.
+  py::object winding_numbers(const py::handle& points_in, long long nthreads, bool inside) {
+    const PointArrays points = points_from_array(points_in, "query_points");
+    const uint32_t threads = thread_count(nthreads);
+    py::array_t<double> w(points.shape), bound(points.shape);
+    py::array_t<bool> in(points.shape);
+    double* w_out = w.mutable_data();
+    double* bound_out = bound.mutable_data();
+    bool* in_out = in.mutable_data();
+    {
+      py::gil_scoped_release release;
+      const Frame f = frame();
+      const Geometries& geometries = *f.geometries;
+      for (const auto& g : geometries) g->winding();  // made once, before the threads
+      const Chunks plan = plan_chunks(points.count, threads);
+      for_each_chunk(plan, threads, [&](size_t chunk) {
+        const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
+        std::vector<Vec3> local(n);
+        std::vector<WindingNumbers::Answer> part(n), sum(n);
+        for (const auto& g : geometries) {
+          for (size_t i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k) local[i][k] = float(points.coordinate(begin + i, k) - g->centre[k]);
+          g->winding().evaluate(local, part);
+          for (size_t i = 0; i < n; ++i) sum[i].w += part[i].w, sum[i].bound += part[i].bound;
+        }
+        for (size_t i = 0; i < n; ++i) {
+          w_out[begin + i] = sum[i].w, bound_out[begin + i] = sum[i].bound;
+          if (!inside) continue;
+          double total = sum[i].w;
+          if (!(std::fabs(std::fabs(total) - 0.5) > sum[i].bound)) {  // in doubt: every triangle
+            total = 0;
+            for (const auto& g : geometries) {
+              Vec3 p;
+              for (int k = 0; k < 3; ++k) p[k] = float(points.coordinate(begin + i, k) - g->centre[k]);
+              total += g->winding().exact(p);
+            }
+          }
+          in_out[begin + i] = std::fabs(total) > 0.5;
+        }
+      });
+    }
+    if (inside) return std::move(in);
+    py::dict answer;
+    answer["winding_number"] = w;
+    answer["bound"] = bound;
+    return std::move(answer);
+  }
+
   // The bytes the scene holds: every geometry's blob, its normals (and the
-  // corners' table, once a ray through an edge made it) and the top level
-  // over the instances.
+  // corners' table, once a ray through an edge made it, and the winding
+  // numbers' clusters, once a call asked for them) and the top level over
+  // the instances.
   size_t nbytes() const {
     std::lock_guard<std::mutex> lock(mutex_);
     size_t bytes = scene_.owned_blob_bytes() + scene_.top_level_bytes();
-    for (const auto& g : geometries_) bytes += g->normals.capacity() * sizeof(PackedNormal) + g->corners.nbytes();
+    for (const auto& g : geometries_)
+      bytes += g->normals.capacity() * sizeof(PackedNormal) + g->corners.nbytes() + g->winding_bytes();
     return bytes;
   }
 
@@ -375,6 +527,9 @@ class RaycastingScene {
   };
   Frame frame() {
     std::lock_guard<std::mutex> lock(mutex_);
+    return frame_locked();
+  }
+  Frame frame_locked() {
     if (changed_) {
       scene_.commit();
       committed_ = std::make_shared<const Geometries>(geometries_);
@@ -384,10 +539,35 @@ class RaycastingScene {
     if (committed_->size() == 1) f.single = &*first_, f.centre = first_centre_;
     return f;
   }
-  // Every hit of every ray (as many as a row keeps: kMaxHitsLimit; the
-  // rest counted), handed to use(all, corners_of) without the GIL, for the
+  // backend="vulkan": the rays in one batch through the host layer's scene
+  // method on the GPU, each hit handed to write(geometries)(i, hit).
+  // Without the GIL. A ray that is not one is the GPU's miss.
+  template <class Write>
+  void cast_on_gpu(const RayArrays& rays, Query query, HitOutputs outputs, const Write& write) {
+    if (rays.count == 0) return;
+    std::vector<RayD> world(rays.count);
+    rays.pack(0, rays.count, world.data());
+    std::vector<SceneHit> hits(rays.count);
+    std::unique_lock<std::mutex> gpu_lock;
+    host::Caster& caster = gpu_.get(
+        outputs, [](const host::CasterOptions& options) { return std::make_unique<host::Caster>(options); }, gpu_lock);
+    host::Ticket ticket;
+    std::shared_ptr<const Geometries> geometries;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);  // the scene as committed now, no edit meanwhile
+      geometries = frame_locked().geometries;
+      ticket = caster.submit(scene_, world, {query, Cull::None, 0xFF});
+    }
+    caster.wait(ticket, hits);
+    const auto each = write(*geometries);
+    for (size_t i = 0; i < rays.count; ++i) each(i, hits[i]);
+  }
+  // Every hit of every ray, handed to use(for_each_row, corners_of)
+  // without the GIL: for_each_row(row) calls row(i, dropped, hits) for
+  // each ray i in order, its hits nearest first (a ray of more than
+  // kMaxHitsLimit walked again for the rest: whole_row), for the
   // crossings to be told from with the corners of the frame they were
-  // found in.
+  // found in. A ray that is not one has no hits.
   template <class Use>
   void every_hit(const RayArrays& rays, HitOutputs outputs, long long nthreads, const Use& use) {
     const uint32_t threads = thread_count(nthreads);
@@ -399,11 +579,18 @@ class RaycastingScene {
         const auto all = cast_all(target, rays, Cull::None, outputs, kMaxHitsLimit, threads);
         refused = all.refused;
         const Geometries& geometries = *f.geometries;
-        if (refused.count == 0) use(all, CornersOf([&geometries](uint32_t g) -> const TriangleCorners& { return geometries[g]->corners; }));
+        const auto for_each_row = [&](const auto& row) {
+          all.for_each_row([&](size_t i, uint32_t found, auto kept) {
+            if (found <= kept.size()) return row(i, uint64_t(0), kept);
+            uint64_t dropped = 0;
+            const auto whole = whole_row(target, rays, i, kept, found, dropped);
+            row(i, dropped, decltype(kept)(whole.data(), whole.size()));
+          });
+        };
+        use(for_each_row, CornersOf([&geometries](uint32_t g) -> const TriangleCorners& { return geometries[g]->corners; }));
       });
     }
-    // Before any answer array reaches the caller: a refused ray has none.
-    raise_for_refused(rays, refused, false);
+    raise_for_refused(rays, refused, false, Invalid::Miss);
   }
   // The scene's next geometry and its instance, placed at `centre`; the
   // caller holds the lock.
@@ -443,6 +630,7 @@ class RaycastingScene {
   std::optional<BlobView> first_;  // geometry 0's blob (in the scene), walked alone while it is the only one
   double first_centre_[3] = {0, 0, 0};
   bool changed_ = false;
+  VulkanCasters gpu_;  // backend="vulkan"'s scene casters, made on first use (and gone before the scene)
 };
 
 }  // namespace
@@ -455,14 +643,18 @@ void register_raycasting_scene(py::module_& m) {
            }),
            py::arg("nthreads") = 0)
       .def("add_triangles", &RaycastingScene::add_triangles, py::arg("vertex_positions"), py::arg("triangle_indices"))
-      .def("cast_rays", &RaycastingScene::cast_rays, py::arg("rays"), py::arg("nthreads") = 0)
+      .def("cast_rays", &RaycastingScene::cast_rays, py::arg("rays"), py::arg("nthreads") = 0,
+           py::arg("uvs") = true, py::arg("normals") = true, py::arg("out") = py::none(), py::arg("backend") = "cpu")
       .def("test_occlusions", &RaycastingScene::test_occlusions, py::arg("rays"), py::arg("tnear") = 0.0,
-           py::arg("tfar") = INFINITY, py::arg("nthreads") = 0)
+           py::arg("tfar") = INFINITY, py::arg("nthreads") = 0, py::arg("out") = py::none(),
+           py::arg("backend") = "cpu")
       .def("count_intersections", &RaycastingScene::count_intersections, py::arg("rays"), py::arg("nthreads") = 0)
       .def("list_intersections", &RaycastingScene::list_intersections, py::arg("rays"), py::arg("nthreads") = 0)
       .def("compute_closest_points", &RaycastingScene::compute_closest_points, py::arg("query_points"),
            py::arg("nthreads") = 0)
       .def("compute_distance", &RaycastingScene::compute_distance, py::arg("query_points"), py::arg("nthreads") = 0)
+      .def("winding_numbers", &RaycastingScene::winding_numbers, py::arg("query_points"), py::arg("nthreads") = 0,
+           py::arg("inside") = false)
       .def("copy", &RaycastingScene::copy)
       .def_property_readonly("nbytes", &RaycastingScene::nbytes);
   m.attr("INVALID_ID") = kInvalidId;

@@ -57,15 +57,18 @@ uint8_t checked_mask(long long mask) {
 
 py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& directions, const py::handle& t_min,
                     const py::handle& t_max, const std::string& query_name, const std::string& cull_name,
-                    long long mask, long long max_hits, bool uv, const py::object& out, long long nthreads) {
+                    long long mask, long long max_hits, bool uv, const py::object& out, long long nthreads,
+                    const std::string& invalid_name) {
   const Query query = parse_query(query_name);
+  const Invalid invalid = parse_invalid(invalid_name);
   const Cull cull = parse_cull(cull_name);
   const uint32_t kept = checked_max_hits(max_hits);
   RayArrays rays = rays_from_pair(origins, directions);
   set_segment(rays, t_min, t_max);
   const HitOutputs outputs = uv ? HitOutputs::Uv : HitOutputs::None;
   const uint32_t threads = thread_count(nthreads);
-  return cast_answer(SceneTarget(s.scene, checked_mask(mask)), rays, query, cull, outputs, kept, threads, out, false);
+  return cast_answer(SceneTarget(s.scene, checked_mask(mask)), rays, query, cull, outputs, kept, threads, out, false,
+                     invalid);
 }
 
 }  // namespace
@@ -122,7 +125,34 @@ by casts after commit(). One thread edits and commits; any number cast.)")
       .def("cast", &cast_scene, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
            py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",
            py::arg("mask") = 0xFF, py::arg("max_hits") = 16, py::arg("uv") = false, py::arg("out") = py::none(),
-           py::arg("nthreads") = 0, "See the package's documentation (help(meshcast)).");
+           py::arg("nthreads") = 0, py::arg("invalid") = "raise", R"(Casts rays against the committed instances.
+
+origins: (..., 3) float32 or float64 (float64 origins are walked in
+double as far as each instance's frame), or one (3,) origin for every
+ray. directions: (..., 3), need not be normalized; t is in their units.
+t_min, t_max: None (0 and inf), a number, or an array of the rays' shape;
+a hit needs t_min <= t <= t_max.
+query: "closest" (the nearest hit), "any" (a hit, the first found:
+occlusion) or "all" (every hit, nearest first).
+cull: "none" (two-sided), "back" or "front" (the front face's corners
+run counter-clockwise seen from the ray's origin; an instance's
+flip_facing and a mirroring transform swap them).
+mask: instances whose mask shares a bit with it are seen (0 to 255).
+max_hits: query="all" keeps the nearest max_hits of each ray (1 to 4096;
+"found" counts them all).
+uv: also answer each hit's barycentrics of corners 1 and 2.
+out: a dict of arrays to write the answer into (keys as below, C-
+contiguous, the answer's dtype and shape; closest and any only).
+nthreads: the cast's threads (0: every core).
+invalid: "raise" (ValueError naming the first ray with a NaN or
+infinite component, a zero direction or t_min above t_max) or "miss"
+(such a ray answered as a miss).
+
+Returns a dict of arrays in the rays' shape: "t" (float32, inf on a miss),
+"instance" and "triangle" (uint32, NO_HIT on a miss), with uv=True "uv"
+(..., 2). query="all": "found" (N,) uint32, "offsets" (N + 1,) int64, and
+"t", "instance", "triangle" (and "uv") of the kept hits, ray i's from
+offsets[i] to offsets[i + 1].)");
 }
 
 }  // namespace meshcast::python

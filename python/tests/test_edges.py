@@ -270,19 +270,76 @@ def test_crossings_of_two_geometries_stay_two():
     assert sorted(np.asarray(listed["geometry_ids"])[:2].tolist()) == [0, 1]
 
 
-def test_list_intersections_warning_as_error():
-    """More hits on a ray than a row keeps warn; a filter that makes warnings
-    errors raises that error (not a SystemError)."""
-    import warnings
-    n = 4100
-    v = np.array([[0, 0, z] for z in range(n) for _ in range(3)], np.float64)
+def stacked_triangles(zs):
+    """One triangle over (0..1, 0..1) at each height of zs."""
+    zs = np.asarray(zs, np.float64)
+    v = np.zeros((3 * len(zs), 3))
+    v[:, 2] = np.repeat(zs, 3)
     v[1::3, 0] = 1
     v[2::3, 1] = 1
-    f = np.arange(3 * n).reshape(n, 3)
+    return v, np.arange(3 * len(zs)).reshape(-1, 3)
+
+
+def fan(n, z, centre=(0.25, 0.25)):
+    """A flat disk of n triangles around the vertex `centre` at height z: a
+    ray through that vertex meets all n at one t, one crossing."""
+    angle = 2 * np.pi * np.arange(n) / n
+    v = np.zeros((n + 1, 3))
+    v[0, :2] = centre
+    v[1:, 0] = centre[0] + 0.5 * np.cos(angle)
+    v[1:, 1] = centre[1] + 0.5 * np.sin(angle)
+    v[:, 2] = z
+    k = np.arange(n)
+    return v, np.stack([np.zeros(n, np.int64), 1 + k, 1 + (k + 1) % n], axis=1)
+
+
+def joined(*meshes):
+    vertices, triangles, base = [], [], 0
+    for v, t in meshes:
+        vertices.append(v)
+        triangles.append(t + base)
+        base += len(v)
+    return np.concatenate(vertices), np.concatenate(triangles)
+
+
+def test_list_intersections_lists_every_crossing_beyond_a_row():
+    """A ray of more hits than a walk's row keeps (4096) is listed whole,
+    nearest first: 4090 planes, then a fan of 40 triangles through whose
+    centre it passes (where the first row is cut: 6 of its 40 hits kept),
+    then 30 planes. The fan is one crossing, as with fewer hits."""
+    planes = np.concatenate([np.arange(4090), np.arange(4091, 4121)])
+    v, f = joined(stacked_triangles(planes), fan(40, 4090.0))
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(v, f)
+    ray = np.array([[0.25, 0.25, -1.0, 0, 0, 1.0], [0.25, 0.25, 9000.0, 0, 0, -1.0]], np.float32)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        listed = rc.list_intersections(ray)
+    crossings = len(planes) + 1
+    assert np.asarray(rc.count_intersections(ray)).tolist() == [crossings, crossings]
+    splits = np.asarray(listed["ray_splits"])
+    assert splits.tolist() == [0, crossings, 2 * crossings]
+    heights = np.sort(np.concatenate([planes, [4090.0]]))
+    for r, order in ((0, 1), (1, -1)):
+        ids = np.asarray(listed["primitive_ids"])[splits[r]:splits[r + 1]]
+        t = np.asarray(listed["t_hit"])[splits[r]:splits[r + 1]]
+        assert np.all(np.diff(t) > 0)
+        assert np.array_equal(np.sort(ray[r, 2] + order * t), heights.astype(np.float32))
+        planes_listed = ids[ids < len(planes)]
+        assert sorted(planes_listed.tolist()) == list(range(len(planes)))  # each plane once
+        assert (ids >= len(planes)).sum() == 1  # the fan once, by one of its triangles
+
+
+def test_list_intersections_warns_of_what_it_leaves_out():
+    """More hits at one t than a row keeps (a fan of 4100 triangles about
+    the ray's vertex) warn; a filter that makes warnings errors raises that
+    error (not a SystemError)."""
+    import warnings
+    v, f = joined(fan(4100, 0.0), stacked_triangles([1.0]))
     rc = meshcast.RaycastingScene()
     rc.add_triangles(v, f)
     ray = np.array([[0.25, 0.25, -1.0, 0, 0, 1.0]], np.float32)
-    assert int(np.asarray(rc.count_intersections(ray))[0]) == n
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(RuntimeWarning, match="left out"):

@@ -145,3 +145,172 @@ def test_mesh_keyword_copies_and_isfinite():
     assert np.allclose(points[0], [0, 0, -1])
     with pytest.raises(TypeError):
         scene.add_triangles(v, t, mesh=mesh)
+
+
+def padded_rays():
+    """Rays at a sphere, with a camera's padding among them: a NaN origin, an
+    infinite direction, a zero direction (rows 1, 3, 5)."""
+    v, t = shapes.sphere()
+    centre = v.mean(axis=0)
+    rays = np.zeros((7, 6), np.float32)
+    rays[:, :3] = centre + [0, 0, 10]
+    rays[:, 3:] = [0, 0, -1]
+    rays[:, 0] += np.linspace(-0.5, 0.5, 7)
+    rays[1, 0] = np.nan
+    rays[3, 4] = np.inf
+    rays[5, 3:] = 0
+    return v, t, rays
+
+
+def test_rays_that_are_not_rays_miss_as_in_open3d():
+    v, t, rays = padded_rays()
+    scene = meshcast.RaycastingScene()
+    scene.add_triangles(v, t)
+    bad, good = [1, 3, 5], [0, 2, 4, 6]
+    hit = scene.cast_rays(rays)
+    assert np.isinf(hit["t_hit"].numpy()[bad]).all() and np.isfinite(hit["t_hit"].numpy()[good]).all()
+    assert (hit["geometry_ids"].numpy()[bad] == scene.INVALID_ID).all()
+    assert (hit["primitive_ids"].numpy()[bad] == scene.INVALID_ID).all()
+    assert (hit["primitive_normals"].numpy()[bad] == 0).all()
+    alone = scene.cast_rays(rays[good])
+    for key in hit:
+        assert np.array_equal(hit[key].numpy()[good], alone[key].numpy()), key
+    assert scene.test_occlusions(rays).numpy().tolist() == [True, False, True, False, True, False, True]
+    assert scene.count_intersections(rays).numpy().tolist() == [2, 0, 2, 0, 2, 0, 2]
+    listed = scene.list_intersections(rays)
+    assert np.diff(listed["ray_splits"].numpy()).tolist() == [2, 0, 2, 0, 2, 0, 2]
+    # a second geometry: the scene's own walk, not one blob's
+    scene.add_triangles(*shapes.cube())
+    assert np.isinf(scene.cast_rays(rays)["t_hit"].numpy()[bad]).all()
+    assert scene.count_intersections(rays).numpy()[bad].tolist() == [0, 0, 0]
+
+
+def test_cast_rays_leaves_out_uvs_and_normals_and_writes_into_out():
+    v, t, rays = padded_rays()
+    scene = meshcast.RaycastingScene()
+    scene.add_triangles(v, t)
+    whole = scene.cast_rays(rays)
+    bare = scene.cast_rays(rays, uvs=False, normals=False)
+    assert sorted(bare) == ["geometry_ids", "primitive_ids", "t_hit"]
+    for key in bare:
+        assert np.array_equal(bare[key].numpy(), whole[key].numpy()), key
+    assert sorted(scene.cast_rays(rays, normals=False)) == ["geometry_ids", "primitive_ids", "primitive_uvs", "t_hit"]
+    out = {"t_hit": np.full(7, -1, np.float32), "primitive_normals": np.zeros((7, 3), np.float32)}
+    written = scene.cast_rays(rays, out=out)
+    assert np.shares_memory(written["t_hit"], out["t_hit"])
+    assert np.array_equal(out["t_hit"], whole["t_hit"].numpy())
+    assert np.array_equal(out["primitive_normals"], whole["primitive_normals"].numpy())
+    occluded = np.zeros(7, bool)
+    scene.test_occlusions(rays, out=occluded)
+    assert occluded.tolist() == scene.test_occlusions(rays).numpy().tolist()
+    with pytest.raises(ValueError, match=r"out\[\"t\"\]: the answer has no such array"):
+        scene.cast_rays(rays, out={"t": np.zeros(7, np.float32)})
+    with pytest.raises(ValueError, match=r"out\[\"t_hit\"\]: dtype float64"):
+        scene.cast_rays(rays, out={"t_hit": np.zeros(7)})
+    with pytest.raises(ValueError, match=r"out\[\"out\"\]: shape \(6,\)"):
+        scene.test_occlusions(rays, out=np.zeros(6, bool))
+    with pytest.raises(ValueError, match=r"backend \"cuda\": cpu or vulkan"):
+        scene.cast_rays(rays, backend="cuda")
+
+
+def holed_sphere(directions, half_angle_deg=20):
+    """A sphere with a round hole wherever one of `directions` leaves it from
+    its centre: the triangles whose centroids lie within half_angle of it."""
+    v, t = shapes.sphere(rings=24, segments=40)
+    centre = v.astype(np.float64).mean(axis=0)
+    centroid = v[t].astype(np.float64).mean(axis=1) - centre
+    centroid /= np.linalg.norm(centroid, axis=1, keepdims=True)
+    near = (centroid @ np.asarray(directions, np.float64).T > np.cos(np.radians(half_angle_deg))).any(axis=1)
+    return v, t[~near], centre
+
+
+def test_winding_sign_is_right_where_parity_and_votes_fail():
+    """A sphere with holes where the sign rays leave it: from points about
+    its centre every ray escapes, so parity and a vote of three rays answer
+    outside, while the winding number (about 0.9 there) answers inside, as
+    the exact winding number does."""
+    v, t, centre = holed_sphere(meshcast._SIGN_DIRECTIONS[:3])
+    rng = np.random.default_rng(12)
+    p = centre + rng.uniform(-0.05, 0.05, (50, 3))
+    exact = winding_number(p, v, t)
+    assert (exact > 0.8).all() and (exact < 0.95).all()
+    scene = meshcast.RaycastingScene()
+    scene.add_triangles(v, t)
+    assert (scene.compute_occupancy(p).numpy() == 0).all()               # parity: wrong
+    assert (scene.compute_occupancy(p, nsamples=3).numpy() == 0).all()   # three votes: wrong
+    assert (scene.compute_occupancy(p, sign="winding").numpy() == 1).all()
+    sd = scene.compute_signed_distance(p, sign="winding").numpy()
+    assert (sd < 0).all() and np.array_equal(-sd, scene.compute_distance(p).numpy())
+    with pytest.raises(ValueError, match=r"sign: 'votes' is neither"):
+        scene.compute_occupancy(p, sign="votes")
+
+
+def test_winding_sign_of_overlapping_and_open_meshes():
+    """Two overlapping closed spheres (their common part has winding number
+    2: two crossings there, parity says outside) and the holed sphere,
+    wound both ways: sign="winding" is the exact winding number's on every
+    point whose exact |w| is not within 1e-3 of 1/2."""
+    sv, st = shapes.sphere()
+    moved = sv + np.float32([0.8, 0, 0])
+    both = (np.concatenate([sv, moved]), np.concatenate([st, st + len(sv)]))
+    hv, ht, _ = holed_sphere(meshcast._SIGN_DIRECTIONS[:3])
+    rng = np.random.default_rng(13)
+    for name, (v, t) in {"overlapping": both, "holed": (hv, ht), "holed, inward": (hv, ht[:, ::-1].copy())}.items():
+        lo, hi = v.min(0).astype(np.float64), v.max(0).astype(np.float64)
+        p = lo - 0.2 * (hi - lo) + rng.uniform(0, 1.4, (600, 3)) * (hi - lo)
+        exact = winding_number(p, v, t)
+        clear = np.abs(np.abs(exact) - 0.5) > 1e-3
+        scene = meshcast.RaycastingScene()
+        scene.add_triangles(v, t)
+        got = scene.compute_occupancy(p, sign="winding").numpy()
+        assert np.array_equal(got[clear] == 1, (np.abs(exact) > 0.5)[clear]), name
+        if name == "overlapping":
+            common = np.abs(exact - 2) < 0.1
+            assert common.sum() > 10 and (scene.compute_occupancy(p[common]).numpy() == 0).all()
+
+
+def test_winding_number_within_its_bound():
+    """compute_winding_number against the exact sum over the stored
+    triangles (the exact layout stores the input's): within the bound it
+    answers, and the bound small where the mesh is far."""
+    v, t = shapes.sphere(rings=30, segments=50)
+    v2, t2 = shapes.cube(lo=-0.4, hi=0.6)
+    scene = meshcast.RaycastingScene()
+    scene.add_triangles(v, t)
+    scene.add_triangles(v2, t2)
+    rng = np.random.default_rng(14)
+    p = rng.uniform(-3, 5, (300, 3))
+    got = scene.compute_winding_number(p)
+    w, bound = got["winding_number"].numpy(), got["bound"].numpy()
+    assert w.dtype == np.float64 and w.shape == (300,)
+    exact = winding_number(p, v, t) + winding_number(p, v2, t2)
+    # The scene stores the recommended layout: its corners within 2^-18 of
+    # the mesh's extent of the input's, which moves w by little away from
+    # the surface.
+    far = (nearest(p, v, t)[0] > 0.05) & (nearest(p, v2, t2)[0] > 0.05)
+    assert far.sum() > 200
+    assert (np.abs(w - exact)[far] <= bound[far] + 1e-4).all()
+    assert np.median(bound) < 0.05 and (bound >= 0).all()
+
+
+def test_help_states_arguments_and_keys():
+    """help() of the casts and of every RaycastingScene member names their
+    arguments and what they answer; help(meshcast) stays a page a reader
+    reads (the answers' Tensor, an ndarray, is left out of it)."""
+    import inspect
+    import pydoc
+    text = pydoc.render_doc(meshcast, renderer=pydoc.plaintext)
+    assert len(text.splitlines()) < 1200 and "class Tensor" not in text
+    blob_doc = meshcast.Blob.cast.__doc__
+    for word in ("origins", "t_min", "query", "cull", "max_hits", "out", "backend", "invalid", "\"t\"", "\"found\""):
+        assert word in blob_doc, word
+    for word in ("mask", "\"instance\"", "invalid"):
+        assert word in meshcast.Scene.cast.__doc__, word
+    for name, member in inspect.getmembers(meshcast.RaycastingScene, inspect.isfunction):
+        if name.startswith("_"):
+            continue
+        doc = member.__doc__ or ""
+        for parameter in inspect.signature(member).parameters:
+            if parameter not in ("self", "args", "kwargs", "memo"):
+                assert parameter in doc, f"{name}: {parameter}"
+        assert "Tensor" in doc or "Returns" in doc or "rays" in doc, name

@@ -74,3 +74,28 @@ def test_vulkan_out_and_uv(problem):
     cpu = b.cast(o, d, uv=True)
     np.testing.assert_array_equal(r["triangle"], cpu["triangle"])
     np.testing.assert_allclose(r["uv"], cpu["uv"], atol=1e-5)
+
+
+def test_raycasting_scene_on_vulkan_equals_cpu(problem):
+    """RaycastingScene's backend="vulkan": the scene's geometries on the GPU,
+    the same answers as on the CPU (a padded ray a miss on both)."""
+    v, f, o, d = problem
+    scene = meshcast.RaycastingScene()
+    scene.add_triangles(v, f)
+    rays = np.concatenate([o, d], axis=1).astype(np.float32)
+    rays[7, 4] = np.nan
+    for geometries in (1, 2):
+        if geometries == 2:
+            scene.add_triangles(*shapes.grid(8, 8, z=0.5, scale=0.5))
+        cpu = scene.cast_rays(rays)
+        try:
+            gpu = scene.cast_rays(rays, backend="vulkan")
+        except RuntimeError as e:
+            pytest.skip(f"no Vulkan device: {e}")
+        assert sorted(gpu) == sorted(cpu)
+        for key in cpu:
+            assert np.array_equal(gpu[key].numpy(), cpu[key].numpy()), key
+        assert np.isinf(gpu["t_hit"].numpy()[7])
+        tfar = np.linspace(0.1, 5, len(rays)).astype(np.float32)
+        assert np.array_equal(scene.test_occlusions(rays, tfar=tfar, backend="vulkan").numpy(),
+                              scene.test_occlusions(rays, tfar=tfar).numpy())

@@ -38,16 +38,20 @@ double solid_angle(const double a[3], const double b[3], const double c[3]) {
   return 2 * std::atan2(det, la * lb * lc + ab * lc + bcd * la + ca * lb);
 }
 
+// The expansion's rule for a tolerance: gap >= radius * sqrt(3 / tolerance).
+double ratio_for(double tolerance) {
+  if (!(tolerance > 0 && tolerance < 1))
+    throw UsageError("WindingNumbers: tolerance " + std::to_string(tolerance) + " is not in (0, 1)");
+  return std::sqrt(3 / tolerance);
+}
+
 }  // namespace
 
-WindingNumbers::WindingNumbers(const BlobView& view, double tolerance) : blob_(view.bytes()) {
+WindingNumbers::WindingNumbers(const BlobView& view) : blob_(view.bytes()) {
   const layout::BlobHeader& h = layout::header_of(blob_.data());
   if (h.tree_format != uint32_t(TreeFormat::OctTreeCompressed))
     throw UsageError("WindingNumbers: winding numbers walk OctTreeCompressed blobs (the recommended layout, and the "
                      "exact OctTreeCompressed/Float3SOA8); this blob is " + layout_name(view.layout()));
-  if (!(tolerance > 0 && tolerance < 1))
-    throw UsageError("WindingNumbers: tolerance " + std::to_string(tolerance) + " is not in (0, 1)");
-  ratio_ = std::sqrt(3 / tolerance);
   clusters_.resize(1);
   fill(0, h.root);
   clusters_.shrink_to_fit();
@@ -174,7 +178,8 @@ WindingNumbers::Answer WindingNumbers::walk(const double p[3], double ratio) con
   return answer;
 }
 
-void WindingNumbers::evaluate(std::span<const Vec3> points, std::span<Answer> out) const {
+void WindingNumbers::evaluate(std::span<const Vec3> points, std::span<Answer> out, double tolerance) const {
+  const double ratio = ratio_for(tolerance);
   if (out.size() < points.size())
     throw UsageError("WindingNumbers::evaluate: " + std::to_string(points.size()) + " points but room for " +
                      std::to_string(out.size()) + " answers");
@@ -184,7 +189,7 @@ void WindingNumbers::evaluate(std::span<const Vec3> points, std::span<Answer> ou
       out[i] = {NAN, NAN};
       continue;
     }
-    out[i] = walk(p, ratio_);
+    out[i] = walk(p, ratio);
   }
 }
 
@@ -199,8 +204,14 @@ void WindingNumbers::inside(std::span<const Vec3> points, std::span<uint8_t> out
                      std::to_string(out.size()) + " answers");
   for (size_t i = 0; i < points.size(); ++i) {
     const double p[3] = {points[i].x, points[i].y, points[i].z};
-    Answer a = walk(p, ratio_);
-    if (!(std::fabs(std::fabs(a.w) - 0.5) > a.bound)) a = walk(p, INFINITY);  // in doubt: every triangle
+    // Loose, then tight, then every triangle: each step only where the
+    // last left |w| within its bound of 1/2.
+    static const double ratios[] = {ratio_for(0.3), ratio_for(1e-2), INFINITY};
+    Answer a;
+    for (const double ratio : ratios) {
+      a = walk(p, ratio);
+      if (std::fabs(std::fabs(a.w) - 0.5) > a.bound) break;
+    }
     out[i] = std::fabs(a.w) > 0.5;
   }
 }

@@ -18,7 +18,9 @@
 // is at most `tolerance` times its own largest contribution (A / (4 pi
 // (s - r)^2)), so the bound is at most `tolerance` times the sum of the
 // clusters' absolute solid angles: about `tolerance` for a point seeing
-// the mesh once around.
+// the mesh once around. A cluster is expanded where its gap to the point
+// is at least sqrt(3 / tolerance) times its radius: the looser the
+// tolerance, the fewer clusters are opened.
 #pragma once
 #include <cstdint>
 #include <span>
@@ -34,21 +36,24 @@ class WindingNumbers {
   // Reads the moments of every cluster of the blob's tree once (about 35
   // bytes a triangle, beside the blob, which it reads again for near
   // triangles and must outlive it). OctTreeCompressed blobs alone:
-  // UsageError naming another layout, or a tolerance not in (0, 1).
-  explicit WindingNumbers(const BlobView& view, double tolerance = 1e-2);
+  // UsageError naming another layout.
+  explicit WindingNumbers(const BlobView& view);
 
   struct Answer {
     double w = 0;      // the winding number, in double
     double bound = 0;  // |w - exact| <= bound (besides double's rounding of the sum)
   };
-  // The winding number at each point (in the blob's frame). A NaN or
-  // infinite point gets NaN. UsageError when out is shorter than points.
-  void evaluate(std::span<const Vec3> points, std::span<Answer> out) const;
+  // The winding number at each point (in the blob's frame), expanded to
+  // `tolerance` (above). A NaN or infinite point gets NaN. UsageError when
+  // out is shorter than points, or for a tolerance not in (0, 1).
+  void evaluate(std::span<const Vec3> points, std::span<Answer> out, double tolerance = 1e-2) const;
   // The exact sum at one point, every triangle by its solid angle (the
   // reference the bound is against; slow: the whole mesh).
   double exact(const Vec3& point) const;
-  // Whether |w| > 1/2 at each point, decided on the exact sum wherever the
-  // expansion's bound leaves it in doubt. UsageError as evaluate.
+  // Whether |w| > 1/2 at each point: evaluated loosely first (a bound of
+  // a few tenths decides most points, which lie near 0 or 1), again more
+  // tightly where that leaves it in doubt, and on the exact sum where the
+  // tight bound still does. UsageError when out is shorter than points.
   void inside(std::span<const Vec3> points, std::span<uint8_t> out) const;
 
   size_t nbytes() const { return clusters_.capacity() * sizeof(Cluster); }
@@ -72,7 +77,6 @@ class WindingNumbers {
   Answer walk(const double p[3], double ratio) const;
 
   std::span<const uint8_t> blob_;
-  double ratio_;  // the expansion's rule: s - r >= r sqrt(3 / tolerance)
   std::vector<Cluster> clusters_;  // [0]: the whole mesh
 };
 

@@ -269,7 +269,7 @@ class RaycastingScene:
         # mesh (a crossing through an edge or vertex counts once), so one ray
         # decides; nsamples rays vote, as Open3D's do. Or the winding number.
         if sign == "winding":
-            return self._scene.winding_numbers(_array(query_points), self._threads(nthreads), True)
+            return self._scene.winding_inside(_array(query_points), self._threads(nthreads))
         if sign != "parity":
             raise ValueError(f"sign: {sign!r} is neither \"parity\" nor \"winding\"")
         if not isinstance(nsamples, (int, _np.integer)) or nsamples < 1 or nsamples % 2 == 0:
@@ -316,7 +316,7 @@ class RaycastingScene:
         query_points, nthreads, nsamples and sign."""
         return _tensors(self._inside(query_points, nsamples, nthreads, sign).astype(_np.float32))
 
-    def compute_winding_number(self, query_points, nthreads=0):
+    def compute_winding_number(self, query_points, nthreads=0, tolerance=1e-2):
         """The generalized winding number of the scene's meshes at each point
         (Jacobson et al. 2013; every geometry's summed): 1 inside a closed
         mesh wound outward, -1 wound inward, 0 outside, in between near
@@ -328,12 +328,13 @@ class RaycastingScene:
         threads (0: the scene's). Returns float64 Tensors in the points'
         shape: winding_number, and bound, such that |winding_number - exact|
         <= bound, where exact is the sum of every stored triangle's solid
-        angle (Van Oosterom and Strackee) over 4 pi, seen from the point. A
-        cluster of triangles is expanded only where its error is at most 1%
-        of the most it could add, so the bound is at most 1% of the sum of
-        those (a few hundredths for a point seeing a closed mesh from
-        outside)."""
-        return _tensors(self._scene.winding_numbers(_array(query_points), self._threads(nthreads), False))
+        angle (Van Oosterom and Strackee) over 4 pi, seen from the point.
+        tolerance, in (0, 1): a cluster of triangles is expanded only where
+        its error is at most this share of the most it could add, so the
+        bound is at most that share of the sum of those (for the default
+        1e-2, a few thousandths for a point seeing a closed mesh from
+        outside); a looser tolerance opens fewer clusters."""
+        return _tensors(self._scene.winding_numbers(_array(query_points), self._threads(nthreads), tolerance))
 
     @staticmethod
     def create_rays_pinhole(*args, **kwargs):

@@ -445,55 +445,61 @@ class RaycastingScene {
 
   // The scene's generalized winding number at each point: every
   // geometry's, summed (WindingNumbers, in each geometry's frame), and
-  // the bound on its error. With `inside`, whether |w| > 1/2 instead,
-  // decided on the exact sums wherever the bound leaves it in doubt.
-  py::object winding_numbers(const py::handle& points_in, long long nthreads, bool inside) {
+  // the bound on its error, expanded to `tolerance`.
+  py::dict winding_numbers(const py::handle& points_in, long long nthreads, double tolerance) {
     const PointArrays points = points_from_array(points_in, "query_points");
-    const uint32_t threads = thread_count(nthreads);
+    if (!(tolerance > 0 && tolerance < 1))
+      throw py::value_error("tolerance: " + std::to_string(tolerance) + " is not in (0, 1)");
     py::array_t<double> w(points.shape), bound(points.shape);
-    py::array_t<bool> in(points.shape);
     double* w_out = w.mutable_data();
     double* bound_out = bound.mutable_data();
-    bool* in_out = in.mutable_data();
     {
       py::gil_scoped_release release;
-      const Frame f = frame();
-      const Geometries& geometries = *f.geometries;
-      for (const auto& g : geometries) g->winding();  // made once, before the threads
-      const Chunks plan = plan_chunks(points.count, threads);
-      for_each_chunk(plan, threads, [&](size_t chunk) {
-        const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
-        std::vector<Vec3> local(n);
-        std::vector<WindingNumbers::Answer> part(n), sum(n);
-        for (const auto& g : geometries) {
-          for (size_t i = 0; i < n; ++i)
-            for (int k = 0; k < 3; ++k) local[i][k] = float(points.coordinate(begin + i, k) - g->centre[k]);
-          g->winding().evaluate(local, part);
-          for (size_t i = 0; i < n; ++i) sum[i].w += part[i].w, sum[i].bound += part[i].bound;
-        }
-        for (size_t i = 0; i < n; ++i) {
-          w_out[begin + i] = sum[i].w, bound_out[begin + i] = sum[i].bound;
-          if (!inside) continue;
-          double total = sum[i].w;
-          if (!(std::fabs(std::fabs(total) - 0.5) > sum[i].bound)) {  // in doubt: every triangle
-            total = 0;
-            for (const auto& g : geometries) {
-              Vec3 p;
-              for (int k = 0; k < 3; ++k) p[k] = float(points.coordinate(begin + i, k) - g->centre[k]);
-              total += g->winding().exact(p);
-            }
-          }
-          in_out[begin + i] = std::fabs(total) > 0.5;
-        }
+      for_each_winding_chunk(points, nthreads, [&](const Geometries& geometries, size_t begin, size_t n) {
+        const std::vector<WindingNumbers::Answer> sum = summed(geometries, points, begin, n, tolerance);
+        for (size_t i = 0; i < n; ++i) w_out[begin + i] = sum[i].w, bound_out[begin + i] = sum[i].bound;
       });
     }
-    if (inside) return std::move(in);
     py::dict answer;
     answer["winding_number"] = w;
     answer["bound"] = bound;
-    return std::move(answer);
+    return answer;
   }
 
+  // Whether the scene's winding number is above 1/2 in magnitude at each
+  // point: summed loosely first (a bound of a few tenths decides the
+  // points near 0 or 1, most of them), then tightly where that leaves it
+  // in doubt, then over every triangle where the tight bound still does.
+  py::array winding_inside(const py::handle& points_in, long long nthreads) {
+    const PointArrays points = points_from_array(points_in, "query_points");
+    py::array_t<bool> in(points.shape);
+    bool* in_out = in.mutable_data();
+    {
+      py::gil_scoped_release release;
+      for_each_winding_chunk(points, nthreads, [&](const Geometries& geometries, size_t begin, size_t n) {
+        std::vector<size_t> doubt(n);
+        for (size_t i = 0; i < n; ++i) doubt[i] = begin + i;
+        for (const double tolerance : {0.3, 1e-2}) {
+          std::vector<size_t> still;
+          // The points in doubt, one at a time (n = 1 from each).
+          for (const size_t i : doubt) {
+            const WindingNumbers::Answer a = summed(geometries, points, i, 1, tolerance)[0];
+            if (std::fabs(std::fabs(a.w) - 0.5) > a.bound)
+              in_out[i] = std::fabs(a.w) > 0.5;
+            else
+              still.push_back(i);
+          }
+          doubt.swap(still);
+        }
+        for (const size_t i : doubt) {
+          double total = 0;
+          for (const auto& g : geometries) total += g->winding().exact(local_point(points, i, g->centre));
+          in_out[i] = std::fabs(total) > 0.5;
+        }
+      });
+    }
+    return in;
+  }
   // The bytes the scene holds: every geometry's blob, its normals (and the
   // corners' table, once a ray through an edge made it, and the winding
   // numbers' clusters, once a call asked for them) and the top level over
@@ -622,6 +628,35 @@ class RaycastingScene {
     }
     for (size_t i = 0; i < points.count; ++i) use(i, best_geometry[i], best[i]);
   }
+  // A point in a geometry's frame, as its blob stores the mesh.
+  static Vec3 local_point(const PointArrays& points, size_t i, const double centre[3]) {
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) p[k] = float(points.coordinate(i, k) - centre[k]);
+    return p;
+  }
+  // Points begin..begin + n: every geometry's winding number summed.
+  static std::vector<WindingNumbers::Answer> summed(const Geometries& geometries, const PointArrays& points,
+                                                    size_t begin, size_t n, double tolerance) {
+    std::vector<Vec3> local(n);
+    std::vector<WindingNumbers::Answer> part(n), sum(n);
+    for (const auto& g : geometries) {
+      for (size_t i = 0; i < n; ++i) local[i] = local_point(points, begin + i, g->centre);
+      g->winding().evaluate(local, part, tolerance);
+      for (size_t i = 0; i < n; ++i) sum[i].w += part[i].w, sum[i].bound += part[i].bound;
+    }
+    return sum;
+  }
+  // chunk(geometries, begin, n) for the points in chunks on the call's
+  // threads, the geometries' clusters made first. Without the GIL.
+  template <class Chunk>
+  void for_each_winding_chunk(const PointArrays& points, long long nthreads, const Chunk& chunk) {
+    const uint32_t threads = thread_count(nthreads);
+    const Frame f = frame();
+    const Geometries& geometries = *f.geometries;
+    for (const auto& g : geometries) g->winding();  // made once, before the threads
+    const Chunks plan = plan_chunks(points.count, threads);
+    for_each_chunk(plan, threads, [&](size_t c) { chunk(geometries, plan.begin(c), plan.end(c) - plan.begin(c)); });
+  }
   const uint32_t build_threads_;  // BuildOptions::threads of add_triangles (0: every core)
   mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
@@ -654,7 +689,8 @@ void register_raycasting_scene(py::module_& m) {
            py::arg("nthreads") = 0)
       .def("compute_distance", &RaycastingScene::compute_distance, py::arg("query_points"), py::arg("nthreads") = 0)
       .def("winding_numbers", &RaycastingScene::winding_numbers, py::arg("query_points"), py::arg("nthreads") = 0,
-           py::arg("inside") = false)
+           py::arg("tolerance") = 1e-2)
+      .def("winding_inside", &RaycastingScene::winding_inside, py::arg("query_points"), py::arg("nthreads") = 0)
       .def("copy", &RaycastingScene::copy)
       .def_property_readonly("nbytes", &RaycastingScene::nbytes);
   m.attr("INVALID_ID") = kInvalidId;

@@ -291,6 +291,12 @@ def test_winding_number_within_its_bound():
     assert far.sum() > 200
     assert (np.abs(w - exact)[far] <= bound[far] + 1e-4).all()
     assert np.median(bound) < 0.05 and (bound >= 0).all()
+    loose = scene.compute_winding_number(p, tolerance=0.3)
+    assert (np.abs(loose["winding_number"].numpy() - exact)[far] <= loose["bound"].numpy()[far] + 1e-4).all()
+    assert np.median(loose["bound"].numpy()) > np.median(bound)
+    for bad in (0, 1, float("nan")):
+        with pytest.raises(ValueError, match="tolerance"):
+            scene.compute_winding_number(p, tolerance=bad)
 
 
 def test_help_states_arguments_and_keys():

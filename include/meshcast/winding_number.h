@@ -33,7 +33,7 @@ namespace meshcast {
 
 class WindingNumbers {
  public:
-  // Reads the moments of every cluster of the blob's tree once (about 35
+  // Reads the moments of every cluster of the blob's tree once (about 16
   // bytes a triangle, beside the blob, which it reads again for near
   // triangles and must outlive it). OctTreeCompressed blobs alone:
   // UsageError naming another layout.

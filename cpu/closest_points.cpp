@@ -6,6 +6,13 @@
 // walked next; the walk ends when it is farther than the best. In a leaf
 // each triangle's nearest point is worked out in double from its stored
 // corners (cpu/point_triangle.h), after a test of its corners' box.
+//
+// Scene::closest_points walks the same way through the scene's top level
+// (the instances' world boxes) and, for each instance near enough, its
+// blob in the instance's frame: the boxes' distances there scaled down to
+// a bound on the world's, each triangle's corners placed in the world and
+// its nearest point found there, so a scaled instance answers its world
+// distance.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -13,9 +20,12 @@
 
 #include "cpu/point_triangle.h"
 #include "layout/blob_format.h"
+#include "layout/tree/top_level.h"
 #include "layout/tree/leaves.h"
 #include "layout/tree/octtree.h"
 #include "meshcast/blob.h"
+#include "meshcast/scene.h"
+#include "scene/snapshot.h"
 
 namespace meshcast {
 
@@ -33,6 +43,7 @@ struct Best {
   double d2;             // the squared limit until a triangle is found
   PointOnTriangle near;
   uint32_t triangle = kNoHit;
+  uint32_t instance = 0;  // a scene's instance id (a blob's walk: 0)
 };
 
 // The squared distance from p to the box [lo, hi] (0 inside): a leaf's
@@ -48,8 +59,38 @@ inline double box_d2(const double p[3], const Bound lo[3], const Bound hi[3]) {
   return d2;
 }
 
-void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset, uint32_t count, const double p[3],
-               Best& best) {
+// Where a walk measures. The blob's own frame: distances as they are.
+struct OwnFrame {
+  double p[3];  // the query point
+  // A lower bound on the distance squared from a local box's squared one.
+  double bound(double local_d2) const { return local_d2; }
+  PointOnTriangle nearest(const float (&v)[3][3]) const { return nearest_on_triangle(p, v[0], v[1], v[2]); }
+};
+
+// An instance's frame: the point taken into it (p) for the boxes, whose
+// distances shrink by at most the transform's least stretch, and the
+// triangles placed in the world (to_world: the inverse of the instance's
+// float to_local, in double, as the walk of a ray sees it) for their
+// distances from the world point.
+struct InstanceFrame {
+  double p[3];
+  double world[3];
+  double to_world[9];
+  double translation[3];
+  double least_stretch2;  // (1 / |to_local|_F)^2: no vector shrinks more under to_world
+  double bound(double local_d2) const { return local_d2 * least_stretch2; }
+  PointOnTriangle nearest(const float (&v)[3][3]) const {
+    double w[3][3];
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r)
+        w[c][r] = translation[r] + to_world[3 * r] * v[c][0] + to_world[3 * r + 1] * v[c][1] + to_world[3 * r + 2] * v[c][2];
+    return nearest_on_triangle(world, w[0], w[1], w[2]);
+  }
+};
+
+template <class Frame>
+void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset, uint32_t count, const Frame& frame,
+               uint32_t instance, Best& best) {
   float corners[MC_OCT_MAX_COUNT][3][3];
   layout::decode_leaf(blob, h.tree_offset + offset, count, corners);
   for (uint32_t i = 0; i < count; ++i) {
@@ -59,13 +100,16 @@ void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset
       lo[a] = std::min({v[0][a], v[1][a], v[2][a]});
       hi[a] = std::max({v[0][a], v[1][a], v[2][a]});
     }
-    if (box_d2(p, lo, hi) * kBoxSlack > best.d2) continue;
-    const PointOnTriangle near = nearest_on_triangle(p, v[0], v[1], v[2]);
+    if (frame.bound(box_d2(frame.p, lo, hi)) * kBoxSlack > best.d2) continue;
+    const PointOnTriangle near = frame.nearest(v);
     if (near.d2 > best.d2) continue;
     const uint32_t triangle = layout::remap_entry(blob, h, layout::slot_of(h, offset, i));
-    // At one distance the lower triangle number, whatever the walk's order.
-    if (near.d2 == best.d2 && best.triangle != kNoHit && triangle > best.triangle) continue;
-    best.d2 = near.d2, best.near = near, best.triangle = triangle;
+    // At one distance the lower instance, then the lower triangle number,
+    // whatever the walk's order.
+    if (near.d2 == best.d2 && best.triangle != kNoHit &&
+        (instance > best.instance || (instance == best.instance && triangle > best.triangle)))
+      continue;
+    best.d2 = near.d2, best.near = near, best.triangle = triangle, best.instance = instance;
   }
 }
 
@@ -80,7 +124,8 @@ struct Pending {
 // the final answer would allow to skip (a point far from the mesh would
 // otherwise walk down one side, then another, before the distance shrinks).
 // `heap`: the caller's, reused from point to point.
-void walk_point(const uint8_t* blob, const layout::BlobHeader& h, const double p[3], Best& best,
+template <class Frame>
+void walk_point(const uint8_t* blob, const layout::BlobHeader& h, const Frame& frame, uint32_t instance, Best& best,
                 std::vector<Pending>& heap) {
   const uint8_t* tree = blob + h.tree_offset;
   const auto farther = [](const Pending& x, const Pending& y) { return x.d2 > y.d2; };
@@ -93,7 +138,7 @@ void walk_point(const uint8_t* blob, const layout::BlobHeader& h, const double p
     if (next.d2 * kBoxSlack > best.d2) return;  // every box left is farther still
     const uint32_t count = layout::oct_count(next.properties), offset = layout::oct_offset(next.properties);
     if (count > 0) {
-      test_leaf(blob, h, offset, count, p, best);
+      test_leaf(blob, h, offset, count, frame, instance, best);
       continue;
     }
     const uint8_t* node = tree + offset;
@@ -113,7 +158,7 @@ void walk_point(const uint8_t* blob, const layout::BlobHeader& h, const double p
         lo[a] = origin[a] + node[MC_OCT_QLO_AT + 8 * a + k] * scale[a];
         hi[a] = origin[a] + node[MC_OCT_QHI_AT + 8 * a + k] * scale[a];
       }
-      const double d2 = box_d2(p, lo, hi);
+      const double d2 = frame.bound(box_d2(frame.p, lo, hi));
       if (d2 * kBoxSlack > best.d2) continue;
       heap.push_back({d2, child});
       std::push_heap(heap.begin(), heap.end(), farther);
@@ -147,7 +192,7 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
       continue;
     }
     Best best{limit2, {}, kNoHit};
-    walk_point(bytes_.data(), h, p, best, heap);
+    walk_point(bytes_.data(), h, OwnFrame{{p[0], p[1], p[2]}}, 0, best, heap);
     if (best.triangle == kNoHit) continue;
     answer.triangle = best.triangle;
     answer.distance = float(std::sqrt(best.d2));
@@ -155,6 +200,111 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
     answer.u = float(best.near.u), answer.v = float(best.near.v);
   }
   return skipped;
+}
+
+namespace {
+
+// The double inverse of a float 3x3 (row-major), by its adjugate.
+void inverse(const float m[9], double out[9]) {
+  const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5], g = m[6], k = m[7], l = m[8];
+  const double det = a * (e * l - f * k) - b * (d * l - f * g) + c * (d * k - e * g);
+  const double cof[9] = {e * l - f * k, c * k - b * l, b * f - c * e, f * g - d * l, a * l - c * g,
+                         c * d - a * f, d * k - e * g, b * g - a * k, a * e - b * d};
+  for (int i = 0; i < 9; ++i) out[i] = cof[i] / det;
+}
+
+}  // namespace
+
+uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const std::array<double, 3>> points,
+                                 std::span<SceneClosestPoint> out, double max_distance, uint8_t mask) {
+  if (out.size() < points.size())
+    throw UsageError("Scene::closest_points: " + std::to_string(points.size()) + " points but room for " +
+                     std::to_string(out.size()) + " answers; out must hold one a point");
+  if (!(max_distance >= 0))
+    throw UsageError("Scene::closest_points: max_distance " + std::to_string(max_distance) +
+                     " is not a distance (0 to infinity)");
+  const layout::TopLevel& top = snapshot.top;
+  for (const auto& mesh : snapshot.meshes) {
+    const layout::BlobHeader& h = layout::header_of(mesh->bytes.data());
+    if (h.tree_format != uint32_t(TreeFormat::OctTreeCompressed))
+      throw UsageError("Scene::closest_points: point queries walk OctTreeCompressed blobs (the recommended layout, "
+                       "and the exact OctTreeCompressed/Float3SOA8); mesh " + mesh->name + " is " +
+                       layout_name(mesh->view.layout()));
+  }
+  // Each placed instance's frame, the point aside.
+  std::vector<InstanceFrame> frames(top.placed.size());
+  for (size_t i = 0; i < top.placed.size(); ++i) {
+    const layout::PlacedInstance& placed = top.placed[i];
+    InstanceFrame& f = frames[i];
+    inverse(placed.to_local, f.to_world);
+    double norm2 = 0;
+    for (int k = 0; k < 9; ++k) norm2 += double(placed.to_local[k]) * placed.to_local[k];
+    // |to_local x| <= |to_local|_F |x|, so |to_world y| >= |y| / |to_local|_F;
+    // less 2^-40 of itself for the rounding of these sums.
+    f.least_stretch2 = (1 - 0x1p-40) / norm2;
+    for (int k = 0; k < 3; ++k) f.translation[k] = placed.translation[k];
+  }
+  uint64_t skipped = 0;
+  std::vector<Pending> top_heap, heap;
+  const double limit2 = max_distance * max_distance;
+  const auto farther = [](const Pending& x, const Pending& y) { return x.d2 > y.d2; };
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double* w = points[i].data();
+    SceneClosestPoint& answer = out[i];
+    answer = SceneClosestPoint{};
+    if (!std::isfinite(w[0]) || !std::isfinite(w[1]) || !std::isfinite(w[2])) {
+      ++skipped;
+      continue;
+    }
+    Best best{limit2, {}, kNoHit};
+    // Best first over the top level's boxes (float, about the anchor,
+    // rounded outward), then each instance's blob as it comes up.
+    top_heap.clear();
+    if (!top.wide.empty()) top_heap.push_back({0, 0});
+    const double from_anchor[3] = {w[0] - top.anchor[0], w[1] - top.anchor[1], w[2] - top.anchor[2]};
+    while (!top_heap.empty()) {
+      std::pop_heap(top_heap.begin(), top_heap.end(), farther);
+      const Pending next = top_heap.back();
+      top_heap.pop_back();
+      if (next.d2 * kBoxSlack > best.d2) break;
+      if (next.properties & layout::kTopInstance) {
+        const uint32_t index = next.properties & ~layout::kTopInstance;
+        const layout::PlacedInstance& placed = top.placed[index];
+        if (!(placed.mask & mask)) continue;
+        InstanceFrame& f = frames[index];
+        double d[3];
+        for (int k = 0; k < 3; ++k) d[k] = w[k] - f.translation[k], f.world[k] = w[k];
+        for (int r = 0; r < 3; ++r)
+          f.p[r] = placed.to_local[3 * r] * d[0] + placed.to_local[3 * r + 1] * d[1] + placed.to_local[3 * r + 2] * d[2];
+        const uint8_t* blob = snapshot.meshes[placed.mesh]->bytes.data();
+        walk_point(blob, layout::header_of(blob), f, placed.id, best, heap);
+        continue;
+      }
+      const layout::TopWideNode& node = top.wide[next.properties];
+      for (int k = 0; k < layout::kTopWidth; ++k) {
+        const uint32_t slot = node.slot[k];
+        if (slot == layout::kTopEmpty) continue;
+        const float lo[3] = {node.lo[0][k], node.lo[1][k], node.lo[2][k]};
+        const float hi[3] = {node.hi[0][k], node.hi[1][k], node.hi[2][k]};
+        const double d2 = box_d2(from_anchor, lo, hi);
+        if (d2 * kBoxSlack > best.d2) continue;
+        top_heap.push_back({d2, slot});
+        std::push_heap(top_heap.begin(), top_heap.end(), farther);
+      }
+    }
+    if (best.triangle == kNoHit) continue;
+    answer.instance = best.instance;
+    answer.triangle = best.triangle;
+    answer.distance = std::sqrt(best.d2);
+    for (int k = 0; k < 3; ++k) answer.point[k] = best.near.point[k];
+    answer.u = float(best.near.u), answer.v = float(best.near.v);
+  }
+  return skipped;
+}
+
+uint64_t Scene::closest_points(std::span<const std::array<double, 3>> points, std::span<SceneClosestPoint> out,
+                               double max_distance, uint8_t mask) const {
+  return closest_points_snapshot(*snapshot(), points, out, max_distance, mask);
 }
 
 }  // namespace meshcast

@@ -46,7 +46,10 @@ inline void nearest_on_edge(const double p[3], const double a[3], const double a
 }
 }  // namespace point_detail
 
-inline PointOnTriangle nearest_on_triangle(const double p[3], const float fa[3], const float fb[3], const float fc[3]) {
+// Corners in float (a blob's, as stored) or double (an instance's, placed
+// in the world).
+template <class Real>
+inline PointOnTriangle nearest_on_triangle(const double p[3], const Real fa[3], const Real fb[3], const Real fc[3]) {
   using point_detail::dot;
   using point_detail::finish;
   const double a[3] = {fa[0], fa[1], fa[2]}, b[3] = {fb[0], fb[1], fb[2]}, c[3] = {fc[0], fc[1], fc[2]};

@@ -25,6 +25,7 @@
 // commits (the edits themselves are for one thread at a time).
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -64,6 +65,16 @@ struct SceneHit {
   uint32_t instance = kNoHit;
   uint32_t triangle = kNoHit;
   float u = 0, v = 0;  // only with HitOutputs::Uv, as Hit's
+};
+
+// A scene's nearest point to a query point (Scene::closest_points): in the
+// world, in double.
+struct SceneClosestPoint {
+  double point[3] = {0, 0, 0};
+  double distance = INFINITY;   // INFINITY: none within the limit
+  uint32_t instance = kNoHit;
+  uint32_t triangle = kNoHit;   // of the instance's mesh, the caller's number
+  float u = 0, v = 0;           // the point's barycentrics on the triangle's stored corners
 };
 
 // Query::All's answers on a scene, compact rows as HitLists: ray i found
@@ -169,6 +180,21 @@ class Scene {
   uint64_t trace_all_hits(std::span<const RayD> rays, SceneHitLists& lists, HitOutputs outputs = HitOutputs::None,
                           Cull cull = Cull::None, uint8_t mask = 0xFF) const;
 
+  // The nearest point of the committed scene to each world point (in
+  // double), within max_distance (inclusive), among the instances whose
+  // mask shares a bit with `mask`: each instance near enough is walked in
+  // its own frame, and each of its triangles placed in the world (its
+  // corners through the inverse of the instance's float to_local, as a
+  // ray's walk places them) before its nearest point is found, so the
+  // distance is the world's under any rotation and scale, uniform or not.
+  // At one distance the lower instance, then the lower triangle. Returns
+  // how many points had a NaN or infinite coordinate (answered as none
+  // found). OctTreeCompressed meshes alone: UsageError naming another
+  // layout, when out is shorter than points, or for a negative or NaN
+  // max_distance.
+  uint64_t closest_points(std::span<const std::array<double, 3>> points, std::span<SceneClosestPoint> out,
+                          double max_distance = INFINITY, uint8_t mask = 0xFF) const;
+
   // What the last commit() made, for a caster that keeps a batch on the
   // scene it was submitted to (traces through it see that frame).
   std::shared_ptr<const SceneSnapshot> snapshot() const;
@@ -185,6 +211,10 @@ class Scene {
   MeshId add_validated(const BlobView& view, std::shared_ptr<const void> owner, const std::string& name);
   std::unique_ptr<Edits> edits_;  // and the committed snapshot, behind a mutex
 };
+
+// A snapshot's point queries: the same as Scene's, on the frame it holds.
+uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const std::array<double, 3>> points,
+                                 std::span<SceneClosestPoint> out, double max_distance = INFINITY, uint8_t mask = 0xFF);
 
 // A snapshot's traces: the same as Scene's, on the frame it holds.
 uint64_t trace_snapshot(const SceneSnapshot& snapshot, std::span<const RayD> rays, std::span<SceneHit> hits,

@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <functional>
@@ -406,8 +407,8 @@ class RaycastingScene {
   }
 
   // The nearest point of every geometry to each query point (Open3D's
-  // compute_closest_points): each geometry's blob walked with the points
-  // in its frame, the nearest kept, at one distance the lower geometry id.
+  // compute_closest_points): the scene's point query, each geometry's blob
+  // walked in its frame, at one distance the lower geometry id.
   py::dict compute_closest_points(const py::handle& points_in, long long nthreads) {
     const PointArrays points = points_from_array(points_in, "query_points");
     py::array_t<float> point(shape_with(points.shape, 3));
@@ -416,10 +417,9 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      nearest_of_all(*f.geometries, points, thread_count(nthreads), [&](size_t i, uint32_t g, const ClosestPoint& c) {
-        for (int k = 0; k < 3; ++k)
-          p_out[3 * i + k] = g == kInvalidId ? NAN : float(double(c.point[k]) + (*f.geometries)[g]->centre[k]);
-        primitives.write(i, g, c.triangle, c.u, c.v, *f.geometries);
+      nearest_of_all(f, points, thread_count(nthreads), [&](size_t i, const SceneClosestPoint& c) {
+        for (int k = 0; k < 3; ++k) p_out[3 * i + k] = c.instance == kInvalidId ? NAN : float(c.point[k]);
+        primitives.write(i, c.instance, c.triangle, c.u, c.v, *f.geometries);
       });
     }
     py::dict answer;
@@ -437,8 +437,8 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      nearest_of_all(*f.geometries, points, thread_count(nthreads),
-                     [&](size_t i, uint32_t, const ClosestPoint& c) { out[i] = c.distance; });
+      nearest_of_all(f, points, thread_count(nthreads),
+                     [&](size_t i, const SceneClosestPoint& c) { out[i] = float(c.distance); });
     }
     return distance;
   }
@@ -614,19 +614,23 @@ class RaycastingScene {
     changed_ = true;
     return id;
   }
-  // Each point's nearest over the geometries, handed to use(i, geometry,
-  // answer) (geometry kInvalidId: none). Without the GIL.
+  // Each point's nearest over the geometries (Scene::closest_points on
+  // the frame's snapshot: the instances' top level, then each geometry's
+  // blob in its frame, in double), handed to use(i, answer) on `threads`
+  // threads (instance kInvalidId: none; an instance is its geometry).
+  // Without the GIL.
   template <class Use>
-  static void nearest_of_all(const Geometries& geometries, const PointArrays& points, uint32_t threads, const Use& use) {
-    std::vector<ClosestPoint> best(points.count), found;
-    std::vector<uint32_t> best_geometry(points.count, kInvalidId);
-    for (uint32_t g = 0; g < geometries.size(); ++g) {
-      nearest_points(geometries[g]->view, geometries[g]->centre, points, INFINITY, threads, found);
-      for (size_t i = 0; i < points.count; ++i)
-        if (found[i].triangle != kNoHit && found[i].distance < best[i].distance)
-          best[i] = found[i], best_geometry[i] = g;
-    }
-    for (size_t i = 0; i < points.count; ++i) use(i, best_geometry[i], best[i]);
+  static void nearest_of_all(const Frame& f, const PointArrays& points, uint32_t threads, const Use& use) {
+    const Chunks plan = plan_chunks(points.count, threads);
+    for_each_chunk(plan, threads, [&](size_t chunk) {
+      const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
+      std::vector<std::array<double, 3>> world(n);
+      std::vector<SceneClosestPoint> found(n);
+      for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(begin + i, k);
+      closest_points_snapshot(*f.target.frame, world, found);
+      for (size_t i = 0; i < n; ++i) use(begin + i, found[i]);
+    });
   }
   // A point in a geometry's frame, as its blob stores the mesh.
   static Vec3 local_point(const PointArrays& points, size_t i, const double centre[3]) {

@@ -12,6 +12,8 @@
 #include "python/src/arrays.h"
 #include "python/src/blob_api.h"
 #include "python/src/cast.h"
+#include "python/src/parallel.h"
+#include "python/src/points.h"
 
 namespace meshcast::python {
 
@@ -69,6 +71,53 @@ py::dict cast_scene(PyScene& s, const py::handle& origins, const py::handle& dir
   const uint32_t threads = thread_count(nthreads);
   return cast_answer(SceneTarget(s.scene, checked_mask(mask)), rays, query, cull, outputs, kept, threads, out, false,
                      invalid);
+}
+
+// The nearest point of the committed scene to each world point, on the
+// call's threads (meshcast/scene.h: Scene::closest_points).
+py::dict closest_points_scene(const PyScene& s, const py::handle& points_in, double max_distance, long long mask,
+                              long long nthreads) {
+  const PointArrays points = points_from_array(points_in, "points");
+  if (!(max_distance >= 0))
+    throw py::value_error("max_distance: " + std::to_string(max_distance) + " is not a distance (0 to inf)");
+  const uint8_t seen = checked_mask(mask);
+  const uint32_t threads = thread_count(nthreads);
+  py::array_t<double> point(shape_with(points.shape, 3)), distance(points.shape);
+  py::array_t<uint32_t> instance(points.shape), triangle(points.shape);
+  py::array_t<float> uv(shape_with(points.shape, 2));
+  double* p_out = point.mutable_data();
+  double* d_out = distance.mutable_data();
+  uint32_t* i_out = instance.mutable_data();
+  uint32_t* t_out = triangle.mutable_data();
+  float* uv_out = uv.mutable_data();
+  {
+    py::gil_scoped_release release;
+    const std::shared_ptr<const SceneSnapshot> frame = s.scene.snapshot();
+    const Chunks plan = plan_chunks(points.count, threads);
+    for_each_chunk(plan, threads, [&](size_t chunk) {
+      const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
+      std::vector<std::array<double, 3>> world(n);
+      std::vector<SceneClosestPoint> found(n);
+      for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(begin + i, k);
+      closest_points_snapshot(*frame, world, found, max_distance, seen);
+      for (size_t i = 0; i < n; ++i) {
+        const SceneClosestPoint& c = found[i];
+        for (int k = 0; k < 3; ++k) p_out[3 * (begin + i) + k] = c.triangle == kNoHit ? NAN : c.point[k];
+        d_out[begin + i] = c.distance;
+        i_out[begin + i] = c.instance;
+        t_out[begin + i] = c.triangle;
+        uv_out[2 * (begin + i)] = c.u, uv_out[2 * (begin + i) + 1] = c.v;
+      }
+    });
+  }
+  py::dict answer;
+  answer["point"] = point;
+  answer["distance"] = distance;
+  answer["instance"] = instance;
+  answer["triangle"] = triangle;
+  answer["uv"] = uv;
+  return answer;
 }
 
 }  // namespace
@@ -152,7 +201,23 @@ Returns a dict of arrays in the rays' shape: "t" (float32, inf on a miss),
 "instance" and "triangle" (uint32, NO_HIT on a miss), with uv=True "uv"
 (..., 2). query="all": "found" (N,) uint32, "offsets" (N + 1,) int64, and
 "t", "instance", "triangle" (and "uv") of the kept hits, ray i's from
-offsets[i] to offsets[i + 1].)");
+offsets[i] to offsets[i + 1].)")
+      .def("closest_points", &closest_points_scene, py::arg("points"), py::arg("max_distance") = INFINITY,
+           py::arg("mask") = 0xFF, py::arg("nthreads") = 0, R"(The nearest point of the committed instances to each world point.
+
+points: (..., 3) float32 or float64 (finite; kept in double). max_distance:
+none farther is answered (inclusive). mask: instances whose mask shares a
+bit with it are seen. nthreads: the call's threads (0: every core). Each
+instance near enough is walked in its own frame and its triangles placed
+in the world, so the distance is the world's under any rotation and
+scale, uneven ones too. OctTreeCompressed meshes alone (the recommended
+layout and OctTreeCompressed/Float3SOA8).
+
+Returns a dict of arrays in the points' shape: "point" (..., 3) float64
+(NaN where none), "distance" float64 (inf where none), "instance" and
+"triangle" uint32 (NO_HIT where none), "uv" (..., 2) float32, the
+point's barycentrics on the triangle's stored corners; at one distance
+the lower instance, then the lower triangle.)");
 }
 
 }  // namespace meshcast::python

@@ -163,3 +163,50 @@ def test_raycasting_scene_without_geometry():
     got = scene.compute_closest_points(np.zeros((3, 3), np.float32))
     assert np.all(got["geometry_ids"].numpy() == meshcast.RaycastingScene.INVALID_ID)
     assert np.all(np.isinf(scene.compute_distance(np.zeros((2, 3)))))
+
+
+def test_scene_closest_points_are_world_distances():
+    """Scene.closest_points on instances rotated, scaled unevenly and
+    mirrored: the nearest point of the world's triangles (each instance's
+    mesh placed by its transform in float64), not of the frames'."""
+    sv, st = shapes.sphere(rings=10, segments=16)
+    gv, gt = shapes.grid(6, 5)
+    blobs = [meshcast.build(sv, st, layout="OctTreeCompressed/Float3SOA8"), meshcast.build(gv, gt)]
+    scene = meshcast.Scene()
+    meshes = [scene.add_mesh(b) for b in blobs]
+    rng = np.random.default_rng(21)
+    world_v, world_t, owner = [], [], []
+    base = 0
+    for i in range(6):
+        a = rng.uniform(0, 2 * np.pi)
+        rotation = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+        m = (rotation * rng.uniform(0.3, 3.0, 3)).astype(np.float32)
+        if i == 2:
+            m[:, 0] *= -1
+        translation = rng.uniform(-6, 6, 3) + [1e5, 0, 0]  # far out: the translations stay in double
+        instance = scene.add_instance(meshes[i % 2], rotation_scale=m, translation=translation)
+        v, t = (sv, st) if i % 2 == 0 else (gv, gt)
+        world_v.append(v.astype(np.float64) @ m.astype(np.float64).T + translation)
+        world_t.append(t.astype(np.int64) + base)
+        owner += [(instance, k) for k in range(len(t))]
+        base += len(v)
+    scene.commit()
+    world_v, world_t = np.concatenate(world_v), np.concatenate(world_t)
+    p = rng.uniform(-10, 10, (300, 3)) + [1e5, 0, 0]
+    got = scene.closest_points(p)
+    want, tri, point = nearest(p, world_v, world_t)
+    # The grid's blob is quantized: its corners within its stated bound
+    # (a few millionths of its diagonal, times the scale) of the input's.
+    assert np.allclose(got["distance"], want, rtol=0, atol=1e-4)
+    assert got["distance"].dtype == np.float64 and got["point"].shape == (300, 3)
+    assert np.allclose(np.linalg.norm(got["point"] - p, axis=1), got["distance"], atol=1e-6)
+    ids = list(zip(got["instance"].tolist(), got["triangle"].tolist()))
+    own = [owner.index(k) for k in ids]
+    assert np.allclose(distance_to(p, world_v, world_t, own), want, atol=1e-4)
+    # Within a limit
+    near = scene.closest_points(p, max_distance=1.0)
+    found = np.isfinite(near["distance"])
+    assert found[want < 1.0 - 1e-4].all() and not found[want > 1.0 + 1e-4].any()
+    assert (near["triangle"][~found] == meshcast.NO_HIT).all()
+    with pytest.raises(ValueError, match="max_distance"):
+        scene.closest_points(p, max_distance=-1.0)

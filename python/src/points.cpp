@@ -1,5 +1,6 @@
 #include "python/src/points.h"
 
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <stdexcept>
@@ -54,6 +55,20 @@ void nearest_points(const BlobView& view, const double* centre, const PointArray
   if (beyond > 0)
     throw std::invalid_argument(std::to_string(beyond.load()) + " query points lie beyond float's range (3.4e38) "
                                 "from the mesh's stored frame");
+}
+
+void scene_nearest_points(const SceneSnapshot& frame, const PointArrays& points, double max_distance, uint8_t mask,
+                          uint32_t threads, const std::function<void(size_t, const SceneClosestPoint&)>& use) {
+  const Chunks plan = plan_chunks(points.count, threads);
+  for_each_chunk(plan, threads, [&](size_t chunk) {
+    const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
+    std::vector<std::array<double, 3>> world(n);
+    std::vector<SceneClosestPoint> found(n);
+    for (size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(begin + i, k);
+    closest_points_snapshot(frame, world, found, max_distance, mask);
+    for (size_t i = 0; i < n; ++i) use(begin + i, found[i]);
+  });
 }
 
 }  // namespace meshcast::python

@@ -7,9 +7,11 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "meshcast/blob.h"
+#include "meshcast/scene.h"
 
 namespace meshcast::python {
 
@@ -37,5 +39,11 @@ float checked_max_distance(double max_distance);
 // subtracted from each point first.
 void nearest_points(const BlobView& view, const double* centre, const PointArrays& points, float max_distance,
                     uint32_t threads, std::vector<ClosestPoint>& out);
+
+// The nearest point of a scene's frame to each of `points` (world
+// coordinates, in double: Scene::closest_points), on `threads` threads
+// without the GIL (the caller releases it), each handed to use(i, answer).
+void scene_nearest_points(const SceneSnapshot& frame, const PointArrays& points, double max_distance, uint8_t mask,
+                          uint32_t threads, const std::function<void(size_t, const SceneClosestPoint&)>& use);
 
 }  // namespace meshcast::python

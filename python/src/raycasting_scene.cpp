@@ -417,7 +417,9 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      nearest_of_all(f, points, thread_count(nthreads), [&](size_t i, const SceneClosestPoint& c) {
+      // Scene::closest_points on the frame's snapshot: an instance is its
+      // geometry (kInvalidId: none).
+      scene_nearest_points(*f.target.frame, points, INFINITY, 0xFF, thread_count(nthreads), [&](size_t i, const SceneClosestPoint& c) {
         for (int k = 0; k < 3; ++k) p_out[3 * i + k] = c.instance == kInvalidId ? NAN : float(c.point[k]);
         primitives.write(i, c.instance, c.triangle, c.u, c.v, *f.geometries);
       });
@@ -437,8 +439,8 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      nearest_of_all(f, points, thread_count(nthreads),
-                     [&](size_t i, const SceneClosestPoint& c) { out[i] = float(c.distance); });
+      scene_nearest_points(*f.target.frame, points, INFINITY, 0xFF, thread_count(nthreads),
+                           [&](size_t i, const SceneClosestPoint& c) { out[i] = float(c.distance); });
     }
     return distance;
   }
@@ -613,24 +615,6 @@ class RaycastingScene {
     }
     changed_ = true;
     return id;
-  }
-  // Each point's nearest over the geometries (Scene::closest_points on
-  // the frame's snapshot: the instances' top level, then each geometry's
-  // blob in its frame, in double), handed to use(i, answer) on `threads`
-  // threads (instance kInvalidId: none; an instance is its geometry).
-  // Without the GIL.
-  template <class Use>
-  static void nearest_of_all(const Frame& f, const PointArrays& points, uint32_t threads, const Use& use) {
-    const Chunks plan = plan_chunks(points.count, threads);
-    for_each_chunk(plan, threads, [&](size_t chunk) {
-      const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
-      std::vector<std::array<double, 3>> world(n);
-      std::vector<SceneClosestPoint> found(n);
-      for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(begin + i, k);
-      closest_points_snapshot(*f.target.frame, world, found);
-      for (size_t i = 0; i < n; ++i) use(begin + i, found[i]);
-    });
   }
   // A point in a geometry's frame, as its blob stores the mesh.
   static Vec3 local_point(const PointArrays& points, size_t i, const double centre[3]) {

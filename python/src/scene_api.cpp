@@ -92,24 +92,14 @@ py::dict closest_points_scene(const PyScene& s, const py::handle& points_in, dou
   float* uv_out = uv.mutable_data();
   {
     py::gil_scoped_release release;
-    const std::shared_ptr<const SceneSnapshot> frame = s.scene.snapshot();
-    const Chunks plan = plan_chunks(points.count, threads);
-    for_each_chunk(plan, threads, [&](size_t chunk) {
-      const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
-      std::vector<std::array<double, 3>> world(n);
-      std::vector<SceneClosestPoint> found(n);
-      for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(begin + i, k);
-      closest_points_snapshot(*frame, world, found, max_distance, seen);
-      for (size_t i = 0; i < n; ++i) {
-        const SceneClosestPoint& c = found[i];
-        for (int k = 0; k < 3; ++k) p_out[3 * (begin + i) + k] = c.triangle == kNoHit ? NAN : c.point[k];
-        d_out[begin + i] = c.distance;
-        i_out[begin + i] = c.instance;
-        t_out[begin + i] = c.triangle;
-        uv_out[2 * (begin + i)] = c.u, uv_out[2 * (begin + i) + 1] = c.v;
-      }
-    });
+    scene_nearest_points(*s.scene.snapshot(), points, max_distance, seen, threads,
+                         [&](size_t i, const SceneClosestPoint& c) {
+                           for (int k = 0; k < 3; ++k) p_out[3 * i + k] = c.triangle == kNoHit ? NAN : c.point[k];
+                           d_out[i] = c.distance;
+                           i_out[i] = c.instance;
+                           t_out[i] = c.triangle;
+                           uv_out[2 * i] = c.u, uv_out[2 * i + 1] = c.v;
+                         });
   }
   py::dict answer;
   answer["point"] = point;

@@ -77,7 +77,7 @@ struct InstanceFrame {
   double world[3];
   double to_world[9];
   double translation[3];
-  double least_stretch2;  // (1 / |to_local|_F)^2: no vector shrinks more under to_world
+  double least_stretch2;  // 1 / (to_local's largest singular value)^2: no vector shrinks more under to_world
   double bound(double local_d2) const { return local_d2 * least_stretch2; }
   PointOnTriangle nearest(const float (&v)[3][3]) const {
     double w[3][3];
@@ -204,6 +204,21 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
 
 namespace {
 
+// The largest eigenvalue of a symmetric 3x3 (row-major), by the
+// trigonometric solution of its characteristic cubic.
+double largest_eigenvalue(const double b[9]) {
+  const double off = b[1] * b[1] + b[2] * b[2] + b[5] * b[5];
+  if (off == 0) return std::max({b[0], b[4], b[8]});
+  const double q = (b[0] + b[4] + b[8]) / 3;
+  const double p = std::sqrt(((b[0] - q) * (b[0] - q) + (b[4] - q) * (b[4] - q) + (b[8] - q) * (b[8] - q) + 2 * off) / 6);
+  double c[9];
+  for (int i = 0; i < 9; ++i) c[i] = (b[i] - (i % 4 == 0 ? q : 0)) / p;
+  const double det = c[0] * (c[4] * c[8] - c[5] * c[7]) - c[1] * (c[3] * c[8] - c[5] * c[6]) +
+                     c[2] * (c[3] * c[7] - c[4] * c[6]);
+  const double r = std::clamp(det / 2, -1.0, 1.0);
+  return q + 2 * p * std::cos(std::acos(r) / 3);
+}
+
 // The double inverse of a float 3x3 (row-major), by its adjugate.
 void inverse(const float m[9], double out[9]) {
   const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5], g = m[6], k = m[7], l = m[8];
@@ -237,11 +252,16 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
     const layout::PlacedInstance& placed = top.placed[i];
     InstanceFrame& f = frames[i];
     inverse(placed.to_local, f.to_world);
-    double norm2 = 0;
-    for (int k = 0; k < 9; ++k) norm2 += double(placed.to_local[k]) * placed.to_local[k];
-    // |to_local x| <= |to_local|_F |x|, so |to_world y| >= |y| / |to_local|_F;
-    // less 2^-40 of itself for the rounding of these sums.
-    f.least_stretch2 = (1 - 0x1p-40) / norm2;
+    // |to_local x| <= s |x| with s^2 the largest eigenvalue of
+    // to_local^T to_local, so |to_world y| >= |y| / s; less a millionth for
+    // the rounding of the eigenvalue's solution (2^-40 of it at most here).
+    double gram[9];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        gram[3 * r + c] = 0;
+        for (int k = 0; k < 3; ++k) gram[3 * r + c] += double(placed.to_local[3 * k + r]) * placed.to_local[3 * k + c];
+      }
+    f.least_stretch2 = (1 - 1e-6) / largest_eigenvalue(gram);
     for (int k = 0; k < 3; ++k) f.translation[k] = placed.translation[k];
   }
   uint64_t skipped = 0;

@@ -373,7 +373,7 @@ check truncated-rays 2 "cut.rays" -- "$meshcast" trace "$work/m.blob" --rays "$w
 # distances are known: the centre (-0.5 inside), 2 above the top face, 1
 # beside a side face.
 printf 'OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n3 0 2 1\n3 0 3 2\n3 4 5 6\n3 4 6 7\n3 0 1 5\n3 0 5 4\n3 1 2 6\n3 1 6 5\n3 2 3 7\n3 2 7 6\n3 3 0 4\n3 3 4 7\n' >"$work/cube.off"
-check distance-grid 0 '"points":512,"signed":true,"inside":64' -- "$meshcast" distance "$work/cube.off" --grid 8 --margin 0.5 --signed --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8
+check distance-grid 0 '"points":512,"signed":true,"sign":"parity","inside":64' -- "$meshcast" distance "$work/cube.off" --grid 8 --margin 0.5 --signed --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8
 [[ $(stat -c %s "$work/grid.npy") == 2176 ]] || { echo "FAIL distance-grid: grid.npy is not 128 header bytes and 512 float32"; failures=$((failures + 1)); }
 python3 -c 'import struct, sys
 h = "{\x27descr\x27: \x27<f8\x27, \x27fortran_order\x27: False, \x27shape\x27: (3, 3), }"
@@ -385,6 +385,15 @@ got=$(python3 -c 'import struct, sys
 b = open(sys.argv[1], "rb").read(); n = struct.unpack("<H", b[8:10])[0]
 print(*struct.unpack("<3f", b[10 + n:]))' "$work/d.npy")
 [[ $got == "-0.5 2.0 1.0" ]] || { echo "FAIL distance-points: distances $got, not -0.5 2.0 1.0"; failures=$((failures + 1)); }
+# The cube without its +y face: a ray from inside along the inside test's
+# direction (mostly +y) escapes through the hole from most cells, while the
+# winding number is above 1/2 in every cell inside (0.61 at the cells
+# nearest the hole) and below it outside (0.39 there).
+grep -v '^3 2 3 7$\|^3 2 7 6$' "$work/cube.off" | sed 's/^8 12 0$/8 10 0/' >"$work/open_cube.off"
+check distance-winding 0 '"points":512,"signed":true,"sign":"winding","inside":64' -- "$meshcast" distance "$work/open_cube.off" --grid 8 --margin 0.5 --signed --sign winding --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8
+"$meshcast" distance "$work/open_cube.off" --grid 8 --margin 0.5 --signed --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8 | grep -q '"inside":64' &&
+  { echo "FAIL distance-winding: parity found every cell of the open cube inside (the test's hole does not show)"; failures=$((failures + 1)); }
+check distance-sign 2 "--sign: votes not in \{parity,winding\}|votes" -- "$meshcast" distance "$work/cube.off" --grid 4 --signed --sign votes --out "$work/x.npy"
 check distance-both 2 "--points FILE.npy or --grid N, one of them" -- "$meshcast" distance "$work/cube.off" --grid 4 --points "$work/p.npy" --out "$work/x.npy"
 check distance-not-npy 2 "cube.off: not a .npy file" -- "$meshcast" distance "$work/cube.off" --points "$work/cube.off" --out "$work/x.npy"
 check distance-layout 2 "point queries walk OctTreeCompressed layouts.*AABBTree/Float3" -- "$meshcast" distance "$work/cube.off" --grid 4 --layout AABBTree/Float3 --out "$work/x.npy"

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "cpu/crossings.h"
 #include "host/chunks.h"
 #include "host/jobs.h"
 #include "layout/blob_format.h"
 #include "meshcast/blob.h"
+#include "meshcast/winding_number.h"
 #include "tools/commands.h"
 #include "tools/npy.h"
 
@@ -26,6 +28,7 @@ struct DistanceArgs {
   double margin = 0.05;
   float max_distance = INFINITY;
   bool signed_distance = false;
+  std::string sign = "parity";  // how --signed tells inside: parity or winding
   uint32_t threads = 0;
   bool json = false;
   LayoutArgs layout;
@@ -83,14 +86,22 @@ void run(const DistanceArgs& a) {
   const double setup_ms = ms_since(t0);
   t0 = std::chrono::steady_clock::now();
   std::vector<ClosestPoint> found(points.size());
-  std::vector<uint32_t> crossings(a.signed_distance ? points.size() : 0);
+  const bool by_winding = a.signed_distance && a.sign == "winding";
+  std::vector<uint32_t> crossings(a.signed_distance && !by_winding ? points.size() : 0);
+  std::vector<uint8_t> enclosed(by_winding ? points.size() : 0);
   const TriangleCorners corners(view.bytes());  // one table for every chunk's inside test
+  std::optional<WindingNumbers> winding;  // the clusters, made once for every chunk
+  if (by_winding) winding.emplace(view);
   host::WorkerPool pool(a.threads);
   const host::Chunks plan = host::plan_chunks(points.size(), pool.threads());
   host::for_each_chunk(plan, &pool, [&](size_t c) {
     const size_t begin = plan.begin(c), n = plan.end(c) - begin;
     view.closest_points(std::span(points).subspan(begin, n), std::span(found).subspan(begin, n), a.max_distance);
     if (!a.signed_distance) return;
+    if (by_winding) {
+      winding->inside(std::span(points).subspan(begin, n), std::span(enclosed).subspan(begin, n));
+      return;
+    }
     std::vector<Ray> rays(n);
     for (size_t i = 0; i < n; ++i)
       rays[i] = Ray{{points[begin + i].x, points[begin + i].y, points[begin + i].z},
@@ -102,7 +113,7 @@ void run(const DistanceArgs& a) {
   std::vector<uint32_t> triangle(points.size());
   size_t inside = 0, none = 0;
   for (size_t i = 0; i < points.size(); ++i) {
-    const bool in_mesh = a.signed_distance && crossings[i] % 2 == 1;
+    const bool in_mesh = by_winding ? enclosed[i] != 0 : a.signed_distance && crossings[i] % 2 == 1;
     inside += in_mesh;
     none += found[i].triangle == kNoHit;
     distance[i] = in_mesh ? -found[i].distance : found[i].distance;
@@ -113,7 +124,7 @@ void run(const DistanceArgs& a) {
   const double ns = points.empty() ? 0 : query_ms * 1e6 / double(points.size());
   if (a.json) {
     print_json({{"input", a.input}, {"layout", layout_name(view.layout())}, {"points", points.size()},
-                {"signed", a.signed_distance}, {"inside", inside}, {"none_within_limit", none},
+                {"signed", a.signed_distance}, {"sign", a.sign}, {"inside", inside}, {"none_within_limit", none},
                 {"threads", pool.threads()}, {"ns_per_point", ns}, {"out", a.out}});
     return;
   }
@@ -146,6 +157,10 @@ void add_distance(CLI::App& app) {
   cmd->add_flag("--signed", args->signed_distance,
                 "negative inside: an odd number of crossings of a ray from the point (a crossing through an edge "
                 "or vertex counts once), exact on a closed mesh wound either way");
+  cmd->add_option("--sign", args->sign,
+                  "--signed's inside test: parity (a ray's crossings, the default) or winding (the generalized "
+                  "winding number above 1/2 in magnitude: right on meshes with holes, gaps and self-intersections)")
+      ->check(CLI::IsMember({"parity", "winding"}));
   cmd->add_option("--threads", args->threads, "threads (0: every core, the default)")->check(integer_in(0, 1024));
   cmd->add_flag("--json", args->json, "print the figures as one JSON object");
   add_layout_options(cmd, args->layout);

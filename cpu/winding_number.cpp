@@ -206,7 +206,7 @@ void WindingNumbers::inside(std::span<const Vec3> points, std::span<uint8_t> out
     const double p[3] = {points[i].x, points[i].y, points[i].z};
     // Loose, then tight, then every triangle: each step only where the
     // last left |w| within its bound of 1/2.
-    static const double ratios[] = {ratio_for(0.3), ratio_for(1e-2), INFINITY};
+    static const double ratios[] = {ratio_for(kInsideTolerances[0]), ratio_for(kInsideTolerances[1]), INFINITY};
     Answer a;
     for (const double ratio : ratios) {
       a = walk(p, ratio);

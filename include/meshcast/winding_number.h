@@ -55,6 +55,9 @@ class WindingNumbers {
   // tightly where that leaves it in doubt, and on the exact sum where the
   // tight bound still does. UsageError when out is shorter than points.
   void inside(std::span<const Vec3> points, std::span<uint8_t> out) const;
+  // The tolerances inside() tries in turn before the exact sum (a caller
+  // summing several blobs' numbers decides as it does).
+  static constexpr double kInsideTolerances[2] = {0.3, 1e-2};
 
   size_t nbytes() const { return clusters_.capacity() * sizeof(Cluster); }
 

@@ -164,8 +164,10 @@ std::string number(double x) {
 
 namespace {
 
-// Why ray i is not a ray the walkers take, without its index, or "".
-std::string refusal_reason(const RayArrays& rays, size_t i, bool float_origin) {
+// Whether ray i breaks a rule of the walkers', and with `why`, which one
+// in words (without its index). The words are made only when asked for: a
+// batch of padded pixels answered as misses asks this of each of them.
+bool breaks_a_rule(const RayArrays& rays, size_t i, bool float_origin, std::string* why) {
   RayD r = rays.ray_d(i);
   double o[3], d[3];
   for (int k = 0; k < 3; ++k) {
@@ -173,27 +175,35 @@ std::string refusal_reason(const RayArrays& rays, size_t i, bool float_origin) {
     o[k] = float_origin ? double(float(r.org[k])) : r.org[k];
     d[k] = read_real(rays.dir + i * rays.dir_stride + k * (rays.dir_double ? 8 : 4), rays.dir_double);
   }
+  const auto broken = [why](const auto& words) {
+    if (why) *why = words();
+    return true;
+  };
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(o[k])) return "origin " + triple(o) + " is not finite";
+    if (!std::isfinite(o[k])) return broken([&] { return "origin " + triple(o) + " is not finite"; });
   for (int k = 0; k < 3; ++k)
-    if (std::fabs(o[k]) > kMaxCoordinate) return "origin " + triple(o) + " lies beyond 2^100 on an axis";
+    if (std::fabs(o[k]) > kMaxCoordinate)
+      return broken([&] { return "origin " + triple(o) + " lies beyond 2^100 on an axis"; });
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(d[k]) || !std::isfinite(r.dir[k])) return "direction " + triple(d) + " is not finite (in float)";
+    if (!std::isfinite(d[k]) || !std::isfinite(r.dir[k]))
+      return broken([&] { return "direction " + triple(d) + " is not finite (in float)"; });
   for (int k = 0; k < 3; ++k)
-    if (std::fabs(r.dir[k]) > kMaxDirection) return "direction " + triple(d) + " has a component beyond 2^126";
+    if (std::fabs(r.dir[k]) > kMaxDirection)
+      return broken([&] { return "direction " + triple(d) + " has a component beyond 2^126"; });
   if (std::fabs(r.dir[0]) < FLT_MIN && std::fabs(r.dir[1]) < FLT_MIN && std::fabs(r.dir[2]) < FLT_MIN)
-    return "direction " + triple(d) + " is zero (every component below FLT_MIN)";
-  if (std::isnan(r.tmax) || r.tmax < 0) return "t_max " + number(r.tmax) + " is NaN or negative";
-  if (std::isnan(r.tmin) || r.tmin < 0) return "t_min " + number(r.tmin) + " is NaN or negative";
-  if (r.tmin > r.tmax) return "t_min " + number(r.tmin) + " is above t_max " + number(r.tmax);
-  return "";
+    return broken([&] { return "direction " + triple(d) + " is zero (every component below FLT_MIN)"; });
+  if (std::isnan(r.tmax) || r.tmax < 0) return broken([&] { return "t_max " + number(r.tmax) + " is NaN or negative"; });
+  if (std::isnan(r.tmin) || r.tmin < 0) return broken([&] { return "t_min " + number(r.tmin) + " is NaN or negative"; });
+  if (r.tmin > r.tmax)
+    return broken([&] { return "t_min " + number(r.tmin) + " is above t_max " + number(r.tmax); });
+  return false;
 }
 
 }  // namespace
 
 std::string refusal(const RayArrays& rays, size_t i, bool float_origin) {
-  std::string why = refusal_reason(rays, i, float_origin);
-  return why.empty() ? why : "rays[" + std::to_string(i) + "]: " + why;
+  std::string why;
+  return breaks_a_rule(rays, i, float_origin, &why) ? "rays[" + std::to_string(i) + "]: " + why : "";
 }
 
 Invalid parse_invalid(const std::string& name) {
@@ -215,7 +225,7 @@ void raise_for_refused(const RayArrays& rays, const Refused& refused, bool float
     // world that some geometry's frame could not take (below) is not, and
     // is still raised.
     uint64_t not_rays = 0;
-    for (size_t j = i; j < rays.count; ++j) not_rays += !refusal_reason(rays, j, float_origin).empty();
+    for (size_t j = i; j < rays.count; ++j) not_rays += breaks_a_rule(rays, j, float_origin, nullptr);
     if (not_rays == refused.count) return;
     if (!why.empty())
       throw py::value_error(std::to_string(refused.count - not_rays) + " of " + std::to_string(rays.count) +

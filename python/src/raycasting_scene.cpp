@@ -481,7 +481,7 @@ class RaycastingScene {
       for_each_winding_chunk(points, nthreads, [&](const Geometries& geometries, size_t begin, size_t n) {
         std::vector<size_t> doubt(n);
         for (size_t i = 0; i < n; ++i) doubt[i] = begin + i;
-        for (const double tolerance : {0.3, 1e-2}) {
+        for (const double tolerance : WindingNumbers::kInsideTolerances) {
           std::vector<size_t> still;
           // The points in doubt, one at a time (n = 1 from each).
           for (const size_t i : doubt) {

@@ -178,7 +178,7 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
   const layout::BlobHeader& h = layout::header_of(bytes_.data());
   if (h.tree_format != uint32_t(TreeFormat::OctTreeCompressed))
     throw UsageError("BlobView::closest_points: point queries walk OctTreeCompressed blobs (the recommended layout, "
-                     "and the exact OctTreeCompressed/Float3SOA8); this blob is " + layout_name(layout()));
+                     "and the exact OctTreeCompressed/ClusterFloat3SOA8); this blob is " + layout_name(layout()));
   uint64_t skipped = 0;
   std::vector<Pending> heap;
   heap.reserve(256);
@@ -243,7 +243,7 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
     const layout::BlobHeader& h = layout::header_of(mesh->bytes.data());
     if (h.tree_format != uint32_t(TreeFormat::OctTreeCompressed))
       throw UsageError("Scene::closest_points: point queries walk OctTreeCompressed blobs (the recommended layout, "
-                       "and the exact OctTreeCompressed/Float3SOA8); mesh " + mesh->name + " is " +
+                       "and the exact OctTreeCompressed/ClusterFloat3SOA8); mesh " + mesh->name + " is " +
                        layout_name(mesh->view.layout()));
   }
   // Each placed instance's frame, the point aside.

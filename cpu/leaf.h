@@ -286,15 +286,18 @@ template <TriangleTest kTest>
   }
 }
 
-// A cluster's vertices along axis `a`, decoded into registers.
+// A cluster's vertices along axis `a`, decoded (or loaded) into registers.
 template <class Codec>
 [[gnu::always_inline]] inline simd::V16 decode_cluster_axis(const uint8_t* blob, const layout::BlobHeader& h, uint32_t at, int a) {
-  const uint64_t origin = layout::load<uint64_t>(blob + at);
   const uint32_t vertices = Codec::vertex_count(blob, at);
   const bool wide = Codec::wide(blob, at);
-  const uint32_t row_bytes = (wide ? 4 : 2) * vertices;
-  return simd::cluster_decode(blob + Codec::rows_at(blob, at) + uint32_t(a) * row_bytes, vertices, wide,
-                              layout::bitpack_component(origin, a), h.quant_scale[a], h.quant_offset[a]);
+  const uint8_t* row = blob + Codec::rows_at(blob, at) + uint32_t(a) * Codec::row_bytes(vertices, wide);
+  if constexpr (Codec::kExact) {
+    return simd::cluster_load(row, vertices);
+  } else {
+    const uint64_t origin = layout::load<uint64_t>(blob + at);
+    return simd::cluster_decode(row, vertices, wide, layout::bitpack_component(origin, a), h.quant_scale[a], h.quant_offset[a]);
+  }
 }
 
 // Cluster leaves (layout/triangles/cluster.h): each cluster's 16 vertices

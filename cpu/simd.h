@@ -170,6 +170,13 @@ inline V16 cluster_decode(const uint8_t* row, uint32_t count, bool wide, uint32_
   return {{_mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(lo, o)), s, b)},
           {_mm256_fmadd_ps(_mm256_cvtepi32_ps(_mm256_add_epi32(hi, o)), s, b)}};
 }
+// ClusterFloat3SOA8's row: the `count` floats themselves (lanes past it 0).
+inline V16 cluster_load(const uint8_t* row, uint32_t count) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const float* p = reinterpret_cast<const float*>(row);
+  return {{_mm256_maskload_ps(p, _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count)), lane))},
+          {_mm256_maskload_ps(p + 8, _mm256_cmpgt_epi32(_mm256_set1_epi32(int(count) - 8), lane))}};
+}
 inline F8 cluster_pick(const V16& v, uint32_t nibbles) {
   const __m256i idx = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(nibbles)), _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
                                        _mm256_set1_epi32(15));
@@ -329,6 +336,14 @@ inline V16 cluster_decode(const uint8_t* row, uint32_t count, bool wide, uint32_
     uint32_t q = 0;
     if (i < count) std::memcpy(&q, row + (wide ? 4 : 2) * i, wide ? 4 : 2);
     r.v[i] = __builtin_fmaf(float(q + origin), scale, offset);
+  }
+  return r;
+}
+inline V16 cluster_load(const uint8_t* row, uint32_t count) {
+  V16 r;
+  for (uint32_t i = 0; i < 16; ++i) {
+    r.v[i] = 0.0f;
+    if (i < count) std::memcpy(&r.v[i], row + 4 * i, 4);
   }
   return r;
 }

@@ -51,7 +51,7 @@ WindingNumbers::WindingNumbers(const BlobView& view) : blob_(view.bytes()) {
   const layout::BlobHeader& h = layout::header_of(blob_.data());
   if (h.tree_format != uint32_t(TreeFormat::OctTreeCompressed))
     throw UsageError("WindingNumbers: winding numbers walk OctTreeCompressed blobs (the recommended layout, and the "
-                     "exact OctTreeCompressed/Float3SOA8); this blob is " + layout_name(view.layout()));
+                     "exact OctTreeCompressed/ClusterFloat3SOA8); this blob is " + layout_name(view.layout()));
   clusters_.resize(1);
   fill(0, h.root);
   clusters_.shrink_to_fit();

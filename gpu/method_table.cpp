@@ -36,6 +36,7 @@ const MethodReading kTable[] = {
     {{"aabbtree", {TF::AABBTree, TRI::UncompressedStrip}}, MC_SPIRV(aabbtree_strip), {}, make_walker},
     {{"quadtree", {TF::QuadTreeHalfFloat, TRI::Indexed8BitPackSOA4}}, MC_SPIRV(quadtree_i8), {}, make_walker},
     {{"octtree", {TF::OctTreeCompressed, TRI::ClusterBitPackSOA8}}, MC_SPIRV(octtree_cluster), {}, make_walker},
+    {{"octtree", {TF::OctTreeCompressed, TRI::ClusterFloat3SOA8}}, MC_SPIRV(octtree_cluster), {}, make_walker},
     {{"aabblist", {TF::AABBList, TRI::Float3SOA128}}, MC_SPIRV(aabblist_float3), MC_SPIRV(resolve_float3),
      make_aabblist_method},
     {{"aabblist", {TF::AABBList, TRI::BitPackSOA128}}, MC_SPIRV(aabblist_bitpack), MC_SPIRV(resolve_bitpack),

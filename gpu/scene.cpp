@@ -1,5 +1,7 @@
 #include "gpu/scene.h"
 
+#include <algorithm>
+
 #include <cstddef>
 #include <cstring>
 #include <stdexcept>
@@ -23,7 +25,9 @@ constexpr uint32_t kTopNodes = 18, kTopPlacedAt = 19, kTopWideAt = 20, kTopMeshB
 constexpr uint32_t kSceneHitWords = 6;
 constexpr uint32_t kGroup = 64;
 // The one layout the scene shader reads (its walk is the octtree method's).
-constexpr Layout kSceneLayout{TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8};
+// The layouts shaders/octtree_walk.glsl reads: the octtree over either cluster.
+constexpr Layout kSceneLayouts[] = {{TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8},
+                                    {TreeFormat::OctTreeCompressed, TriangleFormat::ClusterFloat3SOA8}};
 
 struct ScenePush {
   uint32_t ray_base, ray_count, mask;
@@ -96,9 +100,10 @@ std::string SceneMethod::refusal(const SceneSnapshot& s) {
   uint64_t bytes = 0;
   for (const auto& m : s.meshes) {
     const layout::BlobHeader& h = layout::header_of(m->bytes.data());
-    if (h.tree_format != uint32_t(kSceneLayout.tree) || h.triangle_format != uint32_t(kSceneLayout.triangles))
-      return m->name + ": the GPU scene method reads " + layout_name(kSceneLayout) + " blobs, not " +
-             layout_name(h.tree_format, h.triangle_format);
+    const Layout l{TreeFormat(h.tree_format), TriangleFormat(h.triangle_format)};
+    if (std::find(std::begin(kSceneLayouts), std::end(kSceneLayouts), l) == std::end(kSceneLayouts))
+      return m->name + ": the GPU scene method reads " + layout_name(kSceneLayouts[0]) + " and " +
+             layout_name(kSceneLayouts[1]) + " blobs, not " + layout_name(h.tree_format, h.triangle_format);
     bytes += (m->bytes.size() + 3) / 4 * 4;  // each blob starts on a word
     if (bytes / 4 >= (uint64_t(1) << 32))
       return m->name + ": the scene's blobs pass 2^32 words, more than the GPU scene method addresses";

@@ -2,7 +2,8 @@
 // snapshot's top level and then each instance's blob, reading the bytes
 // Scene::commit() made (the placed records and wide nodes, copied
 // unchanged) and the blobs the CPU walks. Every mesh must be in the
-// recommended layout, OctTreeCompressed/ClusterBitPackSOA8.
+// recommended layout, OctTreeCompressed/ClusterBitPackSOA8, or its exact
+// twin OctTreeCompressed/ClusterFloat3SOA8.
 #pragma once
 #include <cstdint>
 #include <memory>

@@ -106,6 +106,7 @@
 #define MC_TRI_FLOAT3PAIRSOA4 18u      // seed 003: triangle pairs, the shared edge stored once
 #define MC_TRI_INDEXED24 17u           // seed 004: 32-bit index words, 24 bits of vertex index, 8 of tree
 #define MC_TRI_CLUSTERBITPACKSOA8 19u  // clusters of mesh-grid vertices stored once, 4-bit indices
+#define MC_TRI_CLUSTERFLOAT3SOA8 20u   // the same clusters over the mesh's own float vertices
 
 // ClusterBitPackSOA8: a leaf is a run of clusters, each
 //   Origin     uint64 BitPack word: the mesh-grid codes (18 bits used of
@@ -127,6 +128,15 @@
 #define MC_CLUSTER_WIDE 0x80u
 #define MC_CLUSTER_BLOCK_LANES 8u
 #define MC_CLUSTER_INDEX_BLOCK_BYTES 12u
+
+// ClusterFloat3SOA8: the same clusters with the vertices as the mesh gives
+// them, nothing moved:
+//   Vertices   byte: the cluster's vertex count (1..16)
+//   Triangles  byte: its triangle count (1..16)
+//   (2 bytes, 0: the rows below stay 4-aligned)
+//   Indices    as ClusterBitPackSOA8's
+//   Vertices   rows X[v], Y[v], Z[v] of float32
+#define MC_CLUSTER_FLOAT_HEADER_BYTES 4u
 
 // Zero-byte tree (seed 004). Triangle P starts a node when a walk reaches
 // it: the top bytes of its three index words, low byte first, hold the

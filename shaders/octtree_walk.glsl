@@ -1,10 +1,10 @@
-// The walk of OctTreeCompressed (layout/tree/octtree.h) with ClusterBitPackSOA8
-// leaves (layout/triangles/cluster.h), one ray a thread: cpu/walk_octtree.cpp's (8
+// The walk of OctTreeCompressed (layout/tree/octtree.h) with cluster leaves
+// (ClusterBitPackSOA8 or ClusterFloat3SOA8, layout/triangles/cluster.h), one ray a thread: cpu/walk_octtree.cpp's (8
 // child boxes decoded and tested, the hit ones pushed farthest first,
 // popped entries dropped once the closest hit is nearer). A child bound is
 // Origin + q * 2^e, exact in float, so a plain product and sum (precise)
-// give the CPU's bits; a cluster vertex is BitPack's decode of its grid
-// code (fma_exact), the CPU's std::fma. The blob method (octtree_cluster)
+// give the CPU's bits; a grid cluster's vertex is BitPack's decode of its
+// grid code (fma_exact), the CPU's std::fma. The blob method (octtree_cluster)
 // and the scene method (scene_octtree) walk with it.
 #ifndef MESHCAST_OCTTREE_WALK_GLSL
 #define MESHCAST_OCTTREE_WALK_GLSL
@@ -30,8 +30,11 @@ void oct_child_box(uint at, uint k, out vec3 mn, out vec3 mx) {
   }
 }
 
-// Vertex k of the cluster at blob offset `at`, whose offset rows start at `rows`.
-vec3 cluster_vertex(uint at, uint rows, uint vertices, bool wide, uint k) {
+// Vertex k of the cluster at blob offset `at`, whose vertex rows start at
+// `rows`: a float of ClusterFloat3SOA8 (4-aligned) as stored, or
+// ClusterBitPackSOA8's grid offset decoded.
+vec3 cluster_vertex(bool exact, uint at, uint rows, uint vertices, bool wide, uint k) {
+  if (exact) return vec3(blob_f32(rows + 4u * k), blob_f32(rows + 4u * (vertices + k)), blob_f32(rows + 4u * (2u * vertices + k)));
   const uint64_t origin = uint64_t(blob_u32_at2(at)) | (uint64_t(blob_u32_at2(at + 4u)) << 32);  // clusters are 2-aligned
   vec3 v;
   for (uint a = 0u; a < 3u; ++a) {
@@ -43,24 +46,29 @@ vec3 cluster_vertex(uint at, uint rows, uint vertices, bool wide, uint k) {
   return v;
 }
 
+// A leaf of either cluster format (the blob's header says which; the
+// layouts differ only in the header's size and the vertex rows).
 void test_cluster_leaf(GpuRay r, uint block, uint count, uint slot0, inout Closest c) {
+  const bool exact = header(MC_HDR_TRIANGLE_FORMAT) == MC_TRI_CLUSTERFLOAT3SOA8;
+  const uint counts_at = exact ? 0u : 8u;
+  const uint header_bytes = exact ? MC_CLUSTER_FLOAT_HEADER_BYTES : MC_CLUSTER_HEADER_BYTES;
   uint at = block, made = 0u;
   while (made < count) {
-    const uint flags = blob_u8(at + 8u), vertices = flags & 31u, triangles = blob_u8(at + 9u);
-    const bool wide = (flags & MC_CLUSTER_WIDE) != 0u;
-    const uint index = at + MC_CLUSTER_HEADER_BYTES;
+    const uint flags = blob_u8(at + counts_at), vertices = flags & 31u, triangles = blob_u8(at + counts_at + 1u);
+    const bool wide = !exact && (flags & MC_CLUSTER_WIDE) != 0u;
+    const uint index = at + header_bytes;
     const uint rows = index + (triangles + 7u) / 8u * MC_CLUSTER_INDEX_BLOCK_BYTES;
     for (uint i = 0u; i < triangles; ++i) {
       const uint word = index + (i / 8u) * MC_CLUSTER_INDEX_BLOCK_BYTES, shift = 4u * (i % 8u);
       const uint k0 = (blob_u32_at2(word) >> shift) & 15u;
       const uint k1 = (blob_u32_at2(word + 4u) >> shift) & 15u;
       const uint k2 = (blob_u32_at2(word + 8u) >> shift) & 15u;
-      consider(r, cluster_vertex(at, rows, vertices, wide, k0), cluster_vertex(at, rows, vertices, wide, k1),
-               cluster_vertex(at, rows, vertices, wide, k2), slot0 + made + i, c);
+      consider(r, cluster_vertex(exact, at, rows, vertices, wide, k0), cluster_vertex(exact, at, rows, vertices, wide, k1),
+               cluster_vertex(exact, at, rows, vertices, wide, k2), slot0 + made + i, c);
     }
     made += triangles;
-    at = rows + (wide ? 12u * vertices : 2u * (3u * vertices + (vertices & 1u)));
-    at = max(at, index - MC_CLUSTER_HEADER_BYTES + 4u * triangles);  // the 4-bytes-a-triangle floor (cluster_bytes)
+    at = rows + (exact || wide ? 12u * vertices : 2u * (3u * vertices + (vertices & 1u)));
+    at = max(at, index - header_bytes + 4u * triangles);  // the 4-bytes-a-triangle floor (cluster_bytes)
   }
 }
 

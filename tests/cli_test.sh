@@ -350,10 +350,10 @@ done
 check trace-vulkan-auto-method 0 '"layout":"StacklessLBVH/Float3"' -- "$meshcast" trace "$mesh" --layout auto --backend vulkan --method lbvh --rays "$work/r.rays" --out "$work/hx.hits" --repeat 1 --json
 # A layout no GPU method reads, and a method that does not exist, are
 # refused naming them and what the methods read (not "GPU method ''").
-check trace-vulkan-no-method 2 "no GPU method reads QuadTree/Float3SOA4 blobs.*octtree \(OctTreeCompressed/ClusterBitPackSOA8\)" -- "$meshcast" trace "$mesh" --layout QuadTree/Float3SOA4 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
+check trace-vulkan-no-method 2 "no GPU method reads QuadTree/Float3SOA4 blobs.*octtree \(OctTreeCompressed/ClusterBitPackSOA8 or OctTreeCompressed/ClusterFloat3SOA8\)" -- "$meshcast" trace "$mesh" --layout QuadTree/Float3SOA4 --backend vulkan --rays "$work/r.rays" --out "$work/hx.hits"
 check render-vulkan-no-method 2 "no GPU method reads QuadTree/Float3SOA4 blobs" -- "$meshcast" render "$mesh" --layout QuadTree/Float3SOA4 --backend vulkan --png "$work/x.png" --width 16 --height 16
 check trace-vulkan-unknown-method 2 "--method octree: no such GPU method; the methods: aabbtree" -- "$meshcast" trace "$mesh" --backend vulkan --method octree --rays "$work/r.rays" --out "$work/hx.hits"
-check trace-help-methods 0 "octtree \(OctTreeCompressed/ClusterBitPackSOA8\), aabblist \(AABBList/Float3SOA128 or AABBList/BitPackSOA128\)" -- "$meshcast" trace --help
+check trace-help-methods 0 "octtree \(OctTreeCompressed/ClusterBitPackSOA8 or OctTreeCompressed/ClusterFloat3SOA8\), aabblist \(AABBList/Float3SOA128 or AABBList/BitPackSOA128\)" -- "$meshcast" trace --help
 check vulkan-no-device 3 "no device matches" -- "$meshcast" trace "$mesh" --layout BruteForce/Float3SOA128 --backend vulkan --device nonesuch --rays "$work/r.rays" --out "$work/hx.hits"
 check missing-mesh 2 "nope.off" -- "$meshcast" info "$work/nope.off"
 printf 'OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n' >"$work/nan.off"
@@ -390,7 +390,7 @@ print(*struct.unpack("<3f", b[10 + n:]))' "$work/d.npy")
 # winding number is above 1/2 in every cell inside (0.61 at the cells
 # nearest the hole) and below it outside (0.39 there).
 grep -v '^3 2 3 7$\|^3 2 7 6$' "$work/cube.off" | sed 's/^8 12 0$/8 10 0/' >"$work/open_cube.off"
-check distance-winding 0 '"points":512,"signed":true,"sign":"winding","inside":64' -- "$meshcast" distance "$work/open_cube.off" --grid 8 --margin 0.5 --signed --sign winding --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8
+check distance-winding 0 '"points":512,"signed":true,"sign":"winding","inside":64' -- "$meshcast" distance "$work/open_cube.off" --grid 8 --margin 0.5 --signed --sign winding --json --out "$work/grid.npy" --layout OctTreeCompressed/ClusterFloat3SOA8
 "$meshcast" distance "$work/open_cube.off" --grid 8 --margin 0.5 --signed --json --out "$work/grid.npy" --layout OctTreeCompressed/Float3SOA8 | grep -q '"inside":64' &&
   { echo "FAIL distance-winding: parity found every cell of the open cube inside (the test's hole does not show)"; failures=$((failures + 1)); }
 check distance-sign 2 "--sign: votes not in \{parity,winding\}|votes" -- "$meshcast" distance "$work/cube.off" --grid 4 --signed --sign votes --out "$work/x.npy"

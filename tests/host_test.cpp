@@ -133,7 +133,8 @@ const char* const kGpuLayouts[] = {"OctTreeCompressed/ClusterBitPackSOA8"};
 const char* const kGpuLayouts[] = {"BruteForce/Float3SOA128", "BruteForce/BitPackSOA128", "AABBList/Float3SOA128",
                                    "AABBList/BitPackSOA128", "AABBTree/Float3",
                                    "AABBTree/UncompressedStrip", "SKDTree/Float3", "StacklessLBVH/Float3",
-                                   "QuadTreeHalfFloat/Indexed8BitPackSOA4", "OctTreeCompressed/ClusterBitPackSOA8"};
+                                   "QuadTreeHalfFloat/Indexed8BitPackSOA4", "OctTreeCompressed/ClusterBitPackSOA8",
+                                   "OctTreeCompressed/ClusterFloat3SOA8"};
 #endif
 
 TEST(Host, SubmitWaitEqualsTheSynchronousCpuOnEveryGpuLayout) {

@@ -1,7 +1,8 @@
 // Point queries (BlobView::closest_points) against the double-precision
 // oracle of check/point_oracle.h, every triangle tried: on the recommended
 // layout (quantized: judged on the mesh it stores, and against the input
-// mesh within its stated bound) and on the exact OctTreeCompressed/Float3SOA8.
+// mesh within its stated bound) and on the exact OctTreeCompressed/Float3SOA8
+// and OctTreeCompressed/ClusterFloat3SOA8.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,7 +18,10 @@
 namespace meshcast::testing {
 namespace {
 
-const char* const kPointLayouts[] = {"OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/Float3SOA8"};
+// The compact cluster first, then the exact layouts: 8-wide float blocks,
+// the exact cluster.
+const char* const kPointLayouts[] = {"OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/Float3SOA8",
+                                     "OctTreeCompressed/ClusterFloat3SOA8"};
 
 // Points of every kind a user asks about: scattered through the mesh's box
 // grown by a fifth, just off the surface (a triangle's point moved along

@@ -51,10 +51,10 @@ gpu::SceneMethod& scene_method(Query query, Cull cull, HitOutputs outputs) {
 constexpr bool kGpu = false;
 #endif
 
-// The layouts the levels are built in: the GPU build walks the one its
+// The layouts the levels are built in: the GPU build walks the ones its
 // scene method reads.
 std::vector<std::string> walked_layouts() {
-  if (kGpu) return {"OctTreeCompressed/ClusterBitPackSOA8"};
+  if (kGpu) return {"OctTreeCompressed/ClusterBitPackSOA8", "OctTreeCompressed/ClusterFloat3SOA8"};
   return {"OctTreeCompressed/ClusterBitPackSOA8", "AABBTree/Float3", "QuadTreeHalfFloat/Indexed8BitPackSOA4"};
 }
 

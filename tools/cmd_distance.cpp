@@ -46,7 +46,7 @@ void run(const DistanceArgs& a) {
   const layout::BlobHeader& h = layout::header_of(in.blob.data());
   if (view.layout().tree != TreeFormat::OctTreeCompressed)
     throw InputError("distance " + a.input + ": point queries walk OctTreeCompressed layouts (the recommended one, or "
-                     "OctTreeCompressed/Float3SOA8, exact); this blob is " + layout_name(view.layout()));
+                     "OctTreeCompressed/ClusterFloat3SOA8, exact); this blob is " + layout_name(view.layout()));
   // The points, and the shape the answers take.
   std::vector<Vec3> points;
   std::vector<uint64_t> shape;

@@ -55,6 +55,7 @@ enum class TriangleFormat : uint32_t {
   Indexed24 = 17,
   Float3PairSOA4 = 18,
   ClusterBitPackSOA8 = 19,  // clusters of up to 16 mesh-grid vertices stored once, 4-bit indices
+  ClusterFloat3SOA8 = 20,   // the same clusters over the mesh's float vertices: exact
 };
 
 // A tree format with a triangle format. The default is the recommended

@@ -17,7 +17,8 @@
 // snapshot), while the game moves, hides and adds instances and commits the
 // next frames. The CPU's workers walk it, or with Backend::Vulkan the GPU
 // (closest or any hit of meshes in the recommended layout,
-// OctTreeCompressed/ClusterBitPackSOA8: gpu/scene.h), one scene batch on
+// OctTreeCompressed/ClusterBitPackSOA8, or the exact
+// OctTreeCompressed/ClusterFloat3SOA8: gpu/scene.h), one scene batch on
 // the device at a time, begun in submission order by the caster's GPU
 // thread; Query::All, other layouts, a refused batch and a lost device
 // are the CPU's (BatchRecord::ran_on says which answered). The Automatic

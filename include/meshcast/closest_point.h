@@ -3,7 +3,7 @@
 // snapping. The nearest point on each triangle is worked out in double
 // from the stored corners, so a distance is the exact one to the stored
 // mesh, rounded once to float. On a layout that stores vertices exactly
-// (Float3SOA8) that is the input mesh; on a quantized one
+// (ClusterFloat3SOA8, Float3SOA8) that is the input mesh; on a quantized one
 // (ClusterBitPackSOA8) the stored corners lie within the layout's stated
 // bound of the input's (relative_error_bound, a fraction of the mesh's
 // diagonal), and so does every distance.

@@ -33,6 +33,8 @@ void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[
 void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]) {
   if (header_of(blob).triangle_format == ClusterBitPackSOA8::kFormat)
     return ClusterBitPackSOA8::decode_leaf(blob, block, count, out);
+  if (header_of(blob).triangle_format == ClusterFloat3SOA8::kFormat)
+    return ClusterFloat3SOA8::decode_leaf(blob, block, count, out);
   for (uint32_t i = 0; i < count; ++i) decode_triangle(blob, block, i, out[i]);
 }
 

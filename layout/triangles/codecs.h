@@ -29,7 +29,8 @@
   X(UncompressedStrip, "UncompressedStrip")            \
   X(CompressedStrip, "CompressedStrip")                \
   X(Float3PairSOA4, "Float3PairSOA4")                  \
-  X(ClusterBitPackSOA8, "ClusterBitPackSOA8")
+  X(ClusterBitPackSOA8, "ClusterBitPackSOA8")          \
+  X(ClusterFloat3SOA8, "ClusterFloat3SOA8")
 
 namespace meshcast::layout {
 #define MC_CHECK_CODEC(Codec, name) static_assert(TriangleCodec<Codec>, name " meets the codec contract");

@@ -1,10 +1,12 @@
 // meshcast.RaycastingScene: Open3D's RaycastingScene (open3d.t.geometry)
 // with its names, shapes, dtypes and sentinels, on a meshcast Scene. Each
-// add_triangles() builds a blob in the recommended layout from the mesh
-// taken relative to a float64 centre, the centre becoming its instance's
-// translation: meshes far from the origin keep their precision.
+// add_triangles() builds a blob from the mesh taken relative to a float64
+// centre, the centre becoming its instance's translation: meshes far from
+// the origin keep their precision. The blob is exact unless the user allows
+// an error (GeometryLayout).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <array>
 #include <atomic>
@@ -18,7 +20,9 @@
 #include <optional>
 #include <vector>
 
+#include "builder/error_bounds.h"
 #include "meshcast/build.h"
+#include "meshcast/errors.h"
 #include "meshcast/scene.h"
 #include "meshcast/winding_number.h"
 #include "python/src/arrays.h"
@@ -203,12 +207,20 @@ std::vector<Record> whole_row(const Target& target, const RayArrays& rays, size_
     const size_t before = row.size();
     while (!row.empty() && row.back().t == from) row.pop_back();
     const bool stuck = row.size() + kMaxHitsLimit <= before;  // a whole row at one t
-    ray.tmin = from;
+    // A walk decides t_min on the triangle test's own terms, not on the t
+    // it reports: a hit reported at `from` may fall just short of a t_min
+    // of `from`. So the walk starts a little before (the crossings'
+    // window) and what it finds before `from` (kept already) is dropped.
+    ray.tmin = from - std::ldexp(std::fabs(from), -20);
     more.clear();
     target.trace_all(std::span<const RayRecord>(&ray, 1), more, HitOutputs::Uv, Cull::None);
     const std::span<const Record> next = more.row(0);
-    row.insert(row.end(), next.begin(), next.end());
-    found = more.found[0];
+    uint32_t before_from = 0;
+    for (const Record& r : next) {
+      if (r.t < from) ++before_from;
+      else row.push_back(r);
+    }
+    found = more.found[0] - before_from;
     if (stuck && found > kMaxHitsLimit) {
       dropped += found - kMaxHitsLimit;
       break;
@@ -218,9 +230,38 @@ std::vector<Record> whole_row(const Target& target, const RayArrays& rays, size_
 }
 
 
+// The layout each geometry is built in. By default the exact cluster
+// (OctTreeCompressed/ClusterFloat3SOA8): every answer is the float mesh's,
+// as Open3D's are. `max_error` (a fraction of the mesh's diagonal) lets the
+// compact cluster (ClusterBitPackSOA8, about 30% fewer bytes) in where its
+// stated bound is within it; `layout` names one outright.
+struct GeometryLayout {
+  std::optional<std::string> named;
+  double max_error = 0;
+
+  std::vector<uint8_t> build(const Mesh& mesh, BuildOptions options, const std::string& name) const {
+    if (named) {
+      options.layout = parse_layout_name(*named);
+      std::vector<uint8_t> blob = build_blob(mesh, options, name);
+      const double bound = relative_error_bound(blob, mesh.bounds().diagonal());
+      if (max_error > 0 && bound > max_error)
+        throw InputError(name + ": layout " + *named + " states an error of " + std::to_string(bound) +
+                         " of the diagonal, over max_error=" + std::to_string(max_error));
+      return blob;
+    }
+    if (max_error > 0) {
+      options.layout = {TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8};
+      std::vector<uint8_t> blob = build_blob(mesh, options, name);
+      if (relative_error_bound(blob, mesh.bounds().diagonal()) <= max_error) return blob;
+    }
+    options.layout = {TreeFormat::OctTreeCompressed, TriangleFormat::ClusterFloat3SOA8};
+    return build_blob(mesh, options, name);
+  }
+};
+
 class RaycastingScene {
  public:
-  explicit RaycastingScene(uint32_t build_threads) : build_threads_(build_threads) {}
+  RaycastingScene(uint32_t build_threads, GeometryLayout layout) : build_threads_(build_threads), layout_(std::move(layout)) {}
   uint32_t add_triangles(const py::handle& vertices, const py::handle& triangles) {
     double lo[3], hi[3], centre[3];
     vertex_box(vertices, lo, hi);
@@ -237,7 +278,7 @@ class RaycastingScene {
       py::gil_scoped_release release;
       BuildOptions options;
       options.threads = build_threads_;
-      blob = build_blob(mesh, options, name);
+      blob = layout_.build(mesh, options, name);
       // Open3D's primitive_normals: the unit geometric normal (b - a) x (c - a).
       for (size_t i = 0; i < mesh.triangle_count(); ++i) {
         double e1[3], e2[3];
@@ -258,7 +299,7 @@ class RaycastingScene {
   // A scene of the same geometries, each blob and its normals copied (copy
   // and deepcopy in Python): adding to one leaves the other as it was.
   std::unique_ptr<RaycastingScene> copy() const {
-    auto twin = std::make_unique<RaycastingScene>(build_threads_);
+    auto twin = std::make_unique<RaycastingScene>(build_threads_, layout_);
     std::lock_guard<std::mutex> lock(mutex_), twin_lock(twin->mutex_);
     for (size_t g = 0; g < geometries_.size(); ++g) {
       const Geometry& from = *geometries_[g];
@@ -646,6 +687,7 @@ class RaycastingScene {
     for_each_chunk(plan, threads, [&](size_t c) { chunk(geometries, plan.begin(c), plan.end(c) - plan.begin(c)); });
   }
   const uint32_t build_threads_;  // BuildOptions::threads of add_triangles (0: every core)
+  const GeometryLayout layout_;
   mutable std::mutex mutex_;  // the geometries added, and the frame committed
   Scene scene_;
   Geometries geometries_;  // every geometry's, added so far
@@ -660,11 +702,15 @@ class RaycastingScene {
 
 void register_raycasting_scene(py::module_& m) {
   py::class_<RaycastingScene>(m, "_RaycastingScene")
-      .def(py::init([](long long nthreads) {
+      .def(py::init([](long long nthreads, std::optional<std::string> layout, double max_error) {
+             if (!(max_error >= 0) || !std::isfinite(max_error))
+               throw py::value_error("RaycastingScene: max_error must be a finite fraction >= 0, not " + std::to_string(max_error));
+             if (layout) parse_layout_name(*layout);  // a typo refused here, not at the first add_triangles
              // Open3D's: the threads its build uses (0: every core).
-             return std::make_unique<RaycastingScene>(nthreads == 0 ? 0 : thread_count(nthreads));
+             return std::make_unique<RaycastingScene>(nthreads == 0 ? 0 : thread_count(nthreads),
+                                                      GeometryLayout{std::move(layout), max_error});
            }),
-           py::arg("nthreads") = 0)
+           py::arg("nthreads") = 0, py::arg("layout") = py::none(), py::arg("max_error") = 0.0)
       .def("add_triangles", &RaycastingScene::add_triangles, py::arg("vertex_positions"), py::arg("triangle_indices"))
       .def("cast_rays", &RaycastingScene::cast_rays, py::arg("rays"), py::arg("nthreads") = 0,
            py::arg("uvs") = true, py::arg("normals") = true, py::arg("out") = py::none(), py::arg("backend") = "cpu")

@@ -15,6 +15,8 @@ import pytest
 import shapes
 import meshcast
 
+LAYOUT = "OctTreeCompressed/ClusterBitPackSOA8"
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 CLI = os.environ.get("MESHCAST_CLI", os.path.join(HERE, "..", "..", "build", "bin", "meshcast"))
 
@@ -42,7 +44,7 @@ def case(tmp_path_factory):
     extra_v, extra_t = shapes.soup(n=400, seed=5)
     triangles = np.concatenate([triangles, extra_t + len(vertices)])
     vertices = np.concatenate([vertices, extra_v]).astype(np.float32)
-    blob = meshcast.build(vertices, triangles, layout="OctTreeCompressed/ClusterBitPackSOA8")
+    blob = meshcast.build(vertices, triangles, layout=LAYOUT)
     blob.save(str(tmp / "mesh.mcb"))
     origins, directions = shapes.rays(vertices, 6000, seed=11)
     t_max = np.random.default_rng(3).choice(np.array([np.inf, 2.0, 5.0], np.float32), len(origins))
@@ -78,11 +80,12 @@ def test_blob_cast_is_the_library(case, query):
 def test_cast_rays_is_the_library(case):
     """RaycastingScene goes through a scene, the mesh stored about a centre
     rounded to a power of two at or above its extent: 0 for this mesh about
-    the origin, so the same walk gives the same answers."""
+    the origin, so in the saved blob's layout the same walk gives the same
+    answers."""
     tmp, vertices, triangles, _, origins, directions, _ = case
     write_rays(str(tmp / "unbounded.rays"), origins, directions, np.full(len(origins), np.inf, np.float32))
     t, triangle = trace(tmp, "closest", 1, "unbounded.rays")
-    scene = meshcast.RaycastingScene()
+    scene = meshcast.RaycastingScene(layout=LAYOUT)
     scene.add_triangles(vertices, triangles)
     got = scene.cast_rays(np.concatenate([origins, directions], axis=1))
     np.testing.assert_array_equal(np.asarray(got["primitive_ids"]), triangle)

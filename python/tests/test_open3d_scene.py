@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import meshcast
+import oracle
 import shapes
 from point_oracle import nearest, winding_number
 
@@ -320,3 +321,76 @@ def test_help_states_arguments_and_keys():
             if parameter not in ("self", "args", "kwargs", "memo"):
                 assert parameter in doc, f"{name}: {parameter}"
         assert "Tensor" in doc or "Returns" in doc or "rays" in doc, name
+
+
+def hits_against_float64(answer, rays, v, t, delta):
+    """The clean rays' t_hit against the oracle's within its tolerance for
+    corners moved by `delta`, and each hit's uv against the float64 point
+    on the triangle it names. Returns the largest t error in float32 ulps
+    of t, and the largest uv error."""
+    rays = np.asarray(rays, np.float64)
+    got_t = answer["t_hit"].numpy().astype(np.float64)
+    got_tri = answer["primitive_ids"].numpy().astype(np.int64)
+    got_uv = answer["primitive_uvs"].numpy().astype(np.float64)
+    truth = oracle.classify(oracle.brute_force(v, t, rays[:, :3], rays[:, 3:], delta=delta))
+    want_t, _, tol, unique = truth.nearest()
+    clean = truth.clean & unique & np.isfinite(want_t)
+    assert clean.sum() > 0.5 * len(rays)
+    error = np.abs(got_t[clean] - want_t[clean])
+    assert np.all(error <= tol[clean]), f"{(error > tol[clean]).sum()} hits beyond the oracle's tolerance"
+    ulps = (error / np.spacing(want_t[clean].astype(np.float32))).max()
+    hit = got_tri != meshcast.RaycastingScene.INVALID_ID
+    a, b, c = (v[t[got_tri[hit], k]].astype(np.float64) for k in range(3))
+    p = rays[hit, :3] + got_t[hit, None] * rays[hit, 3:]
+    # the point's barycentrics on its triangle's plane, in float64
+    e1, e2, w = b - a, c - a, p - a
+    d11, d12, d22 = (e1 * e1).sum(1), (e1 * e2).sum(1), (e2 * e2).sum(1)
+    w1, w2 = (w * e1).sum(1), (w * e2).sum(1)
+    det = d11 * d22 - d12 * d12
+    uv = np.stack([(d22 * w1 - d12 * w2) / det, (d11 * w2 - d12 * w1) / det], axis=1)
+    return ulps, np.abs(uv - got_uv[hit]).max()
+
+
+def test_exact_by_default_and_compact_when_allowed():
+    v, t = shapes.sphere(40, 60)
+    origins, directions = shapes.rays(v, 3000, seed=11, inside_fraction=0.5)
+    rays = np.concatenate([origins, directions], axis=1)
+    diagonal = oracle.mesh_diagonal(v)
+
+    # Exact: t within a few float32 ulps of the float64 hit (about 10
+    # measured), where the compact cluster's moved corners take it tens of
+    # thousands of ulps off at grazing angles.
+    exact = meshcast.RaycastingScene()
+    exact.add_triangles(v, t)
+    ulps, uv_error = hits_against_float64(exact.cast_rays(rays), rays, v, t, 0.0)
+    print("exact: t within", ulps, "ulps, uv within", uv_error)
+    assert ulps <= 64 and uv_error < 1e-4
+
+    # max_error lets the compact cluster in: its bound (below 4e-6 of the
+    # diagonal) holds, and the answers leave float rounding.
+    compact = meshcast.RaycastingScene(max_error=1e-5)
+    compact.add_triangles(v, t)
+    ulps, uv_error = hits_against_float64(compact.cast_rays(rays), rays, v, t, 4e-6 * diagonal)
+    print("compact: t within", ulps, "ulps, uv within", uv_error)
+    assert ulps > 1000
+    d_exact = exact.compute_distance(v[:200]).numpy()
+    assert np.all(d_exact <= 1e-6 * diagonal)  # the vertices themselves: on the mesh
+    assert compact.compute_distance(v[:200]).numpy().max() > 0  # moved to the grid
+
+    # A limit below the compact cluster's bound keeps every geometry exact.
+    tight = meshcast.RaycastingScene(max_error=1e-7)
+    tight.add_triangles(v, t)
+    assert np.array_equal(tight.cast_rays(rays)["t_hit"].numpy(), exact.cast_rays(rays)["t_hit"].numpy())
+
+    # A layout by name, and the refusals.
+    named = meshcast.RaycastingScene(layout="OctTreeCompressed/ClusterBitPackSOA8")
+    named.add_triangles(v, t)
+    assert np.array_equal(named.cast_rays(rays)["t_hit"].numpy(), compact.cast_rays(rays)["t_hit"].numpy())
+    with pytest.raises(ValueError, match="OctTreeCompressed/ClusterBitPackSOA8"):
+        meshcast.RaycastingScene(layout="OctTreeCompressed/ClusterBitPack")
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="max_error"):
+            meshcast.RaycastingScene(max_error=bad)
+    over = meshcast.RaycastingScene(layout="OctTreeCompressed/ClusterBitPackSOA8", max_error=1e-7)
+    with pytest.raises(ValueError, match="max_error"):
+        over.add_triangles(v, t)

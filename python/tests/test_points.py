@@ -12,6 +12,7 @@ import shapes
 from point_oracle import distance_to, nearest
 
 EXACT = "OctTreeCompressed/Float3SOA8"
+EXACT_CLUSTER = "OctTreeCompressed/ClusterFloat3SOA8"
 RECOMMENDED = "OctTreeCompressed/ClusterBitPackSOA8"
 
 
@@ -36,10 +37,11 @@ def tolerance(distance, scale):
 MESHES = {"sphere": shapes.sphere(), "grid": shapes.grid(), "soup": shapes.soup(), "octahedron": shapes.octahedron()}
 
 
+@pytest.mark.parametrize("layout", [EXACT, EXACT_CLUSTER])
 @pytest.mark.parametrize("name", sorted(MESHES))
-def test_exact_layout_distances_match_float64(name):
+def test_exact_layout_distances_match_float64(name, layout):
     v, t = MESHES[name]
-    blob = meshcast.build(v, t, layout=EXACT)
+    blob = meshcast.build(v, t, layout=layout)
     p = query_points(v, 120, 3)
     got = blob.closest_points(p)
     d, tri, q = nearest(p, v, t)

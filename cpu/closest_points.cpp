@@ -7,6 +7,13 @@
 // each triangle's nearest point is worked out in double from its stored
 // corners (cpu/point_triangle.h), after a test of its corners' box.
 //
+// The points are walked along a Morton curve (cpu/point_order.h), each
+// starting from its predecessor's nearest triangle: that triangle's
+// distance bounds the point's own from the start, so the walk drops at
+// once the boxes a walk from nothing would first have to visit to learn
+// it. The answer is the same: every box as near as the best is still
+// walked, and ties still go to the lower number.
+//
 // Scene::closest_points walks the same way through the scene's top level
 // (the instances' world boxes) and, for each instance near enough, its
 // blob in the instance's frame: the boxes' distances there scaled down to
@@ -15,9 +22,11 @@
 // distance.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
+#include "cpu/point_order.h"
 #include "cpu/point_triangle.h"
 #include "layout/blob_format.h"
 #include "layout/tree/top_level.h"
@@ -44,6 +53,10 @@ struct Best {
   PointOnTriangle near;
   uint32_t triangle = kNoHit;
   uint32_t instance = 0;  // a scene's instance id (a blob's walk: 0)
+  // The triangle's corners as stored, and the frame they were measured in
+  // (a scene's placed instance; a blob's walk: 0): the next point's start.
+  float corners[3][3] = {};
+  uint32_t frame = 0;
 };
 
 // The squared distance from p to the box [lo, hi] (0 inside): a leaf's
@@ -61,6 +74,7 @@ inline double box_d2(const double p[3], const Bound lo[3], const Bound hi[3]) {
 
 // Where a walk measures. The blob's own frame: distances as they are.
 struct OwnFrame {
+  static constexpr uint32_t index = 0;
   double p[3];  // the query point
   // A lower bound on the distance squared from a local box's squared one.
   double bound(double local_d2) const { return local_d2; }
@@ -73,6 +87,7 @@ struct OwnFrame {
 // float to_local, in double, as the walk of a ray sees it) for their
 // distances from the world point.
 struct InstanceFrame {
+  uint32_t index;  // the placed instance's
   double p[3];
   double world[3];
   double to_world[9];
@@ -93,6 +108,11 @@ void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset
                uint32_t instance, Best& best) {
   float corners[MC_OCT_MAX_COUNT][3][3];
   layout::decode_leaf(blob, h.tree_offset + offset, count, corners);
+  // The triangles whose corner box is near enough, nearest box first: the
+  // nearest triangle is then most often tested first, and its distance
+  // drops the boxes behind it untested.
+  double box[MC_OCT_MAX_COUNT];
+  uint32_t order[MC_OCT_MAX_COUNT], near_enough = 0;
   for (uint32_t i = 0; i < count; ++i) {
     const float(&v)[3][3] = corners[i];
     float lo[3], hi[3];
@@ -100,7 +120,15 @@ void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset
       lo[a] = std::min({v[0][a], v[1][a], v[2][a]});
       hi[a] = std::max({v[0][a], v[1][a], v[2][a]});
     }
-    if (frame.bound(box_d2(frame.p, lo, hi)) * kBoxSlack > best.d2) continue;
+    const double d2 = frame.bound(box_d2(frame.p, lo, hi)) * kBoxSlack;
+    if (d2 > best.d2) continue;
+    uint32_t j = near_enough++;
+    for (; j > 0 && box[j - 1] > d2; --j) box[j] = box[j - 1], order[j] = order[j - 1];
+    box[j] = d2, order[j] = i;
+  }
+  for (uint32_t j = 0; j < near_enough && box[j] <= best.d2; ++j) {
+    const uint32_t i = order[j];
+    const float(&v)[3][3] = corners[i];
     const PointOnTriangle near = frame.nearest(v);
     if (near.d2 > best.d2) continue;
     const uint32_t triangle = layout::remap_entry(blob, h, layout::slot_of(h, offset, i));
@@ -109,8 +137,18 @@ void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset
     if (near.d2 == best.d2 && best.triangle != kNoHit &&
         (instance > best.instance || (instance == best.instance && triangle > best.triangle)))
       continue;
-    best.d2 = near.d2, best.near = near, best.triangle = triangle, best.instance = instance;
+    best.d2 = near.d2, best.near = near, best.triangle = triangle, best.instance = instance, best.frame = frame.index;
+    std::memcpy(best.corners, v, sizeof best.corners);
   }
+}
+
+// The walk of a point starts from `last`, the previous point's answer,
+// where that triangle (`near`: its nearest point to this one) lies within
+// the limit.
+void start_from(const Best& last, const PointOnTriangle& near, Best& best) {
+  if (near.d2 > best.d2) return;
+  best = last;
+  best.d2 = near.d2, best.near = near;
 }
 
 // A child waiting to be walked, and its box's squared distance.
@@ -183,7 +221,8 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
   std::vector<Pending> heap;
   heap.reserve(256);
   const double limit2 = double(max_distance) * double(max_distance);
-  for (size_t i = 0; i < points.size(); ++i) {
+  Best last{limit2, {}, kNoHit};
+  for (const size_t i : morton_order(points.size(), [&](size_t j, int k) { return double(points[j][k]); })) {
     const double p[3] = {points[i].x, points[i].y, points[i].z};
     ClosestPoint& answer = out[i];
     answer = ClosestPoint{};
@@ -191,8 +230,11 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
       ++skipped;
       continue;
     }
+    const OwnFrame frame{{p[0], p[1], p[2]}};
     Best best{limit2, {}, kNoHit};
-    walk_point(bytes_.data(), h, OwnFrame{{p[0], p[1], p[2]}}, 0, best, heap);
+    if (last.triangle != kNoHit) start_from(last, frame.nearest(last.corners), best);
+    walk_point(bytes_.data(), h, frame, 0, best, heap);
+    last = best;
     if (best.triangle == kNoHit) continue;
     answer.triangle = best.triangle;
     answer.distance = float(std::sqrt(best.d2));
@@ -251,6 +293,7 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
   for (size_t i = 0; i < top.placed.size(); ++i) {
     const layout::PlacedInstance& placed = top.placed[i];
     InstanceFrame& f = frames[i];
+    f.index = uint32_t(i);
     inverse(placed.to_local, f.to_world);
     // |to_local x| <= s |x| with s^2 the largest eigenvalue of
     // to_local^T to_local, so |to_world y| >= |y| / s; less a millionth for
@@ -268,7 +311,8 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
   std::vector<Pending> top_heap, heap;
   const double limit2 = max_distance * max_distance;
   const auto farther = [](const Pending& x, const Pending& y) { return x.d2 > y.d2; };
-  for (size_t i = 0; i < points.size(); ++i) {
+  Best last{limit2, {}, kNoHit};
+  for (const size_t i : morton_order(points.size(), [&](size_t j, int k) { return points[j][k]; })) {
     const double* w = points[i].data();
     SceneClosestPoint& answer = out[i];
     answer = SceneClosestPoint{};
@@ -277,6 +321,11 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
       continue;
     }
     Best best{limit2, {}, kNoHit};
+    if (last.triangle != kNoHit) {
+      InstanceFrame& f = frames[last.frame];
+      for (int k = 0; k < 3; ++k) f.world[k] = w[k];
+      start_from(last, f.nearest(last.corners), best);
+    }
     // Best first over the top level's boxes (float, about the anchor,
     // rounded outward), then each instance's blob as it comes up.
     top_heap.clear();
@@ -312,6 +361,7 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
         std::push_heap(top_heap.begin(), top_heap.end(), farther);
       }
     }
+    last = best;
     if (best.triangle == kNoHit) continue;
     answer.instance = best.instance;
     answer.triangle = best.triangle;

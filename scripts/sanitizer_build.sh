@@ -19,7 +19,9 @@ cd "$(dirname "$0")/.."
 source scripts/packages.sh
 install_missing clang libclang-rt-14-dev
 source scripts/isa.sh
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
+source scripts/ninja.sh
+ninja_dir build-fuzz
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" \
       -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DMESHCAST_FUZZ=ON "-DMESHCAST_ISAS=$(widest_isa)" \
       -DMESHCAST_COUNT_TESTS=ON -DMESHCAST_VULKAN=OFF -DMESHCAST_TOOLS=OFF >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target "$@"

@@ -90,14 +90,16 @@ stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters comp
 # compiled in there: the suites' counted-test checks run in that build
 # alone. The fuzz corpora replay under ASan and UBSan at the start of each
 # fuzz target's run (and without sanitizers in Release's CTest).
-bash scripts/sanitizer_build.sh "${asan_suites[@]}" host_test
+bash scripts/sanitizer_build.sh "${asan_suites[@]}" host_test blob_fuzz mesh_fuzz
 run_suites build-fuzz quick "${asan_suites[@]}" host_test
 bash scripts/fuzz.sh
 
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
 # (uninstrumented) threads ever make TSan report what it cannot see.
-cmake -S . -B build-tsan "${tsan_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
+source scripts/ninja.sh
+ninja_dir build-tsan
+cmake -S . -B build-tsan -G Ninja "${tsan_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test build_test
 # tests/tsan.supp leaves out races inside the Vulkan validation layer's own threads.
 MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \

@@ -5,7 +5,9 @@
 // and OctTreeCompressed/ClusterFloat3SOA8.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "check/generate.h"
@@ -188,6 +190,52 @@ TEST(ClosestPoints, RefusesWhatItCannotAnswer) {
   EXPECT_EQ(got[2].distance, INFINITY);
   EXPECT_NEAR(got[0].distance, 1.0, 0.05);
   EXPECT_NEAR(got[3].distance, 1.0, 0.05);
+}
+
+// The walk takes the points along a Morton curve, each from its
+// predecessor's answer: no answer may depend on that. The same points
+// asked in reverse, and one at a time, get the same bits, ties included
+// (points on a grid's vertices and edges, where several triangles lie at
+// one distance, go to the lower triangle number); in a scene too.
+TEST(ClosestPoints, AnswersDoNotDependOnThePointsOrder) {
+  const Mesh grid = make_grid_plane(12, 10);
+  std::vector<Vec3> points = query_points(grid, 400, 3);
+  for (const Vec3& v : grid.vertices) points.push_back({v.x, v.y, v.z + 0.25f});  // above a vertex: 6 triangles tie
+  for (const char* layout : kPointLayouts) {
+    const std::vector<uint8_t> blob = build_blob(grid, parse_layout(layout), "grid");
+    const BlobView view(blob, "grid");
+    std::vector<ClosestPoint> forward(points.size()), backward(points.size()), alone(points.size());
+    view.closest_points(points, forward);
+    const std::vector<Vec3> reversed(points.rbegin(), points.rend());
+    view.closest_points(reversed, backward);
+    std::reverse(backward.begin(), backward.end());
+    for (size_t i = 0; i < points.size(); ++i) view.closest_points(std::span<const Vec3>(&points[i], 1), std::span<ClosestPoint>(&alone[i], 1));
+    for (size_t i = 0; i < points.size(); ++i)
+      for (const std::vector<ClosestPoint>* other : {&backward, &alone}) {
+        const ClosestPoint &a = forward[i], &b = (*other)[i];
+        ASSERT_EQ(a.triangle, b.triangle) << layout << " point " << i;
+        ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << layout << " point " << i;
+      }
+    Scene scene;
+    const MeshId mesh = scene.add_mesh(blob, "grid");
+    Transform above;
+    above.translation[2] = 0.5;
+    scene.add_instance(mesh, Transform{});
+    scene.add_instance(mesh, above);
+    scene.commit();
+    std::vector<std::array<double, 3>> world;
+    for (const Vec3& p : points) world.push_back({p.x, p.y, p.z});
+    std::vector<SceneClosestPoint> in_order(world.size()), reverse_order(world.size());
+    scene.closest_points(world, in_order);
+    const std::vector<std::array<double, 3>> world_reversed(world.rbegin(), world.rend());
+    scene.closest_points(world_reversed, reverse_order);
+    std::reverse(reverse_order.begin(), reverse_order.end());
+    for (size_t i = 0; i < world.size(); ++i) {
+      ASSERT_EQ(in_order[i].instance, reverse_order[i].instance) << layout << " point " << i;
+      ASSERT_EQ(in_order[i].triangle, reverse_order[i].triangle) << layout << " point " << i;
+      ASSERT_EQ(in_order[i].distance, reverse_order[i].distance) << layout << " point " << i;
+    }
+  }
 }
 
 // Triangles of no area (corners on a line, or at one point) have their

@@ -6,23 +6,29 @@ against Open3D's RaycastingScene, in one run.
 
 For each mesh: a 64^3 grid of cell centres over its box (grown by 5%) and N
 points uniform in the box grown by 20% (default 1,000,000). Contenders:
-meshcast's RaycastingScene (the recommended, quantized layout), a meshcast
-Blob in the exact OctTreeCompressed/Float3SOA8 layout (compute_distance
-alone: Blob.closest_points), and Open3D's RaycastingScene where
+meshcast's RaycastingScene as built by default (exact:
+OctTreeCompressed/ClusterFloat3SOA8), and Open3D's RaycastingScene where
 ``import open3d`` works (Debian 12: python3-open3d). Each is checked
-against the exact blob first (distances within 1e-5 of the diagonal; the
+against an exact blob first (distances within 1e-5 of the diagonal; the
 signs' disagreements counted), then timed in interleaved rounds (the order
 rotated each round), one thread and every core, medians. Open3D runs with
 bench.py's Embree ray-mask shim preloaded (Debian's Open3D would miss every
-ray of its inside test). Memory: bytes a
-triangle, meshcast's structures by their nbytes, Open3D's by the growth
-of the process's resident memory across add_triangles and a first query.
-Writes DIR/points.csv and prints a Markdown table.
+ray of its inside test). The same scene with max_error=1e-5 (the compact,
+quantized cluster) is checked and measured for memory, not timed. Memory,
+bytes a triangle: the growth of a fresh
+process's resident memory across reading nothing but the mesh's arrays,
+add_triangles and a first query (one process a contender and mesh), and
+meshcast's structures by their nbytes beside it. Writes DIR/points.csv and
+DIR/points.png (gnuplot: each time against Open3D's) and prints a Markdown
+table.
 """
 import argparse
 import csv
+import json
 import os
+import shutil
 import statistics
+import subprocess
 import sys
 import time
 
@@ -37,7 +43,79 @@ def rss_bytes():
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 
+def make_scene(meshcast, o3d, who, v, t):
+    """The contender's scene with the mesh added."""
+    if who == "Open3D":
+        peer = o3d.t.geometry.RaycastingScene()
+        peer.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(t.astype(np.uint32)))
+        return peer
+    scene = meshcast.RaycastingScene(max_error=1e-5 if who == "meshcast compact" else 0.0)
+    scene.add_triangles(v, t)
+    return scene
+
+
+def memory_of(build_dir, who, path):
+    """Run in a process of its own: the resident memory a contender's scene
+    adds (add_triangles and a first query of 10 points), in bytes."""
+    sys.path.insert(0, os.path.join(build_dir, "python"))
+    import meshcast
+    o3d = None
+    if who == "Open3D":
+        import open3d as o3d
+    v, t = meshcast.read_mesh(path)
+    probe = v[:10].astype(np.float32)
+    if o3d is not None:
+        o3d.core.Tensor(probe)  # the library's own start-up, outside the figure
+    before = rss_bytes()
+    scene = make_scene(meshcast, o3d, who, v, t)
+    if o3d is not None:
+        scene.compute_distance(o3d.core.Tensor(probe))
+    else:
+        scene.compute_distance(probe)
+    print(json.dumps({"bytes": rss_bytes() - before}))
+
+
+def plot(out_dir, rows):
+    """points.png: each meshcast time over Open3D's on the same row, a bar a
+    row, one thread and every core. Returns a note on failure, else ""."""
+    png = os.path.join(out_dir, "points.png")
+    script = png + ".gp"
+    peer = {(r["mesh"], r["points"], r["query"], r["threads"]): r["ns_per_point"]
+            for r in rows if r["contender"] == "Open3D"}
+    labels, series = [], {}
+    for r in rows:
+        key = (r["mesh"], r["points"], r["query"], r["threads"])
+        if r["contender"] == "Open3D" or key not in peer:
+            continue
+        label = f"{r['mesh']} {r['points']} {r['query']}"
+        if label not in labels:
+            labels.append(label)
+        series.setdefault((r["contender"], r["threads"]), {})[label] = r["ns_per_point"] / peer[key]
+    if not series:
+        return "no Open3D rows: points.png not drawn"
+    with open(script, "w") as gp:
+        gp.write("set terminal pngcairo noenhanced size 1300,650 font 'sans,10'\n")
+        gp.write(f"set output '{png}'\n")
+        gp.write("set title 'Point queries: time over Open3D 0.16.1 RaycastingScene (below 1: faster; the target 0.5)'\n")
+        gp.write("set style data histograms\nset style histogram cluster gap 1\nset style fill solid 0.8 border -1\n")
+        gp.write("set boxwidth 0.9\nset xtics rotate by -35 scale 0\nset ylabel 'time / Open3D time'\nset grid ytics\n")
+        gp.write("set yrange [0:*]\nset key top left\nset arrow from graph 0, first 1 to graph 1, first 1 nohead lw 2\n")
+        gp.write("set arrow from graph 0, first 0.5 to graph 1, first 0.5 nohead dt 2\n")
+        gp.write("plot " + ", ".join(f"'-' using 2:xtic(1) title '{who}, {threads} thread(s)'"
+                                       for (who, threads) in series) + "\n")
+        for values in series.values():
+            for label in labels:
+                gp.write(f"\"{label}\" {values.get(label, 0)}\n")
+            gp.write("e\n")
+    if shutil.which("gnuplot") is None:
+        return "gnuplot not installed: points.png not drawn (points.png.gp is the script)"
+    run = subprocess.run(["gnuplot", script], capture_output=True, text=True)
+    return "" if run.returncode == 0 else f"gnuplot failed on {script}: {run.stderr.strip()}"
+
+
 def main():
+    if len(sys.argv) == 5 and sys.argv[1] == "--memory-of":
+        return memory_of(sys.argv[2], sys.argv[3], sys.argv[4])
     ap = argparse.ArgumentParser()
     ap.add_argument("--build-dir", default=os.path.join(REPO, "build"))
     ap.add_argument("--points", type=int, default=1_000_000)
@@ -77,27 +155,28 @@ def main():
         rng = np.random.default_rng(1)
         scattered = (lo - 0.2 * size + rng.uniform(0, 1.4, (a.points, 3)) * size).astype(np.float32)
         contenders = {}
-        scene = meshcast.RaycastingScene()
-        scene.add_triangles(v, t)
-        contenders["meshcast"] = {"bytes": scene.nbytes,
-                                  "distance": lambda p, n: scene.compute_distance(p, nthreads=n).numpy(),
-                                  "signed": lambda p, n: scene.compute_signed_distance(p, nthreads=n).numpy()}
+        path = os.path.join(a.data, name + ".off")
+        for who in ("meshcast", "meshcast compact") + (("Open3D",) if o3d is not None else ()):
+            measured = subprocess.run([sys.executable, __file__, "--memory-of", a.build_dir, who, path],
+                                      capture_output=True, text=True, check=True)
+            memory = json.loads(measured.stdout.strip().splitlines()[-1])["bytes"]
+            scene = make_scene(meshcast, o3d, who, v, t)
+            if who == "Open3D":
+                contenders[who] = {
+                    "bytes": memory, "nbytes": 0,
+                    "distance": lambda p, n, s=scene: s.compute_distance(o3d.core.Tensor(p), nthreads=n).numpy(),
+                    "signed": lambda p, n, s=scene: s.compute_signed_distance(o3d.core.Tensor(p), nthreads=n).numpy()}
+            else:
+                # The compact layout's rows: its memory and error (its time
+                # differs from the exact one's as on the ray rows).
+                contenders[who] = {"bytes": memory, "nbytes": scene.nbytes, "timed": who == "meshcast",
+                                   "distance": lambda p, n, s=scene: s.compute_distance(p, nthreads=n).numpy(),
+                                   "signed": lambda p, n, s=scene: s.compute_signed_distance(p, nthreads=n).numpy()}
+        # Correctness first, on a sample of both sets, against an exact blob.
         exact = meshcast.build(v, t, layout="OctTreeCompressed/Float3SOA8")
-        contenders["meshcast exact"] = {"bytes": exact.nbytes,
-                                        "distance": lambda p, n: exact.closest_points(p, nthreads=n)["distance"]}
-        if o3d is not None:
-            before = rss_bytes()
-            peer = o3d.t.geometry.RaycastingScene()
-            peer.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(t.astype(np.uint32)))
-            peer.compute_distance(o3d.core.Tensor(grid[:10]))
-            contenders["Open3D"] = {
-                "bytes": rss_bytes() - before,
-                "distance": lambda p, n: peer.compute_distance(o3d.core.Tensor(p), nthreads=n).numpy(),
-                "signed": lambda p, n: peer.compute_signed_distance(o3d.core.Tensor(p), nthreads=n).numpy()}
-        # Correctness first, on a sample of both sets, against the exact blob.
         sample = np.concatenate([grid[::97], scattered[:3000]])
         truth = exact.closest_points(sample)["distance"]
-        inside = scene.compute_signed_distance(sample).numpy() < 0
+        inside = contenders["meshcast"]["signed"](sample, 0) < 0
         checks = {}
         for who, c in contenders.items():
             d = c["distance"](sample, 0)
@@ -109,7 +188,7 @@ def main():
         for set_name, points in (("64^3 grid", grid), (f"{a.points:,} scattered", scattered)):
             for query in ("distance", "signed"):
                 for threads in (1, cores):
-                    who = [w for w, c in contenders.items() if query in c]
+                    who = [w for w, c in contenders.items() if query in c and c.get("timed", True)]
                     times = {w: [] for w in who}
                     for r in range(a.rounds):
                         for w in who[r % len(who):] + who[:r % len(who)]:
@@ -120,20 +199,35 @@ def main():
                         ns = statistics.median(times[w]) / len(points) * 1e9
                         rows.append({"mesh": name, "triangles": len(t), "points": set_name, "query": query,
                                      "threads": threads, "contender": w, "ns_per_point": round(ns, 1),
-                                     "bytes_per_triangle": round(contenders[w]["bytes"] / len(t), 1),
+                                     "process_bytes_per_triangle": round(contenders[w]["bytes"] / len(t), 1),
+                                     "nbytes_per_triangle": round(contenders[w]["nbytes"] / len(t), 1),
                                      "max_error_of_diagonal": checks[w][0], "sign_disagreements": checks[w][1]})
                         print(f"{name} {set_name} {query} {threads} thread(s): {w} {ns:.0f} ns a point",
                               file=sys.stderr)
+        for w, c in contenders.items():
+            if not c.get("timed", True):
+                rows.append({"mesh": name, "triangles": len(t), "points": "", "query": "memory and error", "threads": 0,
+                             "contender": w, "ns_per_point": 0.0,
+                             "process_bytes_per_triangle": round(c["bytes"] / len(t), 1),
+                             "nbytes_per_triangle": round(c["nbytes"] / len(t), 1),
+                             "max_error_of_diagonal": checks[w][0], "sign_disagreements": checks[w][1]})
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "points.csv"), "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
-    print("| mesh | points | query | threads | contender | ns/point | B/tri |")
-    print("|---|---|---|---:|---|---:|---:|")
+    note = plot(a.out, rows)
+    if note:
+        print(note, file=sys.stderr)
+    peer = {(r["mesh"], r["points"], r["query"], r["threads"]): r["ns_per_point"]
+            for r in rows if r["contender"] == "Open3D"}
+    print("| mesh | points | query | threads | contender | ns/point | / Open3D | B/tri (process) | B/tri (nbytes) |")
+    print("|---|---|---|---:|---|---:|---:|---:|---:|")
     for r in rows:
+        key = (r["mesh"], r["points"], r["query"], r["threads"])
+        ratio = f"{r['ns_per_point'] / peer[key]:.2f}" if key in peer else ""
         print(f"| {r['mesh']} | {r['points']} | {r['query']} | {r['threads']} | {r['contender']} | "
-              f"{r['ns_per_point']:.0f} | {r['bytes_per_triangle']} |")
+              f"{r['ns_per_point']:.0f} | {ratio} | {r['process_bytes_per_triangle']} | {r['nbytes_per_triangle'] or ''} |")
 
 
 if __name__ == "__main__":

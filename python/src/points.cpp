@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cpu/point_order.h"
 #include "python/src/arrays.h"
 #include "python/src/parallel.h"
 
@@ -38,17 +39,24 @@ float checked_max_distance(double max_distance) {
   return float(max_distance);
 }
 
+// The points are cut into chunks along a Morton curve over all of them
+// (cpu/point_order.h), not in the caller's order: a chunk of scattered
+// points is then a patch of near ones, which the walk takes each from the
+// last one's answer.
 void nearest_points(const BlobView& view, const double* centre, const PointArrays& points, float max_distance,
                     uint32_t threads, std::vector<ClosestPoint>& out) {
   out.resize(points.count);
+  const std::vector<size_t> order = morton_order(points.count, [&](size_t i, int k) { return points.coordinate(i, k); });
   const Chunks plan = plan_chunks(points.count, threads);
   std::atomic<uint64_t> beyond{0};
   for_each_chunk(plan, threads, [&](size_t chunk) {
     const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
     std::vector<Vec3> local(n);
+    std::vector<ClosestPoint> found(n);
     for (size_t i = 0; i < n; ++i)
-      for (int k = 0; k < 3; ++k) local[i][k] = float(points.coordinate(begin + i, k) - (centre ? centre[k] : 0.0));
-    beyond += view.closest_points(local, std::span<ClosestPoint>(out).subspan(begin, n), max_distance);
+      for (int k = 0; k < 3; ++k) local[i][k] = float(points.coordinate(order[begin + i], k) - (centre ? centre[k] : 0.0));
+    beyond += view.closest_points(local, found, max_distance);
+    for (size_t i = 0; i < n; ++i) out[order[begin + i]] = found[i];
   });
   // Finite in float64 but past float's range in the blob's frame (1e39):
   // refused, as a ray from there is, never answered as "nothing near".
@@ -59,15 +67,16 @@ void nearest_points(const BlobView& view, const double* centre, const PointArray
 
 void scene_nearest_points(const SceneSnapshot& frame, const PointArrays& points, double max_distance, uint8_t mask,
                           uint32_t threads, const std::function<void(size_t, const SceneClosestPoint&)>& use) {
+  const std::vector<size_t> order = morton_order(points.count, [&](size_t i, int k) { return points.coordinate(i, k); });
   const Chunks plan = plan_chunks(points.count, threads);
   for_each_chunk(plan, threads, [&](size_t chunk) {
     const size_t begin = plan.begin(chunk), n = plan.end(chunk) - begin;
     std::vector<std::array<double, 3>> world(n);
     std::vector<SceneClosestPoint> found(n);
     for (size_t i = 0; i < n; ++i)
-      for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(begin + i, k);
+      for (int k = 0; k < 3; ++k) world[i][k] = points.coordinate(order[begin + i], k);
     closest_points_snapshot(frame, world, found, max_distance, mask);
-    for (size_t i = 0; i < n; ++i) use(begin + i, found[i]);
+    for (size_t i = 0; i < n; ++i) use(order[begin + i], found[i]);
   });
 }
 

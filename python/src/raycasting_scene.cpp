@@ -10,6 +10,9 @@
 
 #include <array>
 #include <atomic>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <cmath>
 #include <functional>
 #include <initializer_list>
@@ -292,6 +295,12 @@ class RaycastingScene {
       }
     }
     blob.shrink_to_fit();  // the builder's spare capacity would be memory the scene holds
+#ifdef __GLIBC__
+    // The build's scratch (several times the blob) is freed, but glibc keeps
+    // freed pages in the process unless asked: hand them back, so a
+    // process's memory is the structures it holds.
+    malloc_trim(0);
+#endif
     std::lock_guard<std::mutex> lock(mutex_);
     return add_geometry(std::move(blob), std::move(normals), centre, name);
   }

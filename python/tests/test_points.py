@@ -135,10 +135,9 @@ def test_raycasting_scene_nearest_of_every_geometry():
     scale = np.maximum(np.abs(p).max(1), 1.0)
     dist = scene.compute_distance(p)
     assert dist.dtype == np.float32 and dist.shape == (200,)
-    # the scene's geometries are stored in the recommended layout: within
-    # its bound (4e-6 of a geometry's diagonal) and float32 rounding of each
-    # point in its geometry's frame
-    bound = 4e-6 * max(np.linalg.norm(np.ptp(sv, 0)), np.linalg.norm(np.ptp(cv, 0)))
+    # the scene's geometries are stored exactly: within float32 rounding of
+    # each point in its geometry's frame
+    bound = 0.0
     assert np.all(np.abs(dist - want) <= bound + tolerance(want, scale))
     g = got["geometry_ids"].numpy()
     assert set(np.unique(g)) == {0, 1}
@@ -156,8 +155,14 @@ def test_raycasting_scene_nearest_of_every_geometry():
         uv = got["primitive_uvs"].numpy()[rows].astype(np.float64)
         at = (1 - uv[:, :1] - uv[:, 1:]) * a + uv[:, :1] * b + uv[:, 1:] * c
         at[:, 0] += offset
-        # (u, v) of the stored corners, within the bound of the input's
+        # (u, v) of the stored corners, the input's
         assert np.all(np.abs(at - pts[rows]) <= bound + 1e-6 * np.maximum(np.abs(pts[rows]), 1))
+    # The points are walked in an order of the library's own (near ones
+    # together): asked in another order, each gets the same answer.
+    order = rng.permutation(len(p))
+    again = scene.compute_closest_points(p[order])
+    for key in got:
+        assert np.array_equal(again[key].numpy(), got[key].numpy()[order]), key
 
 
 def test_raycasting_scene_without_geometry():

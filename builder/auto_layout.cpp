@@ -154,9 +154,9 @@ std::vector<AutoCandidate> speed_list(const MeshStats& s, const AutoLimits& l, s
   // fastest in bench peers on every mesh there (bench/RESULTS.md).
   reasons.push_back("the 8-wide compressed tree first (bench peers: fastest on every mesh), leaves of 16");
   add("OctTreeCompressed/ClusterBitPackSOA8", "8 children a node, clusters of shared grid vertices: fast and small", 16);
-  // Exact next: the same clusters over the float vertices, as fast as the
-  // grid clusters (bench peers: within 3-18%) and faster than float blocks,
-  // at 19 bytes a triangle against 48-51.
+  // Exact next: the same clusters over the float vertices, about as fast
+  // as the grid clusters (bench peers: 0.95-1.18x their time) and faster
+  // than float blocks, at 19 bytes a triangle against 48-51.
   add("OctTreeCompressed/ClusterFloat3SOA8", "8 children a node, clusters of shared float vertices: exact, fast and small", 16);
   add("OctTreeCompressed/Float3SOA8", "8 children a node over exact 8-wide float blocks", 16);
   // Half-float nodes are half the bytes of a float node: once the nodes of

@@ -94,7 +94,7 @@ def plot(out_dir, rows):
     if not series:
         return "no Open3D rows: points.png not drawn"
     with open(script, "w") as gp:
-        gp.write("set terminal pngcairo noenhanced size 1300,650 font 'sans,10'\n")
+        gp.write("set terminal pngcairo noenhanced size 1300,750 font 'sans,10'\nset bmargin 13\nset rmargin 12\n")
         gp.write(f"set output '{png}'\n")
         gp.write("set title 'Point queries: time over Open3D 0.16.1 RaycastingScene (below 1: faster; the target 0.5)'\n")
         gp.write("set style data histograms\nset style histogram cluster gap 1\nset style fill solid 0.8 border -1\n")

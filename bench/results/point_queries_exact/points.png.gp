@@ -1,7 +1,7 @@
 set terminal pngcairo noenhanced size 1300,750 font 'sans,10'
 set bmargin 13
 set rmargin 12
-set output 'bench/results/point_queries/points.png'
+set output 'bench/results/point_queries_exact/points.png'
 set title 'Point queries: time over Open3D 0.16.1 RaycastingScene (below 1: faster; the target 0.5)'
 set style data histograms
 set style histogram cluster gap 1

@@ -266,8 +266,15 @@ def plot_all_hits(out_dir, series):
             for x, y in points:
                 gp.write(f"{x} {y}\n")
             gp.write("e\n")
+    return run_gnuplot(script)
+
+
+def run_gnuplot(script):
+    """Draws the picture of a gnuplot script named PICTURE.gp; returns a
+    note on failure, else ""."""
+    picture = os.path.basename(script)[:-len(".gp")]
     if shutil.which("gnuplot") is None:
-        return "gnuplot not installed: all_hits.png not drawn (all_hits.png.gp is the script)"
+        return f"gnuplot not installed: {picture} not drawn ({picture}.gp is the script)"
     run = subprocess.run(["gnuplot", script], capture_output=True, text=True)
     return "" if run.returncode == 0 else f"gnuplot failed on {script}: {run.stderr.strip()}"
 

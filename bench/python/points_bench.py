@@ -26,7 +26,6 @@ import argparse
 import csv
 import json
 import os
-import shutil
 import statistics
 import subprocess
 import sys
@@ -107,10 +106,9 @@ def plot(out_dir, rows):
             for label in labels:
                 gp.write(f"\"{label}\" {values.get(label, 0)}\n")
             gp.write("e\n")
-    if shutil.which("gnuplot") is None:
-        return "gnuplot not installed: points.png not drawn (points.png.gp is the script)"
-    run = subprocess.run(["gnuplot", script], capture_output=True, text=True)
-    return "" if run.returncode == 0 else f"gnuplot failed on {script}: {run.stderr.strip()}"
+    sys.path.insert(0, HERE)
+    from bench import run_gnuplot
+    return run_gnuplot(script)
 
 
 def main():

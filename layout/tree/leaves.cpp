@@ -30,11 +30,26 @@ void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[
 #undef MC_DECODE
 }
 
+namespace {
+// The leaf by Codec's own decode_leaf, where it has one and is the blob's.
+template <class Codec>
+bool decode_whole_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]) {
+  if constexpr (requires { Codec::decode_leaf(blob, block, count, out); }) {
+    if (header_of(blob).triangle_format != Codec::kFormat) return false;
+    Codec::decode_leaf(blob, block, count, out);
+    return true;
+  }
+  return false;
+}
+}  // namespace
+
 void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]) {
-  if (header_of(blob).triangle_format == ClusterBitPackSOA8::kFormat)
-    return ClusterBitPackSOA8::decode_leaf(blob, block, count, out);
-  if (header_of(blob).triangle_format == ClusterFloat3SOA8::kFormat)
-    return ClusterFloat3SOA8::decode_leaf(blob, block, count, out);
+  // A codec with a decode of its own for the whole leaf (the clusters')
+  // takes it; the rest triangle by triangle.
+#define MC_DECODE_LEAF(Codec, name) \
+  if (decode_whole_leaf<Codec>(blob, block, count, out)) return;
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_DECODE_LEAF)
+#undef MC_DECODE_LEAF
   for (uint32_t i = 0; i < count; ++i) decode_triangle(blob, block, i, out[i]);
 }
 

@@ -29,7 +29,7 @@ void for_each_leaf(const uint8_t* blob, const std::function<void(uint32_t block,
 void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[3][3]);
 // All `count` triangles of the block at once (the same bits as
 // decode_triangle gives each): a format whose triangles share a decode
-// (ClusterBitPackSOA8's clusters of vertices) does it once a leaf.
+// (the cluster formats: each cluster's vertices) does it once a leaf.
 void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]);
 
 }  // namespace meshcast::layout

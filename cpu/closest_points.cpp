@@ -1,11 +1,10 @@
 // BlobView::closest_points: the point of the stored mesh nearest each query
-// point, on an OctTreeCompressed blob. The walk is best first: a node's 8
-// child boxes are decoded (exactly, as the ray walk decodes them) and their
-// squared distances from the point taken, the children no farther than the
-// best distance so far wait in a heap, and the nearest waiting box is
-// walked next; the walk ends when it is farther than the best. In a leaf
-// each triangle's nearest point is worked out in double from its stored
-// corners (cpu/point_triangle.h), after a test of its corners' box.
+// point, on an OctTreeCompressed blob. The tree is walked by the chosen
+// instruction set's point walk (cpu/walk_points.h: 8 child boxes and 8
+// triangle boxes at once, in float, nearest first), which hands each
+// leaf's triangles whose boxes are near enough, nearest box first; here
+// each one's nearest point is worked out in double from its stored corners
+// (cpu/point_triangle.h), and the walk's cut narrows to the best distance.
 //
 // The points are walked along a Morton curve (cpu/point_order.h), each
 // starting from its predecessor's nearest triangle: that triangle's
@@ -21,6 +20,7 @@
 // its nearest point found there, so a scaled instance answers its world
 // distance.
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -28,6 +28,7 @@
 
 #include "cpu/point_order.h"
 #include "cpu/point_triangle.h"
+#include "cpu/walk_points.h"
 #include "layout/blob_format.h"
 #include "layout/tree/top_level.h"
 #include "layout/tree/leaves.h"
@@ -40,12 +41,12 @@ namespace meshcast {
 
 namespace {
 
-// A box's squared distance from the point is a lower bound for every
-// triangle inside it. It is taken in double from the decoded float bounds
-// (each difference exact or rounded by 2^-53 of itself, then three
-// products and two sums): it may come out at most 2^-50 of itself above
-// the true one, so a box is dropped only where it is farther than the best
-// distance by more than that.
+// The top level's boxes (a scene's) are measured in double: a box's
+// squared distance from the point is a lower bound for every triangle
+// inside it, taken from the float bounds (each difference exact or rounded
+// by 2^-53 of itself, then three products and two sums): it may come out
+// at most 2^-50 of itself above the true one, so a box is dropped only
+// where it is farther than the best distance by more than that.
 constexpr double kBoxSlack = 1 - 0x1p-48;
 
 struct Best {
@@ -59,10 +60,8 @@ struct Best {
   uint32_t frame = 0;
 };
 
-// The squared distance from p to the box [lo, hi] (0 inside): a leaf's
-// triangles' corner boxes (float) and a node's decoded child boxes (double).
-template <class Bound>
-inline double box_d2(const double p[3], const Bound lo[3], const Bound hi[3]) {
+// The squared distance from p to the box [lo, hi] (0 inside).
+inline double box_d2(const double p[3], const float lo[3], const float hi[3]) {
   double d2 = 0;
   for (int a = 0; a < 3; ++a) {
     const double below = double(lo[a]) - p[a], above = p[a] - double(hi[a]);
@@ -72,12 +71,21 @@ inline double box_d2(const double p[3], const Bound lo[3], const Bound hi[3]) {
   return d2;
 }
 
-// Where a walk measures. The blob's own frame: distances as they are.
+// Where a walk measures. The blob's own frame: distances as they are, the
+// point a float already.
 struct OwnFrame {
   static constexpr uint32_t index = 0;
   double p[3];  // the query point
-  // A lower bound on the distance squared from a local box's squared one.
-  double bound(double local_d2) const { return local_d2; }
+  float pf[3];  // the same, as the float walk takes it
+  // The walk's cut for a best squared distance d2.
+  float cut(double d2) const { return cut_above(d2, 0); }
+  // Where triangles' nearest points are found: the point, and the
+  // triangles' corners there.
+  const double* query() const { return p; }
+  void place(const float (&v)[3][3], double (&w)[3][3]) const {
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) w[c][k] = v[c][k];
+  }
   PointOnTriangle nearest(const float (&v)[3][3]) const { return nearest_on_triangle(p, v[0], v[1], v[2]); }
 };
 
@@ -89,58 +97,80 @@ struct OwnFrame {
 struct InstanceFrame {
   uint32_t index;  // the placed instance's
   double p[3];
+  float pf[3];   // p rounded to float, for the walk
+  double widen;  // at least |p - pf|
   double world[3];
   double to_world[9];
   double translation[3];
   double least_stretch2;  // 1 / (to_local's largest singular value)^2: no vector shrinks more under to_world
-  double bound(double local_d2) const { return local_d2 * least_stretch2; }
-  PointOnTriangle nearest(const float (&v)[3][3]) const {
-    double w[3][3];
+  void place(const double local[3]) {
+    double gap2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      p[k] = local[k], pf[k] = float(local[k]);
+      gap2 += (p[k] - double(pf[k])) * (p[k] - double(pf[k]));
+    }
+    widen = std::sqrt(gap2) * (1 + 0x1p-40);
+  }
+  // A world distance d shrinks to no less than d sqrt(least_stretch2) in
+  // the frame: the cut is d2 / least_stretch2 (less its rounding), from pf.
+  float cut(double d2) const { return cut_above(d2 / least_stretch2 * (1 + 0x1p-50), widen); }
+  const double* query() const { return world; }
+  void place(const float (&v)[3][3], double (&w)[3][3]) const {
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r)
         w[c][r] = translation[r] + to_world[3 * r] * v[c][0] + to_world[3 * r + 1] * v[c][1] + to_world[3 * r + 2] * v[c][2];
+  }
+  PointOnTriangle nearest(const float (&v)[3][3]) const {
+    double w[3][3];
+    place(v, w);
     return nearest_on_triangle(world, w[0], w[1], w[2]);
   }
 };
 
+// A point's tests of one blob's triangles, as its walk hands them over
+// (walk_points's visit): the frame they are measured in, whose triangles
+// they are, the answer so far.
 template <class Frame>
-void test_leaf(const uint8_t* blob, const layout::BlobHeader& h, uint32_t offset, uint32_t count, const Frame& frame,
-               uint32_t instance, Best& best) {
-  float corners[MC_OCT_MAX_COUNT][3][3];
-  layout::decode_leaf(blob, h.tree_offset + offset, count, corners);
-  // The triangles whose corner box is near enough, nearest box first: the
-  // nearest triangle is then most often tested first, and its distance
-  // drops the boxes behind it untested.
-  double box[MC_OCT_MAX_COUNT];
-  uint32_t order[MC_OCT_MAX_COUNT], near_enough = 0;
-  for (uint32_t i = 0; i < count; ++i) {
-    const float(&v)[3][3] = corners[i];
-    float lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min({v[0][a], v[1][a], v[2][a]});
-      hi[a] = std::max({v[0][a], v[1][a], v[2][a]});
+struct LeafTests {
+  const uint8_t* blob;
+  const layout::BlobHeader& h;
+  const Frame& frame;
+  uint32_t instance;
+  Best& best;
+  NearestOnTrianglesFn nearest;
+
+  static float visit(void* context, uint32_t offset, const NearTriangles& near, float cut) {
+    LeafTests& t = *static_cast<LeafTests*>(context);
+    Best& best = t.best;
+    // Nearest box first, 8 at a time: a group's nearest points are worked
+    // out side by side, and the boxes of the next are measured against the
+    // cut the group leaves (the nearest triangle is most often in the
+    // first, and its distance drops the boxes behind it untested).
+    constexpr uint32_t kGroup = 8;
+    for (uint32_t first = 0; first < near.n && near.box_d2[first] <= cut; first += kGroup) {
+      uint32_t n = 1;
+      while (n < kGroup && first + n < near.n && near.box_d2[first + n] <= cut) ++n;
+      double corners[kGroup][3][3];
+      for (uint32_t i = 0; i < n; ++i) t.frame.place(near.corners[first + i], corners[i]);
+      PointOnTriangle found[kGroup];
+      t.nearest(t.frame.query(), corners, n, found);
+      for (uint32_t i = 0; i < n; ++i) {
+        if (found[i].d2 > best.d2) continue;
+        const uint32_t triangle = layout::remap_entry(t.blob, t.h, layout::slot_of(t.h, offset, near.index[first + i]));
+        // At one distance the lower instance, then the lower triangle
+        // number, whatever the walk's order.
+        if (found[i].d2 == best.d2 && best.triangle != kNoHit &&
+            (t.instance > best.instance || (t.instance == best.instance && triangle > best.triangle)))
+          continue;
+        best.d2 = found[i].d2, best.near = found[i], best.triangle = triangle, best.instance = t.instance;
+        best.frame = t.frame.index;
+        std::memcpy(best.corners, near.corners[first + i], sizeof best.corners);
+        cut = t.frame.cut(best.d2);
+      }
     }
-    const double d2 = frame.bound(box_d2(frame.p, lo, hi)) * kBoxSlack;
-    if (d2 > best.d2) continue;
-    uint32_t j = near_enough++;
-    for (; j > 0 && box[j - 1] > d2; --j) box[j] = box[j - 1], order[j] = order[j - 1];
-    box[j] = d2, order[j] = i;
+    return cut;
   }
-  for (uint32_t j = 0; j < near_enough && box[j] <= best.d2; ++j) {
-    const uint32_t i = order[j];
-    const float(&v)[3][3] = corners[i];
-    const PointOnTriangle near = frame.nearest(v);
-    if (near.d2 > best.d2) continue;
-    const uint32_t triangle = layout::remap_entry(blob, h, layout::slot_of(h, offset, i));
-    // At one distance the lower instance, then the lower triangle number,
-    // whatever the walk's order.
-    if (near.d2 == best.d2 && best.triangle != kNoHit &&
-        (instance > best.instance || (instance == best.instance && triangle > best.triangle)))
-      continue;
-    best.d2 = near.d2, best.near = near, best.triangle = triangle, best.instance = instance, best.frame = frame.index;
-    std::memcpy(best.corners, v, sizeof best.corners);
-  }
-}
+};
 
 // The walk of a point starts from `last`, the previous point's answer,
 // where that triangle (`near`: its nearest point to this one) lies within
@@ -151,60 +181,35 @@ void start_from(const Best& last, const PointOnTriangle& near, Best& best) {
   best.d2 = near.d2, best.near = near;
 }
 
-// A child waiting to be walked, and its box's squared distance.
+// The walk of one blob for a point in `frame`, from the answer so far.
+template <class Frame>
+void walk_point(const uint8_t* blob, const Frame& frame, uint32_t instance, Best& best) {
+  static const WalkPointsFn walk = walk_points_fn();
+  static const NearestOnTrianglesFn nearest = nearest_on_triangles_fn();
+  LeafTests<Frame> tests{blob, layout::header_of(blob), frame, instance, best, nearest};
+  walk(blob, frame.pf, frame.cut(best.d2), &LeafTests<Frame>::visit, &tests);
+}
+
+// A top-level box waiting to be walked, and its squared distance.
 struct Pending {
   double d2;
   uint32_t properties;
 };
 
-// Best first over the whole tree, not only among siblings: the nearest box
-// waiting anywhere is walked next, so every box walked is one nearer than
-// the final answer would allow to skip (a point far from the mesh would
-// otherwise walk down one side, then another, before the distance shrinks).
-// `heap`: the caller's, reused from point to point.
-template <class Frame>
-void walk_point(const uint8_t* blob, const layout::BlobHeader& h, const Frame& frame, uint32_t instance, Best& best,
-                std::vector<Pending>& heap) {
-  const uint8_t* tree = blob + h.tree_offset;
-  const auto farther = [](const Pending& x, const Pending& y) { return x.d2 > y.d2; };
-  heap.clear();
-  heap.push_back({0, h.root});
-  while (!heap.empty()) {
-    std::pop_heap(heap.begin(), heap.end(), farther);
-    const Pending next = heap.back();
-    heap.pop_back();
-    if (next.d2 * kBoxSlack > best.d2) return;  // every box left is farther still
-    const uint32_t count = layout::oct_count(next.properties), offset = layout::oct_offset(next.properties);
-    if (count > 0) {
-      test_leaf(blob, h, offset, count, frame, instance, best);
-      continue;
-    }
-    const uint8_t* node = tree + offset;
-    // The 8 child boxes decoded in double: Origin + q 2^e is exact in float
-    // by the format's rule (layout/tree/octtree.h), so in double too, with
-    // no fused multiply-add.
-    double origin[3], scale[3];
-    for (int a = 0; a < 3; ++a) {
-      origin[a] = layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a);
-      scale[a] = layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]);
-    }
-    for (int k = 0; k < 8; ++k) {
-      const uint32_t child = layout::oct_child_properties(node, k);
-      if (child == 0) continue;
-      double lo[3], hi[3];
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = origin[a] + node[MC_OCT_QLO_AT + 8 * a + k] * scale[a];
-        hi[a] = origin[a] + node[MC_OCT_QHI_AT + 8 * a + k] * scale[a];
-      }
-      const double d2 = frame.bound(box_d2(frame.p, lo, hi));
-      if (d2 * kBoxSlack > best.d2) continue;
-      heap.push_back({d2, child});
-      std::push_heap(heap.begin(), heap.end(), farther);
-    }
-  }
-}
-
 }  // namespace
+
+float cut_above(double limit2, double widen) {
+  if (!(limit2 < INFINITY)) return INFINITY;
+  double r2 = limit2;
+  if (widen > 0) {
+    const double r = std::sqrt(limit2) + widen;
+    r2 = r * r * (1 + 0x1p-50);  // the root, the sum and the square: 2^-53 of themselves each
+  }
+  const double grown = r2 * (1 + 0x1p-20) + 0x1p-140;
+  if (!(grown <= FLT_MAX)) return INFINITY;
+  const float cut = float(grown);
+  return double(cut) < grown ? std::nextafter(cut, INFINITY) : cut;
+}
 
 uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<ClosestPoint> out, float max_distance) const {
   if (out.size() < points.size())
@@ -218,8 +223,6 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
     throw UsageError("BlobView::closest_points: point queries walk OctTreeCompressed blobs (the recommended layout, "
                      "and the exact OctTreeCompressed/ClusterFloat3SOA8); this blob is " + layout_name(layout()));
   uint64_t skipped = 0;
-  std::vector<Pending> heap;
-  heap.reserve(256);
   const double limit2 = double(max_distance) * double(max_distance);
   Best last{limit2, {}, kNoHit};
   for (const size_t i : morton_order(points.size(), [&](size_t j, int k) { return double(points[j][k]); })) {
@@ -230,10 +233,10 @@ uint64_t BlobView::closest_points(std::span<const Vec3> points, std::span<Closes
       ++skipped;
       continue;
     }
-    const OwnFrame frame{{p[0], p[1], p[2]}};
+    const OwnFrame frame{{p[0], p[1], p[2]}, {points[i].x, points[i].y, points[i].z}};
     Best best{limit2, {}, kNoHit};
     if (last.triangle != kNoHit) start_from(last, frame.nearest(last.corners), best);
-    walk_point(bytes_.data(), h, frame, 0, best, heap);
+    walk_point(bytes_.data(), frame, 0, best);
     last = best;
     if (best.triangle == kNoHit) continue;
     answer.triangle = best.triangle;
@@ -308,7 +311,7 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
     for (int k = 0; k < 3; ++k) f.translation[k] = placed.translation[k];
   }
   uint64_t skipped = 0;
-  std::vector<Pending> top_heap, heap;
+  std::vector<Pending> top_heap;
   const double limit2 = max_distance * max_distance;
   const auto farther = [](const Pending& x, const Pending& y) { return x.d2 > y.d2; };
   Best last{limit2, {}, kNoHit};
@@ -341,12 +344,12 @@ uint64_t closest_points_snapshot(const SceneSnapshot& snapshot, std::span<const 
         const layout::PlacedInstance& placed = top.placed[index];
         if (!(placed.mask & mask)) continue;
         InstanceFrame& f = frames[index];
-        double d[3];
+        double d[3], local[3];
         for (int k = 0; k < 3; ++k) d[k] = w[k] - f.translation[k], f.world[k] = w[k];
         for (int r = 0; r < 3; ++r)
-          f.p[r] = placed.to_local[3 * r] * d[0] + placed.to_local[3 * r + 1] * d[1] + placed.to_local[3 * r + 2] * d[2];
-        const uint8_t* blob = snapshot.meshes[placed.mesh]->bytes.data();
-        walk_point(blob, layout::header_of(blob), f, placed.id, best, heap);
+          local[r] = placed.to_local[3 * r] * d[0] + placed.to_local[3 * r + 1] * d[1] + placed.to_local[3 * r + 2] * d[2];
+        f.place(local);
+        walk_point(snapshot.meshes[placed.mesh]->bytes.data(), f, placed.id, best);
         continue;
       }
       const layout::TopWideNode& node = top.wide[next.properties];

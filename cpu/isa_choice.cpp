@@ -11,6 +11,7 @@
 #endif
 
 #include "cpu/walk_table.h"
+#include "cpu/walk_points.h"
 #include "cpu/walk_top.h"
 #include "meshcast/blob.h"
 
@@ -83,20 +84,40 @@ const IsaChoice& chosen() {
 
 }  // namespace
 
-WalkTopFn walk_top_fn() {
-  const WalkerIsa isa = chosen().isa;
+// The chosen set's function `name`, of a set this build has.
 #if MESHCAST_HAS_ISA_AVX512
-  if (isa == WalkerIsa::Avx512) return &isa_avx512::walk_top;
+#define MC_PICK_AVX512(name) if (isa == WalkerIsa::Avx512) return &isa_avx512::name;
+#else
+#define MC_PICK_AVX512(name)
 #endif
 #if MESHCAST_HAS_ISA_AVX2
-  if (isa == WalkerIsa::Avx2) return &isa_avx2::walk_top;
-#endif
-  (void)isa;
-#if MESHCAST_HAS_ISA_SCALAR
-  return &isa_scalar::walk_top;
+#define MC_PICK_AVX2(name) if (isa == WalkerIsa::Avx2) return &isa_avx2::name;
 #else
-  return nullptr;  // not reached: choose_isa picks a set this build has
+#define MC_PICK_AVX2(name)
 #endif
+#if MESHCAST_HAS_ISA_SCALAR
+#define MC_PICK_SCALAR(name) return &isa_scalar::name;
+#else
+#define MC_PICK_SCALAR(name) return nullptr;  // not reached: choose_isa picks a set this build has
+#endif
+#define MC_PICK(name) \
+  MC_PICK_AVX512(name) \
+  MC_PICK_AVX2(name)   \
+  (void)isa;           \
+  MC_PICK_SCALAR(name)
+
+WalkTopFn walk_top_fn() {
+  const WalkerIsa isa = chosen().isa;
+  MC_PICK(walk_top)
+}
+WalkPointsFn walk_points_fn() {
+  const WalkerIsa isa = chosen().isa;
+  MC_PICK(walk_points)
+}
+NearestOnTrianglesFn nearest_on_triangles_fn() { return nearest_on_triangles_of(chosen().isa); }
+NearestOnTrianglesFn nearest_on_triangles_of(WalkerIsa isa) {
+  if (!cpu_has(isa)) return nullptr;
+  MC_PICK(nearest_on_triangles)
 }
 
 std::string_view walker_isa_name(WalkerIsa isa) {

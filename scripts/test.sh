@@ -32,7 +32,7 @@ cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_
 # bytes and rays again.
 asan_suites=(walker_test limits_test zerobyte_test scene_test hostile_test io_test point_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
-walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test)
+walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test point_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
   local dir=$1 quick=()
   [[ $2 == quick ]] && quick=(MESHCAST_TEST_QUICK=1)

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -13,6 +14,7 @@
 #include "check/generate.h"
 #include "check/point_oracle.h"
 #include "cpu/crossings.h"
+#include "cpu/walk_points.h"
 #include "meshcast/scene.h"
 #include "meshcast/winding_number.h"
 #include "tests/testing.h"
@@ -261,6 +263,66 @@ TEST(ClosestPoints, DegenerateRepeatedAndFarOutTriangles) {
       EXPECT_EQ(got[1].triangle, 1u) << what << ": the triangle at one point";
     }
   }
+}
+
+// The leaves' nearest points, 8 triangles side by side on each
+// instruction set this processor runs, carry nearest_on_triangle's bits:
+// points in every region of a triangle (its corners, edges and inside,
+// and exactly on them), slivers, triangles of no area (on a line, at one
+// point), and groups of every size from 1 to 19 (partial lane groups).
+TEST(ClosestPoints, EverySetsLanesGiveTheScalarBits) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::vector<std::array<std::array<double, 3>, 3>> triangles;
+  std::vector<std::array<double, 3>> points;
+  for (int i = 0; i < 600; ++i) {
+    std::array<std::array<double, 3>, 3> t;
+    for (auto& corner : t)
+      for (double& x : corner) x = double(float(unit(rng)));
+    switch (i % 6) {
+      case 1: t[2] = t[1]; break;                                              // two corners at one point
+      case 2: t[1] = t[0], t[2] = t[0]; break;                                 // all at one point
+      case 3: for (int k = 0; k < 3; ++k) t[2][k] = 2 * t[1][k] - t[0][k]; break;  // on a line
+      case 4: for (int k = 0; k < 3; ++k) t[2][k] = t[1][k] + 1e-7 * t[0][k]; break;  // a sliver
+      default: break;
+    }
+    triangles.push_back(t);
+    std::array<double, 3> p;
+    for (double& x : p) x = 3 * unit(rng);
+    if (i % 5 == 0) p = t[i % 3];                                               // on a corner
+    if (i % 5 == 1) for (int k = 0; k < 3; ++k) p[k] = 0.5 * (t[0][k] + t[1][k]);  // on an edge
+    points.push_back(p);
+  }
+  const WalkerIsa sets[] = {WalkerIsa::Scalar, WalkerIsa::Avx2, WalkerIsa::Avx512};
+  int tried = 0;
+  for (const WalkerIsa isa : sets) {
+    const NearestOnTrianglesFn nearest = nearest_on_triangles_of(isa);
+    if (!nearest) continue;
+    ++tried;
+    size_t at = 0;
+    for (uint32_t n = 1; at + n <= triangles.size(); n = n % 19 + 1) {
+      for (size_t j = at; j < at + n; ++j) {
+        // Each point against its own group of n triangles.
+        double corners[19][3][3];
+        for (uint32_t i = 0; i < n; ++i)
+          for (int c = 0; c < 3; ++c)
+            for (int k = 0; k < 3; ++k) corners[i][c][k] = triangles[at + i][c][k];
+        PointOnTriangle got[19];
+        nearest(points[j].data(), corners, n, got);
+        for (uint32_t i = 0; i < n; ++i) {
+          const PointOnTriangle want = nearest_on_triangle(points[j].data(), corners[i][0], corners[i][1], corners[i][2]);
+          const std::string what = std::string(walker_isa_name(isa)) + ", triangle " + std::to_string(at + i) +
+                                   " in a group of " + std::to_string(n) + ", point " + std::to_string(j);
+          ASSERT_EQ(std::memcmp(&got[i].d2, &want.d2, 8), 0) << what << ": " << got[i].d2 << " != " << want.d2;
+          ASSERT_EQ(std::memcmp(&got[i].u, &want.u, 8), 0) << what;
+          ASSERT_EQ(std::memcmp(&got[i].v, &want.v, 8), 0) << what;
+          ASSERT_EQ(std::memcmp(got[i].point, want.point, 24), 0) << what;
+        }
+      }
+      at += n;
+    }
+  }
+  EXPECT_GE(tried, 1);
 }
 
 }  // namespace

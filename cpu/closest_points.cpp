@@ -147,16 +147,18 @@ struct LeafTests {
     // cut the group leaves (the nearest triangle is most often in the
     // first, and its distance drops the boxes behind it untested).
     constexpr uint32_t kGroup = 8;
-    for (uint32_t first = 0; first < near.n && near.box_d2[first] <= cut; first += kGroup) {
+    const auto box_of = [&near](uint32_t j) { return near.box_d2[near.entry(j)]; };
+    for (uint32_t first = 0; first < near.n && box_of(first) <= cut; first += kGroup) {
       uint32_t n = 1;
-      while (n < kGroup && first + n < near.n && near.box_d2[first + n] <= cut) ++n;
+      while (n < kGroup && first + n < near.n && box_of(first + n) <= cut) ++n;
       double corners[kGroup][3][3];
-      for (uint32_t i = 0; i < n; ++i) t.frame.place(near.corners[first + i], corners[i]);
+      for (uint32_t i = 0; i < n; ++i) t.frame.place(near.corners[near.entry(first + i)], corners[i]);
       PointOnTriangle found[kGroup];
       t.nearest(t.frame.query(), corners, n, found);
       for (uint32_t i = 0; i < n; ++i) {
         if (found[i].d2 > best.d2) continue;
-        const uint32_t triangle = layout::remap_entry(t.blob, t.h, layout::slot_of(t.h, offset, near.index[first + i]));
+        const uint32_t entry = near.entry(first + i);
+        const uint32_t triangle = layout::remap_entry(t.blob, t.h, layout::slot_of(t.h, offset, near.index[entry]));
         // At one distance the lower instance, then the lower triangle
         // number, whatever the walk's order.
         if (found[i].d2 == best.d2 && best.triangle != kNoHit &&
@@ -164,7 +166,7 @@ struct LeafTests {
           continue;
         best.d2 = found[i].d2, best.near = found[i], best.triangle = triangle, best.instance = t.instance;
         best.frame = t.frame.index;
-        std::memcpy(best.corners, near.corners[first + i], sizeof best.corners);
+        std::memcpy(best.corners, near.corners[entry], sizeof best.corners);
         cut = t.frame.cut(best.d2);
       }
     }

@@ -39,15 +39,16 @@ constexpr int kStackSize = 7 * MC_MAX_DEPTH + 8;
   return d2;
 }
 
-// Keeps `near` sorted by box distance as triangles join it.
+// A triangle joins `near`, its order kept by insertion (8-byte keys moved,
+// not its corners).
 inline void add_near(NearTriangles& near, uint32_t index, float d2, const float (&corners)[3][3]) {
-  uint32_t j = near.n++;
-  for (; j > 0 && near.box_d2[j - 1] > d2; --j) {
-    near.box_d2[j] = near.box_d2[j - 1], near.index[j] = near.index[j - 1];
-    std::memcpy(near.corners[j], near.corners[j - 1], sizeof near.corners[j]);
-  }
-  near.box_d2[j] = d2, near.index[j] = index;
-  std::memcpy(near.corners[j], corners, sizeof near.corners[j]);
+  const uint32_t entry = near.n++;
+  near.index[entry] = index, near.box_d2[entry] = d2;
+  std::memcpy(near.corners[entry], corners, sizeof near.corners[entry]);
+  const uint64_t key = uint64_t(std::bit_cast<uint32_t>(d2)) << 32 | entry;
+  uint32_t j = entry;
+  for (; j > 0 && near.order[j - 1] > key; --j) near.order[j] = near.order[j - 1];
+  near.order[j] = key;
 }
 
 // A cluster leaf's triangles within the cut: each cluster's vertices

@@ -23,14 +23,18 @@
 
 namespace meshcast {
 
-// A leaf's triangles whose corner boxes are within the cut, nearest box
-// first: their numbers in the leaf (decode order, layout::slot_of's lane),
-// their boxes' squared distances, and their corners as stored.
+// A leaf's triangles whose corner boxes are within the cut: their numbers
+// in the leaf (decode order, layout::slot_of's lane), their boxes' squared
+// distances and their corners as stored, in the order met; and `order`,
+// nearest box first: (the distance's bits << 32) | the entry (a distance
+// is never negative, so its bits order as it does).
 struct NearTriangles {
   uint32_t n = 0;
   uint32_t index[MC_OCT_MAX_COUNT];
   float box_d2[MC_OCT_MAX_COUNT];
   float corners[MC_OCT_MAX_COUNT][3][3];
+  uint64_t order[MC_OCT_MAX_COUNT];
+  uint32_t entry(uint32_t j) const { return uint32_t(order[j]); }
 };
 
 // Hands a leaf's near triangles (its offset in the tree, as oct_offset

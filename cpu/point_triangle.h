@@ -8,8 +8,15 @@
 // follows without a square root. A triangle of no area (its corners on a
 // line or at one point) has no inside: its nearest point is the nearest of
 // its three edges'.
+//
+// The functions live in the instruction set's namespace (cpu/isa.h): the
+// walkers' files of each set compile them too (cpu/point_triangle_lanes.cpp),
+// and an inline function one set compiled must never be the copy the
+// baseline code calls.
 #pragma once
 #include <cmath>
+
+#include "cpu/isa.h"
 
 namespace meshcast {
 
@@ -19,6 +26,7 @@ struct PointOnTriangle {
   double d2;    // squared distance from the query point
 };
 
+MC_ISA_BEGIN
 namespace point_detail {
 inline double dot(const double x[3], const double y[3]) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; }
 inline void finish(const double p[3], const double a[3], const double ab[3], const double ac[3], double u, double v,
@@ -92,4 +100,5 @@ inline PointOnTriangle nearest_on_triangle(const double p[3], const Real fa[3], 
   return out;
 }
 
+MC_ISA_END
 }  // namespace meshcast

@@ -18,8 +18,26 @@ uint64_t trace_with_triangle_test(const BlobView& view, TriangleTest test, std::
   const layout::BlobHeader& h = layout::header_of(view.bytes().data());
   // The plain-test walkers exist for the AABBTree and QuadTree families
   // alone (cpu/walk_table.cpp), the trees the benchmark compares.
+  // On the instruction set the watertight walkers run, so the two tests
+  // are compared like for like; a build may have them for fewer sets
+  // (MESHCAST_TRIANGLE_TEST_ISAS).
+  const WalkerIsa isa = walker_isa();
+  bool built = false;
+#if MESHCAST_HAS_ISA_SCALAR
+  built |= isa == WalkerIsa::Scalar;
+#endif
+#if MESHCAST_HAS_ISA_AVX2
+  built |= isa == WalkerIsa::Avx2;
+#endif
+#if MESHCAST_HAS_ISA_AVX512
+  built |= isa == WalkerIsa::Avx512;
+#endif
+  if (!built)
+    throw UsageError("trace_with_triangle_test: this build has the Möller–Trumbore walkers for other instruction "
+                     "sets (MESHCAST_TRIANGLE_TEST_ISAS) than the one the walkers run here, " +
+                     std::string(walker_isa_name(isa)));
   WalkFn walk = nullptr;
-  for (const WalkEntry& e : walk_table_of<TriangleTest::MollerTrumbore>(walker_isa()))
+  for (const WalkEntry& e : walk_table_of<TriangleTest::MollerTrumbore>(isa))
     if (e.tree == h.tree_format && e.triangles == h.triangle_format) walk = e.walk;
   if (!walk)
     throw UsageError("trace_with_triangle_test: the Möller–Trumbore walkers are built for the AABBTree and "

@@ -23,6 +23,10 @@ bash scripts/fetch_meshes.sh
 
 jobs=$(nproc)
 # Debian's interpreter, the one its numpy and pytest belong to (python3 on
-# PATH may be another).
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHCAST_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+# PATH may be another). The walkers are built for every instruction set;
+# the Möller-Trumbore ones, which `meshcast bench robustness` compares with
+# them, for this machine's widest alone (the set its walkers run).
+source scripts/isa.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHCAST_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3 \
+  "-DMESHCAST_TRIANGLE_TEST_ISAS=$(widest_isa)" >/dev/null
 cmake --build build -j"$jobs"

@@ -260,7 +260,9 @@ TMinAnswers check_t_min_queries(const QueryTracer& trace, const NamedMesh& refer
     if (offset_rays[i].tmin < plain_oracle[i].t) kept_first += out.closest[i].triangle == plain_oracle[i].triangle;
     else skipped_first += out.closest[i].triangle != plain_oracle[i].triangle;
   }
-  if (past_origin > rays.size() / 10) {
+  // Judged on 20 such rays at least (a brute-force layout's tenth of its
+  // rays may hold fewer: a handful can all fall one way).
+  if (past_origin >= 20 && past_origin > rays.size() / 10) {
     EXPECT_GT(kept_first, past_origin / 10) << what << ", t_min: too few rays keep their first hit";
     EXPECT_GT(skipped_first, past_origin / 10) << what << ", t_min: too few rays skip their first hit";
   }

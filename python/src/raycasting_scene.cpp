@@ -274,10 +274,13 @@ class RaycastingScene {
       std::lock_guard<std::mutex> lock(mutex_);
       name = "geometry " + std::to_string(geometries_.size());
     }
-    Mesh mesh = mesh_from_arrays(vertices, triangles, centre);
-    std::vector<PackedNormal> normals(mesh.triangle_count());
+    std::vector<PackedNormal> normals;
     std::vector<uint8_t> blob;
     {
+      // The mesh's copy lives in this block alone: freed before the trim
+      // below, it is not left in the process's heap.
+      Mesh mesh = mesh_from_arrays(vertices, triangles, centre);
+      normals.resize(mesh.triangle_count());
       py::gil_scoped_release release;
       BuildOptions options;
       options.threads = build_threads_;
@@ -295,14 +298,20 @@ class RaycastingScene {
       }
     }
     blob.shrink_to_fit();  // the builder's spare capacity would be memory the scene holds
+    uint32_t id;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      id = add_geometry(std::move(blob), std::move(normals), centre, name);
+    }
 #ifdef __GLIBC__
-    // The build's scratch (several times the blob) is freed, but glibc keeps
-    // freed pages in the process unless asked: hand them back, so a
-    // process's memory is the structures it holds.
+    // The build's scratch (several times the blob) and the mesh's copy are
+    // freed, but glibc keeps freed pages in the process unless asked (once
+    // large blocks have been freed, it serves the next ones from its heap
+    // rather than from their own mappings): hand them back, so a process's
+    // memory is the structures it holds.
     malloc_trim(0);
 #endif
-    std::lock_guard<std::mutex> lock(mutex_);
-    return add_geometry(std::move(blob), std::move(normals), centre, name);
+    return id;
   }
 
   // A scene of the same geometries, each blob and its normals copied (copy

@@ -10,6 +10,7 @@
 #include <cfloat>
 #include <cmath>
 
+#include "cpu/oct_children.h"
 #include "cpu/walk.h"
 #include "layout/triangles/codecs.h"
 #include "layout/tree/octtree.h"
@@ -277,12 +278,8 @@ void walk_packet(const uint8_t* blob, const layout::BlobHeader& h, const RayPre*
     if (count == 0) {
       const uint8_t* node = tree + offset;
       F8 lo[3], hi[3];
-      for (int a = 0; a < 3; ++a) {
-        const F8 origin = F8::splat(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a));
-        const F8 scale = F8::splat(layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));
-        lo[a] = simd::fma(simd::from_u8x8(node + MC_OCT_QLO_AT + 8 * a), scale, origin) - origin_of[a];
-        hi[a] = simd::fma(simd::from_u8x8(node + MC_OCT_QHI_AT + 8 * a), scale, origin) - origin_of[a];
-      }
+      decode_oct_children(node, lo, hi);
+      for (int a = 0; a < 3; ++a) lo[a] = lo[a] - origin_of[a], hi[a] = hi[a] - origin_of[a];
       const int used = simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT);
       uint64_t hit_rows = 0;  // byte i: ray i's hit children
       F8 least = inf;         // each child's least entry among the rays that hit it

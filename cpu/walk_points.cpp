@@ -13,6 +13,7 @@
 #include <bit>
 #include <cstring>
 
+#include "cpu/oct_children.h"
 #include "cpu/walk.h"
 #include "layout/tree/leaves.h"
 #include "layout/tree/octtree.h"
@@ -128,15 +129,8 @@ void walk(const uint8_t* blob, const float point[3], float cut, VisitLeafFn visi
     const uint32_t count = layout::oct_count(properties), offset = layout::oct_offset(properties);
     if (count == 0) {
       const uint8_t* node = tree + offset;
-      // The child boxes decoded exactly: Origin + q 2^e is a float by the
-      // format's rule (layout/tree/octtree.h).
       F8 lo[3], hi[3];
-      for (int a = 0; a < 3; ++a) {
-        const F8 origin = F8::splat(layout::load<float>(node + MC_OCT_ORIGIN_AT + 4 * a));
-        const F8 scale = F8::splat(layout::oct_scale(node[MC_OCT_EXPONENTS_AT + a]));
-        lo[a] = simd::from_u8x8(node + MC_OCT_QLO_AT + 8 * a) * scale + origin;
-        hi[a] = simd::from_u8x8(node + MC_OCT_QHI_AT + 8 * a) * scale + origin;
-      }
+      decode_oct_children(node, lo, hi);
       const F8 d2 = box_d2(lo, hi, p);
       const int within = simd::bits(d2 <= F8::splat(cut)) & simd::nonzero_bits8(node + MC_OCT_PROPERTIES_AT);
       if (within) {

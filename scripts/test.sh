@@ -9,6 +9,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 jobs=$(nproc)
+# meshcast.dask's tests (pytest, below) run on Debian's Dask: installed
+# while the CPU suites run (a download, mostly waiting).
+source scripts/packages.sh
+install_missing python3-dask python3-distributed > build/dask_install.log 2>&1 &
+dask_install_job=$!
 
 # The CPU suites (CTest label `cpu`), run one process a suite, $jobs at a
 # time: CTest's one process a test would load the meshes and compute the
@@ -21,7 +26,7 @@ jobs=$(nproc)
 # shards each, so the two cores finish together.
 cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test scene_test point_test
             hostile_test oracle_test io_test)
-# Under AddressSanitizer: the suites that read hostile input, walk, place
+# Under AddressSanitizer: the suites that read hostile input, walk points, place
 # instances and allocate per frame. The layouts' own suites (layout_test,
 # pairing_test, auto_test), the builder's (build_test: its threads run
 # under TSan below), the oracle's and the stiff and extreme inputs'
@@ -30,7 +35,9 @@ cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_
 # their encoders are the builds the suites below make, and the fuzz
 # targets' ASan builds read, build and walk every layout on arbitrary
 # bytes and rays again.
-asan_suites=(walker_test limits_test zerobyte_test scene_test hostile_test io_test point_test)
+# walker_test is not among them: the fuzz targets walk every layout under
+# the sanitizers, and the walks run on three instruction sets in Release.
+asan_suites=(limits_test zerobyte_test scene_test hostile_test io_test point_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
 walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test point_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
@@ -50,6 +57,12 @@ run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
           { echo "  $item: FAILED"; tail -50 "$dir/$item.log"; exit 1; }' "$dir" {}
 }
 stage() { echo "== $* ($((SECONDS / 60)) min $((SECONDS % 60)) s in)"; }
+# A job run beside a stage (one that leaves a core idle much of its time):
+# its output printed when it is waited for, its failure failing the run.
+finish() {  # finish PID LABEL LOG
+  if wait "$1"; then cat "$3"; else cat "$3"; echo "FAILED: $2"; exit 1; fi
+}
+
 # The ThreadSanitizer build: -O1 with line tables only (-g1): reports keep their
 # files, lines and functions; full debug info of the walkers' templates
 # doubled these builds' time, and -O2 took 5.8 min to build the ASan stage
@@ -77,8 +90,13 @@ fi
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
-stage "Python: the package (build/python) against its own double-precision brute force (pytest)"
-PYTHONPATH="$PWD/build/python" MESHCAST_DATA="$PWD/data" /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests
+finish $dask_install_job "installing python3-dask and python3-distributed" build/dask_install.log
+stage "Python: the package (build/python) against its own double-precision brute force, and meshcast.dask on a local cluster (pytest), beside the sanitizer build"
+# pytest keeps one core busy about half its time (the cluster's processes
+# starting, the spawned children): the sanitizer build takes the rest.
+PYTHONPATH="$PWD/build/python" MESHCAST_DATA="$PWD/data" /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests \
+  > build/pytest.log 2>&1 &
+pytest_job=$!
 
 stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters compiled in, without the Vulkan backend: the CPU suites of asan_suites and the CPU host layer, then the fuzz targets"
 # One sanitizer build (scripts/sanitizer_build.sh, build-fuzz/) serves the
@@ -91,22 +109,30 @@ stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters comp
 # alone. The fuzz corpora replay under ASan and UBSan at the start of each
 # fuzz target's run (and without sanitizers in Release's CTest).
 bash scripts/sanitizer_build.sh "${asan_suites[@]}" host_test blob_fuzz mesh_fuzz
+finish $pytest_job pytest build/pytest.log
 run_suites build-fuzz quick "${asan_suites[@]}" host_test
 bash scripts/fuzz.sh
 
-stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads"
+stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads, beside the package's test"
 # MESHCAST_HOST_CPU_ONLY=1 would keep lavapipe out, should its own
 # (uninstrumented) threads ever make TSan report what it cannot see.
 source scripts/ninja.sh
 ninja_dir build-tsan
 cmake -S . -B build-tsan -G Ninja "${tsan_flags[@]}" -DMESHCAST_TSAN=ON "-DMESHCAST_ISAS=$widest" >/dev/null
 cmake --build build-tsan -j"$jobs" --target host_test build_test
+# The runs under TSan keep about one core busy: the package's test (its
+# configure steps one core too) runs beside them.
 # tests/tsan.supp leaves out races inside the Vulkan validation layer's own threads.
-MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
-  build-tsan/bin/host_test
-MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
-  build-tsan/bin/build_test --gtest_brief=1 --gtest_filter='Build.AnyNumberOfThreadsBuildsTheSameBytes:BuildThreads.*'
+{
+  MESHCAST_DATA="$PWD/data" TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/tests/tsan.supp" \
+    build-tsan/bin/host_test &&
+  MESHCAST_DATA="$PWD/data" MESHCAST_TEST_QUICK=1 TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
+    build-tsan/bin/build_test --gtest_brief=1 --gtest_filter='Build.AnyNumberOfThreadsBuildsTheSameBytes:BuildThreads.*'
+} > build-tsan/tsan.log 2>&1 &
+tsan_job=$!
 
 stage "The package: installed and used by the examples (CMake and pkg-config), and as a subproject"
 bash scripts/package_test.sh
+stage "ThreadSanitizer's runs"
+finish $tsan_job "the ThreadSanitizer runs" build-tsan/tsan.log
 stage "done"

@@ -53,10 +53,11 @@ one ray at a time (``packets="off"``), only the time differs.
 """
 
 import os as _os
+import uuid as _uuid
 
 import numpy as _np
 
-from . import _meshcast
+from . import _meshcast, _shipping
 from .images import write_png  # noqa: F401
 from ._meshcast import (NO_HIT, Blob, Scene, __version__, features, layouts,  # noqa: F401
                         walker_isa)
@@ -65,6 +66,9 @@ from ._meshcast import (NO_HIT, Blob, Scene, __version__, features, layouts,  # 
 # numpy.ndarray's whole documentation under it.
 __all__ = ["Blob", "Scene", "RaycastingScene", "build", "load", "read_mesh", "layouts", "features",
            "walker_isa", "write_png", "from_bytes", "NO_HIT", "__version__"]
+
+# Blob's pickling: a mapped file's path, or the bytes (meshcast/_shipping.py).
+_shipping.install()
 
 
 def build(vertices, triangles, layout="auto", max_bytes=0, leaf_size=0, threads=0, name="mesh"):
@@ -99,11 +103,18 @@ def load(path, mmap=False):
     the old file does not see). A file rewritten in place is read as it now
     is, unvalidated: wrong answers, or a crash on corrupted bytes; a file
     truncated under the map kills the process with SIGBUS on the next cast.
+
+    Pickled (``pickle``, ``multiprocessing``, Dask), a mapped Blob travels
+    as its file's absolute path, size and checksum: the process that
+    unpickles it maps the file once (later ones are the same mapping) and
+    raises an error naming itself, the path and what differs where the file
+    is missing or another. A Blob in memory travels as its bytes.
     """
     path = _os.fspath(path)
     with open(path, "rb"):  # the system's own error for a missing or unreadable file
         pass
-    return _meshcast._load(path, bool(mmap))
+    # A mapped file is named by its absolute path: a pickled Blob names it so.
+    return _meshcast._load(_os.path.abspath(path) if mmap else path, bool(mmap), path)
 
 
 def from_bytes(data, name="bytes"):
@@ -157,6 +168,10 @@ class RaycastingScene:
     origins keep their precision, and each geometry is stored about its own
     float64 centre, so scenes far from the origin answer as at the origin.
 
+    Pickled (``pickle``, Dask, ``multiprocessing``), a scene travels as its
+    geometries' structures, every byte as it is: nothing is built again, and
+    the copy answers the same bits.
+
     Each geometry is stored exactly by default: its float32 vertices
     themselves, in clusters under an 8-wide tree (the layout
     "OctTreeCompressed/ClusterFloat3SOA8", about 19 bytes a triangle all
@@ -185,6 +200,15 @@ class RaycastingScene:
         whose stated bound is over it is refused."""
         self._scene = _meshcast._RaycastingScene(nthreads, layout=layout, max_error=max_error)
         self._nthreads = nthreads
+        self._new_content()
+
+    def _new_content(self):
+        # What meshcast.dask names the scene's content by: a new name for
+        # each geometry added (a pickled copy keeps it: the same content).
+        self._token = _uuid.uuid4().hex
+
+    def _content_token(self):
+        return ("meshcast.RaycastingScene", self._token)
 
     def _threads(self, nthreads):
         return nthreads if nthreads else self._nthreads
@@ -203,7 +227,9 @@ class RaycastingScene:
             vertex_positions, triangle_indices = mesh.vertex.positions, mesh.triangle.indices
         if vertex_positions is None:
             raise TypeError("add_triangles: vertex_positions and triangle_indices, or a mesh")
-        return self._scene.add_triangles(_array(vertex_positions), _array(triangle_indices))
+        geometry_id = self._scene.add_triangles(_array(vertex_positions), _array(triangle_indices))
+        self._new_content()
+        return geometry_id
 
     def __copy__(self):
         """A scene of the same geometries (their structures copied): adding to
@@ -211,6 +237,7 @@ class RaycastingScene:
         twin = type(self).__new__(type(self))
         twin._scene = self._scene.copy()
         twin._nthreads = self._nthreads
+        twin._new_content()
         return twin
 
     def __deepcopy__(self, memo):

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "builder/auto_layout.h"
+#include "layout/blob_format.h"
 #include "meshcast/build.h"
 #include "python/src/answers.h"
 #include "python/src/arrays.h"
@@ -22,8 +23,8 @@ PyBlob::PyBlob(std::vector<uint8_t> bytes, std::string name) : owned_(std::move(
   view_.emplace(owned_, name_);
 }
 
-PyBlob::PyBlob(std::shared_ptr<const MappedBlob> file, std::string name)
-    : mapped_(std::move(file)), name_(std::move(name)) {
+PyBlob::PyBlob(std::shared_ptr<const MappedBlob> file, std::string name, std::string path)
+    : mapped_(std::move(file)), name_(std::move(name)), path_(std::move(path)) {
   view_.emplace(mapped_->bytes(), name_);
 }
 
@@ -188,7 +189,10 @@ void register_blob(py::module_& m) {
 
 Made by meshcast.build(), meshcast.load() (the file read into memory, or
 memory-mapped with mmap=True) or meshcast.from_bytes(). Any number of
-Python threads may cast through one Blob at once.)")
+Python threads may cast through one Blob at once. Pickled (pickle, Dask,
+multiprocessing), a mapped Blob travels as its file's path, size and
+checksum (mapped once a process, see meshcast.load), any other as its
+bytes.)")
       .def_property_readonly("layout", [](const PyBlob& b) { return layout_name(b.view().layout()); },
                              "The layout: tree format / triangle format.")
       .def_property_readonly("triangle_count", [](const PyBlob& b) { return b.view().triangle_count(); })
@@ -196,6 +200,13 @@ Python threads may cast through one Blob at once.)")
                              "The blob's bytes: all the memory the structure takes (the mesh included).")
       .def_property_readonly("mapped", &PyBlob::mapped, "Whether the bytes are a file's, mapped read-only (load(path, mmap=True)).")
       .def_property_readonly("name", &PyBlob::name)
+      .def_property_readonly(
+          "path", [](const PyBlob& b) { return b.mapped() ? py::object(py::str(b.path())) : py::object(py::none()); },
+          "The file a mapped blob reads, as an absolute path (what the Blob pickles as); None for bytes in memory.")
+      .def_property_readonly(
+          "checksum", [](const PyBlob& b) { return layout::header_of(b.view().bytes().data()).checksum; },
+          "The checksum in the blob's header (FNV-1a, 32 bits, over every byte; verified when the blob was\n"
+          "built, loaded or mapped): with nbytes, what tells a pickled Blob's file from another.")
       .def(
           "save", [](const PyBlob& b, const std::string& path) { save_blob(path, b.view().bytes()); },
           py::arg("path"), "Writes the blob to a file (replaced whole, or left as it was).")
@@ -262,16 +273,17 @@ ValueError naming it.)")
         py::arg("max_bytes") = 0, py::arg("leaf_size") = 0, py::arg("threads") = 0, py::arg("name") = "mesh");
   m.def(
       "_load",
-      [](const std::string& path, bool mmap) {
-        if (mmap) return std::make_shared<PyBlob>(std::make_shared<const MappedBlob>(path), path);
+      [](const std::string& path, bool mmap, std::string name) {
+        if (name.empty()) name = path;
+        if (mmap) return std::make_shared<PyBlob>(std::make_shared<const MappedBlob>(path), name, path);
         std::vector<uint8_t> bytes;
         {
           py::gil_scoped_release release;
           bytes = load_blob(path);
         }
-        return std::make_shared<PyBlob>(std::move(bytes), path);
+        return std::make_shared<PyBlob>(std::move(bytes), name);
       },
-      py::arg("path"), py::arg("mmap") = false);
+      py::arg("path"), py::arg("mmap") = false, py::arg("name") = "");
   m.def(
       "_from_bytes",
       [](const py::bytes& data, const std::string& name) {

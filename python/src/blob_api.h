@@ -21,13 +21,15 @@ namespace py = pybind11;
 class PyBlob {
  public:
   PyBlob(std::vector<uint8_t> bytes, std::string name);            // built here
-  PyBlob(std::shared_ptr<const MappedBlob> file, std::string name);  // mapped from a file
+  // Mapped from the file at `path` (absolute: what a pickled Blob names).
+  PyBlob(std::shared_ptr<const MappedBlob> file, std::string name, std::string path);
   PyBlob(const PyBlob&) = delete;
   PyBlob& operator=(const PyBlob&) = delete;
   const BlobView& view() const { return *view_; }
   const std::string& name() const { return name_; }
   bool mapped() const { return mapped_ != nullptr; }
   const std::shared_ptr<const MappedBlob>& mapped_file() const { return mapped_; }
+  const std::string& path() const { return path_; }  // empty for bytes in memory
   // The Vulkan caster for answers carrying `outputs` (VulkanCasters::get).
   host::Caster& vulkan(HitOutputs outputs, std::unique_lock<std::mutex>& lock);
 
@@ -35,6 +37,7 @@ class PyBlob {
   std::vector<uint8_t> owned_;
   std::shared_ptr<const MappedBlob> mapped_;
   std::string name_;
+  std::string path_;
   std::optional<BlobView> view_;
   VulkanCasters gpu_;
 };

@@ -14,6 +14,7 @@
 #include <malloc.h>
 #endif
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <initializer_list>
 #include <algorithm>
@@ -326,6 +327,55 @@ class RaycastingScene {
                          "geometry " + std::to_string(g));
     }
     return twin;
+  }
+
+  // What a pickled scene holds: (1, build threads, layout name or None,
+  // max_error, geometries), each geometry (blob bytes, normals bytes,
+  // centre): the structures as they are, not the meshes, so nothing is
+  // built again and the answers are the same bits.
+  py::tuple state() const {
+    py::list geometries;
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& g : geometries_) {
+      const std::span<const uint8_t> bytes = g->view.bytes();
+      geometries.append(py::make_tuple(
+          py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+          py::bytes(reinterpret_cast<const char*>(g->normals.data()), g->normals.size() * sizeof(PackedNormal)),
+          py::make_tuple(g->centre[0], g->centre[1], g->centre[2])));
+    }
+    return py::make_tuple(1, build_threads_, layout_.named ? py::object(py::str(*layout_.named)) : py::object(py::none()),
+                          layout_.max_error, geometries);
+  }
+
+  // The scene of a state(): every blob validated as a loaded one is.
+  static std::unique_ptr<RaycastingScene> from_state(const py::tuple& state) {
+    if (state.size() != 5 || state[0].cast<int>() != 1)
+      throw py::value_error("RaycastingScene: a pickled state of another version of meshcast");
+    GeometryLayout layout{state[2].is_none() ? std::nullopt : std::optional<std::string>(state[2].cast<std::string>()),
+                          state[3].cast<double>()};
+    if (layout.named) parse_layout_name(*layout.named);
+    if (!(layout.max_error >= 0) || !std::isfinite(layout.max_error))
+      throw py::value_error("RaycastingScene: a pickled max_error that is not a finite fraction >= 0");
+    auto scene = std::make_unique<RaycastingScene>(state[1].cast<uint32_t>(), std::move(layout));
+    std::lock_guard<std::mutex> lock(scene->mutex_);
+    for (const py::handle item : state[4].cast<py::list>()) {
+      const py::tuple g = item.cast<py::tuple>();
+      const std::string name = "geometry " + std::to_string(scene->geometries_.size());
+      if (g.size() != 3) throw py::value_error("RaycastingScene: " + name + " of the pickled state is malformed");
+      const std::string_view blob_bytes = g[0].cast<py::bytes>(), normal_bytes = g[1].cast<py::bytes>();
+      const auto centre = g[2].cast<std::vector<double>>();
+      std::vector<uint8_t> blob(blob_bytes.begin(), blob_bytes.end());
+      const uint32_t triangles = BlobView(blob, name).triangle_count();  // InputError naming what is wrong
+      if (normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal) || centre.size() != 3 ||
+          !std::isfinite(centre[0]) || !std::isfinite(centre[1]) || !std::isfinite(centre[2]))
+        throw py::value_error("RaycastingScene: " + name + " of the pickled state has " +
+                              std::to_string(normal_bytes.size()) + " bytes of normals for " +
+                              std::to_string(triangles) + " triangles, or a centre that is not 3 finite numbers");
+      std::vector<PackedNormal> normals(triangles);
+      std::memcpy(normals.data(), normal_bytes.data(), normal_bytes.size());
+      scene->add_geometry(std::move(blob), std::move(normals), centre.data(), name);
+    }
+    return scene;
   }
 
   py::dict cast_rays(const py::handle& rays_in, long long nthreads, bool uvs, bool normals, const py::object& out,
@@ -744,6 +794,8 @@ void register_raycasting_scene(py::module_& m) {
            py::arg("tolerance") = 1e-2)
       .def("winding_inside", &RaycastingScene::winding_inside, py::arg("query_points"), py::arg("nthreads") = 0)
       .def("copy", &RaycastingScene::copy)
+      .def(py::pickle([](const RaycastingScene& s) { return s.state(); },
+                      [](const py::tuple& state) { return RaycastingScene::from_state(state); }))
       .def_property_readonly("nbytes", &RaycastingScene::nbytes);
   m.attr("INVALID_ID") = kInvalidId;
 }

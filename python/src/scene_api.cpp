@@ -3,6 +3,7 @@
 // float64 rays (the origins kept in double: meshcast/scene.h).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <memory>
 #include <vector>
@@ -19,6 +20,13 @@ namespace meshcast::python {
 
 namespace {
 
+struct Placed {
+  MeshId mesh = 0;
+  Transform transform;
+  uint8_t mask = 0xFF;
+  bool flip_facing = false, enabled = true, removed = false;
+};
+
 class PyScene {
  public:
   MeshId add_mesh(const std::shared_ptr<PyBlob>& blob) {
@@ -29,9 +37,25 @@ class PyScene {
     blobs.push_back(blob);
     return id;
   }
+  InstanceId add_instance(MeshId mesh, const Transform& t, uint8_t mask, bool flip_facing) {
+    const InstanceId id = scene.add_instance(mesh, t, mask, flip_facing);
+    instances.resize(size_t(id) + 1);
+    instances[id] = {mesh, t, mask, flip_facing};
+    edited = true;
+    return id;
+  }
+  // The instance's record, after the library has accepted an edit of it
+  // (its error names an unknown or removed id first).
+  Placed& edit(InstanceId i) {
+    edited = true;
+    return instances.at(i);
+  }
   std::vector<std::shared_ptr<PyBlob>> blobs;  // before the scene: they outlive it
   Scene scene;
-  std::vector<Transform> placed;  // each instance's, for set_transform's parts left as they were
+  // Each instance as last edited: set_transform's parts left as they were,
+  // and what a pickled Scene replays.
+  std::vector<Placed> instances;
+  bool edited = false;  // edits not yet committed
 };
 
 // The transform with the parts given (None: `t`'s kept).
@@ -110,25 +134,71 @@ py::dict closest_points_scene(const PyScene& s, const py::handle& points_in, dou
   return answer;
 }
 
+// A committed scene's state: (1, blobs, instances), each instance (mesh,
+// rotation_scale (9 floats, row-major), translation (3 doubles), mask,
+// flip_facing, enabled, removed).
+py::tuple scene_state(const PyScene& s) {
+  if (s.edited)
+    throw py::value_error("Scene: edits since the last commit(); commit them (or undo them) before pickling");
+  py::list blobs, instances;
+  for (const auto& b : s.blobs) blobs.append(b);
+  for (const Placed& p : s.instances) {
+    py::list m, t;
+    for (float v : p.transform.rotation_scale) m.append(v);
+    for (double v : p.transform.translation) t.append(v);
+    instances.append(py::make_tuple(p.mesh, m, t, p.mask, p.flip_facing, p.enabled, p.removed));
+  }
+  return py::make_tuple(1, blobs, instances);
+}
+
+std::unique_ptr<PyScene> scene_from_state(const py::tuple& state) {
+  if (state.size() != 3 || state[0].cast<int>() != 1)
+    throw py::value_error("Scene: a pickled state of another version of meshcast");
+  auto s = std::make_unique<PyScene>();
+  for (const py::handle b : state[1].cast<py::list>()) s->add_mesh(b.cast<std::shared_ptr<PyBlob>>());
+  for (const py::handle item : state[2].cast<py::list>()) {
+    const py::tuple i = item.cast<py::tuple>();
+    if (i.size() != 7) throw py::value_error("Scene: a malformed pickled instance");
+    const auto m = i[1].cast<std::vector<float>>();
+    const auto t = i[2].cast<std::vector<double>>();
+    if (m.size() != 9 || t.size() != 3) throw py::value_error("Scene: a malformed pickled instance");
+    Transform placed;
+    std::copy(m.begin(), m.end(), placed.rotation_scale);
+    std::copy(t.begin(), t.end(), placed.translation);
+    const InstanceId id = s->add_instance(i[0].cast<MeshId>(), placed, checked_mask(i[3].cast<long long>()),
+                                          i[4].cast<bool>());
+    if (!i[5].cast<bool>()) {
+      s->scene.set_enabled(id, false);
+      s->instances[id].enabled = false;
+    }
+    if (i[6].cast<bool>()) {
+      s->scene.remove_instance(id);
+      s->instances[id].removed = true;
+    }
+  }
+  s->scene.commit();
+  s->edited = false;
+  return s;
+}
+
 }  // namespace
+
 
 void register_scene(py::module_& m) {
   py::class_<PyScene>(m, "Scene", R"(Instances of blobs, cast against as one world.
 
 world = rotation_scale @ local + translation; the translation is float64, so
 worlds far larger than a float reaches keep their precision. Edits are seen
-by casts after commit(). One thread edits and commits; any number cast.)")
+by casts after commit(). One thread edits and commits; any number cast.
+Pickled (pickle, Dask, multiprocessing), a committed scene travels as its
+blobs, each once (a mapped one as its file's path), and its instance table.)")
       .def(py::init<>())
       .def("add_mesh", &PyScene::add_mesh, py::arg("blob"), "Adds a Blob (kept alive by the scene); returns its mesh id.")
       .def(
           "add_instance",
           [](PyScene& s, MeshId mesh, const py::handle& rotation_scale, const py::handle& translation, long long mask,
              bool flip_facing) {
-            const Transform t = transform_from(rotation_scale, translation);
-            const InstanceId id = s.scene.add_instance(mesh, t, checked_mask(mask), flip_facing);
-            s.placed.resize(size_t(id) + 1);
-            s.placed[id] = t;
-            return id;
+            return s.add_instance(mesh, transform_from(rotation_scale, translation), checked_mask(mask), flip_facing);
           },
           py::arg("mesh"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none(),
           py::arg("mask") = 0xFF, py::arg("flip_facing") = false,
@@ -136,30 +206,55 @@ by casts after commit(). One thread edits and commits; any number cast.)")
       .def(
           "set_transform",
           [](PyScene& s, InstanceId i, const py::handle& rotation_scale, const py::handle& translation) {
-            if (i >= s.placed.size()) {
+            if (i >= s.instances.size()) {
               s.scene.set_transform(i, Transform{});  // the library's error, naming the instance
             }
-            const Transform t = transform_from(rotation_scale, translation, s.placed[i]);
+            const Transform t = transform_from(rotation_scale, translation, s.instances[i].transform);
             s.scene.set_transform(i, t);
-            s.placed[i] = t;
+            s.edit(i).transform = t;
           },
           py::arg("instance"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none(),
           "A new rotation_scale, translation or both; a part not given is kept.")
       .def(
-          "set_mask", [](PyScene& s, InstanceId i, long long mask) { s.scene.set_mask(i, checked_mask(mask)); },
+          "set_mask",
+          [](PyScene& s, InstanceId i, long long mask) {
+            s.scene.set_mask(i, checked_mask(mask));
+            s.edit(i).mask = uint8_t(mask);
+          },
           py::arg("instance"), py::arg("mask"))
       .def(
-          "set_flip_facing", [](PyScene& s, InstanceId i, bool flip) { s.scene.set_flip_facing(i, flip); },
+          "set_flip_facing",
+          [](PyScene& s, InstanceId i, bool flip) {
+            s.scene.set_flip_facing(i, flip);
+            s.edit(i).flip_facing = flip;
+          },
           py::arg("instance"), py::arg("flip_facing"))
       .def(
-          "set_enabled", [](PyScene& s, InstanceId i, bool enabled) { s.scene.set_enabled(i, enabled); },
+          "set_enabled",
+          [](PyScene& s, InstanceId i, bool enabled) {
+            s.scene.set_enabled(i, enabled);
+            s.edit(i).enabled = enabled;
+          },
           py::arg("instance"), py::arg("enabled"))
       .def(
-          "remove_instance", [](PyScene& s, InstanceId i) { s.scene.remove_instance(i); }, py::arg("instance"))
+          "remove_instance",
+          [](PyScene& s, InstanceId i) {
+            s.scene.remove_instance(i);
+            s.edit(i).removed = true;
+          },
+          py::arg("instance"))
       // The GIL held: edits from other Python threads wait (the library
       // takes edits and commits from one thread at a time).
       .def(
-          "commit", [](PyScene& s) { s.scene.commit(); }, "The edits so far are done: casts from now on see them.")
+          "commit",
+          [](PyScene& s) {
+            s.scene.commit();
+            s.edited = false;
+          },
+          "The edits so far are done: casts from now on see them.")
+      // Pickled as its blobs (each pickled once, as its bytes or the path of
+      // its mapped file) and its instance table, replayed and committed.
+      .def(py::pickle(&scene_state, &scene_from_state))
       .def_property_readonly("instance_count", [](const PyScene& s) { return s.scene.instance_count(); })
       .def("cast", &cast_scene, py::arg("origins"), py::arg("directions"), py::arg("t_min") = py::none(),
            py::arg("t_max") = py::none(), py::arg("query") = "closest", py::arg("cull") = "none",

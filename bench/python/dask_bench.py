@@ -1,0 +1,156 @@
+"""meshcast.dask on a LocalCluster against the in-process cast, on the same machine and rays.
+
+    /usr/bin/python3 bench/python/dask_bench.py [--build-dir build] [--out bench/results/dask]
+                                                [--chunks 1e4,1e5,1e6,1e7] [--rounds 3]
+
+For each chunk size, one batch of rays (4 million, or two chunks where that
+is more) held by the client as numpy arrays is cast three ways, closest hit
+with t and triangle back in the client: Blob.cast in process on every core;
+meshcast.dask.cast on a LocalCluster of one worker process with a thread a
+core; and on one of two worker processes of one thread each (the blob
+scattered to the workers once, before timing; the rays travel to the
+workers and the answers back, as a dataset's would). Interleaved rounds,
+medians. Writes DIR/dask.csv, DIR/dask.png (gnuplot: rays a second against
+the chunk size) and prints a Markdown table: rays a second, the cluster's
+time over in-process, the added time a chunk in milliseconds, and the
+smallest chunk at which each cluster is within 10% of in-process.
+"""
+import argparse
+import csv
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+from bench import interleaved, log, median, processor_name, run_gnuplot  # noqa: E402
+
+LAYOUT = "OctTreeCompressed/ClusterBitPackSOA8"
+
+
+def rays_at(vertices, n, seed):
+    # From a sphere around the mesh toward random points of its box.
+    rng = np.random.default_rng(seed)
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    centre, diag = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
+    d = rng.normal(size=(n, 3)).astype(np.float32)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    origins = (centre + diag * d).astype(np.float32)
+    directions = (rng.uniform(lo, hi, (n, 3)).astype(np.float32) - origins)
+    return origins, directions
+
+
+def plot(out_dir, rows, cpu):
+    png = os.path.join(out_dir, "dask.png")
+    script = png + ".gp"
+    with open(script, "w") as gp:
+        gp.write("set terminal pngcairo noenhanced size 1000,600 font 'sans,10'\n")
+        gp.write(f"set output '{png}'\nset logscale x\nset grid\nset key bottom right\n")
+        gp.write(f"set title 'meshcast.dask against the in-process cast, closest hits on bunny00 ({cpu})'\n")
+        gp.write("set xlabel 'rays a chunk'\nset ylabel 'million rays a second (wall, answers in the client)'\n")
+        gp.write("set yrange [0:*]\nset format x '10^{%L}'\n")
+        contenders = list(dict.fromkeys(r["contender"] for r in rows))
+        gp.write("plot " + ", ".join(f"'-' using 1:2 with linespoints lw 2 title '{c}'" for c in contenders) + "\n")
+        for c in contenders:
+            for r in rows:
+                if r["contender"] == c:
+                    gp.write(f"{r['chunk']} {r['mrays_per_s']}\n")
+            gp.write("e\n")
+    return run_gnuplot(script)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build-dir", default=os.path.join(REPO, "build"))
+    ap.add_argument("--out", default=os.path.join(REPO, "bench", "results", "dask"))
+    ap.add_argument("--chunks", default="1e4,1e5,1e6,1e7")
+    ap.add_argument("--rays", type=float, default=4e6, help="rays a batch (at least two chunks)")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--mesh", default=os.path.join(REPO, "data", "bunny00.off"))
+    a = ap.parse_args()
+    sys.path.insert(0, os.path.join(a.build_dir, "python"))
+    import dask
+    import dask.array as da
+    from distributed import Client, LocalCluster
+
+    import meshcast
+    import meshcast.dask as mcd
+
+    os.makedirs(a.out, exist_ok=True)
+    cpu = processor_name()
+    cores = os.cpu_count()
+    v, t = meshcast.read_mesh(a.mesh)
+    blob = meshcast.build(v, t, layout=LAYOUT, name=os.path.basename(a.mesh))
+    log(f"{blob}; {cpu}, {cores} cores")
+    clusters = {
+        f"1 worker x {cores} threads": LocalCluster(n_workers=1, threads_per_worker=cores, dashboard_address=None,
+                                                    silence_logs=40),
+        f"{cores} workers x 1 thread": LocalCluster(n_workers=cores, threads_per_worker=1, dashboard_address=None,
+                                                    silence_logs=40),
+    }
+    clients = {name: Client(c, set_as_default=False) for name, c in clusters.items()}
+    rows = []
+    for chunk in [int(float(c)) for c in a.chunks.split(",")]:
+        n = max(int(a.rays), 2 * chunk)
+        origins, directions = rays_at(np.asarray(v), n, seed=chunk)
+        expected = blob.cast(origins, directions)
+
+        def in_process():
+            start = time.perf_counter()
+            blob.cast(origins, directions)
+            return time.perf_counter() - start
+
+        def on(client):
+            def run():
+                with client.as_current():
+                    answer = mcd.cast(blob, da.from_array(origins, chunks=(chunk, 3)),
+                                      da.from_array(directions, chunks=(chunk, 3)))
+                    start = time.perf_counter()
+                    got = dask.compute(answer["t"], answer["triangle"])
+                    seconds = time.perf_counter() - start
+                assert np.array_equal(got[0], expected["t"]) and np.array_equal(got[1], expected["triangle"])
+                return seconds
+            return run
+
+        contenders = [("in process", in_process)] + [(name, on(c)) for name, c in clients.items()]
+        for _, fn in contenders:  # warm: the blob scattered, the pools made
+            fn()
+        samples = interleaved(contenders, a.rounds)
+        base = median(samples["in process"])
+        for name, seconds in samples.items():
+            s = median(seconds)
+            chunks = -(-n // chunk)
+            rows.append({"chunk": chunk, "rays": n, "chunks": chunks, "contender": name, "seconds": round(s, 4),
+                         "mrays_per_s": round(n / s / 1e6, 3), "over_in_process": round(s / base, 3),
+                         "ms_added_per_chunk": round(1e3 * (s - base) / chunks, 3) if name != "in process" else 0.0})
+            log(rows[-1])
+    for c in clients.values():
+        c.close()
+    for c in clusters.values():
+        c.close()
+    with open(os.path.join(a.out, "dask.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    note = plot(a.out, rows, cpu)
+    print(f"Closest hits on {os.path.basename(a.mesh)} ({blob.triangle_count:,} triangles, {LAYOUT}); {cpu}, "
+          f"{cores} cores; medians of {a.rounds} interleaved rounds; the rays in the client, the answers "
+          "gathered back.\n")
+    print("| rays a chunk | rays | contender | Mrays/s | time / in process | ms added a chunk |")
+    print("|---:|---:|---|---:|---:|---:|")
+    for r in rows:
+        print(f"| {r['chunk']:,} | {r['rays']:,} | {r['contender']} | {r['mrays_per_s']} | {r['over_in_process']} | "
+              f"{r['ms_added_per_chunk']} |")
+    for name in clients:
+        within = [r["chunk"] for r in rows if r["contender"] == name and r["over_in_process"] <= 1 / 0.9]
+        print(f"\n{name}: within 10% of in-process from {min(within):,} rays a chunk" if within else
+              f"\n{name}: never within 10% of in-process at these chunk sizes")
+    if note:
+        print("\n" + note)
+
+
+if __name__ == "__main__":
+    main()

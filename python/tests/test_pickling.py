@@ -1,0 +1,176 @@
+"""Blobs, Scenes and RaycastingScenes through pickle and spawned processes:
+the same answers, bit for bit; a mapped blob travels as its path and is
+mapped once a process; a file missing or another is named."""
+
+import copy
+import multiprocessing
+import os
+import pickle
+
+import numpy as np
+import pytest
+
+import meshcast
+import shapes
+from meshcast import _shipping
+
+RECOMMENDED = "OctTreeCompressed/ClusterBitPackSOA8"
+
+
+def _rays(vertices, n=3000, seed=5):
+    o, d = shapes.rays(vertices, n, seed=seed)
+    return np.asarray(o, np.float32), np.asarray(d, np.float32)
+
+
+def _equal(a, b):
+    assert a.keys() == b.keys()
+    for key in a:
+        np.testing.assert_array_equal(np.asarray(a[key]), np.asarray(b[key]), err_msg=key)
+
+
+def test_a_blob_in_memory_travels_as_its_bytes():
+    v, f = shapes.sphere()
+    blob = meshcast.build(v, f, name="sphere")
+    data = pickle.dumps(blob)
+    assert len(data) > blob.nbytes  # the bytes themselves
+    twin = pickle.loads(data)
+    assert not twin.mapped and twin.name == "sphere" and twin.checksum == blob.checksum
+    o, d = _rays(v)
+    _equal(twin.cast(o, d, uv=True), blob.cast(o, d, uv=True))
+    _equal(copy.deepcopy(blob).cast(o, d, query="all"), blob.cast(o, d, query="all"))
+
+
+def test_a_mapped_blob_travels_as_its_path_and_is_mapped_once(tmp_path):
+    v, f = shapes.soup()
+    path = tmp_path / "soup.blob"
+    meshcast.build(v, f).save(str(path))
+    blob = meshcast.load(path, mmap=True)
+    assert blob.path == str(path.resolve())
+    data = pickle.dumps(blob)
+    assert len(data) < 1000 < blob.nbytes  # the path, not the bytes
+    before = _shipping.arrivals()["mapped"]
+    twins = [pickle.loads(data) for _ in range(3)]
+    assert _shipping.arrivals()["mapped"] == before + 1
+    assert all(t is twins[0] for t in twins) and twins[0].mapped
+    o, d = _rays(v)
+    _equal(twins[0].cast(o, d), blob.cast(o, d))
+
+
+def test_a_mapped_blob_whose_file_is_gone_or_another_is_refused_by_name(tmp_path):
+    v, f = shapes.sphere()
+    path = tmp_path / "moved.blob"
+    meshcast.build(v, f, layout="AABBTree/Float3").save(str(path))
+    data = pickle.dumps(meshcast.load(path, mmap=True))
+    # The same size, other bytes: the mesh moved a little.
+    meshcast.build(v + np.float32(0.125), f, layout="AABBTree/Float3").save(str(path))
+    assert os.path.getsize(path) == len(meshcast.load(path).to_bytes())
+    with pytest.raises(ValueError, match=r"process \d+ on .*moved\.blob has checksum .* other bytes"):
+        pickle.loads(data)
+    meshcast.build(v[:-1], f[f.max(axis=1) < len(v) - 1]).save(str(path))
+    with pytest.raises(ValueError, match=r"moved\.blob has \d+ bytes, the file the Blob was pickled from \d+"):
+        pickle.loads(data)
+    os.remove(path)
+    with pytest.raises(FileNotFoundError, match=r"moved\.blob is missing"):
+        pickle.loads(data)
+
+
+def _scene():
+    sv, sf = shapes.sphere()
+    gv, gf = shapes.grid(10, 8)
+    scene = meshcast.Scene()
+    sphere = scene.add_mesh(meshcast.build(sv, sf, layout=RECOMMENDED))
+    grid = scene.add_mesh(meshcast.build(gv, gf, layout=RECOMMENDED))
+    scene.add_instance(sphere)
+    scene.add_instance(sphere, np.diag([2.0, 1.0, 0.5]), [1e6 + 0.25, -3.0, 2.0], mask=2, flip_facing=True)
+    gone = scene.add_instance(grid, translation=[5.0, 5.0, -1.0])
+    scene.add_instance(grid, translation=[0.0, 0.0, -2.0])
+    off = scene.add_instance(sphere, translation=[0.0, 4.0, 0.0])
+    scene.remove_instance(gone)
+    scene.set_enabled(off, False)
+    scene.commit()
+    return scene, sv
+
+
+def test_a_scene_travels_as_its_blobs_and_instances():
+    scene, v = _scene()
+    twin = pickle.loads(pickle.dumps(scene))
+    assert twin.instance_count == scene.instance_count
+    o, d = _rays(v, 4000)
+    o = o.astype(np.float64)
+    o[::2, 0] += 1e6  # toward the far instance, in double
+    for mask in (0xFF, 2):
+        _equal(twin.cast(o, d, uv=True, mask=mask), scene.cast(o, d, uv=True, mask=mask))
+    _equal(twin.cast(o, d, query="all"), scene.cast(o, d, query="all"))
+    _equal(twin.closest_points(o[:500]), scene.closest_points(o[:500]))
+    # One blob pickled once, whatever its meshes: the two scenes share it.
+    shared = meshcast.build(v, shapes.sphere()[1])
+    a, b = meshcast.Scene(), meshcast.Scene()
+    a.add_mesh(shared), b.add_mesh(shared)
+    a.commit(), b.commit()
+    one = len(pickle.dumps(a))
+    assert len(pickle.dumps((a, b))) < 1.5 * one
+
+
+def test_a_scene_with_edits_not_committed_is_not_pickled():
+    scene, _ = _scene()
+    scene.set_mask(0, 4)
+    with pytest.raises(ValueError, match="commit"):
+        pickle.dumps(scene)
+
+
+def test_a_raycasting_scene_of_several_geometries_travels_whole():
+    scene = meshcast.RaycastingScene()
+    sv, sf = shapes.sphere()
+    gv, gf = shapes.grid(9, 7)
+    scene.add_triangles(sv, sf)
+    scene.add_triangles(gv.astype(np.float64) + 1e5, gf)
+    twin = pickle.loads(pickle.dumps(scene))
+    o, d = _rays(sv, 4000)
+    rays = np.concatenate([o, d], axis=1)
+    rays[::3, :3] += 1e5
+    _equal(twin.cast_rays(rays), scene.cast_rays(rays))
+    _equal(twin.list_intersections(rays), scene.list_intersections(rays))
+    points = rays[:300, :3]
+    _equal(twin.compute_closest_points(points), scene.compute_closest_points(points))
+    np.testing.assert_array_equal(twin.compute_signed_distance(points).numpy(),
+                                  scene.compute_signed_distance(points).numpy())
+    assert twin.nbytes == scene.nbytes
+    # The compact layout too: its normals are the input mesh's, kept as they were.
+    compact = meshcast.RaycastingScene(max_error=1e-5)
+    compact.add_triangles(sv, sf)
+    _equal(pickle.loads(pickle.dumps(compact)).cast_rays(rays), compact.cast_rays(rays))
+    # Later geometries go to the copy alone.
+    twin.add_triangles(gv, gf)
+    assert scene.count_intersections(rays).shape == twin.count_intersections(rays).shape
+
+
+def test_a_corrupted_pickle_of_a_raycasting_scene_is_refused():
+    scene = meshcast.RaycastingScene()
+    scene.add_triangles(*shapes.sphere())
+    state = scene._scene.__getstate__()
+    blob, normals, centre = state[4][0]
+    broken = bytearray(blob)
+    broken[len(broken) // 2] ^= 0xFF
+    for geometries, message in (([(bytes(broken), normals, centre)], "checksum"),
+                                ([(blob, normals[:-4], centre)], "bytes of normals"),
+                                ([(blob, normals, (0.0, float("nan"), 0.0))], "centre")):
+        twin = meshcast._meshcast._RaycastingScene.__new__(meshcast._meshcast._RaycastingScene)
+        with pytest.raises(ValueError, match=message):
+            twin.__setstate__(state[:4] + (geometries,))
+
+
+def _cast_in_child(blob, origins, directions):
+    return blob.cast(origins, directions), _shipping.arrivals()
+
+
+def test_spawned_processes_take_blobs_directly(tmp_path):
+    v, f = shapes.sphere()
+    path = tmp_path / "spawned.blob"
+    meshcast.build(v, f).save(str(path))
+    mapped, in_memory = meshcast.load(path, mmap=True), meshcast.build(v, f, layout="AABBTree/Float3")
+    o, d = _rays(v, 2000)
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        for blob, kind in ((mapped, "mapped"), (in_memory, "bytes")):
+            answer, arrivals = pool.apply(_cast_in_child, (blob, o, d))
+            _equal(answer, blob.cast(o, d))
+            assert arrivals[kind] == 1

@@ -109,7 +109,7 @@ def main():
                     answer = mcd.cast(blob, da.from_array(origins, chunks=(chunk, 3)),
                                       da.from_array(directions, chunks=(chunk, 3)))
                     start = time.perf_counter()
-                    got = dask.compute(answer["t"], answer["triangle"])
+                    got = dask.compute(answer["t"], answer["triangle"], scheduler=client)
                     seconds = time.perf_counter() - start
                 assert np.array_equal(got[0], expected["t"]) and np.array_equal(got[1], expected["triangle"])
                 return seconds

@@ -242,9 +242,15 @@ def _ship_object(obj, token):
         client.register_worker_plugin(_Held(token, obj), name=name)
         _registered[key] = name
         while len(_registered) > _KEEP_REGISTERED:  # the oldest let go on the workers
-            old_client, old_name = next(iter(_registered)), _registered.pop(next(iter(_registered)))
-            if old_client[0] == client.id:
+            old = next(iter(_registered))
+            old_name = _registered.pop(old)
+            if old[0] == client.id:
                 client.unregister_worker_plugin(old_name)
+            if not any(k[1] == old[1] for k in _registered):
+                _held.pop(old[1], None)
+    # Held here too: a graph made with a Client current may still be
+    # computed by Dask's threads scheduler in this process.
+    _held[token] = obj
     return None
 
 

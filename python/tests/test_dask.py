@@ -138,6 +138,17 @@ def test_a_raycasting_scene_answers_as_in_process(client, bunny_rays):
     np.testing.assert_array_equal(counts.compute(), scene.count_intersections(image).numpy())
 
 
+def test_dasks_local_schedulers_answer_alike(client, bunny_rays):
+    # A graph made with the Client current, computed in this process.
+    v, f, o, d = bunny_rays
+    blob = meshcast.build(v, f, layout="AABBTree/Float3")
+    answer = mcd.cast(blob, da.from_array(o, chunks=(9000, 3)), da.from_array(d, chunks=(9000, 3)), query="all")
+    expected = blob.cast(o, d, query="all")
+    for scheduler in ("threads", "sync"):
+        got = dict(zip(answer, dask.compute(*answer.values(), scheduler=scheduler)))
+        _equal(got, expected)
+
+
 def test_a_worker_killed_mid_cast_changes_no_answer(client, bunny_rays):
     v, f, o, d = bunny_rays
     blob = meshcast.build(v, f, layout=RECOMMENDED)

@@ -122,8 +122,8 @@ def plot(out_dir, rows, cpu):
         gp.write("set terminal pngcairo noenhanced size 1000,600 font 'sans,10'\n")
         gp.write(f"set output '{png}'\nset logscale x\nset grid\nset key bottom right\n")
         gp.write(f"set title 'meshcast.dask on a LocalCluster against the in-process cast, closest hits ({cpu})'\n")
-        gp.write("set xlabel 'rays a chunk'\nset ylabel 'million rays a second (wall, answers in the client)'\n")
-        gp.write("set yrange [0:*]\nset format x '10^{%L}'\n")
+        gp.write("set xlabel 'rays a chunk'\nset ylabel 'million rays a second (wall time)'\n")
+        gp.write("set yrange [0:*]\nset format x '10^%T'\n")
         series = list(dict.fromkeys((r["rays_are"], r["contender"]) for r in rows))
         gp.write("plot " + ", ".join(f"'-' using 1:2 with linespoints lw 2 dt {1 if mode == 'made on the workers' else 2} "
                                      f"title '{who}, rays {mode}'" for mode, who in series) + "\n")

@@ -5,9 +5,9 @@ set grid
 set key bottom right
 set title 'meshcast.dask on a LocalCluster against the in-process cast, closest hits (Intel(R) Xeon(R) Processor)'
 set xlabel 'rays a chunk'
-set ylabel 'million rays a second (wall, answers in the client)'
+set ylabel 'million rays a second (wall time)'
 set yrange [0:*]
-set format x '10^{%L}'
+set format x '10^%T'
 plot '-' using 1:2 with linespoints lw 2 dt 2 title 'in process, rays from the client', '-' using 1:2 with linespoints lw 2 dt 2 title '1 worker x 2 threads, rays from the client', '-' using 1:2 with linespoints lw 2 dt 2 title '2 workers x 1 thread, rays from the client', '-' using 1:2 with linespoints lw 2 dt 1 title 'in process, rays made on the workers', '-' using 1:2 with linespoints lw 2 dt 1 title '1 worker x 2 threads, rays made on the workers', '-' using 1:2 with linespoints lw 2 dt 1 title '2 workers x 1 thread, rays made on the workers'
 10000 4.101
 100000 3.691

@@ -46,6 +46,11 @@ of the mesh to each (..., 3) point, worked out in double from the stored
 triangles (exact on ``OctTreeCompressed/Float3SOA8``, within the recommended
 layout's stated bound of the input mesh, a few millionths of its diagonal).
 
+Processes and clusters: a Blob, a Scene and a RaycastingScene pickle (a
+blob mapped from a file as the file's path, mapped once a process; any
+other as its bytes), and ``meshcast.dask`` casts dask arrays of rays on a
+Dask cluster (``help(meshcast.dask)``).
+
 A blob's cast whose rays all start at one point (a sensor, a probe) walks
 them as packets on the recommended layout: sorted by direction, 8 at a
 time, each node decoded once for them; the answers are the same bits as

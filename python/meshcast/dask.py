@@ -136,42 +136,35 @@ def count_intersections(scene, rays, *, nthreads=0):
 def _rays_array(value, width, name):
     if not isinstance(value, da.Array):
         value = np.asarray(getattr(value, "numpy", lambda: value)())
-        if value.ndim < 1 or value.shape[-1] != width:
-            raise ValueError(f"{name}: shape {value.shape} is not (..., {width})")
-        value = da.from_array(value, chunks=value.shape[:-1] and ("auto",) * (value.ndim - 1) + (width,))
     if value.ndim < 1 or value.shape[-1] != width:
         raise ValueError(f"{name}: shape {value.shape} is not (..., {width})")
     if value.dtype.kind not in "fiu":
         raise ValueError(f"{name}: dtype {value.dtype} is not a real number type")
-    if len(value.chunks[-1]) != 1:
-        value = value.rechunk(value.chunks[:-1] + ((width,),))
-    return value
+    if not isinstance(value, da.Array):
+        return da.from_array(value, chunks=("auto",) * (value.ndim - 1) + (width,))
+    return value if len(value.chunks[-1]) == 1 else value.rechunk(value.chunks[:-1] + ((width,),))
 
 
 def _origins(origins, directions):
-    if not isinstance(origins, da.Array):
-        origins = np.asarray(origins)
-        if origins.shape == (3,):
-            return origins  # one origin for every ray: the same small array in every task
-        if origins.shape == directions.shape:
-            origins = da.from_array(origins, chunks=directions.chunks)
-    if origins.shape != directions.shape:
-        raise ValueError(f"origins: shape {origins.shape}, neither (3,) nor the directions' {directions.shape}")
-    return origins.rechunk(directions.chunks)
+    if not isinstance(origins, da.Array) and np.shape(origins) == (3,):
+        return np.asarray(origins)  # one origin for every ray: the same small array in every task
+    return _like(origins, directions.shape, directions.chunks, "origins", "(3,) nor ")
 
 
 def _per_ray(value, rays, name):
     # None or a number as it is; an array chunked like the rays.
     if value is None or np.ndim(value) == 0 and not isinstance(value, da.Array):
         return value
-    shape = rays.shape[:-1]
-    if not isinstance(value, da.Array):
-        value = np.asarray(value)
-        if value.shape == shape:
-            value = da.from_array(value, chunks=rays.chunks[:-1])
-    if value.shape != shape:
-        raise ValueError(f"{name}: shape {value.shape}, not the rays' {shape}")
-    return value.rechunk(rays.chunks[:-1])
+    return _like(value, rays.shape[:-1], rays.chunks[:-1], name)
+
+
+def _like(value, shape, chunks, name, also=""):
+    """`value` (a dask or numpy array) of `shape`, chunked as `chunks`."""
+    if np.shape(value) != shape:
+        raise ValueError(f"{name}: shape {np.shape(value)}, not {also}the rays' {shape}")
+    if isinstance(value, da.Array):
+        return value.rechunk(chunks)
+    return da.from_array(np.asarray(value), chunks=chunks)
 
 
 # --- how the target travels ----------------------------------------------------
@@ -217,15 +210,16 @@ def _client():
 
 
 class _File:
-    """A mapped blob as a task carries it: what names its file. Mapped (once
-    a process) when the task runs, so a file missing or another on a worker
-    fails that task with the error, not the worker's receipt of it."""
+    """A mapped blob as a task carries it: its pickled form (the file's
+    path, size and checksum), undone when the task runs, so a file missing
+    or another on a worker fails that task with the error, not the
+    worker's receipt of it."""
 
     def __init__(self, blob):
-        self.path, self.nbytes, self.checksum, self.name = blob.path, blob.nbytes, blob.checksum, blob.name
+        self.undo, self.args = _shipping.reduce_blob(blob)
 
     def blob(self):
-        return _shipping.blob_of_file(self.path, self.nbytes, self.checksum, self.name)
+        return self.undo(*self.args)
 
 
 def _ship_object(obj, token):

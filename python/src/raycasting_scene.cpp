@@ -243,6 +243,15 @@ struct GeometryLayout {
   std::optional<std::string> named;
   double max_error = 0;
 
+  // Refuses a mistyped layout name or a max_error that is no fraction, when
+  // the scene is made (or unpickled), not at its first add_triangles.
+  static GeometryLayout checked(std::optional<std::string> named, double max_error) {
+    if (!(max_error >= 0) || !std::isfinite(max_error))
+      throw py::value_error("RaycastingScene: max_error must be a finite fraction >= 0, not " + std::to_string(max_error));
+    if (named) parse_layout_name(*named);
+    return {std::move(named), max_error};
+  }
+
   std::vector<uint8_t> build(const Mesh& mesh, BuildOptions options, const std::string& name) const {
     if (named) {
       options.layout = parse_layout_name(*named);
@@ -351,12 +360,9 @@ class RaycastingScene {
   static std::unique_ptr<RaycastingScene> from_state(const py::tuple& state) {
     if (state.size() != 5 || state[0].cast<int>() != 1)
       throw py::value_error("RaycastingScene: a pickled state of another version of meshcast");
-    GeometryLayout layout{state[2].is_none() ? std::nullopt : std::optional<std::string>(state[2].cast<std::string>()),
-                          state[3].cast<double>()};
-    if (layout.named) parse_layout_name(*layout.named);
-    if (!(layout.max_error >= 0) || !std::isfinite(layout.max_error))
-      throw py::value_error("RaycastingScene: a pickled max_error that is not a finite fraction >= 0");
-    auto scene = std::make_unique<RaycastingScene>(state[1].cast<uint32_t>(), std::move(layout));
+    auto scene = std::make_unique<RaycastingScene>(
+        state[1].cast<uint32_t>(),
+        GeometryLayout::checked(state[2].cast<std::optional<std::string>>(), state[3].cast<double>()));
     std::lock_guard<std::mutex> lock(scene->mutex_);
     for (const py::handle item : state[4].cast<py::list>()) {
       const py::tuple g = item.cast<py::tuple>();
@@ -771,12 +777,9 @@ class RaycastingScene {
 void register_raycasting_scene(py::module_& m) {
   py::class_<RaycastingScene>(m, "_RaycastingScene")
       .def(py::init([](long long nthreads, std::optional<std::string> layout, double max_error) {
-             if (!(max_error >= 0) || !std::isfinite(max_error))
-               throw py::value_error("RaycastingScene: max_error must be a finite fraction >= 0, not " + std::to_string(max_error));
-             if (layout) parse_layout_name(*layout);  // a typo refused here, not at the first add_triangles
              // Open3D's: the threads its build uses (0: every core).
              return std::make_unique<RaycastingScene>(nthreads == 0 ? 0 : thread_count(nthreads),
-                                                      GeometryLayout{std::move(layout), max_error});
+                                                      GeometryLayout::checked(std::move(layout), max_error));
            }),
            py::arg("nthreads") = 0, py::arg("layout") = py::none(), py::arg("max_error") = 0.0)
       .def("add_triangles", &RaycastingScene::add_triangles, py::arg("vertex_positions"), py::arg("triangle_indices"))

@@ -50,6 +50,14 @@ class PyScene {
     edited = true;
     return instances.at(i);
   }
+  void set_enabled(InstanceId i, bool enabled) {
+    scene.set_enabled(i, enabled);
+    edit(i).enabled = enabled;
+  }
+  void remove_instance(InstanceId i) {
+    scene.remove_instance(i);
+    edit(i).removed = true;
+  }
   std::vector<std::shared_ptr<PyBlob>> blobs;  // before the scene: they outlive it
   Scene scene;
   // Each instance as last edited: set_transform's parts left as they were,
@@ -167,14 +175,8 @@ std::unique_ptr<PyScene> scene_from_state(const py::tuple& state) {
     std::copy(t.begin(), t.end(), placed.translation);
     const InstanceId id = s->add_instance(i[0].cast<MeshId>(), placed, checked_mask(i[3].cast<long long>()),
                                           i[4].cast<bool>());
-    if (!i[5].cast<bool>()) {
-      s->scene.set_enabled(id, false);
-      s->instances[id].enabled = false;
-    }
-    if (i[6].cast<bool>()) {
-      s->scene.remove_instance(id);
-      s->instances[id].removed = true;
-    }
+    if (!i[5].cast<bool>()) s->set_enabled(id, false);
+    if (i[6].cast<bool>()) s->remove_instance(id);
   }
   s->scene.commit();
   s->edited = false;
@@ -182,7 +184,6 @@ std::unique_ptr<PyScene> scene_from_state(const py::tuple& state) {
 }
 
 }  // namespace
-
 
 void register_scene(py::module_& m) {
   py::class_<PyScene>(m, "Scene", R"(Instances of blobs, cast against as one world.
@@ -229,20 +230,8 @@ blobs, each once (a mapped one as its file's path), and its instance table.)")
             s.edit(i).flip_facing = flip;
           },
           py::arg("instance"), py::arg("flip_facing"))
-      .def(
-          "set_enabled",
-          [](PyScene& s, InstanceId i, bool enabled) {
-            s.scene.set_enabled(i, enabled);
-            s.edit(i).enabled = enabled;
-          },
-          py::arg("instance"), py::arg("enabled"))
-      .def(
-          "remove_instance",
-          [](PyScene& s, InstanceId i) {
-            s.scene.remove_instance(i);
-            s.edit(i).removed = true;
-          },
-          py::arg("instance"))
+      .def("set_enabled", &PyScene::set_enabled, py::arg("instance"), py::arg("enabled"))
+      .def("remove_instance", &PyScene::remove_instance, py::arg("instance"))
       // The GIL held: edits from other Python threads wait (the library
       // takes edits and commits from one thread at a time).
       .def(

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
+#include "builder/error_bounds.h"
 #include "builder/ray_sets.h"
 #include "layout/message_text.h"
 #include "meshcast/blob.h"
@@ -72,6 +74,14 @@ bool worth_trying(const AutoLimits& l, const MeshStats& s, const std::string& la
 std::vector<uint8_t> judge(const Mesh& mesh, const MeshStats& s, const AutoLimits& l, AutoCandidate& c,
                            const std::string& name, BuildReport* report) {
   c.built = true;
+  // A grid whose half step is already over the error limit is not built.
+  const double floor = l.max_error > 0 ? relative_error_floor(mesh, uint32_t(c.options.layout.triangles)) : 0;
+  if (std::isfinite(floor) && floor > l.max_error) {
+    c.error = floor;
+    c.refused = "stated error at least " + over_limit(floor, l.max_error, false) +
+                " of the diagonal (half its grid's step), over the limit of " + limit_text(l.max_error) + "; not built";
+    return {};
+  }
   std::vector<uint8_t> blob;
   try {
     blob = build_blob(mesh, c.options, name, report);
@@ -319,20 +329,28 @@ AutoChoice choose_layout(const Mesh& mesh, const AutoLimits& limits, const std::
     run(from);
   }
   if (pick == kNone) {
+    // A candidate whose grid was over the error limit before its build
+    // (bytes 0, error its floor) tells the least error it could state.
     double bytes = 1e300, error = 1e300;
-    for (const AutoCandidate& c : out.candidates)
-      if (c.built && c.bytes_per_triangle > 0) bytes = std::min(bytes, c.bytes_per_triangle), error = std::min(error, c.error);
+    bool error_is_floor = false;
+    for (const AutoCandidate& c : out.candidates) {
+      if (!c.built || (c.bytes_per_triangle == 0 && !(c.error > 0))) continue;
+      if (c.bytes_per_triangle > 0) bytes = std::min(bytes, c.bytes_per_triangle);
+      if (c.error < error) error = c.error, error_is_floor = c.bytes_per_triangle == 0;
+    }
     std::string set;
     if (limits.max_bytes_per_triangle > 0) set += "at most " + bytes_limit_text(limits.max_bytes_per_triangle);
     if (limits.max_error > 0) set += (set.empty() ? "" : ", ") + ("error at most " + limit_text(limits.max_error) + " of the diagonal");
     if (!limits.readers.empty()) set += std::string(set.empty() ? "" : ", ") + "read by the GPU too";
     // What the nearest came to each limit, in whole words.
-    const std::string exact = error > 0 ? "states an error of " + over_limit(error, limits.max_error, false) + " of the diagonal"
+    const std::string exact = error > 0 ? std::string("states an error of ") + (error_is_floor ? "at least " : "") +
+                                              over_limit(error, limits.max_error, false) + " of the diagonal"
                                         : std::string("is exact (an error of 0)");
     throw InputError(name + ": no layout meets the limits (" + set + "); " +
-                     (bytes < 1e300 ? "the smallest built takes " + over_limit(bytes, limits.max_bytes_per_triangle, true) +
+                     (bytes < 1e300   ? "the smallest built takes " + over_limit(bytes, limits.max_bytes_per_triangle, true) +
                                           " bytes a triangle and the most exact " + exact
-                                    : std::string("no layout could be built")));
+                      : error < 1e300 ? "none was built (each grid's step is over the error limit): the most exact " + exact
+                                      : std::string("no layout could be built")));
   }
   out.chosen = pick;
   return out;

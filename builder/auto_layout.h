@@ -57,7 +57,7 @@ struct AutoCandidate {
   std::string why;    // the rule that shortlisted it
   bool built = false;
   double bytes_per_triangle = 0;  // whole blob
-  double error = 0;               // relative_error_bound
+  double error = 0;               // relative_error_bound (not built: relative_error_floor)
   double trial_ns = -1;           // per ray; -1: not timed
   std::string refused;            // why it cannot be used: the builder's refusal or the limit it exceeds
 };

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "builder/quantize.h"
 #include "builder/writer.h"
 #include "layout/blob_format.h"
 
@@ -47,6 +48,22 @@ double relative_error_bound(const std::vector<uint8_t>& blob, double diagonal) {
   float b[3];
   displacement_bound(blob, b);
   return std::sqrt(double(b[0]) * b[0] + double(b[1]) * b[1] + double(b[2]) * b[2]) / std::max(1e-30, diagonal);
+}
+
+double relative_error_floor(const Mesh& mesh, uint32_t triangle_format) {
+  if (!moves_vertices(triangle_format)) return 0;
+  const CodecOps codec = codec_ops(triangle_format);
+  if (codec.grid == layout::kGridNone) return 0;
+  BlobHeader h{};
+  h.triangle_format = triangle_format;
+  try {
+    set_mesh_grid(mesh.bounds(), codec, "mesh", h);
+  } catch (const InputError&) {
+    return INFINITY;
+  }
+  const double half[3] = {0.5 * h.quant_scale[0], 0.5 * h.quant_scale[1], 0.5 * h.quant_scale[2]};
+  return std::sqrt(half[0] * half[0] + half[1] * half[1] + half[2] * half[2]) /
+         std::max(1e-30, mesh.bounds().diagonal());
 }
 
 bool moves_vertices(uint32_t triangle_format) {

@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "meshcast/mesh.h"
+
 namespace meshcast {
 
 // True for the triangle formats that store moved vertices (grids, cleared
@@ -21,5 +23,14 @@ void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]);
 // mesh diagonal `diagonal`: the error the error report states and the
 // automatic layout's --max-error limits.
 double relative_error_bound(const std::vector<uint8_t>& blob, double diagonal);
+
+// The least relative_error_bound a blob of `triangle_format` built from
+// `mesh` can state, known before it is built: half its grid's step over the
+// diagonal (0 for a format that keeps floats; the stated bound adds a
+// rounding of the largest coordinate and, for nested formats, the block
+// lattices). A caller choosing a layout under an error limit skips a build
+// this already puts over the limit. A mesh too thin for the format's grid
+// (which its build refuses) gets infinity.
+double relative_error_floor(const Mesh& mesh, uint32_t triangle_format);
 
 }  // namespace meshcast

@@ -19,11 +19,13 @@ bool watertight_lane_double(const float ax, const float ay, const float bx, cons
   double T = (U * az + V * bz + W * cz) * double(sz);
   if (det < 0) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0) return false;
-  // Compared in double: a t past the largest float is no hit. Both ends
-  // are floats, so the float t reported lies between them too.
-  const double t = T / det;
-  if (!(t >= double(tmin) && t <= double(std::min(closest, FLT_MAX)))) return false;
-  out->t = float(t), out->u = float(V / det), out->v = float(W / det);
+  // The ends are compared with the float t reported, as the float test
+  // does: a hit reported at t is found again by a ray whose tmin or tmax
+  // is that t (a t in double just below tmin, rounded up to it, would not
+  // be). A t that rounds past the largest float is no hit.
+  const float t = float(T / det);
+  if (!(t >= tmin && t <= std::min(closest, FLT_MAX))) return false;
+  out->t = t, out->u = float(V / det), out->v = float(W / det);
   return true;
 }
 

@@ -40,9 +40,9 @@ bool watertight_double(float ax, float ay, float bx, float by, float cx, float c
   precise double T = (U * double(az) + V * double(bz) + W * double(cz)) * double(sz);
   if (det < 0.0lf) T = -T, U = -U, V = -V, W = -W, det = -det;
   if (T < 0.0lf) return false;
-  precise double td = T / det;
-  if (!(td >= double(tmin) && td <= double(min(closest, kFloatMax)))) return false;
-  t = float(td);
+  // The ends compared with the float t reported, as below and on the CPU.
+  t = float(T / det);
+  if (!(t >= tmin && t <= min(closest, kFloatMax))) return false;
   u = float(V / det), v = float(W / det);
   return true;
 }

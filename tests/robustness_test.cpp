@@ -574,6 +574,51 @@ TEST_P(Robustness, TMinTMaxZeroInfinityAndOriginsOnTheSurface) {
   EXPECT_EQ(hits[11].t, 1.0f);
 }
 
+// Both ends are compared with the t a walk reports: a ray cast again with
+// t_min (or t_max) set to a hit's t finds that hit at that t, and with the
+// next float past it does not. On a tilted grid, rays straight down each
+// grid line meet an edge function of exactly 0 (the test's double
+// precision path, where t is computed in double and rounded), and rays
+// between the lines take the float path.
+TEST_P(Robustness, ReportedTIsFoundAgainAsTMinAndTMax) {
+  Mesh tilted = make_grid_plane(8, 8);
+  for (Vec3& v : tilted.vertices) v.z = 0.3137f * v.x + 0.7071f * v.y + 0.1f;
+  std::vector<Ray> rays;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> along(0.05f, 7.95f);
+  for (int i = 0; i < 240; ++i) {
+    const float line = float(1 + i % 7), other = along(rng);
+    Vec3 o = i % 3 == 0 ? Vec3{line, other, 9.3f} : i % 3 == 1 ? Vec3{other, line, 9.3f} : Vec3{other, along(rng), 9.3f};
+    rays.push_back({{o.x, o.y, o.z}, {0, 0, -1}, INFINITY});
+  }
+  const std::vector<uint8_t> blob = build(tilted, "tilted grid");
+  const std::vector<Hit> first = trace(blob, rays);
+  // Cast again in one batch: t_min = t, t_max = t, t_min past t, t_max short of t.
+  const size_t n = rays.size();
+  std::vector<Ray> again;
+  for (int variant = 0; variant < 4; ++variant)
+    for (size_t i = 0; i < n; ++i) {
+      ASSERT_NE(first[i].triangle, MC_NO_HIT) << "ray " << i << " misses the grid under it";
+      Ray r = rays[i];
+      const float t = first[i].t;
+      if (variant == 0) r.tmin = t;
+      if (variant == 1) r.tmax = t;
+      if (variant == 2) r.tmin = std::nextafter(t, INFINITY);
+      if (variant == 3) r.tmax = std::nextafter(t, 0.0f);
+      again.push_back(r);
+    }
+  const std::vector<Hit> hits = trace(blob, again);
+  for (size_t i = 0; i < n; ++i) {
+    const std::string what = "ray " + std::to_string(i) + " (hit at t " + std::to_string(first[i].t) + ")";
+    for (size_t at : {i, n + i}) {
+      EXPECT_EQ(hits[at].t, first[i].t) << what << (at == i ? ", t_min = t" : ", t_max = t");
+      EXPECT_EQ(hits[at].triangle, first[i].triangle) << what << (at == i ? ", t_min = t" : ", t_max = t");
+    }
+    EXPECT_EQ(hits[2 * n + i].triangle, MC_NO_HIT) << what << ", t_min past t: a hit at " << hits[2 * n + i].t;
+    EXPECT_EQ(hits[3 * n + i].triangle, MC_NO_HIT) << what << ", t_max short of t: a hit at " << hits[3 * n + i].t;
+  }
+}
+
 std::string param_name(const ::testing::TestParamInfo<std::string>& info) {
   std::string n = info.param;
   for (char& c : n)

@@ -211,20 +211,14 @@ std::vector<Record> whole_row(const Target& target, const RayArrays& rays, size_
     const size_t before = row.size();
     while (!row.empty() && row.back().t == from) row.pop_back();
     const bool stuck = row.size() + kMaxHitsLimit <= before;  // a whole row at one t
-    // A walk decides t_min on the triangle test's own terms, not on the t
-    // it reports: a hit reported at `from` may fall just short of a t_min
-    // of `from`. So the walk starts a little before (the crossings'
-    // window) and what it finds before `from` (kept already) is dropped.
-    ray.tmin = from - std::ldexp(std::fabs(from), -20);
+    // A walk compares t_min with the t it reports: every hit reported at
+    // `from` is found again from there.
+    ray.tmin = from;
     more.clear();
     target.trace_all(std::span<const RayRecord>(&ray, 1), more, HitOutputs::Uv, Cull::None);
     const std::span<const Record> next = more.row(0);
-    uint32_t before_from = 0;
-    for (const Record& r : next) {
-      if (r.t < from) ++before_from;
-      else row.push_back(r);
-    }
-    found = more.found[0] - before_from;
+    row.insert(row.end(), next.begin(), next.end());
+    found = more.found[0];
     if (stuck && found > kMaxHitsLimit) {
       dropped += found - kMaxHitsLimit;
       break;
@@ -262,8 +256,12 @@ struct GeometryLayout {
                          " of the diagonal, over max_error=" + std::to_string(max_error));
       return blob;
     }
-    if (max_error > 0) {
-      options.layout = {TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8};
+    // The compact cluster is built only where its grid's half step is
+    // within max_error: a second build (the exact cluster after it) is left
+    // for a max_error within a rounding of the largest coordinate above that.
+    const Layout compact{TreeFormat::OctTreeCompressed, TriangleFormat::ClusterBitPackSOA8};
+    if (max_error > 0 && relative_error_floor(mesh, uint32_t(compact.triangles)) <= max_error) {
+      options.layout = compact;
       std::vector<uint8_t> blob = build_blob(mesh, options, name);
       if (relative_error_bound(blob, mesh.bounds().diagonal()) <= max_error) return blob;
     }
@@ -370,16 +368,19 @@ class RaycastingScene {
       if (g.size() != 3) throw py::value_error("RaycastingScene: " + name + " of the pickled state is malformed");
       const std::string_view blob_bytes = g[0].cast<py::bytes>(), normal_bytes = g[1].cast<py::bytes>();
       const auto centre = g[2].cast<std::vector<double>>();
-      std::vector<uint8_t> blob(blob_bytes.begin(), blob_bytes.end());
-      const uint32_t triangles = BlobView(blob, name).triangle_count();  // InputError naming what is wrong
-      if (normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal) || centre.size() != 3 ||
-          !std::isfinite(centre[0]) || !std::isfinite(centre[1]) || !std::isfinite(centre[2]))
+      if (centre.size() != 3 || !std::isfinite(centre[0]) || !std::isfinite(centre[1]) || !std::isfinite(centre[2]))
+        throw py::value_error("RaycastingScene: " + name + " of the pickled state has a centre that is not 3 finite numbers");
+      std::vector<PackedNormal> normals(normal_bytes.size() / sizeof(PackedNormal));
+      std::memcpy(normals.data(), normal_bytes.data(), normals.size() * sizeof(PackedNormal));
+      // The blob validated as it joins the scene (InputError naming what is
+      // wrong); a scene left half made by an error below is dropped.
+      scene->add_geometry(std::vector<uint8_t>(blob_bytes.begin(), blob_bytes.end()), std::move(normals), centre.data(),
+                          name);
+      const uint32_t triangles = scene->geometries_.back()->view.triangle_count();
+      if (normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal))
         throw py::value_error("RaycastingScene: " + name + " of the pickled state has " +
                               std::to_string(normal_bytes.size()) + " bytes of normals for " +
-                              std::to_string(triangles) + " triangles, or a centre that is not 3 finite numbers");
-      std::vector<PackedNormal> normals(triangles);
-      std::memcpy(normals.data(), normal_bytes.data(), normal_bytes.size());
-      scene->add_geometry(std::move(blob), std::move(normals), centre.data(), name);
+                              std::to_string(triangles) + " triangles");
     }
     return scene;
   }
@@ -659,7 +660,7 @@ class RaycastingScene {
       changed_ = false;
     }
     Frame f{SceneTarget(scene_, 0xFF), committed_};
-    if (committed_->size() == 1) f.single = &*first_, f.centre = first_centre_;
+    if (committed_->size() == 1) f.single = &(*committed_)[0]->view, f.centre = (*committed_)[0]->centre;
     return f;
   }
   // backend="vulkan": the rays in one batch through the host layer's scene
@@ -724,10 +725,6 @@ class RaycastingScene {
     for (int k = 0; k < 3; ++k) placed.translation[k] = centre[k];
     const InstanceId id = scene_.add_instance(mesh_id, placed);
     geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id), name, centre));
-    if (id == 0) {  // the one geometry's blob (validated again: cheap beside its build)
-      first_.emplace(scene_.mesh_blob(mesh_id), name);
-      std::copy(centre, centre + 3, first_centre_);
-    }
     changed_ = true;
     return id;
   }
@@ -766,8 +763,6 @@ class RaycastingScene {
   Scene scene_;
   Geometries geometries_;  // every geometry's, added so far
   std::shared_ptr<const Geometries> committed_ = std::make_shared<const Geometries>();
-  std::optional<BlobView> first_;  // geometry 0's blob (in the scene), walked alone while it is the only one
-  double first_centre_[3] = {0, 0, 0};
   bool changed_ = false;
   VulkanCasters gpu_;  // backend="vulkan"'s scene casters, made on first use (and gone before the scene)
 };

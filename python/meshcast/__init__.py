@@ -412,8 +412,12 @@ class RaycastingScene:
 
     @property
     def nbytes(self):
-        """The memory the scene's structures hold: every geometry's blob, its
-        normals and the top level."""
+        """The memory the scene's structures hold: every geometry's blob, the
+        top level, and what calls have made since: the triangles' normals (4
+        bytes a triangle; kept from the start for a compact geometry, made by
+        the first call answering primitive_normals for an exact one), the
+        winding numbers' clusters, and the corners' table of list and count
+        calls."""
         return self._scene.nbytes
 
 

@@ -25,6 +25,8 @@
 #include <vector>
 
 #include "builder/error_bounds.h"
+#include "layout/blob_format.h"
+#include "layout/tree/leaves.h"
 #include "meshcast/build.h"
 #include "meshcast/errors.h"
 #include "meshcast/scene.h"
@@ -96,18 +98,63 @@ void unpack_normal(const PackedNormal& p, float out[3]) {
   out[0] = float(x / length), out[1] = float(y / length), out[2] = float(z / length);
 }
 
+// The unit geometric normal (b - a) x (c - a) of corners a, b, c, packed.
+PackedNormal normal_of(const float a[3], const float b[3], const float c[3]) {
+  double e1[3], e2[3];
+  for (int k = 0; k < 3; ++k) e1[k] = double(b[k]) - a[k], e2[k] = double(c[k]) - a[k];
+  const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  return pack_normal(n);
+}
+
+// Each triangle's normal from the corners a blob stores, by the caller's
+// triangle number (a triangle no leaf holds keeps the degenerate mark).
+std::vector<PackedNormal> stored_normals(std::span<const uint8_t> blob) {
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  std::vector<PackedNormal> normals(h.triangle_count);
+  layout::for_each_leaf(blob.data(), [&](uint32_t block, uint32_t count) {
+    for (uint32_t i = 0; i < count; ++i) {
+      const uint32_t triangle = layout::remap_entry(blob.data(), h, layout::slot_of(h, block, i));
+      if (triangle >= normals.size()) continue;
+      float v[3][3];
+      layout::decode_triangle(blob.data(), h.tree_offset + block, i, v);
+      normals[triangle] = normal_of(v[0], v[1], v[2]);
+    }
+  });
+  return normals;
+}
+
 // What a geometry keeps beside its blob (which the scene holds): its
 // triangles' normals, and their corners for the crossings (crossings.h).
 // Its blob's view and float64 centre serve the point queries, which walk
 // each geometry's blob with the point in its frame.
 struct Geometry {
-  std::vector<PackedNormal> normals;
   TriangleCorners corners;
   BlobView view;
   double centre[3];
-  Geometry(std::vector<PackedNormal> normals, std::span<const uint8_t> blob, const std::string& name,
-           const double at[3])
-      : normals(std::move(normals)), corners(blob), view(blob, name), centre{at[0], at[1], at[2]} {}
+  // `given`: the mesh's normals, for a layout that moves its vertices; none
+  // for one that keeps the mesh's floats, whose normals are the stored
+  // corners' and are made by the first call that asks for them (a scene
+  // queried for distances, signs or t alone never holds them).
+  Geometry(std::vector<PackedNormal> given, std::span<const uint8_t> blob, const std::string& name, const double at[3])
+      : corners(blob), view(blob, name), centre{at[0], at[1], at[2]}, normals_(std::move(given)) {
+    if (!normals_.empty()) normals_made_.store(true);
+  }
+  // Open3D's primitive_normals, by triangle (made on first use: see above).
+  const std::vector<PackedNormal>& normals() const {
+    if (!normals_made_.load(std::memory_order_acquire)) {
+      std::lock_guard<std::mutex> lock(normals_making_);
+      if (!normals_made_.load(std::memory_order_relaxed)) {
+        normals_ = stored_normals(view.bytes());
+        normals_made_.store(true, std::memory_order_release);
+      }
+    }
+    return normals_;
+  }
+  // The normals held: none until made.
+  std::span<const PackedNormal> held_normals() const {
+    if (!normals_made_.load(std::memory_order_acquire)) return {};
+    return normals_;
+  }
   // The winding numbers' clusters, made by the first call that asks for them.
   const WindingNumbers& winding() const {
     std::call_once(winding_made_, [this] {
@@ -119,6 +166,9 @@ struct Geometry {
   size_t winding_bytes() const { return winding_ready_ ? winding_->nbytes() : 0; }
 
  private:
+  mutable std::vector<PackedNormal> normals_;
+  mutable std::mutex normals_making_;
+  mutable std::atomic<bool> normals_made_{false};
   mutable std::once_flag winding_made_;
   mutable std::unique_ptr<const WindingNumbers> winding_;
   mutable std::atomic<bool> winding_ready_{false};
@@ -175,7 +225,7 @@ struct PrimitiveArrays {
     g_out[i] = geometry_id;
     p_out[i] = found ? triangle : kInvalidId;
     if (uv_out) uv_out[2 * i] = u, uv_out[2 * i + 1] = v;
-    if (n_out) unpack_normal(found ? geometries[geometry_id]->normals[triangle] : PackedNormal{}, n_out + 3 * i);
+    if (n_out) unpack_normal(found ? geometries[geometry_id]->normals()[triangle] : PackedNormal{}, n_out + 3 * i);
   }
   void add_to(py::dict& answer) const {
     answer["geometry_ids"] = geometry;
@@ -288,21 +338,20 @@ class RaycastingScene {
       // The mesh's copy lives in this block alone: freed before the trim
       // below, it is not left in the process's heap.
       Mesh mesh = mesh_from_arrays(vertices, triangles, centre);
-      normals.resize(mesh.triangle_count());
       py::gil_scoped_release release;
       BuildOptions options;
       options.threads = build_threads_;
       blob = layout_.build(mesh, options, name);
-      // Open3D's primitive_normals: the unit geometric normal (b - a) x (c - a).
-      for (size_t i = 0; i < mesh.triangle_count(); ++i) {
-        double e1[3], e2[3];
-        for (int k = 0; k < 3; ++k) {
-          e1[k] = double(mesh.corner(i, 1)[k]) - mesh.corner(i, 0)[k];
-          e2[k] = double(mesh.corner(i, 2)[k]) - mesh.corner(i, 0)[k];
+      // Open3D's primitive_normals are the mesh's: kept now where the layout
+      // moves vertices (their normals would differ), else made from the
+      // blob when first asked for (Geometry).
+      if (moves_vertices(layout::header_of(blob.data()).triangle_format)) {
+        normals.resize(mesh.triangle_count());
+        for (size_t i = 0; i < mesh.triangle_count(); ++i) {
+          const Vec3 a = mesh.corner(i, 0), b = mesh.corner(i, 1), c = mesh.corner(i, 2);
+          const float fa[3] = {a.x, a.y, a.z}, fb[3] = {b.x, b.y, b.z}, fc[3] = {c.x, c.y, c.z};
+          normals[i] = normal_of(fa, fb, fc);
         }
-        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                             e1[0] * e2[1] - e1[1] * e2[0]};
-        normals[i] = pack_normal(n);
       }
     }
     blob.shrink_to_fit();  // the builder's spare capacity would be memory the scene holds
@@ -330,7 +379,9 @@ class RaycastingScene {
     for (size_t g = 0; g < geometries_.size(); ++g) {
       const Geometry& from = *geometries_[g];
       const std::span<const uint8_t> bytes = from.view.bytes();
-      twin->add_geometry(std::vector<uint8_t>(bytes.begin(), bytes.end()), from.normals, from.centre,
+      const std::span<const PackedNormal> normals = from.held_normals();
+      twin->add_geometry(std::vector<uint8_t>(bytes.begin(), bytes.end()),
+                         std::vector<PackedNormal>(normals.begin(), normals.end()), from.centre,
                          "geometry " + std::to_string(g));
     }
     return twin;
@@ -347,7 +398,7 @@ class RaycastingScene {
       const std::span<const uint8_t> bytes = g->view.bytes();
       geometries.append(py::make_tuple(
           py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
-          py::bytes(reinterpret_cast<const char*>(g->normals.data()), g->normals.size() * sizeof(PackedNormal)),
+          py::bytes(reinterpret_cast<const char*>(g->held_normals().data()), g->held_normals().size_bytes()),
           py::make_tuple(g->centre[0], g->centre[1], g->centre[2])));
     }
     return py::make_tuple(1, build_threads_, layout_.named ? py::object(py::str(*layout_.named)) : py::object(py::none()),
@@ -376,8 +427,12 @@ class RaycastingScene {
       // wrong); a scene left half made by an error below is dropped.
       scene->add_geometry(std::vector<uint8_t>(blob_bytes.begin(), blob_bytes.end()), std::move(normals), centre.data(),
                           name);
-      const uint32_t triangles = scene->geometries_.back()->view.triangle_count();
-      if (normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal))
+      // No normals: a blob of the mesh's floats, whose normals are made when
+      // asked for.
+      const BlobView& view = scene->geometries_.back()->view;
+      const uint32_t triangles = view.triangle_count();
+      const bool made_later = normal_bytes.empty() && !moves_vertices(uint32_t(view.layout().triangles));
+      if (!made_later && normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal))
         throw py::value_error("RaycastingScene: " + name + " of the pickled state has " +
                               std::to_string(normal_bytes.size()) + " bytes of normals for " +
                               std::to_string(triangles) + " triangles");
@@ -626,7 +681,7 @@ class RaycastingScene {
     std::lock_guard<std::mutex> lock(mutex_);
     size_t bytes = scene_.owned_blob_bytes() + scene_.top_level_bytes();
     for (const auto& g : geometries_)
-      bytes += g->normals.capacity() * sizeof(PackedNormal) + g->corners.nbytes() + g->winding_bytes();
+      bytes += g->held_normals().size_bytes() + g->corners.nbytes() + g->winding_bytes();
     return bytes;
   }
 

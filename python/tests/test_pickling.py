@@ -146,9 +146,13 @@ def test_a_raycasting_scene_of_several_geometries_travels_whole():
 
 def test_a_corrupted_pickle_of_a_raycasting_scene_is_refused():
     scene = meshcast.RaycastingScene()
-    scene.add_triangles(*shapes.sphere())
+    v, f = shapes.sphere()
+    scene.add_triangles(v, f)
+    assert scene._scene.__getstate__()[4][0][1] == b""  # no normals held until asked for
+    scene.compute_closest_points(v[:3])  # primitive_normals: made now, and pickled
     state = scene._scene.__getstate__()
     blob, normals, centre = state[4][0]
+    assert len(normals) == 4 * len(f)
     broken = bytearray(blob)
     broken[len(broken) // 2] ^= 0xFF
     for geometries, message in (([(bytes(broken), normals, centre)], "checksum"),

@@ -50,7 +50,9 @@ std::vector<size_t> morton_order(size_t n, const Coordinate& coordinate) {
     }
     keyed[i] = {key, i};
   }
-  std::sort(keyed.begin(), keyed.end());
+  // Points given in Morton order already (a chunk of an ordered batch,
+  // whose own box gives the same order) are not sorted again.
+  if (!std::is_sorted(keyed.begin(), keyed.end())) std::sort(keyed.begin(), keyed.end());
   std::vector<size_t> order(n);
   for (size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
   return order;

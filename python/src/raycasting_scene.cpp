@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <mutex>
 #include <optional>
 #include <vector>
@@ -588,9 +589,8 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      // Scene::closest_points on the frame's snapshot: an instance is its
-      // geometry (kInvalidId: none).
-      scene_nearest_points(*f.target.frame, points, INFINITY, 0xFF, thread_count(nthreads), [&](size_t i, const SceneClosestPoint& c) {
+      // An instance is its geometry (kInvalidId: none).
+      f.nearest(points, thread_count(nthreads), [&](size_t i, const SceneClosestPoint& c) {
         for (int k = 0; k < 3; ++k) p_out[3 * i + k] = c.instance == kInvalidId ? NAN : float(c.point[k]);
         primitives.write(i, c.instance, c.triangle, c.u, c.v, *f.geometries);
       });
@@ -610,8 +610,7 @@ class RaycastingScene {
     {
       py::gil_scoped_release release;
       const Frame f = frame();
-      scene_nearest_points(*f.target.frame, points, INFINITY, 0xFF, thread_count(nthreads),
-                           [&](size_t i, const SceneClosestPoint& c) { out[i] = float(c.distance); });
+      f.nearest(points, thread_count(nthreads), [&](size_t i, const SceneClosestPoint& c) { out[i] = float(c.distance); });
     }
     return distance;
   }
@@ -702,6 +701,40 @@ class RaycastingScene {
     auto visit(const Fn& fn) const -> decltype(fn(target)) {
       if (single) return fn(BlobTarget{*single, centre});
       return fn(target);
+    }
+    // The nearest point of any geometry to each point, use(i, nearest) for
+    // each (on the call's threads, in any order). One geometry's blob is
+    // walked alone, with each point in its frame as float (the centre
+    // subtracted in double): the scene's answer where the centre is 0 (the
+    // triangles it places in the world are then the blob's own), within
+    // the point's float rounding elsewhere, without the scene's top level
+    // and its placing of every triangle tested (a third of a point's time
+    // on a mesh of large, flat triangles). A point the float frame cannot
+    // take (beyond 3.4e38 of the centre) is left to the scene.
+    template <class Use>
+    void nearest(const PointArrays& points, uint32_t threads, const Use& use) const {
+      if (single) {
+        std::vector<ClosestPoint> found;
+        bool in_range = true;
+        try {
+          nearest_points(*single, centre, points, INFINITY, threads, found);
+        } catch (const std::invalid_argument&) {
+          in_range = false;
+        }
+        if (in_range) {
+          for (size_t i = 0; i < points.count; ++i) {
+            const ClosestPoint& c = found[i];
+            SceneClosestPoint s;
+            if (c.triangle != kNoHit) {
+              s.instance = 0, s.triangle = c.triangle, s.distance = c.distance, s.u = c.u, s.v = c.v;
+              for (int k = 0; k < 3; ++k) s.point[k] = double(c.point[k]) + centre[k];
+            }
+            use(i, s);
+          }
+          return;
+        }
+      }
+      scene_nearest_points(*target.frame, points, INFINITY, 0xFF, threads, use);
     }
   };
   Frame frame() {

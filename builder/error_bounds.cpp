@@ -22,7 +22,7 @@ void quantization_bound(const float offset[3], const float scale[3], float bound
   }
 }
 
-void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
+void displacement_bound(std::span<const uint8_t> blob, float bound[3]) {
   const BlobHeader& h = layout::header_of(blob.data());
   if (h.triangle_format == MC_TRI_INDEXED24) {  // the mesh's own floats
     for (int a = 0; a < 3; ++a) bound[a] = 0;
@@ -44,7 +44,7 @@ void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]) {
   }
 }
 
-double relative_error_bound(const std::vector<uint8_t>& blob, double diagonal) {
+double relative_error_bound(std::span<const uint8_t> blob, double diagonal) {
   float b[3];
   displacement_bound(blob, b);
   return std::sqrt(double(b[0]) * b[0] + double(b[1]) * b[1] + double(b[2]) * b[2]) / std::max(1e-30, diagonal);

@@ -2,6 +2,7 @@
 // corner (0 for the float formats that keep the input's bits).
 #pragma once
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "meshcast/mesh.h"
@@ -18,11 +19,11 @@ void quantization_bound(const float offset[3], const float scale[3], float bound
 
 // The stated worst-case displacement, per axis, of any stored corner from
 // its input vertex, for the blob's triangle format (0 for the float ones).
-void displacement_bound(const std::vector<uint8_t>& blob, float bound[3]);
+void displacement_bound(std::span<const uint8_t> blob, float bound[3]);
 // The same as one length (the per-axis bounds' Euclidean norm) over the
 // mesh diagonal `diagonal`: the error the error report states and the
 // automatic layout's --max-error limits.
-double relative_error_bound(const std::vector<uint8_t>& blob, double diagonal);
+double relative_error_bound(std::span<const uint8_t> blob, double diagonal);
 
 // The least relative_error_bound a blob of `triangle_format` built from
 // `mesh` can state, known before it is built: half its grid's step over the

@@ -1,7 +1,7 @@
 # `cmake --install`: the public headers, the libraries, the meshcast program
 # (when built), a CMake package (find_package(meshcast CONFIG) with
 # components) with its version file, and pkg-config files (meshcast,
-# meshcast-host, meshcast-reader).
+# meshcast-host, meshcast-reader, meshcast-c).
 include(CMakePackageConfigHelpers)
 
 # One export set a component, so a user's find_package looks only for what
@@ -22,7 +22,14 @@ if(MESHCAST_TOOLS)
   install(TARGETS meshcast RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endif()
 
+if(MESHCAST_C_API)
+  install(TARGETS meshcast_c EXPORT meshcastCTargets LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+endif()
+
 set(MESHCAST_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/meshcast)
+if(MESHCAST_C_API)
+  install(EXPORT meshcastCTargets NAMESPACE meshcast:: DESTINATION ${MESHCAST_CMAKE_DIR})
+endif()
 install(EXPORT meshcastCoreTargets NAMESPACE meshcast:: DESTINATION ${MESHCAST_CMAKE_DIR})
 install(EXPORT meshcastHostTargets NAMESPACE meshcast:: DESTINATION ${MESHCAST_CMAKE_DIR})
 if(MESHCAST_READER)
@@ -46,6 +53,9 @@ string(REGEX REPLACE "/$" "" MESHCAST_PC_TO_PREFIX "${MESHCAST_PC_TO_PREFIX}")
 set(MESHCAST_PC_FILES meshcast meshcast-host)
 if(MESHCAST_READER)
   list(APPEND MESHCAST_PC_FILES meshcast-reader)
+endif()
+if(MESHCAST_C_API)
+  list(APPEND MESHCAST_PC_FILES meshcast-c)
 endif()
 foreach(pc ${MESHCAST_PC_FILES})
   configure_file(${PROJECT_SOURCE_DIR}/cmake/${pc}.pc.in ${PROJECT_BINARY_DIR}/${pc}.pc @ONLY)

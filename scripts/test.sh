@@ -98,7 +98,7 @@ PYTHONPATH="$PWD/build/python" MESHCAST_DATA="$PWD/data" /usr/bin/python3 -m pyt
   > build/pytest.log 2>&1 &
 pytest_job=$!
 
-stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters compiled in, without the Vulkan backend: the CPU suites of asan_suites and the CPU host layer, then the fuzz targets"
+stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters compiled in, without the Vulkan backend: the CPU suites of asan_suites, the CPU host layer and the C API, then the fuzz targets"
 # One sanitizer build (scripts/sanitizer_build.sh, build-fuzz/) serves the
 # suites and the libFuzzer targets: the walkers' templates, most of a
 # build's time, are compiled once for both. The Vulkan suites stay out of
@@ -108,9 +108,9 @@ stage "AddressSanitizer + UBSan (clang, $widest walkers), the test counters comp
 # compiled in there: the suites' counted-test checks run in that build
 # alone. The fuzz corpora replay under ASan and UBSan at the start of each
 # fuzz target's run (and without sanitizers in Release's CTest).
-bash scripts/sanitizer_build.sh "${asan_suites[@]}" host_test blob_fuzz mesh_fuzz
+bash scripts/sanitizer_build.sh "${asan_suites[@]}" host_test c_api_test blob_fuzz mesh_fuzz
 finish $pytest_job pytest build/pytest.log
-run_suites build-fuzz quick "${asan_suites[@]}" host_test
+run_suites build-fuzz quick "${asan_suites[@]}" host_test c_api_test
 bash scripts/fuzz.sh
 
 stage "ThreadSanitizer: the host layer, several threads submitting at once (CPU and Vulkan), and the builder's threads, beside the package's test"

@@ -1,0 +1,164 @@
+// The C API's scenes: meshes, instances, commits, casts and point queries
+// (meshcast/meshcast_c.h).
+#include <array>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "capi/casts.h"
+#include "capi/handles.h"
+#include "capi/status.h"
+
+using namespace meshcast;
+using namespace meshcast::capi;
+
+namespace {
+
+Transform transform_of(const meshcast_transform* t) {
+  Transform out;
+  if (!t) return out;
+  std::copy(t->rotation_scale, t->rotation_scale + 9, out.rotation_scale);
+  std::copy(t->translation, t->translation + 3, out.translation);
+  return out;
+}
+
+uint8_t mask_of(uint32_t mask) {
+  if (mask > 0xFF) throw UsageError("mask " + std::to_string(mask) + ": 8 bits (0..255)");
+  return uint8_t(mask);
+}
+
+bool flag_of(uint32_t flag, const char* what) {
+  if (flag > 1) throw UsageError(std::string(what) + " " + std::to_string(flag) + ": 0 or 1");
+  return flag == 1;
+}
+
+}  // namespace
+
+extern "C" {
+
+void meshcast_transform_identity(meshcast_transform* transform) {
+  if (!transform) return;
+  *transform = meshcast_transform{{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
+}
+
+meshcast_status meshcast_scene_create(meshcast_scene** out) {
+  return guarded("meshcast_scene_create", [&] {
+    *required(out, "out") = nullptr;
+    hand_out(std::make_unique<meshcast_scene>(), out);
+  });
+}
+
+meshcast_status meshcast_scene_add_mesh(meshcast_scene* scene, const meshcast_blob* blob, uint32_t* mesh_id) {
+  return guarded("meshcast_scene_add_mesh", [&] {
+    meshcast_scene& s = live(scene, "scene");
+    const meshcast_blob& b = live(blob, "blob");
+    uint32_t* id = required(mesh_id, "mesh_id");
+    // A mapped blob's mapping is shared; any other blob is referenced, its
+    // bytes kept alive by the scene.
+    if (b.mapped) {
+      *id = s.scene.add_mesh(b.mapped, b.name);
+    } else {
+      s.owners.push_back(b.owner);
+      *id = s.scene.add_mesh(b.view, b.name);
+    }
+  });
+}
+
+meshcast_status meshcast_scene_add_instance(meshcast_scene* scene, uint32_t mesh_id, const meshcast_transform* transform,
+                                            uint32_t mask, uint32_t flip_facing, uint32_t* instance_id) {
+  return guarded("meshcast_scene_add_instance", [&] {
+    meshcast_scene& s = live(scene, "scene");
+    uint32_t* id = required(instance_id, "instance_id");
+    *id = s.scene.add_instance(mesh_id, transform_of(transform), mask_of(mask), flag_of(flip_facing, "flip_facing"));
+  });
+}
+
+meshcast_status meshcast_scene_set_transform(meshcast_scene* scene, uint32_t instance_id,
+                                             const meshcast_transform* transform) {
+  return guarded("meshcast_scene_set_transform", [&] {
+    live(scene, "scene").scene.set_transform(instance_id, transform_of(required(transform, "transform")));
+  });
+}
+
+meshcast_status meshcast_scene_set_mask(meshcast_scene* scene, uint32_t instance_id, uint32_t mask) {
+  return guarded("meshcast_scene_set_mask", [&] { live(scene, "scene").scene.set_mask(instance_id, mask_of(mask)); });
+}
+
+meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* scene, uint32_t instance_id, uint32_t flip_facing) {
+  return guarded("meshcast_scene_set_flip_facing", [&] {
+    live(scene, "scene").scene.set_flip_facing(instance_id, flag_of(flip_facing, "flip_facing"));
+  });
+}
+
+meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, uint32_t instance_id, uint32_t enabled) {
+  return guarded("meshcast_scene_set_enabled", [&] {
+    live(scene, "scene").scene.set_enabled(instance_id, flag_of(enabled, "enabled"));
+  });
+}
+
+meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, uint32_t instance_id) {
+  return guarded("meshcast_scene_remove_instance", [&] { live(scene, "scene").scene.remove_instance(instance_id); });
+}
+
+meshcast_status meshcast_scene_commit(meshcast_scene* scene) {
+  return guarded("meshcast_scene_commit", [&] { live(scene, "scene").scene.commit(); });
+}
+
+meshcast_status meshcast_scene_cast(const meshcast_scene* scene, const meshcast_ray_d* rays, uint64_t ray_count,
+                                    const meshcast_query* query, meshcast_scene_hit* hits, uint64_t hit_capacity,
+                                    uint64_t* not_walkable) {
+  return guarded("meshcast_scene_cast", [&] {
+    const meshcast_scene& s = live(scene, "scene");
+    const CastQuery q = cast_query(query);
+    check_capacity(hit_capacity, ray_count, "hits");
+    const std::span<const RayD> r = rays_of(array(rays, ray_count, "rays"), ray_count);
+    const std::span<SceneHit> h = hits_of(array(hits, ray_count, "hits"), ray_count);
+    const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
+      return s.scene.trace(r.subspan(begin, n), h.subspan(begin, n), q.outputs, q.query, q.cull, q.mask);
+    });
+    if (not_walkable) *not_walkable = skipped;
+  });
+}
+
+meshcast_status meshcast_scene_cast_all(const meshcast_scene* scene, const meshcast_ray_d* rays, uint64_t ray_count,
+                                        const meshcast_query* query, uint32_t max_hits, uint32_t* found,
+                                        meshcast_scene_hit* hits, uint64_t hit_capacity, uint64_t* not_walkable) {
+  return guarded("meshcast_scene_cast_all", [&] {
+    const meshcast_scene& s = live(scene, "scene");
+    const CastQuery q = cast_query(query);
+    check_max_hits(max_hits);
+    check_capacity(hit_capacity, row_records(ray_count, max_hits), "hits");
+    const std::span<const RayD> r = rays_of(array(rays, ray_count, "rays"), ray_count);
+    array(found, ray_count, "found");
+    SceneHit* rows = hits_of(array(hits, ray_count, "hits"), 0).data();
+    const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
+      SceneHitLists lists;
+      lists.max_hits = max_hits;
+      const uint64_t walked = s.scene.trace_all_hits(r.subspan(begin, n), lists, q.outputs, q.cull, q.mask);
+      scatter_rows(lists, begin, max_hits, found, rows);
+      return walked;
+    });
+    if (not_walkable) *not_walkable = skipped;
+  });
+}
+
+meshcast_status meshcast_scene_closest_points(const meshcast_scene* scene, const double* points, uint64_t point_count,
+                                              double max_distance, uint32_t mask, uint32_t threads,
+                                              meshcast_scene_closest_point* out, uint64_t out_capacity) {
+  return guarded("meshcast_scene_closest_points", [&] {
+    const meshcast_scene& s = live(scene, "scene");
+    check_capacity(out_capacity, point_count, "out");
+    const uint8_t m = mask_of(mask);
+    const auto* p = reinterpret_cast<const std::array<double, 3>*>(array(points, point_count, "points"));
+    auto* o = reinterpret_cast<SceneClosestPoint*>(array(out, point_count, "out"));
+    in_chunks(point_count, threads_of(threads), [&](size_t begin, size_t n) {
+      return s.scene.closest_points({p + begin, n}, {o + begin, n}, max_distance, m);
+    });
+  });
+}
+
+meshcast_status meshcast_scene_release(meshcast_scene* scene) {
+  return guarded("meshcast_scene_release", [&] { release(scene, "scene"); });
+}
+
+}  // extern "C"

@@ -1,0 +1,77 @@
+#include "capi/status.h"
+
+#include <atomic>
+#include <mutex>
+
+#include "host/shared_pool.h"
+
+namespace meshcast::capi {
+
+namespace {
+
+thread_local std::string last_message;
+
+struct Callback {
+  meshcast_error_callback function = nullptr;
+  void* user = nullptr;
+};
+std::mutex callback_lock;
+Callback callback;
+
+}  // namespace
+
+meshcast_status fail(const char* call, meshcast_status status, const char* message) noexcept {
+  try {
+    last_message = std::string(call) + ": " + message;
+  } catch (...) {  // no memory for the message: the call's name at least
+    last_message.clear();
+  }
+  Callback c;
+  {
+    std::lock_guard<std::mutex> lock(callback_lock);
+    c = callback;
+  }
+  if (c.function) c.function(c.user, status, last_message.empty() ? call : last_message.c_str());
+  return status;
+}
+
+void succeed() noexcept { last_message.clear(); }
+
+void check_capacity(uint64_t capacity, uint64_t needed, const char* what) {
+  if (capacity < needed)
+    throw UsageError(std::string(what) + " holds " + std::to_string(capacity) + " answers, fewer than the " +
+                     std::to_string(needed) + " asked for");
+}
+
+uint32_t threads_of(uint32_t threads) {
+  if (threads > 1024) throw UsageError("threads " + std::to_string(threads) + ": from 0 (every core) to 1024");
+  return threads ? threads : host::every_core();
+}
+
+}  // namespace meshcast::capi
+
+extern "C" {
+
+uint32_t meshcast_api_version(void) { return MESHCAST_C_API_VERSION; }
+
+const char* meshcast_last_error(void) { return meshcast::capi::last_message.c_str(); }
+
+const char* meshcast_status_name(meshcast_status status) {
+  switch (status) {
+    case MESHCAST_OK: return "MESHCAST_OK";
+    case MESHCAST_ERROR_INPUT: return "MESHCAST_ERROR_INPUT";
+    case MESHCAST_ERROR_USAGE: return "MESHCAST_ERROR_USAGE";
+    case MESHCAST_ERROR_OUTPUT: return "MESHCAST_ERROR_OUTPUT";
+    case MESHCAST_ERROR_GPU: return "MESHCAST_ERROR_GPU";
+    case MESHCAST_ERROR_OUT_OF_MEMORY: return "MESHCAST_ERROR_OUT_OF_MEMORY";
+    case MESHCAST_ERROR_INTERNAL: return "MESHCAST_ERROR_INTERNAL";
+  }
+  return "an unknown meshcast_status";
+}
+
+void meshcast_set_error_callback(meshcast_error_callback callback, void* user) {
+  std::lock_guard<std::mutex> lock(meshcast::capi::callback_lock);
+  meshcast::capi::callback = {callback, user};
+}
+
+}  // extern "C"

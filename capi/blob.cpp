@@ -183,14 +183,10 @@ meshcast_status meshcast_blob_cast(const meshcast_blob* blob, const meshcast_ray
                                    uint64_t* not_walkable) {
   return guarded("meshcast_blob_cast", [&] {
     const meshcast_blob& b = live(blob, "blob");
-    const CastQuery q = cast_query(query);
-    check_capacity(hit_capacity, ray_count, "hits");
-    const std::span<const Ray> r = rays_of(array(rays, ray_count, "rays"), ray_count);
-    const std::span<Hit> h = hits_of(array(hits, ray_count, "hits"), ray_count);
-    const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
-      return b.view.trace(r.subspan(begin, n), h.subspan(begin, n), q.outputs, q.query, q.cull);
-    });
-    if (not_walkable) *not_walkable = skipped;
+    cast_batch(rays, ray_count, query, hits, hit_capacity, not_walkable,
+               [&](std::span<const Ray> r, std::span<Hit> h, const CastQuery& q) {
+                 return b.view.trace(r, h, q.outputs, q.query, q.cull);
+               });
   });
 }
 
@@ -199,20 +195,10 @@ meshcast_status meshcast_blob_cast_all(const meshcast_blob* blob, const meshcast
                                        meshcast_hit* hits, uint64_t hit_capacity, uint64_t* not_walkable) {
   return guarded("meshcast_blob_cast_all", [&] {
     const meshcast_blob& b = live(blob, "blob");
-    const CastQuery q = cast_query(query);
-    check_max_hits(max_hits);
-    check_capacity(hit_capacity, row_records(ray_count, max_hits), "hits");
-    const std::span<const Ray> r = rays_of(array(rays, ray_count, "rays"), ray_count);
-    array(found, ray_count, "found");
-    Hit* rows = hits_of(array(hits, ray_count, "hits"), 0).data();
-    const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
-      HitLists lists;
-      lists.max_hits = max_hits;
-      const uint64_t s = b.view.trace_all_hits(r.subspan(begin, n), lists, q.outputs, q.cull);
-      scatter_rows(lists, begin, max_hits, found, rows);
-      return s;
-    });
-    if (not_walkable) *not_walkable = skipped;
+    cast_rows<HitLists>(rays, ray_count, query, max_hits, found, hits, hit_capacity, not_walkable,
+                        [&](std::span<const Ray> r, HitLists& lists, const CastQuery& q) {
+                          return b.view.trace_all_hits(r, lists, q.outputs, q.cull);
+                        });
   });
 }
 

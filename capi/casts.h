@@ -81,4 +81,41 @@ void scatter_rows(const Lists& lists, size_t first, uint32_t max_hits, uint32_t*
   }
 }
 
+// A batch of closest or any hits: the checks every cast makes, the rays
+// in chunks on the query's threads, each chunk walked by trace(rays, hits,
+// query), and the rays not walkable written where asked for.
+template <class CRay, class CHit, class Trace>
+void cast_batch(const CRay* rays, uint64_t ray_count, const meshcast_query* query, CHit* hits, uint64_t hit_capacity,
+                uint64_t* not_walkable, const Trace& trace) {
+  const CastQuery q = cast_query(query);
+  check_capacity(hit_capacity, ray_count, "hits");
+  const auto r = rays_of(array(rays, ray_count, "rays"), ray_count);
+  const auto h = hits_of(array(hits, ray_count, "hits"), ray_count);
+  const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
+    return trace(r.subspan(begin, n), h.subspan(begin, n), q);
+  });
+  if (not_walkable) *not_walkable = skipped;
+}
+
+// A batch of every hit, each chunk's compact rows (`Lists`, filled by
+// trace_all(rays, lists, query)) scattered into the caller's fixed rows.
+template <class Lists, class CRay, class CHit, class TraceAll>
+void cast_rows(const CRay* rays, uint64_t ray_count, const meshcast_query* query, uint32_t max_hits, uint32_t* found,
+               CHit* hits, uint64_t hit_capacity, uint64_t* not_walkable, const TraceAll& trace_all) {
+  const CastQuery q = cast_query(query);
+  check_max_hits(max_hits);
+  check_capacity(hit_capacity, row_records(ray_count, max_hits), "hits");
+  const auto r = rays_of(array(rays, ray_count, "rays"), ray_count);
+  array(found, ray_count, "found");
+  auto* rows = hits_of(array(hits, ray_count, "hits"), 0).data();
+  const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
+    Lists lists;
+    lists.max_hits = max_hits;
+    const uint64_t walked = trace_all(r.subspan(begin, n), lists, q);
+    scatter_rows(lists, begin, max_hits, found, rows);
+    return walked;
+  });
+  if (not_walkable) *not_walkable = skipped;
+}
+
 }  // namespace meshcast::capi

@@ -109,14 +109,10 @@ meshcast_status meshcast_scene_cast(const meshcast_scene* scene, const meshcast_
                                     uint64_t* not_walkable) {
   return guarded("meshcast_scene_cast", [&] {
     const meshcast_scene& s = live(scene, "scene");
-    const CastQuery q = cast_query(query);
-    check_capacity(hit_capacity, ray_count, "hits");
-    const std::span<const RayD> r = rays_of(array(rays, ray_count, "rays"), ray_count);
-    const std::span<SceneHit> h = hits_of(array(hits, ray_count, "hits"), ray_count);
-    const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
-      return s.scene.trace(r.subspan(begin, n), h.subspan(begin, n), q.outputs, q.query, q.cull, q.mask);
-    });
-    if (not_walkable) *not_walkable = skipped;
+    cast_batch(rays, ray_count, query, hits, hit_capacity, not_walkable,
+               [&](std::span<const RayD> r, std::span<SceneHit> h, const CastQuery& q) {
+                 return s.scene.trace(r, h, q.outputs, q.query, q.cull, q.mask);
+               });
   });
 }
 
@@ -125,20 +121,10 @@ meshcast_status meshcast_scene_cast_all(const meshcast_scene* scene, const meshc
                                         meshcast_scene_hit* hits, uint64_t hit_capacity, uint64_t* not_walkable) {
   return guarded("meshcast_scene_cast_all", [&] {
     const meshcast_scene& s = live(scene, "scene");
-    const CastQuery q = cast_query(query);
-    check_max_hits(max_hits);
-    check_capacity(hit_capacity, row_records(ray_count, max_hits), "hits");
-    const std::span<const RayD> r = rays_of(array(rays, ray_count, "rays"), ray_count);
-    array(found, ray_count, "found");
-    SceneHit* rows = hits_of(array(hits, ray_count, "hits"), 0).data();
-    const uint64_t skipped = in_chunks(ray_count, q.threads, [&](size_t begin, size_t n) {
-      SceneHitLists lists;
-      lists.max_hits = max_hits;
-      const uint64_t walked = s.scene.trace_all_hits(r.subspan(begin, n), lists, q.outputs, q.cull, q.mask);
-      scatter_rows(lists, begin, max_hits, found, rows);
-      return walked;
-    });
-    if (not_walkable) *not_walkable = skipped;
+    cast_rows<SceneHitLists>(rays, ray_count, query, max_hits, found, hits, hit_capacity, not_walkable,
+                             [&](std::span<const RayD> r, SceneHitLists& lists, const CastQuery& q) {
+                               return s.scene.trace_all_hits(r, lists, q.outputs, q.cull, q.mask);
+                             });
   });
 }
 

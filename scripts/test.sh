@@ -9,11 +9,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 jobs=$(nproc)
-# meshcast.dask's tests (pytest, below) run on Debian's Dask: installed
-# while the CPU suites run (a download, mostly waiting).
+# meshcast.dask's tests (pytest, below) run on Debian's Dask, the C#
+# binding's on Debian's Mono: installed while the CPU suites run (a
+# download, mostly waiting).
 source scripts/packages.sh
-install_missing python3-dask python3-distributed > build/dask_install.log 2>&1 &
-dask_install_job=$!
+install_missing python3-dask python3-distributed mono-mcs mono-runtime > build/package_install.log 2>&1 &
+package_install_job=$!
 
 # The CPU suites (CTest label `cpu`), run one process a suite, $jobs at a
 # time: CTest's one process a test would load the meshes and compute the
@@ -90,7 +91,10 @@ fi
 stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
 
-finish $dask_install_job "installing python3-dask and python3-distributed" build/dask_install.log
+finish $package_install_job "installing Dask and Mono" build/package_install.log
+stage "C#: the binding (bindings/csharp) under Mono, its answers against the C++ library's"
+mcs -nologo -target:exe -out:build/MeshcastTest.exe bindings/csharp/Meshcast.cs bindings/csharp/test/MeshcastTest.cs
+LD_LIBRARY_PATH="$PWD/build" mono build/MeshcastTest.exe build/bin/meshcast data/bunny00.off build
 stage "Python: the package (build/python) against its own double-precision brute force, and meshcast.dask on a local cluster (pytest), beside the sanitizer build"
 # pytest keeps one core busy about half its time (the cluster's processes
 # starting, the spawned children): the sanitizer build takes the rest.

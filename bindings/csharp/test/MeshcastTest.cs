@@ -1,0 +1,173 @@
+// The C# binding's test: answers equal the C++ library's on the same rays
+// (the meshcast program's own casts of a public mesh, read from its hits
+// file), answers known from a mesh's construction, scenes, casters, and
+// failures as exceptions. Run by scripts/test.sh under Debian's Mono:
+//   mono MeshcastTest.exe MESHCAST_PROGRAM MESH_FILE SCRATCH_DIR
+using System;
+using System.Diagnostics;
+using System.IO;
+using Meshcast;
+
+static class MeshcastTest {
+  static int failures = 0;
+
+  static void Check(bool ok, string what) {
+    if (ok) return;
+    Console.Error.WriteLine("FAILED: " + what);
+    ++failures;
+  }
+
+  static void Throws<T>(Action call, string words, string what) where T : Exception {
+    try {
+      call();
+    } catch (T e) {
+      Check(e.Message.Contains(words), $"{what}: the message \"{e.Message}\" lacks \"{words}\"");
+      return;
+    }
+    Check(false, $"{what}: no {typeof(T).Name}");
+  }
+
+  static void Run(string program, string arguments) {
+    var start = new ProcessStartInfo(program, arguments) { UseShellExecute = false, RedirectStandardOutput = true };
+    using (var p = Process.Start(start)) {
+      p.StandardOutput.ReadToEnd();
+      p.WaitForExit();
+      if (p.ExitCode != 0) throw new Exception($"{program} {arguments}: exit {p.ExitCode}");
+    }
+  }
+
+  // The C++ library's answers: the meshcast program builds the mesh's blob
+  // and casts rays of each kind; this process casts the same rays through
+  // the binding and compares every t and triangle, bit for bit.
+  static void SameAsTheLibrary(string program, string mesh, string scratch) {
+    string blobPath = Path.Combine(scratch, "cs_mesh.blob");
+    Run(program, $"build \"{mesh}\" --out \"{blobPath}\"");
+    using (var blob = Blob.Load(blobPath, map: true)) {
+      foreach (var kind in new[] { "long", "probe", "radial", "segment" }) {
+        string rays = Path.Combine(scratch, $"cs_{kind}.rays"), hits = Path.Combine(scratch, $"cs_{kind}.hits");
+        Run(program, $"rays \"{mesh}\" --kind {kind} --count 20000 --seed 3 --out \"{rays}\"");
+        Run(program, $"trace \"{blobPath}\" --rays \"{rays}\" --out \"{hits}\"");
+        Ray[] batch = ReadRays(rays);
+        var mine = new Hit[batch.Length];
+        blob.Cast(batch, mine, threads: 0);
+        using (var r = new BinaryReader(File.OpenRead(hits))) {
+          Check(new string(r.ReadChars(4)) == "HITS" && r.ReadUInt32() == batch.Length, kind + ": a HITS file");
+          int differ = 0;
+          for (int i = 0; i < batch.Length; ++i) {
+            float t = r.ReadSingle();
+            uint triangle = r.ReadUInt32();
+            if (BitConverter.ToInt32(BitConverter.GetBytes(t), 0) != BitConverter.ToInt32(BitConverter.GetBytes(mine[i].T), 0) ||
+                triangle != mine[i].Triangle)
+              ++differ;
+          }
+          Check(differ == 0, $"{kind} rays: {differ} of {batch.Length} answers differ from the C++ library's");
+          Console.WriteLine($"  {kind}: {batch.Length} rays, the same answers as the C++ library");
+        }
+      }
+    }
+  }
+
+  static Ray[] ReadRays(string path) {
+    using (var r = new BinaryReader(File.OpenRead(path))) {
+      if (new string(r.ReadChars(4)) != "RAYS") throw new Exception(path + ": not a RAYS file");
+      var rays = new Ray[r.ReadUInt32()];
+      for (int i = 0; i < rays.Length; ++i)
+        rays[i] = new Ray(r.ReadSingle(), r.ReadSingle(), r.ReadSingle(), r.ReadSingle(), r.ReadSingle(), r.ReadSingle(),
+                          r.ReadSingle());
+      return rays;
+    }
+  }
+
+  // Two unit squares, A at z = 0 (triangles 0, 1) and B at z = 1 (2, 3),
+  // split along x = y (triangles 0 and 2 hold x >= y).
+  static readonly float[] Squares = { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1 };
+  static readonly uint[] Corners = { 0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7 };
+
+  static void KnownAnswers() {
+    using (var blob = Blob.Build(Squares, Corners, name: "two squares")) {
+      Check(blob.TriangleCount == 4 && blob.Layout.StartsWith("OctTreeCompressed/"), "the blob's info");
+      var rays = new[] { new Ray(0.75f, 0.25f, 2, 0, 0, -1), new Ray(0.25f, 0.75f, 2, 0, 0, -1), new Ray(3, 3, 2, 0, 0, -1) };
+      var hits = new Hit[3];
+      blob.Cast(rays, hits, outputs: HitOutputs.Uv);
+      Check(hits[0].Triangle == 2 && hits[0].T == 1 && hits[1].Triangle == 3 && !hits[2].Found, "closest hits");
+      blob.Cast(rays, hits, cull: Cull.Front);
+      Check(!hits[0].Found && !hits[1].Found, "front faces culled");
+      var found = new uint[3];
+      var rows = new Hit[3 * 2];
+      blob.CastAll(rays, 2, found, rows);
+      Check(found[0] == 2 && rows[0].Triangle == 2 && rows[1].Triangle == 0 && rows[1].T == 2 && found[2] == 0, "every hit");
+      ClosestPoint[] near = blob.ClosestPoints(new[] { 0.5f, 0.5f, 0.3f });
+      Check(Math.Abs(near[0].Distance - 0.3f) < 1e-6f && near[0].Triangle == 0, "the nearest point");
+
+      using (var scene = new Scene()) {
+        uint mesh = scene.AddMesh(blob);
+        uint far = scene.AddInstance(mesh, Transform.Translate(1e9, 0, 0));
+        uint near0 = scene.AddInstance(mesh, Transform.Translate(0, 0, 0), mask: 1);
+        scene.Commit();
+        var sceneRays = new[] { new RayD(1e9 + 0.75, 0.25, 2, 0, 0, -1), new RayD(0.25, 0.75, 2, 0, 0, -1) };
+        var sceneHits = new SceneHit[2];
+        scene.Cast(sceneRays, sceneHits);
+        Check(sceneHits[0].Instance == far && sceneHits[0].Triangle == 2 && sceneHits[0].T == 1, "a far instance's hit");
+        Check(sceneHits[1].Instance == near0 && sceneHits[1].Triangle == 3, "the near instance's hit");
+        scene.SetEnabled(near0, false);
+        scene.Commit();
+        scene.Cast(sceneRays, sceneHits);
+        Check(!sceneHits[1].Found, "a disabled instance");
+
+        using (var caster = Caster.Create(blob, Backend.Cpu))
+        using (var other = Caster.Create(blob, Backend.Cpu)) {
+          Ticket ticket = caster.Submit(rays);
+          caster.Poll(ticket);
+          Throws<MeshcastException>(() => other.Wait(ticket, hits), "", "another caster's ticket");
+          var batch = new Hit[3];
+          BatchRecord record = caster.Wait(ticket, batch);
+          Check(batch[0].Triangle == 2 && batch[1].Triangle == 3 && record.Rays == 3 && record.RanOn == Backend.Cpu,
+                "a caster's batch");
+          var (where, why) = caster.BackendFor(1000);
+          Check(where == Backend.Cpu && why.Length > 0, "the caster's backend and why");
+        }
+        using (var scenes = Caster.Create(null, Backend.Cpu)) {
+          Ticket ticket = scenes.SubmitScene(scene, sceneRays);
+          var batch = new SceneHit[2];
+          scenes.WaitScene(ticket, batch);
+          Check(batch[0].Instance == far && !batch[1].Found, "a scene batch");
+        }
+      }
+    }
+  }
+
+  static void Failures(string scratch) {
+    var nan = (float[])Squares.Clone();
+    nan[4] = float.NaN;
+    try {
+      Blob.Build(nan, Corners);
+      Check(false, "a NaN vertex was built");
+    } catch (MeshcastException e) {
+      Check(e.Status == Status.Input && e.Message.Contains("vertex 1"), "a NaN vertex: " + e.Message);
+    }
+    Throws<MeshcastException>(() => Blob.Build(Squares, Corners, layout: "NoSuchTree/Float3"), "NoSuchTree", "a layout name");
+    Throws<MeshcastException>(() => Blob.Load(Path.Combine(scratch, "missing.blob")), "missing.blob", "a missing file");
+    Throws<MeshcastException>(() => Blob.FromBytes(new byte[100]), "blob in memory", "bytes that are no blob");
+    var blob = Blob.Build(Squares, Corners);
+    Throws<ArgumentException>(() => blob.Cast(new Ray[4], new Hit[2]), "fewer than the 4", "too few hits");
+    blob.Dispose();
+    Throws<ObjectDisposedException>(() => blob.Cast(new Ray[1], new Hit[1]), "Blob", "a disposed blob");
+  }
+
+  static int Main(string[] args) {
+    if (args.Length != 3) {
+      Console.Error.WriteLine("usage: mono MeshcastTest.exe MESHCAST_PROGRAM MESH_FILE SCRATCH_DIR");
+      return 2;
+    }
+    Console.WriteLine($"meshcast C API {Blob.ApiVersion >> 16}.{Blob.ApiVersion & 0xFFFF} from C#");
+    SameAsTheLibrary(args[0], args[1], args[2]);
+    KnownAnswers();
+    Failures(args[2]);
+    if (failures > 0) {
+      Console.Error.WriteLine($"{failures} checks failed");
+      return 1;
+    }
+    Console.WriteLine("every check of the C# binding passed");
+    return 0;
+  }
+}

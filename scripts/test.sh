@@ -95,6 +95,11 @@ finish $package_install_job "installing Dask and Mono" build/package_install.log
 stage "C#: the binding (bindings/csharp) under Mono, its answers against the C++ library's"
 mcs -nologo -target:exe -out:build/MeshcastTest.exe bindings/csharp/Meshcast.cs bindings/csharp/test/MeshcastTest.cs
 LD_LIBRARY_PATH="$PWD/build" mono build/MeshcastTest.exe build/bin/meshcast data/bunny00.off build
+stage "Rust: meshcast-sys's declarations against the header, the safe crate's answers against the C++ library's (cargo test --offline)"
+command -v cargo >/dev/null || install_missing cargo  # the machine's own cargo where there is one, else Debian's
+(cd bindings/rust && MESHCAST_LIB_DIR="$OLDPWD/build" LD_LIBRARY_PATH="$OLDPWD/build" \
+   MESHCAST_PROGRAM="$OLDPWD/build/bin/meshcast" MESHCAST_MESH="$OLDPWD/data/bunny00.off" \
+   CARGO_TARGET_DIR="$OLDPWD/build/rust" cargo test --offline -q 2>&1 | grep -v '^$')
 stage "Python: the package (build/python) against its own double-precision brute force, and meshcast.dask on a local cluster (pytest), beside the sanitizer build"
 # pytest keeps one core busy about half its time (the cluster's processes
 # starting, the spawned children): the sanitizer build takes the rest.

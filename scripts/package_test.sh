@@ -6,13 +6,16 @@
 #     parts use is disabled (Assimp, Vulkan, CLI11, libpng, JSON,
 #     GoogleTest); the reader component, asked for, finds Assimp and reads
 #     a mesh file; an unknown component is refused;
+#     the README's C example built against the C API through find_package
+#     (COMPONENTS c) and through pkg-config (meshcast-c);
 #  2. examples/ configured as a separate project against the same prefix,
 #     built and run (each checks its own hits and exits non-zero if wrong),
 #     and compiled by hand with pkg-config's flags;
 #  3. a library-only build (no reader, Vulkan, tools or tests; those
 #     packages disabled) installed to a prefix of its own, as a user without
 #     root would, and the README's program built against it; the reader
-#     component is refused there, naming the option that builds it;
+#     component is refused there, naming the option that builds it; the C
+#     example of step 1, not rebuilt, runs on this build's libmeshcast_c;
 #  4. tests/consumer: meshcast through add_subdirectory with every package
 #     but the core's disabled (configuring fails if it reaches for one);
 #  5. the Python package: imported from where step 1's cmake --install put
@@ -187,6 +190,14 @@ scratch "$tmp/alone" "" meshcast::meshcast "$tmp/first.cpp"
 cmake --no-warn-unused-cli -S "$tmp/alone" -B "$tmp/alone/build" -DCMAKE_PREFIX_PATH="$home/.local" "${disabled[@]}" >/dev/null
 cmake --build "$tmp/alone/build" -j"$jobs" >/dev/null
 run_first "$tmp/alone/build" "a library-only build in ~/.local"
+# The C example step 1 built against the first library, run unchanged on
+# this rebuilt one (scalar walkers, no Vulkan, -O0): its soname and its
+# versioned symbols keep a program built earlier running.
+LD_LIBRARY_PATH="$home/.local/lib" ldd "$tmp/c_api/floor_pc" | grep -q "$home/.local/lib/libmeshcast_c.so.1" ||
+  { echo "FAIL: the C example did not load the rebuilt libmeshcast_c.so.1"; exit 1; }
+[[ $(LD_LIBRARY_PATH="$home/.local/lib" "$tmp/c_api/floor_pc") == "$c_out" ]] ||
+  { echo "FAIL: the C example built against the first library answers otherwise on the rebuilt one"; exit 1; }
+echo "  the C example built against the first library, run on the rebuilt one: the same answers"
 scratch "$tmp/alone_reader" reader meshcast::reader "$tmp/read_off.cpp"
 if cmake -S "$tmp/alone_reader" -B "$tmp/alone_reader/build" -DCMAKE_PREFIX_PATH="$home/.local" \
      > "$tmp/alone_reader.log" 2>&1 || ! grep -q "MESHCAST_READER=ON" "$tmp/alone_reader.log"; then

@@ -153,6 +153,11 @@ static class Native {
   [DllImport(Lib)] internal static extern Status meshcast_blob_release(IntPtr blob);
   [DllImport(Lib)] internal static extern Status meshcast_blob_cast(IntPtr blob, [In] Ray[] rays, ulong count, ref Query query,
                                                                    [Out] Hit[] hits, ulong capacity, out ulong notWalkable);
+  // The same call for spans: their first records by reference (pinned for
+  // the call), the counts beside them.
+  [DllImport(Lib, EntryPoint = "meshcast_blob_cast")]
+  internal static extern Status meshcast_blob_cast_span(IntPtr blob, ref Ray rays, ulong count, ref Query query,
+                                                        ref Hit hits, ulong capacity, out ulong notWalkable);
   [DllImport(Lib)] internal static extern Status meshcast_blob_cast_all(IntPtr blob, [In] Ray[] rays, ulong count, ref Query query,
                                                                        uint maxHits, [Out] uint[] found, [Out] Hit[] hits,
                                                                        ulong capacity, out ulong notWalkable);
@@ -310,6 +315,19 @@ public sealed class Blob : Handle {
     var q = Native.MakeQuery(kind, cull, outputs, 0xFF, threads);
     Native.Check(Native.meshcast_blob_cast(Live, rays, (ulong)rays.LongLength, ref q, hits, (ulong)hits.LongLength,
                                            out var skipped));
+    return skipped;
+  }
+
+  /// <summary>The same for spans of records (a slice of a larger array, or
+  /// memory of one's own), read and written in place.</summary>
+  public ulong Cast(ReadOnlySpan<Ray> rays, Span<Hit> hits, QueryKind kind = QueryKind.Closest, Cull cull = Cull.None,
+                    HitOutputs outputs = HitOutputs.None, uint threads = 1) {
+    if (hits.Length < rays.Length)
+      throw new ArgumentException($"hits holds {hits.Length} answers, fewer than the {rays.Length} asked for");
+    if (rays.Length == 0) return 0;
+    var q = Native.MakeQuery(kind, cull, outputs, 0xFF, threads);
+    Native.Check(Native.meshcast_blob_cast_span(Live, ref MemoryMarshal.GetReference(rays), (ulong)rays.Length, ref q,
+                                                ref MemoryMarshal.GetReference(hits), (ulong)hits.Length, out var skipped));
     return skipped;
   }
 

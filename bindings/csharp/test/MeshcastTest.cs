@@ -3,6 +3,8 @@
 // file), answers known from a mesh's construction, scenes, casters, and
 // failures as exceptions. Run by scripts/test.sh under Debian's Mono:
 //   mono MeshcastTest.exe MESHCAST_PROGRAM MESH_FILE SCRATCH_DIR
+// and, for the one-ray call's cost (bench/RESULTS.md):
+//   mono MeshcastTest.exe bench BLOB RAYS
 using System;
 using System.Diagnostics;
 using System.IO;
@@ -90,6 +92,10 @@ static class MeshcastTest {
       var hits = new Hit[3];
       blob.Cast(rays, hits, outputs: HitOutputs.Uv);
       Check(hits[0].Triangle == 2 && hits[0].T == 1 && hits[1].Triangle == 3 && !hits[2].Found, "closest hits");
+      // Spans: the second ray alone, answered into the middle of a larger array.
+      var wide = new Hit[5];
+      blob.Cast(new ReadOnlySpan<Ray>(rays, 1, 1), new Span<Hit>(wide, 2, 3));
+      Check(wide[2].Triangle == 3 && wide[2].T == 1 && wide[1].T == 0 && wide[3].T == 0, "a cast of spans");
       blob.Cast(rays, hits, cull: Cull.Front);
       Check(!hits[0].Found && !hits[1].Found, "front faces culled");
       var found = new uint[3];
@@ -154,7 +160,32 @@ static class MeshcastTest {
     Throws<ObjectDisposedException>(() => blob.Cast(new Ray[1], new Hit[1]), "Blob", "a disposed blob");
   }
 
+  // One ray a call through the binding, in a loop: the median of 11
+  // rounds of 200,000 calls for each ray of RAYS (bench/c_api_bench.cpp
+  // writes a miss and a hit), ns a call.
+  static int Bench(string blobPath, string raysPath) {
+    using (var blob = Blob.Load(blobPath)) {
+      Ray[] rays = ReadRays(raysPath);
+      var one = new Ray[1];
+      var hit = new Hit[1];
+      const int calls = 200000;
+      foreach (int k in new[] { 0, 1 }) {
+        one[0] = rays[k];
+        var times = new double[11];
+        for (int r = 0; r < times.Length; ++r) {
+          var clock = Stopwatch.StartNew();
+          for (int i = 0; i < calls; ++i) blob.Cast(one, hit);
+          times[r] = clock.Elapsed.TotalMilliseconds * 1e6 / calls;
+        }
+        Array.Sort(times);
+        Console.WriteLine($"| C# | ray {k} ({(hit[0].Found ? "a hit" : "a miss")}) | {times[times.Length / 2]:F1} ns a call |");
+      }
+    }
+    return 0;
+  }
+
   static int Main(string[] args) {
+    if (args.Length == 3 && args[0] == "bench") return Bench(args[1], args[2]);
     if (args.Length != 3) {
       Console.Error.WriteLine("usage: mono MeshcastTest.exe MESHCAST_PROGRAM MESH_FILE SCRATCH_DIR");
       return 2;

@@ -23,7 +23,8 @@ if(MESHCAST_TOOLS)
 endif()
 
 if(MESHCAST_C_API)
-  install(TARGETS meshcast_c EXPORT meshcastCTargets LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(TARGETS meshcast_c meshcast_c_static EXPORT meshcastCTargets LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endif()
 
 set(MESHCAST_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/meshcast)

@@ -124,22 +124,27 @@ mkdir -p "$tmp/c_api"
 cp "$tmp/floor.c" "$tmp/c_api/"
 cat > "$tmp/c_api/CMakeLists.txt" <<'CMAKE'
 cmake_minimum_required(VERSION 3.25)
-project(c_api LANGUAGES C)
+project(c_api LANGUAGES C CXX)  # CXX: the static library's archives need the C++ runtime
 find_package(meshcast REQUIRED COMPONENTS c)
 add_executable(floor floor.c)
 set_target_properties(floor PROPERTIES C_STANDARD 11)
 target_link_libraries(floor PRIVATE meshcast::c m)
+add_executable(floor_static floor.c)
+set_target_properties(floor_static PROPERTIES C_STANDARD 11)
+target_link_libraries(floor_static PRIVATE meshcast::c_static m)
 CMAKE
 cmake --no-warn-unused-cli -S "$tmp/c_api" -B "$tmp/c_api/build" -DCMAKE_PREFIX_PATH="$prefix" "${disabled[@]}" >/dev/null
 cmake --build "$tmp/c_api/build" >/dev/null
 c_out=$("$tmp/c_api/build/floor")
 grep -q "ray 0: triangle 1 at t 1" <<<"$c_out" && grep -q "ray 1: triangle 4294967295 at t inf" <<<"$c_out" ||
   { echo "FAIL: the README's C example printed:"; echo "$c_out"; exit 1; }
+! ldd "$tmp/c_api/build/floor_static" | grep -q libmeshcast_c && [[ $("$tmp/c_api/build/floor_static") == "$c_out" ]] ||
+  { echo "FAIL: the C example linked with libmeshcast_c.a answers otherwise, or loads the shared library"; exit 1; }
 # shellcheck disable=SC2046
 cc -std=c11 -o "$tmp/c_api/floor_pc" "$tmp/floor.c" $(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs meshcast-c) -lm
 [[ $(LD_LIBRARY_PATH="$prefix/lib" "$tmp/c_api/floor_pc") == "$c_out" ]] ||
   { echo "FAIL: the C example built with pkg-config answers otherwise"; exit 1; }
-echo "  find_package COMPONENTS c and pkg-config meshcast-c: the README's C example: $(head -1 <<<"$c_out")"
+echo "  find_package COMPONENTS c (shared and static) and pkg-config meshcast-c: the README's C example: $(head -1 <<<"$c_out")"
 
 # The Python package, as cmake --install put it: PREFIX/lib/python3.X/site-packages.
 pyver=$(/usr/bin/python3 -c 'import sys; print("%d.%d" % sys.version_info[:2])')

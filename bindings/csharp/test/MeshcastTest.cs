@@ -171,14 +171,20 @@ static class MeshcastTest {
       const int calls = 200000;
       foreach (int k in new[] { 0, 1 }) {
         one[0] = rays[k];
-        var times = new double[11];
-        for (int r = 0; r < times.Length; ++r) {
-          var clock = Stopwatch.StartNew();
-          for (int i = 0; i < calls; ++i) blob.Cast(one, hit);
-          times[r] = clock.Elapsed.TotalMilliseconds * 1e6 / calls;
+        foreach (bool spans in new[] { false, true }) {
+          var times = new double[11];
+          for (int r = 0; r < times.Length; ++r) {
+            var clock = Stopwatch.StartNew();
+            if (spans)
+              for (int i = 0; i < calls; ++i) blob.Cast(new ReadOnlySpan<Ray>(one), new Span<Hit>(hit));
+            else
+              for (int i = 0; i < calls; ++i) blob.Cast(one, hit);
+            times[r] = clock.Elapsed.TotalMilliseconds * 1e6 / calls;
+          }
+          Array.Sort(times);
+          Console.WriteLine($"| C# ({(spans ? "spans" : "arrays")}) | ray {k} ({(hit[0].Found ? "a hit" : "a miss")}) | " +
+                            $"{times[times.Length / 2]:F1} ns a call |");
         }
-        Array.Sort(times);
-        Console.WriteLine($"| C# | ray {k} ({(hit[0].Found ? "a hit" : "a miss")}) | {times[times.Length / 2]:F1} ns a call |");
       }
     }
     return 0;

@@ -56,6 +56,61 @@ fn answers_as_the_cpp_library_on_a_public_mesh() {
     }
 }
 
+/// A scene of the mesh twice (as it is, and turned a quarter about z and
+/// halved, inside the first), cast by the meshcast program from a scene
+/// file and through the crate from the same instances: every t, instance
+/// and triangle the same, both instances hit.
+#[test]
+fn a_scene_answers_as_the_cpp_library() {
+    let (program, mesh) = match (std::env::var("MESHCAST_PROGRAM"), std::env::var("MESHCAST_MESH")) {
+        (Ok(p), Ok(m)) => (p, m),
+        _ => panic!("set MESHCAST_PROGRAM (the meshcast program) and MESHCAST_MESH (a mesh file) to run this test"),
+    };
+    let scratch = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let (blob_path, scene_path) = (scratch.join("rs_scene_mesh.blob"), scratch.join("rs_scene.json"));
+    let (rays_path, hits_path) = (scratch.join("rs_scene.rays"), scratch.join("rs_scene.hiti"));
+    let run = |args: &[&str]| {
+        let status = Command::new(&program).args(args).output().expect("the meshcast program runs").status;
+        assert!(status.success(), "{} {:?}: {}", program, args, status);
+    };
+    run(&["build", &mesh, "--out", blob_path.to_str().unwrap()]);
+    std::fs::write(&scene_path, "{\"meshes\": {\"m\": \"rs_scene_mesh.blob\"}, \"instances\": [{\"mesh\": \"m\"}, \
+         {\"mesh\": \"m\", \"rotation_scale\": [0, -0.5, 0, 0.5, 0, 0, 0, 0, 0.5]}]}").unwrap();
+    run(&["rays", &mesh, "--kind", "long", "--count", "20000", "--seed", "6", "--out", rays_path.to_str().unwrap()]);
+    run(&["trace", scene_path.to_str().unwrap(), "--rays", rays_path.to_str().unwrap(), "--out",
+          hits_path.to_str().unwrap()]);
+    let rays_file = std::fs::read(&rays_path).unwrap();
+    let word = |bytes: &[u8], at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let n = word(&rays_file, 4) as usize;
+    let rays: Vec<RayD> = (0..n)
+        .map(|i| {
+            let f = |k: usize| f32::from_bits(word(&rays_file, 8 + 28 * i + 4 * k));
+            RayD { org: [f(0) as f64, f(1) as f64, f(2) as f64], dir: [f(3), f(4), f(5)], tmax: f(6), tmin: 0.0, reserved: 0 }
+        })
+        .collect();
+    let blob = Blob::load(blob_path.to_str().unwrap(), false).unwrap();
+    let mut scene = Scene::new().unwrap();
+    let m = scene.add_mesh(&blob).unwrap();
+    scene.add_instance(m, &meshcast::translation(0.0, 0.0, 0.0), 0xFF, false).unwrap();
+    let turned = meshcast::Transform { rotation_scale: [0.0, -0.5, 0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.5], translation: [0.0; 3] };
+    scene.add_instance(m, &turned, 0xFF, false).unwrap();
+    scene.commit().unwrap();
+    let mut hits = vec![SceneHit::default(); n];
+    scene.cast(&rays, &mut hits, &Query { threads: 0, ..Query::default() }).unwrap();
+    let file = std::fs::read(&hits_path).unwrap();
+    assert_eq!((&file[..4], word(&file, 4) as usize), (&b"HITI"[..], n));
+    let differ = (0..n)
+        .filter(|&i| {
+            (word(&file, 8 + 12 * i), word(&file, 12 + 12 * i), word(&file, 16 + 12 * i))
+                != (hits[i].t.to_bits(), hits[i].instance, hits[i].triangle)
+        })
+        .count();
+    let second = hits.iter().filter(|h| h.instance == 1).count();
+    let found = hits.iter().filter(|h| h.triangle != meshcast::NO_HIT).count();
+    assert_eq!(differ, 0, "{} of {} answers differ from the C++ library's", differ, n);
+    assert!(second > 0 && second < found, "{} of {} hits on the second instance", second, found);
+}
+
 #[test]
 fn known_answers_scenes_and_casters() {
     let blob = Blob::build(&SQUARES, &CORNERS, None).unwrap();

@@ -11,22 +11,34 @@ use std::process::Command;
 const SQUARES: [f32; 24] = [0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0., 0., 0., 1., 1., 0., 1., 1., 1., 1., 0., 1., 1.];
 const CORNERS: [u32; 12] = [0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7];
 
+/// The meshcast program and the mesh the comparisons use.
+fn program_and_mesh() -> (String, String) {
+    match (std::env::var("MESHCAST_PROGRAM"), std::env::var("MESHCAST_MESH")) {
+        (Ok(p), Ok(m)) => (p, m),
+        _ => panic!("set MESHCAST_PROGRAM (the meshcast program) and MESHCAST_MESH (a mesh file) to run this test"),
+    }
+}
+
+fn run_program(program: &str, args: &[&str]) {
+    let status = Command::new(program).args(args).output().expect("the meshcast program runs").status;
+    assert!(status.success(), "{} {:?}: {}", program, args, status);
+}
+
+/// The little-endian word at `at`.
+fn word(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+}
+
 fn down_at(x: f32, y: f32) -> Ray {
     meshcast::ray([x, y, 2.0], [0.0, 0.0, -1.0])
 }
 
 #[test]
 fn answers_as_the_cpp_library_on_a_public_mesh() {
-    let (program, mesh) = match (std::env::var("MESHCAST_PROGRAM"), std::env::var("MESHCAST_MESH")) {
-        (Ok(p), Ok(m)) => (p, m),
-        _ => panic!("set MESHCAST_PROGRAM (the meshcast program) and MESHCAST_MESH (a mesh file) to run this test"),
-    };
+    let (program, mesh) = program_and_mesh();
     let scratch = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     let blob_path = scratch.join("rs_mesh.blob");
-    let run = |args: &[&str]| {
-        let status = Command::new(&program).args(args).output().expect("the meshcast program runs").status;
-        assert!(status.success(), "{} {:?}: {}", program, args, status);
-    };
+    let run = |args: &[&str]| run_program(&program, args);
     run(&["build", &mesh, "--out", blob_path.to_str().unwrap()]);
     let blob = Blob::load(blob_path.to_str().unwrap(), true).unwrap();
     for kind in ["long", "probe", "radial", "segment"] {
@@ -37,7 +49,6 @@ fn answers_as_the_cpp_library_on_a_public_mesh() {
               hits_path.to_str().unwrap()]);
         let rays_file = std::fs::read(&rays_path).unwrap();
         assert_eq!(&rays_file[..4], b"RAYS");
-        let word = |bytes: &[u8], at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
         let n = word(&rays_file, 4) as usize;
         let rays: Vec<Ray> = (0..n)
             .map(|i| {
@@ -62,17 +73,11 @@ fn answers_as_the_cpp_library_on_a_public_mesh() {
 /// and triangle the same, both instances hit.
 #[test]
 fn a_scene_answers_as_the_cpp_library() {
-    let (program, mesh) = match (std::env::var("MESHCAST_PROGRAM"), std::env::var("MESHCAST_MESH")) {
-        (Ok(p), Ok(m)) => (p, m),
-        _ => panic!("set MESHCAST_PROGRAM (the meshcast program) and MESHCAST_MESH (a mesh file) to run this test"),
-    };
+    let (program, mesh) = program_and_mesh();
     let scratch = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     let (blob_path, scene_path) = (scratch.join("rs_scene_mesh.blob"), scratch.join("rs_scene.json"));
     let (rays_path, hits_path) = (scratch.join("rs_scene.rays"), scratch.join("rs_scene.hiti"));
-    let run = |args: &[&str]| {
-        let status = Command::new(&program).args(args).output().expect("the meshcast program runs").status;
-        assert!(status.success(), "{} {:?}: {}", program, args, status);
-    };
+    let run = |args: &[&str]| run_program(&program, args);
     run(&["build", &mesh, "--out", blob_path.to_str().unwrap()]);
     std::fs::write(&scene_path, "{\"meshes\": {\"m\": \"rs_scene_mesh.blob\"}, \"instances\": [{\"mesh\": \"m\"}, \
          {\"mesh\": \"m\", \"rotation_scale\": [0, -0.5, 0, 0.5, 0, 0, 0, 0, 0.5]}]}").unwrap();
@@ -80,7 +85,6 @@ fn a_scene_answers_as_the_cpp_library() {
     run(&["trace", scene_path.to_str().unwrap(), "--rays", rays_path.to_str().unwrap(), "--out",
           hits_path.to_str().unwrap()]);
     let rays_file = std::fs::read(&rays_path).unwrap();
-    let word = |bytes: &[u8], at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
     let n = word(&rays_file, 4) as usize;
     let rays: Vec<RayD> = (0..n)
         .map(|i| {

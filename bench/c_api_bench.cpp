@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/timing.h"
 #include "builder/ray_sets.h"
 #include "meshcast/blob.h"
 #include "meshcast/build.h"
@@ -21,22 +22,19 @@
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
+// The seconds fn() takes.
 template <class Fn>
 double seconds(const Fn& fn) {
   const auto start = std::chrono::steady_clock::now();
   fn();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return meshcast::bench::ms_since(start) / 1e3;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace meshcast;
+  using bench::median;
   if (argc < 2) {
     std::fprintf(stderr, "usage: c_api_bench MESH [RAYS_A_SET] [ROUNDS]\n");
     return 2;

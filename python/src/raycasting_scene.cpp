@@ -138,17 +138,14 @@ struct Geometry {
   // queried for distances, signs or t alone never holds them).
   Geometry(std::vector<PackedNormal> given, std::span<const uint8_t> blob, const std::string& name, const double at[3])
       : corners(blob), view(blob, name), centre{at[0], at[1], at[2]}, normals_(std::move(given)) {
-    if (!normals_.empty()) normals_made_.store(true);
+    if (!normals_.empty()) normals_made_.store(true);  // normals() then keeps them
   }
   // Open3D's primitive_normals, by triangle (made on first use: see above).
   const std::vector<PackedNormal>& normals() const {
-    if (!normals_made_.load(std::memory_order_acquire)) {
-      std::lock_guard<std::mutex> lock(normals_making_);
-      if (!normals_made_.load(std::memory_order_relaxed)) {
-        normals_ = stored_normals(view.bytes());
-        normals_made_.store(true, std::memory_order_release);
-      }
-    }
+    std::call_once(normals_making_, [this] {
+      if (normals_.empty()) normals_ = stored_normals(view.bytes());
+      normals_made_.store(true, std::memory_order_release);
+    });
     return normals_;
   }
   // The normals held: none until made.
@@ -168,7 +165,7 @@ struct Geometry {
 
  private:
   mutable std::vector<PackedNormal> normals_;
-  mutable std::mutex normals_making_;
+  mutable std::once_flag normals_making_;
   mutable std::atomic<bool> normals_made_{false};
   mutable std::once_flag winding_made_;
   mutable std::unique_ptr<const WindingNumbers> winding_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "check/exact_t.h"
 #include "layout/blob_format.h"
 #include "layout/triangles/block.h"
 #include "layout/tree/leaves.h"
@@ -102,6 +103,16 @@ Agreement compare(const Mesh& mesh, const std::vector<Ray>& rays, const std::vec
       ++a.wrong;
       note(i, "triangle index out of range");
       continue;
+    }
+    if (h.triangle != MC_NO_HIT) {
+      // Whichever triangle it names, the walker's t is the distance to it
+      // within an ulp, by exact arithmetic (meaningful where `mesh` is what
+      // the blob stores: callers judge t_rounding there).
+      const Vec3 ta = mesh.corner(h.triangle, 0), tb = mesh.corner(h.triangle, 1), tc = mesh.corner(h.triangle, 2);
+      if (!t_within_ulps(rays[i], ta, tb, tc, h.t, kTUlps)) {
+        ++a.t_rounding;
+        note(i, "t lies more than " + std::to_string(kTUlps) + " ulp from the exact distance to its triangle");
+      }
     }
     if (h.triangle == MC_NO_HIT || o.triangle == MC_NO_HIT) {
       // Hit/miss may differ only where the hit lies within rounding of the
@@ -276,7 +287,7 @@ Agreement compare_all(const Mesh& mesh, const std::vector<Ray>& rays, const HitL
     }
   }
   Agreement b = compare(mesh, pair_rays, pair_hits, pair_oracle, tolerance);
-  a.rays = b.rays, a.ties = b.ties, a.wrong += b.wrong, a.t_errors = b.t_errors, a.max_t_error = b.max_t_error;
+  a.rays = b.rays, a.ties = b.ties, a.wrong += b.wrong, a.t_errors = b.t_errors, a.t_rounding = b.t_rounding, a.max_t_error = b.max_t_error;
   if (a.first_problem.empty() && !b.first_problem.empty()) {
     // compare() names its own index: the pair's; name the ray too.
     const size_t at = std::stoul(b.first_problem.substr(4));

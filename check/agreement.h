@@ -10,8 +10,18 @@
 
 namespace meshcast {
 
+// How far from the exact distance to the named triangle a walker's t may
+// lie, in float ulps (check/exact_t.h): the walkers work each hit's t out
+// in double from the stored corners, so it is correctly rounded (0.5) but
+// where the origin lies far closer to the triangle's plane than to its
+// corners.
+constexpr double kTUlps = 1.0;
+
 struct Agreement {
-  size_t rays = 0, ties = 0, wrong = 0, t_errors = 0;
+  // t_rounding: hits whose t lies more than kTUlps from the exact distance
+  // to their triangle in `mesh` (judged by the callers whose mesh is the
+  // one the blob stores).
+  size_t rays = 0, ties = 0, wrong = 0, t_errors = 0, t_rounding = 0;
   double max_t_error = 0;
   std::string first_problem;
 };

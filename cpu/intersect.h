@@ -9,9 +9,11 @@
 //    shared edge or vertex always hits at least one of its triangles. So is
 //    a lane whose determinant or T overflowed or fell below kSettleTiny
 //    (coordinates near the +-2^100 limit, tiny meshes, tiny or huge
-//    directions): float cannot settle it, double always can.
+//    directions): float cannot settle it, double always can. A hit's t,
+//    u and v are then worked out in double from the stored corners
+//    (hit_in_double): the float t only picks the lanes near the segment.
 // Both are two-sided and accept t in [t_min, t_max] (the float t they
-// compute, both ends included); a hit whose t exceeds the largest float is
+// report, both ends included); a hit whose t exceeds the largest float is
 // a miss (the hit record carries t as a float).
 #pragma once
 #include <algorithm>
@@ -56,13 +58,22 @@ inline float cull_sign(uint32_t flags) {
   return (flags & MC_CULL_BACK) ? 1.0f : (flags & MC_CULL_FRONT) ? -1.0f : 0.0f;
 }
 
-// Double-precision redo of one lane float could not settle. Corners in ray
-// space (sheared x, y; z not yet scaled by sz): every product of two floats
-// is exact in double, so an edge function's sign is exact.
-// `cull`: cull_sign() of the query.
-bool watertight_lane_double(const float ax, const float ay, const float bx, const float by, const float cx,
-                            const float cy, const float az, const float bz, const float cz, const float sz,
-                            float cull, float tmin, float closest, LaneHit* out);
+// Whether a lane float could not settle lies inside the triangle, on a
+// face the query keeps (`cull`: cull_sign() of the query): its edge
+// functions in double from the corners in ray space (sheared x, y), where
+// every product of two floats is exact.
+bool watertight_inside_double(float ax, float ay, float bx, float by, float cx, float cy, float cull);
+
+// A hit's t, u and v worked out in double from the stored corners a, b, c
+// and the ray's origin o and walked direction d (all in one axis order):
+// t to within an ulp of the exact distance to the stored triangle's plane
+// (correctly rounded but where the origin lies far closer to the plane
+// than to the corner a), an origin on the plane to double's rounding at
+// t = 0. Whether the ray meets the triangle is the watertight test's call;
+// this takes the hit when tmin <= t <= min(limit, FLT_MAX) on the float t
+// reported. u and v only when `uv`, else 0.
+bool hit_in_double(const float o[3], const float d[3], const float a[3], const float b[3], const float c[3],
+                   float tmin, float limit, bool uv, LaneHit* out);
 
 MC_ISA_BEGIN
 
@@ -170,21 +181,53 @@ inline auto float_settles(const F4& det, const F4& T) {
   return (d >= tiny) & (d < huge) & (a >= tiny) & (a < inf);
 }
 
-// The lanes of `redo` settled in double: corners in ray space (x, y of the
-// three corners, then their unscaled z) stored, each lane redone by
-// watertight_lane_double against limit(); take(lane, hit) for each hit.
+// Every hit's t, u and v are worked out in double (hit_in_double): the
+// float t only chooses the lanes to work out. It is off by a few ulps of
+// the largest |sz z| of the lane's corners (t is their weighted mean), by
+// more on rays that graze the triangle, so a lane whose float t lies just
+// past either end may lie inside it exactly: every lane within this
+// fraction of that |sz z| of [tmin, closest] is worked out too (thousands
+// of ulps; the lanes in it past the ends are rare, and each costs one
+// double-precision test).
+constexpr float kFloatWindow = 0x1p-10f;
+
+// The lanes of `near` (inside the triangle by the float test, t within the
+// window) and of `redo` (float could not settle them: inside tested again
+// in double) get their t, u, v in double from their corners `a`, `b`, `c`
+// (the ray's axis order; `xy`: the sheared x, y of the three, which redo
+// reads); those between tmin and limit() go to take(lane, hit), lowest lane
+// first.
 template <class F4, class Limit, class Take>
-[[gnu::noinline, gnu::cold]] void settle_in_double(int redo, const F4 (&p)[9], float sz, float cull, float tmin,
-                                                   Limit&& limit, Take&& take) {
-  float l[9][F4::kLanes];
-  for (int k = 0; k < 9; ++k) p[k].store(l[k]);
-  for (int m = redo; m; m &= m - 1) {
-    int i = __builtin_ctz(m);
+[[gnu::noinline]] void take_in_double(const RayPre& r, int near, int redo, const F4 (&a)[3], const F4 (&b)[3],
+                                      const F4 (&c)[3], const F4 (&xy)[6], Limit&& limit, Take&& take) {
+  constexpr int kW = F4::kLanes;
+  float k[3][3][kW], l[6][kW];
+  for (int j = 0; j < 3; ++j) a[j].store(k[0][j]), b[j].store(k[1][j]), c[j].store(k[2][j]);
+  if (redo)
+    for (int j = 0; j < 6; ++j) xy[j].store(l[j]);
+  float o[3], d[3];
+  for (int j = 0; j < 3; ++j) o[j] = r.org[r.axis[j]], d[j] = r.dir[r.axis[j]];
+  const bool uv = (r.outputs & MC_HIT_UV) != 0;
+  for (int m = near | redo; m; m &= m - 1) {
+    const int i = __builtin_ctz(m);
+    if ((redo >> i & 1) && !watertight_inside_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], r.cull))
+      continue;
+    const float pa[3] = {k[0][0][i], k[0][1][i], k[0][2][i]}, pb[3] = {k[1][0][i], k[1][1][i], k[1][2][i]},
+                pc[3] = {k[2][0][i], k[2][1][i], k[2][2][i]};
     LaneHit h;
-    if (watertight_lane_double(l[0][i], l[1][i], l[2][i], l[3][i], l[4][i], l[5][i], l[6][i], l[7][i], l[8][i], sz,
-                               cull, tmin, limit(), &h))
-      take(i, h);
+    if (hit_in_double(o, d, pa, pb, pc, r.tmin, limit(), uv, &h)) take(i, h);
   }
+}
+
+// The lanes a float test settled inside the triangle, on a face the query
+// keeps, whose t lies within the window of [tmin, closest] (zs: the
+// corners' z relative to the origin, scaled by sz).
+template <class F4, class M4>
+[[gnu::always_inline]] inline M4 near_lanes(const RayPre& r, M4 settled_inside, const F4& det, const F4& t,
+                                            const F4 (&zs)[3], float closest) {
+  const F4 slack = simd::max(simd::max(simd::abs(zs[0]), simd::abs(zs[1])), simd::abs(zs[2])) * F4::splat(kFloatWindow);
+  return settled_inside & (det * F4::splat(r.cull) >= F4::splat(0.0f)) & (t + slack >= F4::splat(r.tmin)) &
+         (t - slack <= F4::splat(std::min(closest, FLT_MAX)));
 }
 
 // The plain Möller–Trumbore test (1997), kept only so `meshcast bench
@@ -241,7 +284,6 @@ inline LaneHit moller_trumbore_test(const RayPre& r, const F4 v[3][3], M4 valid,
 template <TriangleTest kTest, class F4, class M4>
 [[gnu::always_inline]] inline LaneHit triangle_test(const RayPre& r, const F4 v[3][3], M4 valid, float closest,
                                                     LaneSet* every = nullptr) {
-  constexpr int kW = F4::kLanes;
   if constexpr (kCountTests) count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(valid)))));
   if constexpr (kTest == TriangleTest::MollerTrumbore) return moller_trumbore_test(r, v, valid, closest, every);
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
@@ -261,52 +303,22 @@ template <TriangleTest kTest, class F4, class M4>
   M4 inside = simd::andnot(neg & pos, valid);
   M4 edge_zero = (U == zero) | (V == zero) | (W == zero);
   F4 det = U + V + W;
-  F4 T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
+  const F4 zs[3] = {sz * az, sz * bz, sz * cz};
+  F4 T = U * zs[0] + V * zs[1] + W * zs[2];
   F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
   F4 t = Ts / dets;
-  // Lanes float cannot settle go to double below; t past the largest float
-  // is no hit (it cannot be reported).
+  // Lanes float cannot settle go to double; the others inside, near the
+  // segment, get their t there too.
   M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
-  // A culled face fails here; det is finite and not 0 on every lane that
-  // float settles, so cull 0 keeps them all.
-  // t >= tmin beside Ts >= 0: an underflowed t of -0 passes tmin = 0 as
-  // before, while Ts < 0 stays a miss.
-  M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (det * F4::splat(r.cull) >= zero) &
-                                     (t >= F4::splat(r.tmin)) & (t <= F4::splat(std::min(closest, FLT_MAX))));
-
+  M4 near = near_lanes(r, simd::andnot(redo, inside), det, t, zs, closest);
   LaneHit best;
-  int acc = simd::bits(accept);
-  float tl[kW];
-  t.store(tl);
-  for (int m = acc; m; m &= m - 1) {
-    int i = __builtin_ctz(m);
-    if (best.lane < 0 || tl[i] < best.t) best.lane = i, best.t = tl[i];
-  }
-  if (every) [[unlikely]] {
-    every->mask = acc;
-    t.store(every->t);
-    float Ul[kW], Vl[kW], Wl[kW];
-    const bool uv = (r.outputs & MC_HIT_UV) != 0;
-    if (uv) U.store(Ul), V.store(Vl), W.store(Wl);
-    for (int m = acc; m; m &= m - 1) {  // u, v read 0 unless asked for, as in a closest hit
-      int i = __builtin_ctz(m);
-      float d = uv ? Ul[i] + Vl[i] + Wl[i] : 1.0f;
-      every->u[i] = uv ? Vl[i] / d : 0.0f, every->v[i] = uv ? Wl[i] / d : 0.0f;
-    }
-  } else if (best.lane >= 0 && (r.outputs & MC_HIT_UV)) {
-    float Ul[kW], Vl[kW], Wl[kW];
-    U.store(Ul), V.store(Vl), W.store(Wl);
-    float d = Ul[best.lane] + Vl[best.lane] + Wl[best.lane];
-    best.u = Vl[best.lane] / d, best.v = Wl[best.lane] / d;
-  }
-  // Rare: an edge function of 0, or det or T out of float's reach.
-  if (int lanes = simd::bits(redo))
-    settle_in_double(lanes, {ax, ay, bx, by, cx, cy, az, bz, cz}, r.sz, r.cull, r.tmin,
-                     [&] { return best.lane >= 0 && !every ? best.t : closest; },
-                     [&](int i, const LaneHit& h) {
-                       if (every) every->add(i, h);
-                       if (best.lane < 0 || h.t < best.t) best = h, best.lane = i;
-                     });
+  if (const int n = simd::bits(near), d = simd::bits(redo); n | d) [[unlikely]]
+    take_in_double(r, n, d, v[0], v[1], v[2], {ax, ay, bx, by, cx, cy},
+                   [&] { return best.lane >= 0 && !every ? best.t : closest; },
+                   [&](int i, const LaneHit& h) {
+                     if (every) every->add(i, h);
+                     if (best.lane < 0 || h.t < best.t) best = h, best.lane = i;
+                   });
   return best;
 }
 
@@ -328,7 +340,6 @@ struct PairHit {
 template <class F4, class M4>
 inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, float closest,
                          LaneSet* every = nullptr) {
-  constexpr int kW = F4::kLanes;
   if constexpr (kCountTests)
     count_triangles(uint64_t(__builtin_popcount(unsigned(simd::bits(used))) + __builtin_popcount(unsigned(simd::bits(second)))));
   const F4 ox = F4::splat(r.org[r.axis[0]]), oy = F4::splat(r.org[r.axis[1]]), oz = F4::splat(r.org[r.axis[2]]);
@@ -357,29 +368,16 @@ inline PairHit pair_test(const RayPre& r, const F4 v[4][3], M4 used, M4 second, 
     F4 Ts = simd::xor_sign(T, det), dets = simd::abs(det);
     F4 t = Ts / dets;
     M4 redo = valid & (edge_zero | simd::andnot(float_settles(det, T), inside));
-    M4 accept = simd::andnot(redo, inside & (Ts >= zero) & (det * F4::splat(r.cull) >= zero) &
-                                       (t >= F4::splat(r.tmin)) & (t <= F4::splat(std::min(closest, FLT_MAX))));
-    float tl[kW], Ul[kW], Vl[kW], Wl[kW];
-    t.store(tl), U.store(Ul), V.store(Vl), W.store(Wl);
-    for (int m = simd::bits(accept); m; m &= m - 1) {
-      int i = __builtin_ctz(m);
-      LaneHit lane{i, tl[i], 0, 0};
-      if (r.outputs & MC_HIT_UV) {
-        const float d = Ul[i] + Vl[i] + Wl[i];
-        lane.u = Vl[i] / d, lane.v = Wl[i] / d;
-      }
-      if (every) every[tri].add(i, lane);
-      if (best.lane < 0 || tl[i] < best.t) best = {i, tri == 1, lane.t, lane.u, lane.v};
-    }
-    // Rare: an edge function of 0, or det or T out of float's reach.
     const int* k = corner[tri];
-    if (int lanes = simd::bits(redo))
-      settle_in_double(lanes, {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]], z[k[0]], z[k[1]], z[k[2]]}, r.sz,
-                       r.cull, r.tmin, [&] { return best.lane >= 0 && !every ? best.t : closest; },
-                       [&](int i, const LaneHit& h) {
-                         if (every) every[tri].add(i, h);
-                         if (best.lane < 0 || h.t < best.t) best = {i, tri == 1, h.t, h.u, h.v};
-                       });
+    const F4 zk[3] = {zs[k[0]], zs[k[1]], zs[k[2]]};
+    M4 near = near_lanes(r, simd::andnot(redo, inside), det, t, zk, closest);
+    if (const int n = simd::bits(near), d = simd::bits(redo); n | d)
+      take_in_double(r, n, d, v[k[0]], v[k[1]], v[k[2]], {x[k[0]], y[k[0]], x[k[1]], y[k[1]], x[k[2]], y[k[2]]},
+                     [&] { return best.lane >= 0 && !every ? best.t : closest; },
+                     [&](int i, const LaneHit& h) {
+                       if (every) every[tri].add(i, h);
+                       if (best.lane < 0 || h.t < best.t) best = {i, tri == 1, h.t, h.u, h.v};
+                     });
   }
   return best;
 }

@@ -64,6 +64,13 @@ inline void keep_slot(Hit& hit, const Closest& c, uint32_t outputs) {
   if (outputs & MC_HIT_UV) hit.u = c.u, hit.v = c.v;
 }
 
+// Axis a of the point o + t d, in double (t d is exact there) and rounded
+// once, as the GPU's (shaders/ray.glsl): within half an ulp of the point at
+// the float t reported.
+inline float hit_point(const Ray& ray, float t, int a) {
+  return float(double(ray.org[a]) + double(t) * walked_direction(ray.dir[a]));
+}
+
 // Hits [begin, end) from slots to the caller's triangles, with the point if
 // asked for. A remap lookup is two dependent loads that miss the cache on
 // large meshes: made at the end of each walk they stalled every ray, made
@@ -75,7 +82,7 @@ inline void finish_hits(const uint8_t* blob, const Ray* rays, Hit* hits, size_t 
     if (hit.triangle == kNoHit) continue;
     hit.triangle = layout::remap_entry(blob, h, hit.triangle);
     if (outputs & MC_HIT_POINT)
-      for (int a = 0; a < 3; ++a) hit.point[a] = rays[i].org[a] + hit.t * walked_direction(rays[i].dir[a]);  // as the GPU
+      for (int a = 0; a < 3; ++a) hit.point[a] = hit_point(rays[i], hit.t, a);
   }
 }
 
@@ -88,7 +95,7 @@ inline void finish_list(const uint8_t* blob, const Ray& ray, Hit* row, uint32_t 
     row[k].triangle = layout::remap_entry(blob, h, row[k].triangle);
     if (!(outputs & MC_HIT_UV)) row[k].u = row[k].v = 0;  // the double redo sets them unasked
     if (outputs & MC_HIT_POINT)
-      for (int a = 0; a < 3; ++a) row[k].point[a] = ray.org[a] + row[k].t * walked_direction(ray.dir[a]);
+      for (int a = 0; a < 3; ++a) row[k].point[a] = hit_point(ray, row[k].t, a);
   }
   std::sort(row, row + used, [](const Hit& a, const Hit& b) { return a.t < b.t || (a.t == b.t && a.triangle < b.triangle); });
 }

@@ -1,4 +1,6 @@
 #include "layout/blob_format.h"
+
+#include "layout/tree/leaves.h"
 #include "layout/tree/zerobyte.h"
 
 #include <algorithm>
@@ -141,7 +143,10 @@ std::string validate(std::span<const uint8_t> blob) {
         std::isfinite(h.node_origin[1]) && std::isfinite(h.node_origin[2])))
     return "half-float node origin or scale is not finite";
 
-  if (tree_format_info(h.tree_format).triangles == TreeTriangles::Indexed24) return validate_zerobyte(blob, h);
+  if (tree_format_info(h.tree_format).triangles == TreeTriangles::Indexed24) {
+    if (std::string e = validate_zerobyte(blob, h); !e.empty()) return e;
+    return check_tree_bounds(blob.data());
+  }
   if (h.triangle_format == MC_TRI_INDEXED24) return "Indexed24 triangles belong to the zero-byte trees alone";
 
   uint64_t triangles = 0;
@@ -156,7 +161,7 @@ std::string validate(std::span<const uint8_t> blob) {
   if (!e.empty()) return e;
   if (triangles != h.triangle_count)
     return "leaves hold " + num(triangles) + " triangles but the header says " + num(h.triangle_count);
-  return "";
+  return check_tree_bounds(blob.data());
 }
 
 }  // namespace meshcast::layout

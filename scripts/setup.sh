@@ -15,6 +15,8 @@ PACKAGES=(cmake g++ make pkg-config libassimp-dev libcli11-dev libpng-dev libgte
 PACKAGES+=(pybind11-dev python3-dev python3-numpy python3-pytest python3-venv python3-wheel)
 # ccache: the package test builds the library twice (cmake, then pip) with the same compiles.
 PACKAGES+=(ccache)
+# GMP: the tests judge each hit's t against exact rational arithmetic (check/exact_t.h).
+PACKAGES+=(libgmp-dev)
 source scripts/packages.sh
 install_missing "${PACKAGES[@]}"
 

@@ -79,9 +79,12 @@ GpuRay load_ray(uint i) {
 }
 
 // org + t * dir, the direction walked: a hit's point (HitOutputs::Point).
+// In double, as the CPU's (cpu/walk.h): t times a component is exact
+// there, so the point is rounded once, whether or not a compiler fuses.
 vec3 ray_point(uint i, float t) {
   const uint b = i * MC_RAY_WORDS;
-  return ray_vec3(b, MC_RAY_ORG) + t * walked_direction(ray_vec3(b, MC_RAY_DIR));
+  precise dvec3 p = dvec3(ray_vec3(b, MC_RAY_ORG)) + double(t) * dvec3(walked_direction(ray_vec3(b, MC_RAY_DIR)));
+  return vec3(p);
 }
 
 #endif

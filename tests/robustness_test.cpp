@@ -15,6 +15,7 @@
 #include <random>
 #include <string>
 
+#include "check/exact_t.h"
 #include "check/generate.h"
 #include "layout/blob_format.h"
 #include "builder/writer.h"
@@ -261,7 +262,7 @@ TEST_P(Robustness, GridEdgesAndVerticesWithSignedZeros) {
     EXPECT_GT(shared, rays.size() / 2) << "most of these rays meet an edge or a vertex";
   }
   Agreement all = compare_all(stored_grid, rays, trace_rows(blob, rays, 16), expected, 1e-6);
-  EXPECT_EQ(all.wrong + all.t_errors + all.ties, 0u) << all.first_problem;
+  EXPECT_EQ(all.wrong + all.t_errors + all.t_rounding + all.ties, 0u) << all.first_problem;
   expect_answers(g, rays, "grid");
 }
 
@@ -616,6 +617,131 @@ TEST_P(Robustness, ReportedTIsFoundAgainAsTMinAndTMax) {
     }
     EXPECT_EQ(hits[2 * n + i].triangle, MC_NO_HIT) << what << ", t_min past t: a hit at " << hits[2 * n + i].t;
     EXPECT_EQ(hits[3 * n + i].triangle, MC_NO_HIT) << what << ", t_max short of t: a hit at " << hits[3 * n + i].t;
+  }
+}
+
+// A hit's t is the distance along the ray to the stored triangle, worked
+// out in double: within an ulp of the exact value (check/exact_t.h), on
+// rays that graze the surface too, where the float test's own t drifts by
+// tens of ulps (up to 1.2e-5 of the diagonal on the two rays below, past
+// the tolerance the oracle is judged by). Each query: the closest hit, any
+// hit, every hit; t_rounding in expect_oracle and compare_all is the
+// 1-ulp check.
+TEST_P(Robustness, TIsTheExactDistanceOnGrazingRays) {
+  struct Probe {
+    const char* mesh;
+    Ray ray;
+  };
+  const Probe probes[] = {
+      {"sphere", {{0x1.97c2eep+0f, -0x1.907d36p+0f, -0x1.54285p+0f}, {-0x1.cf28fep-2f, 0x1.566d5cp-1f, 0x1.2e1702p-1f}, INFINITY}},
+      {"fandisk", {{-0x1.ad5b7cp-1f, -0x1.19aee6p-2f, 0x1.fdcd6cp+0f}, {0x1.8837a6p-2f, 0x1.48944cp-3f, -0x1.d1c4p-1f}, INFINITY}},
+  };
+  for (const Probe& probe : probes) {
+    const std::optional<Mesh> mesh = data_mesh(probe.mesh);
+    if (!mesh) GTEST_SKIP() << "data/" << probe.mesh << ".off is not there (scripts/fetch_meshes.sh)";
+    // The probe, and rays that graze the mesh's triangles: from a point
+    // just off each of a spread of triangles' planes (1e-4 of its size),
+    // along the plane through the triangle's centroid, and back out.
+    std::vector<Ray> rays = {probe.ray};
+    const size_t step = std::max<size_t>(1, mesh->triangles.size() / (tests_every_triangle() ? 64 : 512));
+    for (size_t t = 0; t < mesh->triangles.size(); t += step) {
+      const Vec3 a = mesh->corner(t, 0), b = mesh->corner(t, 1), c = mesh->corner(t, 2);
+      const Vec3 centroid{(a.x + b.x + c.x) / 3, (a.y + b.y + c.y) / 3, (a.z + b.z + c.z) / 3};
+      const Vec3 e1{b.x - a.x, b.y - a.y, b.z - a.z}, e2{c.x - a.x, c.y - a.y, c.z - a.z};
+      const Vec3 n{e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+      for (float off : {1e-4f, -1e-4f}) {
+        Ray r{};
+        for (int k = 0; k < 3; ++k) {
+          r.dir[k] = e1[k] + off * n[k] / std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+          r.org[k] = centroid[k] - 2 * r.dir[k];
+        }
+        r.tmax = INFINITY;
+        rays.push_back(r);
+      }
+    }
+    const std::vector<uint8_t> blob = build(*mesh, probe.mesh);
+    const Mesh stored = stored_mesh(blob);
+    const std::vector<Hit> hits = trace(blob, rays);
+    EXPECT_GT(expect_oracle(*mesh, blob, rays, hits, probe.mesh), rays.size() / 4) << probe.mesh;
+    ASSERT_NE(hits[0].triangle, MC_NO_HIT) << probe.mesh << ": the probe";
+    EXPECT_TRUE(t_within_ulps(rays[0], stored.corner(hits[0].triangle, 0), stored.corner(hits[0].triangle, 1),
+                              stored.corner(hits[0].triangle, 2), hits[0].t, kTUlps))
+        << probe.mesh << ": the probe's t " << hits[0].t;
+    const std::vector<Hit> any = trace_query(blob, rays, Query::Any, Cull::None);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      if (any[i].triangle == MC_NO_HIT) continue;
+      EXPECT_TRUE(t_within_ulps(rays[i], stored.corner(any[i].triangle, 0), stored.corner(any[i].triangle, 1),
+                                  stored.corner(any[i].triangle, 2), any[i].t, kTUlps))
+          << probe.mesh << " ray " << i << ", Query::Any: t " << any[i].t;
+    }
+    const OracleTree tree(stored);
+    std::vector<std::vector<OracleHit>> expected(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) expected[i] = tree.all(rays[i]);
+    const Agreement all = compare_all(stored, rays, trace_rows(blob, rays, 64), expected, 1e-5 * mesh->bounds().diagonal());
+    EXPECT_EQ(all.wrong + all.t_errors + all.t_rounding, 0u) << probe.mesh << ", Query::All: " << all.first_problem;
+  }
+}
+
+// A ray whose origin lies on a triangle meets it at t = 0, which t_min = 0
+// includes: every origin below lies exactly on its triangle (in float), the
+// first triangle flat, the second tilted (z = (x + y) / 2, which dyadic x
+// and y keep exact), each ray leaving in a direction off the plane, either
+// side. With t_min past 0 the triangle is behind the ray: a miss. (Both
+// triangles where the layout stores the input's corners, the flat one
+// where it moves them to a grid.)
+TEST_P(Robustness, OriginsOnATriangleHitItAtZero) {
+  for (bool tilted : {false, true}) {
+    // The triangle, then a small grid at x = 64 (what a layout's bytes a
+    // triangle are measured on: one triangle is mostly header), which the
+    // rays below, all leaving toward -x, never reach. The corners and the
+    // grid lie on every grid format's grid (powers of two): the stored
+    // triangle is the input's.
+    Mesh m = make_grid_plane(4, 4);
+    for (Vec3& v : m.vertices) v = {64, v.x, v.y};
+    const uint32_t first = uint32_t(m.vertices.size());
+    for (const Vec3& v : tilted ? std::vector<Vec3>{{0, 0, 0}, {4, 0, 2}, {0, 4, 2}} : std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}})
+      m.vertices.push_back(v);
+    m.triangles.push_back({first, first + 1, first + 2});
+    const uint32_t ours = uint32_t(m.triangles.size() - 1);
+    const float size = tilted ? 4.0f : 1.0f;
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> grid(1, 1022);
+    std::uniform_real_distribution<float> u(-1, 1);
+    std::vector<Ray> rays, past;
+    while (rays.size() < 2000) {
+      const int i = grid(rng), j = grid(rng);
+      if (i + j >= 1023) continue;  // inside, off the long edge
+      const float x = size * float(i) / 1024, y = size * float(j) / 1024;
+      Ray r{{x, y, tilted ? (x + y) / 2 : 0.0f}, {-std::fabs(u(rng)), u(rng), u(rng)}, INFINITY};
+      // Off the plane by at least a tenth of the direction's length.
+      const float nd = tilted ? -r.dir[0] - r.dir[1] + 2 * r.dir[2] : r.dir[2];
+      if (std::fabs(nd) < 0.1f * (tilted ? 2.45f : 1.0f) * std::sqrt(r.dir[0] * r.dir[0] + r.dir[1] * r.dir[1] + r.dir[2] * r.dir[2]))
+        continue;
+      rays.push_back(r);
+      r.tmin = 0x1p-20f;
+      past.push_back(r);
+    }
+    const std::vector<uint8_t> blob = build(m, tilted ? "tilted triangle" : "triangle");
+    // A grid format stores the tilted triangle's corners a rounding off the
+    // input's (its steps are no powers of two), and these origins are then
+    // off its plane; the flat one stays in z = 0 on every grid.
+    if (tilted && quantized(blob)) continue;
+    for (Query query : {Query::Closest, Query::Any}) {
+      const std::vector<Hit> hits = trace_query(blob, rays, query, Cull::None);
+      size_t missed = 0, off_zero = 0;
+      for (const Hit& h : hits) missed += h.triangle != ours, off_zero += h.triangle == ours && h.t != 0.0f;
+      EXPECT_EQ(missed + off_zero, 0u) << (tilted ? "tilted" : "flat") << ", query " << int(query) << ": " << missed
+                                       << " missed, " << off_zero << " hit at another t than 0";
+      size_t hit_past = 0;
+      for (const Hit& h : trace_query(blob, past, query, Cull::None)) hit_past += h.triangle != MC_NO_HIT;
+      EXPECT_EQ(hit_past, 0u) << (tilted ? "tilted" : "flat") << ", query " << int(query) << ", t_min 2^-20";
+    }
+    const HitLists rows = trace_rows(blob, rays, 4);
+    size_t zero = 0;
+    for (size_t i = 0; i < rays.size(); ++i) zero += rows.found[i] == 1 && rows.row(i)[0].t == 0.0f && rows.row(i)[0].triangle == ours;
+    EXPECT_EQ(zero, rays.size()) << (tilted ? "tilted" : "flat") << ", Query::All; the first ray's row: " << rows.found[0]
+                                 << " found, " << (rows.found[0] ? rows.row(0)[0].t : -1.0f) << ", triangle "
+                                 << (rows.found[0] ? rows.row(0)[0].triangle : 0u);
   }
 }
 

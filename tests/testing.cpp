@@ -223,19 +223,19 @@ QueryAnswers check_queries(const QueryTracer& trace, const NamedMesh& reference,
   const std::vector<OracleHit>& culled_oracle = oracle_answers(reference, kind, rays, cull);
   out.culled = trace.hits(rays, Query::Closest, cull);
   const Agreement a = compare(*reference.mesh, rays, out.culled, culled_oracle, tolerance);
-  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ", culled: " << a.first_problem;
+  EXPECT_EQ(a.wrong + a.t_errors + a.t_rounding, 0u) << what << ", culled: " << a.first_problem;
   size_t culled_hits = 0;
   for (const Hit& h : out.culled) culled_hits += h.triangle != MC_NO_HIT;
   EXPECT_GT(culled_hits, rays.size() / 50) << what << ", culled: too few hits to show anything";
   out.any = trace.hits(rays, Query::Any, cull);
   const Agreement b = compare_any(*reference.mesh, rays, out.any, culled_oracle, tolerance, cull);
-  EXPECT_EQ(b.wrong + b.t_errors, 0u) << what << ", Query::Any culled: " << b.first_problem;
+  EXPECT_EQ(b.wrong + b.t_errors + b.t_rounding, 0u) << what << ", Query::Any culled: " << b.first_problem;
 
   const Cull all_cull = out.all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
   out.all = trace.rows(rays, max_hits, all_cull);
   const Agreement c = compare_all(*reference.mesh, rays, out.all, oracle_all_answers(reference, kind, rays, all_cull),
                                   tolerance);
-  EXPECT_EQ(c.wrong + c.t_errors, 0u) << what << ", Query::All: " << c.first_problem;
+  EXPECT_EQ(c.wrong + c.t_errors + c.t_rounding, 0u) << what << ", Query::All: " << c.first_problem;
   EXPECT_GT(c.rays, rays.size() / 20) << what << ", Query::All: too few hits to show anything";
   return out;
 }
@@ -250,7 +250,7 @@ TMinAnswers check_t_min_queries(const QueryTracer& trace, const NamedMesh& refer
   const std::vector<OracleHit>& offset_oracle = oracle_answers(reference, kind, offset_rays);
   out.closest = trace.hits(offset_rays, Query::Closest, Cull::None);
   const Agreement d = compare(*reference.mesh, offset_rays, out.closest, offset_oracle, tolerance);
-  EXPECT_EQ(d.wrong + d.t_errors, 0u) << what << ", t_min: " << d.first_problem;
+  EXPECT_EQ(d.wrong + d.t_errors + d.t_rounding, 0u) << what << ", t_min: " << d.first_problem;
   // Where the first hits lie past the origin (not so for rays cast from a
   // plane they lie on), some must keep them and some skip them.
   size_t kept_first = 0, skipped_first = 0, past_origin = 0;
@@ -268,11 +268,11 @@ TMinAnswers check_t_min_queries(const QueryTracer& trace, const NamedMesh& refer
   }
   const Agreement e = compare_any(*reference.mesh, offset_rays, trace.hits(offset_rays, Query::Any, Cull::None),
                                   offset_oracle, tolerance);
-  EXPECT_EQ(e.wrong + e.t_errors, 0u) << what << ", Query::Any, t_min: " << e.first_problem;
+  EXPECT_EQ(e.wrong + e.t_errors + e.t_rounding, 0u) << what << ", Query::Any, t_min: " << e.first_problem;
   const Cull all_cull = kind == RayKind::Long ? Cull::Front : Cull::None;
   const Agreement f = compare_all(*reference.mesh, offset_rays, trace.rows(offset_rays, max_hits, all_cull),
                                   oracle_all_answers(reference, kind, offset_rays, all_cull), tolerance);
-  EXPECT_EQ(f.wrong + f.t_errors, 0u) << what << ", Query::All, t_min: " << f.first_problem;
+  EXPECT_EQ(f.wrong + f.t_errors + f.t_rounding, 0u) << what << ", Query::All, t_min: " << f.first_problem;
   return out;
 }
 
@@ -317,7 +317,7 @@ size_t expect_oracle(const Mesh& mesh, const std::vector<uint8_t>& blob, const s
   std::vector<OracleHit> oracle(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) oracle[i] = tree.closest(rays[i]);
   Agreement a = compare(stored, rays, hits, oracle, 1e-5 * std::max(1e-30, mesh.bounds().diagonal()));
-  EXPECT_EQ(a.wrong + a.t_errors, 0u) << what << ": " << a.first_problem;
+  EXPECT_EQ(a.wrong + a.t_errors + a.t_rounding, 0u) << what << ": " << a.first_problem;
   return size_t(std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.triangle != MC_NO_HIT; }));
 }
 

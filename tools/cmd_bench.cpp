@@ -12,6 +12,7 @@
 #include "check/ray_files.h"
 #include "bench/encodings.h"
 #include "bench/error.h"
+#include "bench/exactness.h"
 #include "bench/gpu.h"
 #include "bench/gpu_scale.h"
 #include "bench/latency.h"
@@ -89,6 +90,16 @@ Mesh bench_mesh(const std::string& input) {
 namespace {
 
 // Options every table takes.
+// Every row of `meshcast bench exactness` summed: hits, and the largest errors.
+struct ExactnessTotals {
+  unsigned long long hits = 0, rounded = 0;
+  double t_ulps = 0, uv = 0, point_ulps = 0;
+  void add(const bench::ExactnessRow& r) {
+    hits += r.hits, rounded += r.rounded;
+    t_ulps = std::max(t_ulps, r.t_ulps), uv = std::max(uv, r.uv), point_ulps = std::max(point_ulps, r.point_ulps);
+  }
+};
+
 struct BenchArgs {
   std::string input = "data/bunny00.off", out_dir = "out";
   size_t rays = 1024;
@@ -471,6 +482,51 @@ void add_bench_robustness(CLI::App* bench) {
   });
 }
 
+// t, u, v and hit points against exact arithmetic, mesh by mesh.
+void add_bench_exactness(CLI::App* bench) {
+  auto meshes = std::make_shared<std::vector<std::string>>();
+  auto rays = std::make_shared<size_t>(2000);
+  CLI::App* cmd = bench->add_subcommand("exactness", "t, u, v and hit points against exact rational arithmetic, "
+                                                     "every ray kind and query, grazing rays too");
+  cmd->add_option("meshes", *meshes, "mesh files (default data/*.off)");
+  cmd->add_option("--rays", *rays, "rays of each kind")->check(integer_in(1, 1000000));
+  cmd->callback([meshes, rays] {
+    std::vector<std::string> paths = *meshes;
+    if (paths.empty()) {
+      if (!std::filesystem::is_directory("data")) throw InputError("data/: no meshes to measure (scripts/fetch_meshes.sh)");
+      for (const auto& e : std::filesystem::directory_iterator("data"))
+        if (e.path().extension() == ".off") paths.push_back(e.path().string());
+      std::sort(paths.begin(), paths.end());
+    }
+    std::printf("\nt against the exact distance to the stored triangle's plane (ulps of the exact t; 0.5: correctly "
+                "rounded), u and v (absolute), the hit point against o + t d at the exact t (ulps of its largest "
+                "coordinate); the closest hit, any hit and every hit together, %zu rays a kind\n\n"
+                "| mesh | layout | rays | hits | t correctly rounded | t, largest error (ulps) | u, v largest error | "
+                "point, largest error (ulps) |\n|---|---|---|---:|---:|---:|---:|---:|\n", *rays);
+    ExactnessTotals totals;
+    for (const std::string& path : paths) {
+      Mesh mesh;
+      try {
+        mesh = bench_mesh(path);
+      } catch (const InputError& e) {  // a mesh the library refuses has no hits to measure
+        std::printf("| %s | (refused: %s) | | | | | | |\n", path.c_str(), e.what());
+        continue;
+      }
+      if (mesh.triangles.empty()) continue;
+      const std::string name = std::filesystem::path(path).stem().string();
+      for (const bench::ExactnessRow& r : bench::bench_exactness(mesh, name, *rays)) {
+        std::printf("| %s | %s | %s | %llu | %llu | %.3f | %.3g | %.3f |\n", r.mesh.c_str(), r.layout.c_str(), r.rays.c_str(),
+                    (unsigned long long)r.hits, (unsigned long long)r.rounded, r.t_ulps, r.uv, r.point_ulps);
+        totals.add(r);
+      }
+      std::fflush(stdout);
+    }
+    std::printf("\n%zu meshes: %llu hits, %llu with t correctly rounded; largest t error %.3f ulps, u or v %.3g, "
+                "point %.3f ulps\n", paths.size(), (unsigned long long)totals.hits, (unsigned long long)totals.rounded,
+                totals.t_ulps, totals.uv, totals.point_ulps);
+  });
+}
+
 // Seed 003: triangle pairing.
 void add_bench_pairing(CLI::App* bench) {
   auto pargs = std::make_shared<BenchArgs>();
@@ -568,6 +624,7 @@ void add_bench(CLI::App& app) {
   add_bench_latency(bench);
   add_bench_error(bench);
   add_bench_robustness(bench);
+  add_bench_exactness(bench);
   add_bench_pairing(bench);
   add_bench_offset(bench);
   // Each bench runs for minutes: a line on a terminal says it is running

@@ -2,6 +2,10 @@
 // (in its layout/tree/<family>.cpp).
 #include "layout/tree/leaves.h"
 
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+
 #include "layout/triangles/codecs.h"
 #include "layout/tree/tree_walks.h"
 #include "layout/tree/zerobyte.h"
@@ -51,6 +55,41 @@ void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*ou
   MC_FOR_EACH_TRIANGLE_CODEC(MC_DECODE_LEAF)
 #undef MC_DECODE_LEAF
   for (uint32_t i = 0; i < count; ++i) decode_triangle(blob, block, i, out[i]);
+}
+
+std::string check_tree_bounds(const uint8_t* blob) {
+  const BlobHeader& h = header_of(blob);
+  std::string problem;
+  std::vector<float[3][3]> corners;
+  for_each_leaf_path(blob, [&](uint32_t block, uint32_t count, const std::vector<PathBox>& path) {
+    if (!problem.empty() || path.empty()) return;
+    corners.resize(count);
+    decode_leaf(blob, h.tree_offset + block, count, corners.data());
+    // The leaf's corners' box against each box above it (comparisons that
+    // fail on NaN too).
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < count; ++i)
+      for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a) {
+          const float v = corners[i][c][a];
+          if (!(std::fabs(v) <= FLT_MAX)) {
+            problem = "triangle block at tree offset " + std::to_string(block) + " decodes a corner that is not finite";
+            return;
+          }
+          lo[a] = std::min(lo[a], v), hi[a] = std::max(hi[a], v);
+        }
+    for (size_t depth = 0; depth < path.size(); ++depth)
+      for (int a = 0; a < 3; ++a)
+        if (!(path[depth].min[a] <= lo[a] && hi[a] <= path[depth].max[a])) {
+          problem = "triangle block at tree offset " + std::to_string(block) + " holds corners from " +
+                    std::to_string(lo[a]) + " to " + std::to_string(hi[a]) + " on axis " + std::to_string(a) +
+                    ", outside the box [" + std::to_string(path[depth].min[a]) + ", " +
+                    std::to_string(path[depth].max[a]) + "] of the node above it at depth " + std::to_string(depth) +
+                    ": the tree does not bound its triangles";
+          return;
+        }
+  });
+  return problem;
 }
 
 }  // namespace meshcast::layout

@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace meshcast::layout {
@@ -31,5 +32,12 @@ void decode_triangle(const uint8_t* blob, uint32_t block, uint32_t i, float out[
 // decode_triangle gives each): a format whose triangles share a decode
 // (the cluster formats: each cluster's vertices) does it once a leaf.
 void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*out)[3][3]);
+
+// Whether every box on each leaf's path holds the leaf's decoded corners
+// (all finite): the walkers cull a subtree by its box, so a tree whose
+// boxes miss their triangles would hide hits (and answer by the order of
+// the walk). "" or what is wrong, naming the block and the box. For
+// validate(), once the structure is known sound.
+std::string check_tree_bounds(const uint8_t* blob);
 
 }  // namespace meshcast::layout

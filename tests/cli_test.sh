@@ -399,6 +399,49 @@ check distance-sign 2 "--sign: votes not in \{parity,winding\}|votes" -- "$meshc
 check distance-both 2 "--points FILE.npy or --grid N, one of them" -- "$meshcast" distance "$work/cube.off" --grid 4 --points "$work/p.npy" --out "$work/x.npy"
 check distance-not-npy 2 "cube.off: not a .npy file" -- "$meshcast" distance "$work/cube.off" --points "$work/cube.off" --out "$work/x.npy"
 check distance-layout 2 "point queries walk OctTreeCompressed layouts.*AABBTree/Float3" -- "$meshcast" distance "$work/cube.off" --grid 4 --layout AABBTree/Float3 --out "$work/x.npy"
+# A .npy file numpy would refuse is refused, naming the file and the limit
+# or what is wrong, rather than read in part or answered with a file numpy
+# cannot open: a header over numpy.load's 10000 bytes (25,001 dimensions,
+# beyond format 1.0's 16-bit header length), more than numpy's 32
+# dimensions, a shape that is not a tuple of integers, a key missing or one
+# too many. npy FILE VERSION DICT: three float64 points under that header.
+npy() {
+  python3 -c 'import struct, sys
+path, version, h = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+h += " " * ((64 - (10 + 2 * (version > 1) + len(h) + 1) % 64) % 64) + "\n"
+size = struct.pack("<H" if version == 1 else "<I", len(h))
+pts = [0.5, 0.5, 0.5, 0.5, 0.5, 3.0, 2.0, 0.5, 0.5]
+open(path, "wb").write(b"\x93NUMPY" + bytes([version, 0]) + size + h.encode() + struct.pack("<9d", *pts))' "$@"
+}
+f8="'descr': '<f8', 'fortran_order': False"
+ones() { printf '1, %.0s' $(seq "$1"); }
+npy "$work/wide.npy" 2 "{$f8, 'shape': ($(ones 25000)3), }"
+check distance-npy-header-size 2 "wide.npy: a .npy header of [0-9]+ bytes; numpy reads at most 10000" -- "$meshcast" distance "$work/cube.off" --points "$work/wide.npy" --out "$work/x.npy"
+npy "$work/dims33.npy" 1 "{$f8, 'shape': ($(ones 32)3), }"
+check distance-npy-dimensions 2 "dims33.npy: a shape of more than 32 dimensions; numpy reads at most 32" -- "$meshcast" distance "$work/cube.off" --points "$work/dims33.npy" --out "$work/x.npy"
+npy "$work/spaced.npy" 1 "{$f8, 'shape': (1 9, 3), }"
+check distance-npy-shape 2 "spaced.npy: the .npy header has no ',' or '\)' after a dimension of 'shape'" -- "$meshcast" distance "$work/cube.off" --points "$work/spaced.npy" --out "$work/x.npy"
+npy "$work/number.npy" 1 "{$f8, 'shape': (3), }"
+check distance-npy-number 2 "number.npy: the .npy header has a number, not a tuple, for 'shape'" -- "$meshcast" distance "$work/cube.off" --points "$work/number.npy" --out "$work/x.npy"
+npy "$work/no_order.npy" 1 "{'descr': '<f8', 'shape': (3, 3), }"
+check distance-npy-no-order 2 "no_order.npy: the .npy header has no 'fortran_order' key" -- "$meshcast" distance "$work/cube.off" --points "$work/no_order.npy" --out "$work/x.npy"
+npy "$work/extra.npy" 1 "{$f8, 'shape': (3, 3), 'unit': 'mm', }"
+check distance-npy-extra-key 2 "extra.npy: the .npy header has a key 'unit'" -- "$meshcast" distance "$work/cube.off" --points "$work/extra.npy" --out "$work/x.npy"
+# What is read is numpy's whole: format 2.0, double quotes, no trailing
+# comma, a shape of 32 dimensions; what is written numpy loads.
+npy "$work/v2.npy" 2 "{\"descr\": \"<f8\", \"fortran_order\": False, \"shape\": (3,3)}"
+check distance-npy-v2 0 "1 inside \(negative\), 2 outside" -- "$meshcast" distance "$work/cube.off" --points "$work/v2.npy" --signed --out "$work/d2.npy"
+npy "$work/dims32.npy" 1 "{$f8, 'shape': ($(ones 31)3), }"
+check distance-npy-32 0 "1 inside \(negative\)" -- "$meshcast" distance "$work/cube.off" --points "$work/dims32.npy" --signed --out "$work/d32.npy" --triangles "$work/t32.npy"
+if python3 -c 'import numpy' 2>/dev/null; then
+  python3 -c 'import sys, numpy as np
+d, t, d32, t32 = (np.load(p) for p in sys.argv[1:])
+assert d.dtype == np.float32 and d.tolist() == [-0.5, 2.0, 1.0], d
+assert t.dtype == np.uint32 and t.shape == (3,) and (t < 12).all(), t
+assert d32.shape == (1,) * 31 and d32.ravel().tolist() == [-0.5], d32.shape
+assert t32.dtype == np.uint32 and t32.shape == (1,) * 31' "$work/d.npy" "$work/t.npy" "$work/d32.npy" "$work/t32.npy" ||
+    { echo "FAIL distance-npy-numpy: numpy.load does not read what distance wrote"; failures=$((failures + 1)); }
+fi
 
 # Hostile input through the command line.
 # Every --json output parses as JSON, a path with quotes, backslashes and a

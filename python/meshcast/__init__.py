@@ -402,11 +402,10 @@ class RaycastingScene:
         height_px)``: a horizontal field of view in degrees, the camera at
         ``eye`` looking at ``center``, ``up`` the up vector, made into K and
         [R t] as Open3D makes them."""
-        names = ("intrinsic_matrix", "extrinsic_matrix", "width_px", "height_px")
-        if "fov_deg" in kwargs or (args and _np.ndim(_array(args[0])) == 0):
-            given = dict(zip(("fov_deg", "center", "eye", "up", "width_px", "height_px"), args), **kwargs)
+        look_at = "fov_deg" in kwargs or (args and _np.ndim(_array(args[0])) == 0)
+        given = _pinhole_arguments(_PINHOLE_FORMS[1] if look_at else _PINHOLE_FORMS[0], args, kwargs)
+        if look_at:
             return _pinhole_rays(*_look_at(**given))
-        given = dict(zip(names, args), **kwargs)
         return _pinhole_rays(_array(given["intrinsic_matrix"]), _array(given["extrinsic_matrix"]),
                              given["width_px"], given["height_px"])
 
@@ -449,6 +448,27 @@ def _pinhole_rays(intrinsic, extrinsic, width_px, height_px):
     rays[..., :3] = -r_t @ e[:3, 3]
     rays[..., 3:] = pixels @ to_world.T
     return rays.view(Tensor)
+
+
+# create_rays_pinhole's two forms, Open3D's overloads.
+_PINHOLE_FORMS = (("intrinsic_matrix", "extrinsic_matrix", "width_px", "height_px"),
+                  ("fov_deg", "center", "eye", "up", "width_px", "height_px"))
+
+
+def _pinhole_arguments(names, args, kwargs):
+    # The arguments of one form by name: TypeError naming what is wrong and
+    # both forms' arguments, as Open3D's overload resolution does, for an
+    # argument too many, one unknown, given twice or missing.
+    given = dict(zip(names, args))
+    wrong = [f"{len(args)} positional arguments"] if len(args) > len(names) else []
+    wrong += [f"{key}= given twice" if key in given else f"an unknown keyword {key}="
+              for key in kwargs if key in given or key not in names]
+    given.update((key, value) for key, value in kwargs.items() if key in names)
+    wrong += [f"no {name}" for name in names if name not in given]
+    if wrong:
+        forms = " or ".join(f"({', '.join(form)})" for form in _PINHOLE_FORMS)
+        raise TypeError(f"create_rays_pinhole: {', '.join(wrong)}; it takes {forms}")
+    return given
 
 
 def _look_at(fov_deg, center, eye, up, width_px, height_px):

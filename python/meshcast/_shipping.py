@@ -9,6 +9,7 @@ its instance table; a RaycastingScene as its geometries' structures. The
 counts of both kinds of arrival in this process are ``arrivals()``.
 """
 
+import copyreg
 import os
 import socket
 import threading
@@ -79,6 +80,15 @@ def blob_of_file(path, nbytes, checksum, name):
     return blob
 
 
+def reduce_by_state(obj):
+    # What pickle protocols 2 and later make of a Scene or a RaycastingScene
+    # (its __getstate__, given to __setstate__ of an object made by
+    # __new__), for every protocol: 0 and 1 would otherwise call the
+    # extension type's base on the object (copyreg._reduce_ex), which
+    # pybind11 answers by ending the process.
+    return (copyreg.__newobj__, (type(obj),), obj.__getstate__())
+
+
 def tokenize_blob(blob):
     # Dask's name for a Blob's content: two Blobs of the same bytes are one.
     return ("meshcast.Blob", blob.name, blob.nbytes, blob.checksum, blob.path)
@@ -87,3 +97,5 @@ def tokenize_blob(blob):
 def install():
     _meshcast.Blob.__reduce__ = reduce_blob
     _meshcast.Blob.__dask_tokenize__ = tokenize_blob
+    _meshcast.Scene.__reduce__ = reduce_by_state
+    _meshcast._RaycastingScene.__reduce__ = reduce_by_state

@@ -34,6 +34,7 @@
 #include "meshcast/winding_number.h"
 #include "python/src/arrays.h"
 #include "python/src/cast.h"
+#include "python/src/pickled.h"
 #include "cpu/crossings.h"
 #include "python/src/points.h"
 #include "python/src/vulkan_casters.h"
@@ -122,6 +123,14 @@ std::vector<PackedNormal> stored_normals(std::span<const uint8_t> blob) {
     }
   });
   return normals;
+}
+
+// What a pickled geometry's normals are checked by: a checksum of them
+// joined with one of their blob's header (which holds the checksum of the
+// whole blob), so normals altered, or another geometry's, are refused.
+uint32_t normals_checksum(std::span<const uint8_t> blob, std::span<const uint8_t> normals) {
+  return layout::checksum(blob.first(std::min(blob.size(), sizeof(layout::BlobHeader)))) * 16777619u ^
+         layout::checksum(normals);
 }
 
 // What a geometry keeps beside its blob (which the scene holds): its
@@ -385,52 +394,83 @@ class RaycastingScene {
     return twin;
   }
 
-  // What a pickled scene holds: (1, build threads, layout name or None,
+  // What a pickled scene holds: (2, build threads, layout name or None,
   // max_error, geometries), each geometry (blob bytes, normals bytes,
-  // centre): the structures as they are, not the meshes, so nothing is
-  // built again and the answers are the same bits.
+  // centre, normals' checksum): the structures as they are, not the meshes,
+  // so nothing is built again and the answers are the same bits. The
+  // normals are pickled only where the layout moves the mesh's vertices (the
+  // mesh's own, which no blob holds), under a checksum of them and their
+  // blob, as strong as the blob's own; any other geometry's are made from
+  // its blob again where it arrives (its checksum and validation cover
+  // them), so a pickle's word about them is never needed.
   py::tuple state() const {
     py::list geometries;
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& g : geometries_) {
       const std::span<const uint8_t> bytes = g->view.bytes();
+      const bool kept = moves_vertices(uint32_t(g->view.layout().triangles));
+      const std::span<const PackedNormal> normals = kept ? g->held_normals() : std::span<const PackedNormal>();
+      const std::span<const uint8_t> normal_bytes(reinterpret_cast<const uint8_t*>(normals.data()), normals.size_bytes());
       geometries.append(py::make_tuple(
           py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
-          py::bytes(reinterpret_cast<const char*>(g->held_normals().data()), g->held_normals().size_bytes()),
-          py::make_tuple(g->centre[0], g->centre[1], g->centre[2])));
+          py::bytes(reinterpret_cast<const char*>(normal_bytes.data()), normal_bytes.size()),
+          py::make_tuple(g->centre[0], g->centre[1], g->centre[2]), normals_checksum(bytes, normal_bytes)));
     }
-    return py::make_tuple(1, build_threads_, layout_.named ? py::object(py::str(*layout_.named)) : py::object(py::none()),
+    return py::make_tuple(2, build_threads_, layout_.named ? py::object(py::str(*layout_.named)) : py::object(py::none()),
                           layout_.max_error, geometries);
   }
 
-  // The scene of a state(): every blob validated as a loaded one is.
-  static std::unique_ptr<RaycastingScene> from_state(const py::tuple& state) {
-    if (state.size() != 5 || state[0].cast<int>() != 1)
+  // The scene of a state(): every blob validated as a loaded one is. A state
+  // of version 1 (the normals pickled for every geometry, no checksum) still
+  // loads: a geometry's normals made from its blob where the layout keeps
+  // the mesh's floats, the pickled ones taken where it moves them (nothing
+  // there to check them by).
+  static std::unique_ptr<RaycastingScene> from_state(const py::object& pickled_state) {
+    const std::string of = "RaycastingScene: the pickled state";
+    const py::tuple state = pickled<py::tuple>(pickled_state, of, "a tuple");
+    const long long version = state.size() == 5 ? pickled<long long>(state[0], of + "'s version", "an int") : 0;
+    if (version != 1 && version != 2)
       throw py::value_error("RaycastingScene: a pickled state of another version of meshcast");
     auto scene = std::make_unique<RaycastingScene>(
-        state[1].cast<uint32_t>(),
-        GeometryLayout::checked(state[2].cast<std::optional<std::string>>(), state[3].cast<double>()));
+        pickled<uint32_t>(state[1], of + "'s build threads", "an int from 0 to 2^32 - 1"),
+        GeometryLayout::checked(pickled<std::optional<std::string>>(state[2], of + "'s layout", "a str or None"),
+                                pickled<double>(state[3], of + "'s max_error", "a float")));
     std::lock_guard<std::mutex> lock(scene->mutex_);
-    for (const py::handle item : state[4].cast<py::list>()) {
-      const py::tuple g = item.cast<py::tuple>();
+    for (const py::handle item : pickled<py::list>(state[4], of + "'s geometries", "a list")) {
       const std::string name = "geometry " + std::to_string(scene->geometries_.size());
-      if (g.size() != 3) throw py::value_error("RaycastingScene: " + name + " of the pickled state is malformed");
-      const std::string_view blob_bytes = g[0].cast<py::bytes>(), normal_bytes = g[1].cast<py::bytes>();
-      const auto centre = g[2].cast<std::vector<double>>();
+      const std::string what = of + "'s " + name;
+      const py::tuple g = pickled<py::tuple>(item, what, "a tuple");
+      if (g.size() != (version == 1 ? 3u : 4u))
+        throw py::value_error("RaycastingScene: " + name + " of the pickled state is malformed");
+      const std::string_view blob_bytes = pickled<py::bytes>(g[0], what + "'s blob", "bytes"),
+                             normal_bytes = pickled<py::bytes>(g[1], what + "'s normals", "bytes");
+      const auto centre = pickled<std::vector<double>>(g[2], what + "'s centre", "a tuple of 3 floats");
       if (centre.size() != 3 || !std::isfinite(centre[0]) || !std::isfinite(centre[1]) || !std::isfinite(centre[2]))
         throw py::value_error("RaycastingScene: " + name + " of the pickled state has a centre that is not 3 finite numbers");
-      std::vector<PackedNormal> normals(normal_bytes.size() / sizeof(PackedNormal));
+      const std::span<const uint8_t> blob(reinterpret_cast<const uint8_t*>(blob_bytes.data()), blob_bytes.size()),
+          normal_span(reinterpret_cast<const uint8_t*>(normal_bytes.data()), normal_bytes.size());
+      if (version == 2 && pickled<uint32_t>(g[3], what + "'s checksum", "an int from 0 to 2^32 - 1") !=
+                              normals_checksum(blob, normal_span))
+        throw py::value_error("RaycastingScene: " + name + " of the pickled state has normals or a blob that do not "
+                              "match its checksum (a damaged or altered pickle)");
+      // Whether the layout moves the mesh's vertices, read from the header
+      // the blob is validated by as it joins the scene (InputError naming
+      // what is wrong; one too short for a header is refused there).
+      layout::BlobHeader header{};
+      if (blob.size() >= sizeof header) std::memcpy(&header, blob.data(), sizeof header);
+      const bool kept = blob.size() >= sizeof header && moves_vertices(header.triangle_format);
+      // Made from the blob when asked for where the layout keeps the mesh's
+      // floats; a version-1 state's are those same normals, and not read.
+      if (!kept && version == 2 && !normal_bytes.empty())
+        throw py::value_error("RaycastingScene: " + name + " of the pickled state has normals; its layout's are "
+                              "made from its blob");
+      std::vector<PackedNormal> normals(kept ? normal_bytes.size() / sizeof(PackedNormal) : 0);
       std::memcpy(normals.data(), normal_bytes.data(), normals.size() * sizeof(PackedNormal));
-      // The blob validated as it joins the scene (InputError naming what is
-      // wrong); a scene left half made by an error below is dropped.
+      // A scene left half made by an error below is dropped.
       scene->add_geometry(std::vector<uint8_t>(blob_bytes.begin(), blob_bytes.end()), std::move(normals), centre.data(),
                           name);
-      // No normals: a blob of the mesh's floats, whose normals are made when
-      // asked for.
-      const BlobView& view = scene->geometries_.back()->view;
-      const uint32_t triangles = view.triangle_count();
-      const bool made_later = normal_bytes.empty() && !moves_vertices(uint32_t(view.layout().triangles));
-      if (!made_later && normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal))
+      const uint32_t triangles = scene->geometries_.back()->view.triangle_count();
+      if (kept && normal_bytes.size() != size_t(triangles) * sizeof(PackedNormal))
         throw py::value_error("RaycastingScene: " + name + " of the pickled state has " +
                               std::to_string(normal_bytes.size()) + " bytes of normals for " +
                               std::to_string(triangles) + " triangles");
@@ -877,8 +917,8 @@ void register_raycasting_scene(py::module_& m) {
            py::arg("tolerance") = 1e-2)
       .def("winding_inside", &RaycastingScene::winding_inside, py::arg("query_points"), py::arg("nthreads") = 0)
       .def("copy", &RaycastingScene::copy)
-      .def(py::pickle([](const RaycastingScene& s) { return s.state(); },
-                      [](const py::tuple& state) { return RaycastingScene::from_state(state); }))
+      .def(py::pickle([](const RaycastingScene& s) -> py::object { return s.state(); },
+                      [](const py::object& state) { return RaycastingScene::from_state(state); }))
       .def_property_readonly("nbytes", &RaycastingScene::nbytes);
   m.attr("INVALID_ID") = kInvalidId;
 }

@@ -14,6 +14,7 @@
 #include "python/src/blob_api.h"
 #include "python/src/cast.h"
 #include "python/src/parallel.h"
+#include "python/src/pickled.h"
 #include "python/src/points.h"
 
 namespace meshcast::python {
@@ -145,7 +146,7 @@ py::dict closest_points_scene(const PyScene& s, const py::handle& points_in, dou
 // A committed scene's state: (1, blobs, instances), each instance (mesh,
 // rotation_scale (9 floats, row-major), translation (3 doubles), mask,
 // flip_facing, enabled, removed).
-py::tuple scene_state(const PyScene& s) {
+py::object scene_state(const PyScene& s) {
   if (s.edited)
     throw py::value_error("Scene: edits since the last commit(); commit them (or undo them) before pickling");
   py::list blobs, instances;
@@ -159,24 +160,32 @@ py::tuple scene_state(const PyScene& s) {
   return py::make_tuple(1, blobs, instances);
 }
 
-std::unique_ptr<PyScene> scene_from_state(const py::tuple& state) {
-  if (state.size() != 3 || state[0].cast<int>() != 1)
+std::unique_ptr<PyScene> scene_from_state(const py::object& pickled_state) {
+  const std::string of = "Scene: the pickled state";
+  const py::tuple state = pickled<py::tuple>(pickled_state, of, "a tuple");
+  if (state.size() != 3 || pickled<long long>(state[0], of + "'s version", "an int") != 1)
     throw py::value_error("Scene: a pickled state of another version of meshcast");
   auto s = std::make_unique<PyScene>();
-  for (const py::handle b : state[1].cast<py::list>()) s->add_mesh(b.cast<std::shared_ptr<PyBlob>>());
-  for (const py::handle item : state[2].cast<py::list>()) {
-    const py::tuple i = item.cast<py::tuple>();
+  for (const py::handle b : pickled<py::list>(state[1], of + "'s blobs", "a list")) {
+    const std::string what = of + "'s blob " + std::to_string(s->blobs.size());
+    if (!py::isinstance<PyBlob>(b)) throw pickled_error(b, what, "a meshcast.Blob");
+    s->add_mesh(b.cast<std::shared_ptr<PyBlob>>());
+  }
+  for (const py::handle item : pickled<py::list>(state[2], of + "'s instances", "a list")) {
+    const std::string what = of + "'s instance " + std::to_string(s->instances.size());
+    const py::tuple i = pickled<py::tuple>(item, what, "a tuple");
     if (i.size() != 7) throw py::value_error("Scene: a malformed pickled instance");
-    const auto m = i[1].cast<std::vector<float>>();
-    const auto t = i[2].cast<std::vector<double>>();
+    const auto m = pickled<std::vector<float>>(i[1], what + " rotation_scale", "a list of 9 floats");
+    const auto t = pickled<std::vector<double>>(i[2], what + " translation", "a list of 3 floats");
     if (m.size() != 9 || t.size() != 3) throw py::value_error("Scene: a malformed pickled instance");
     Transform placed;
     std::copy(m.begin(), m.end(), placed.rotation_scale);
     std::copy(t.begin(), t.end(), placed.translation);
-    const InstanceId id = s->add_instance(i[0].cast<MeshId>(), placed, checked_mask(i[3].cast<long long>()),
-                                          i[4].cast<bool>());
-    if (!i[5].cast<bool>()) s->set_enabled(id, false);
-    if (i[6].cast<bool>()) s->remove_instance(id);
+    const InstanceId id = s->add_instance(pickled<MeshId>(i[0], what + " mesh", "a mesh id (an int)"), placed,
+                                          checked_mask(pickled<long long>(i[3], what + " mask", "an int")),
+                                          pickled<bool>(i[4], what + " flip_facing", "a bool"));
+    if (!pickled<bool>(i[5], what + " enabled", "a bool")) s->set_enabled(id, false);
+    if (pickled<bool>(i[6], what + " removed", "a bool")) s->remove_instance(id);
   }
   s->scene.commit();
   s->edited = false;

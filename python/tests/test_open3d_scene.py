@@ -124,6 +124,22 @@ def test_pinhole_rays_from_a_look_at_camera():
     assert np.array_equal(again.numpy(), rays)
 
 
+def test_pinhole_arguments_of_neither_form_are_a_type_error_naming_both():
+    k, e = np.eye(3), np.eye(4)
+    forms = (r"\(intrinsic_matrix, extrinsic_matrix, width_px, height_px\) or "
+             r"\(fov_deg, center, eye, up, width_px, height_px\)")
+    create = meshcast.RaycastingScene.create_rays_pinhole
+    for args, kwargs, wrong in (((), dict(intrinsic=k, extrinsic_matrix=e, width_px=4, height_px=3),
+                                 "an unknown keyword intrinsic=, no intrinsic_matrix"),
+                                ((k, e, 4), {}, "no height_px"),
+                                ((k, e, 4, 3), dict(width_px=4), "width_px= given twice"),
+                                ((k, e, 4, 3, 1), {}, "5 positional arguments"),
+                                ((), dict(fov_deg=60.0, center=[0, 0, 1], eye=[0, 0, 0], up=[0, 1, 0], width=4,
+                                          height_px=3), "an unknown keyword width=, no width_px")):
+        with pytest.raises(TypeError, match=f"create_rays_pinhole: {wrong}; it takes {forms}"):
+            create(*args, **kwargs)
+
+
 def test_mesh_keyword_copies_and_isfinite():
     v, t = shapes.cube()
     mesh = types.SimpleNamespace(vertex=types.SimpleNamespace(positions=v), triangle=types.SimpleNamespace(indices=t))

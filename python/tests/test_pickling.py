@@ -6,6 +6,9 @@ import copy
 import multiprocessing
 import os
 import pickle
+import subprocess
+import sys
+import textwrap
 
 import numpy as np
 import pytest
@@ -148,19 +151,127 @@ def test_a_corrupted_pickle_of_a_raycasting_scene_is_refused():
     scene = meshcast.RaycastingScene()
     v, f = shapes.sphere()
     scene.add_triangles(v, f)
-    assert scene._scene.__getstate__()[4][0][1] == b""  # no normals held until asked for
-    scene.compute_closest_points(v[:3])  # primitive_normals: made now, and pickled
+    scene.compute_closest_points(v[:3])  # primitive_normals: made now, and still not pickled
     state = scene._scene.__getstate__()
-    blob, normals, centre = state[4][0]
-    assert len(normals) == 4 * len(f)
+    assert state[0] == 2 and state[4][0][1] == b""  # made from the blob again where it arrives
+    blob, normals, centre, checksum = state[4][0]
     broken = bytearray(blob)
     broken[len(broken) // 2] ^= 0xFF
-    for geometries, message in (([(bytes(broken), normals, centre)], "checksum"),
-                                ([(blob, normals[:-4], centre)], "bytes of normals"),
-                                ([(blob, normals, (0.0, float("nan"), 0.0))], "centre")):
+    # The compact layout's normals are the mesh's: pickled, and checked.
+    compact = meshcast.RaycastingScene(max_error=1e-5)
+    compact.add_triangles(v, f)
+    cstate = compact._scene.__getstate__()
+    cblob, cnormals, ccentre, cchecksum = cstate[4][0]
+    assert len(cnormals) == 4 * len(f)
+    for given, geometries, message in ((state, [(bytes(broken), normals, centre, checksum)], "checksum"),
+                                       (state, [(blob, normals, (0.0, float("nan"), 0.0), checksum)], "centre"),
+                                       (cstate, [(cblob, cnormals[:-4], ccentre, cchecksum)], "checksum"),
+                                       # a state of the version before the checksum
+                                       ((1,) + cstate[1:4], [(cblob, cnormals[:-4], ccentre)], "bytes of normals")):
         twin = meshcast._meshcast._RaycastingScene.__new__(meshcast._meshcast._RaycastingScene)
         with pytest.raises(ValueError, match=message):
-            twin.__setstate__(state[:4] + (geometries,))
+            twin.__setstate__(given[:4] + (geometries,))
+
+
+def _raycasting_twin(state):
+    twin = meshcast.RaycastingScene()
+    twin._scene = meshcast._meshcast._RaycastingScene.__new__(meshcast._meshcast._RaycastingScene)
+    twin._scene.__setstate__(state)
+    return twin
+
+
+def test_normals_altered_in_a_raycasting_scene_pickle_are_never_answered():
+    v, f = shapes.sphere()
+    o, d = _rays(v, 2000)
+    rays = np.concatenate([o, d], axis=1)
+    # Every triangle's normal said to be +z (packed as two zero codes): the
+    # sphere's are mostly not.
+    up = b"\0" * (4 * len(f))
+    for max_error in (0.0, 1e-5):  # the exact layout, and the compact one (the mesh's normals kept)
+        scene = meshcast.RaycastingScene(max_error=max_error)
+        scene.add_triangles(v, f)
+        truth = scene.cast_rays(rays)["primitive_normals"].numpy()  # made now: a pickle could hold them
+        assert (np.abs(truth[:, 2]) < 0.9).sum() > 100
+        state = scene._scene.__getstate__()
+        geometry = state[4][0]
+        altered = state[:4] + ([(geometry[0], up) + tuple(geometry[2:])],)
+        with pytest.raises(ValueError, match=r"geometry 0 of the pickled state has normals"):
+            _raycasting_twin(altered)
+    # A state of the version before: the exact layout's normals pickled, not
+    # read (made from the blob); the compact one's taken as pickled.
+    exact = meshcast.RaycastingScene()
+    exact.add_triangles(v, f)
+    state = exact._scene.__getstate__()
+    blob, _, centre = state[4][0][:3]
+    twin = _raycasting_twin((1,) + state[1:4] + ([(blob, up, centre)],))
+    np.testing.assert_array_equal(twin.cast_rays(rays)["primitive_normals"].numpy(),
+                                  exact.cast_rays(rays)["primitive_normals"].numpy())
+    compact = meshcast.RaycastingScene(max_error=1e-5)
+    compact.add_triangles(v, f)
+    state = compact._scene.__getstate__()
+    twin = _raycasting_twin((1,) + state[1:4] + ([state[4][0][:3]],))
+    _equal(twin.cast_rays(rays), compact.cast_rays(rays))
+
+
+def test_a_pickled_state_of_other_types_is_refused_naming_them():
+    scene, _ = _scene()
+    version, blobs, instances = scene.__getstate__()
+    for state, message in (((version, ["a blob"] + blobs[1:], instances),
+                            r"Scene: the pickled state's blob 0: a meshcast\.Blob expected, str 'a blob' found"),
+                           ((version, blobs, [("0",) + tuple(instances[0][1:])] + instances[1:]),
+                            r"Scene: the pickled state's instance 0 mesh: a mesh id \(an int\) expected, str '0' found"),
+                           ((version, tuple(blobs), instances),
+                            r"Scene: the pickled state's blobs: a list expected, tuple found"),
+                           (list((version, blobs, instances)), r"Scene: the pickled state: a tuple expected, list found")):
+        twin = meshcast.Scene.__new__(meshcast.Scene)
+        with pytest.raises(TypeError, match=message):
+            twin.__setstate__(state)
+    rc = meshcast.RaycastingScene()
+    rc.add_triangles(*shapes.sphere())
+    state = rc._scene.__getstate__()
+    geometry = state[4][0]
+    for given, message in ((state[:4] + ([("text",) + tuple(geometry[1:])],),
+                            r"RaycastingScene: the pickled state's geometry 0's blob: bytes expected, str 'text' found"),
+                           (state[:1] + ("8",) + state[2:],
+                            r"the pickled state's build threads: an int from 0 to 2\^32 - 1 expected, str '8' found"),
+                           (state[:4] + (None,), r"the pickled state's geometries: a list expected, NoneType None found")):
+        with pytest.raises(TypeError, match=message):
+            _raycasting_twin(given)
+
+
+def test_every_pickle_protocol_carries_blobs_and_scenes():
+    """Protocols 0 and 1 (and __reduce__ called directly) as well as 2 to 5:
+    the same answers, or a Python exception; run in a child process, so a
+    process that ends itself fails the test rather than the test run."""
+    script = textwrap.dedent("""
+        import pickle
+        import numpy as np
+        import meshcast, shapes
+        v, f = shapes.sphere()
+        blob = meshcast.build(v, f)
+        scene = meshcast.Scene()
+        scene.add_instance(scene.add_mesh(blob), translation=[0.5, 0.0, 0.0])
+        scene.commit()
+        rcs = meshcast.RaycastingScene()
+        rcs.add_triangles(v, f)
+        o, d = (np.asarray(a, np.float32) for a in shapes.rays(v, 500, seed=3))
+        rays = np.concatenate([o, d], axis=1)
+        answers = (lambda x: x.cast(o, d, uv=True), lambda x: x.cast(o, d, uv=True),
+                   lambda x: x.cast_rays(rays))
+        scene.__reduce__(), rcs._scene.__reduce__(), blob.__reduce__()
+        for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+            for x, answer in zip((blob, scene, rcs), answers):
+                twin = pickle.loads(pickle.dumps(x, protocol))
+                a, b = answer(twin), answer(x)
+                assert a.keys() == b.keys()
+                for key in a:
+                    assert np.array_equal(np.asarray(a[key]), np.asarray(b[key])), (protocol, type(x), key)
+            print("protocol", protocol)
+    """)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([os.path.dirname(__file__), os.environ.get("PYTHONPATH", "")]))
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, env=env)
+    assert run.returncode == 0, f"exit {run.returncode}: {run.stderr[-2000:]}"
+    assert run.stdout.split("\n")[:-1] == [f"protocol {p}" for p in range(pickle.HIGHEST_PROTOCOL + 1)]
 
 
 def _cast_in_child(blob, origins, directions):

@@ -10,9 +10,12 @@
  * 2 hold the points with x >= y. Their corners run counter-clockwise seen
  * from above. */
 #include <math.h>
+#include <stdlib.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <threads.h>
 
 #include "meshcast/meshcast_c.h"
 
@@ -357,6 +360,137 @@ static void test_casters(void) {
   EXPECT_FAILS(meshcast_caster_release(caster), MESHCAST_ERROR_USAGE, "released already");
 }
 
+/* A handle released while another thread casts through it: the cast in
+ * flight keeps what it reads until it returns (a mapped blob's pages
+ * included), and the thread's next call is refused. Large batches, so the
+ * release lands inside a cast; three rounds of each kind. */
+enum { kGrid = 256, kRaceRays = 1 << 15 };
+typedef struct racer {
+  int kind; /* 0 a blob's cast, 1 a scene's, 2 a caster's batch */
+  void* handle;
+  const meshcast_ray* rays;
+  const meshcast_ray_d* scene_rays;
+  meshcast_hit* hits;
+  meshcast_scene_hit* scene_hits;
+  atomic_int casts;
+  atomic_int ended;
+  meshcast_status refused;
+  char message[512];
+} racer;
+
+static int cast_until_refused(void* arg) {
+  racer* r = arg;
+  for (;;) {
+    meshcast_status status;
+    if (r->kind == 0) {
+      status = meshcast_blob_cast(r->handle, r->rays, kRaceRays, NULL, r->hits, kRaceRays, NULL);
+    } else if (r->kind == 1) {
+      status = meshcast_scene_cast(r->handle, r->scene_rays, kRaceRays, NULL, r->scene_hits, kRaceRays, NULL);
+    } else {
+      meshcast_ticket ticket;
+      status = meshcast_caster_submit(r->handle, r->rays, kRaceRays, NULL, &ticket);
+      if (status == MESHCAST_OK) status = meshcast_caster_wait(r->handle, &ticket, r->hits, kRaceRays, NULL);
+    }
+    if (status != MESHCAST_OK) {
+      r->refused = status;
+      snprintf(r->message, sizeof r->message, "%s", meshcast_last_error());
+      atomic_store(&r->ended, 1);
+      return 0;
+    }
+    atomic_fetch_add(&r->casts, 1);
+  }
+}
+
+static void race_release(racer* r) {
+  atomic_store(&r->casts, 0);
+  atomic_store(&r->ended, 0);
+  r->refused = MESHCAST_OK;
+  r->message[0] = 0;
+  thrd_t thread;
+  CHECK(thrd_create(&thread, cast_until_refused, r) == thrd_success);
+  /* Released during its second cast (unless the first failed: reported below). */
+  while (atomic_load(&r->casts) < 1 && !atomic_load(&r->ended)) thrd_yield();
+  if (r->kind == 0) EXPECT_OK(meshcast_blob_release(r->handle));
+  else if (r->kind == 1) EXPECT_OK(meshcast_scene_release(r->handle));
+  else EXPECT_OK(meshcast_caster_release(r->handle));
+  CHECK(thrd_join(thread, NULL) == thrd_success);
+  if (r->refused != MESHCAST_ERROR_USAGE || !strstr(r->message, "released already")) {
+    fprintf(stderr, "%s:%d: the casting thread ended with %s: \"%s\"\n", __FILE__, __LINE__,
+            meshcast_status_name(r->refused), r->message);
+    ++failures;
+  }
+  CHECK(r->kind == 1 ? r->scene_hits[0].t == 1.0f : r->hits[0].t == 1.0f); /* its last whole cast */
+}
+
+static void test_release_while_casting(void) {
+  /* A grid of kGrid x kGrid squares at z = 0 over [0, 1]^2, mapped from a file. */
+  const int side = kGrid + 1;
+  float* vertices = malloc(sizeof(float) * 3 * side * side);
+  uint32_t* indices = malloc(sizeof(uint32_t) * 6 * kGrid * kGrid);
+  meshcast_ray* rays = malloc(sizeof(meshcast_ray) * kRaceRays);
+  meshcast_ray_d* scene_rays = malloc(sizeof(meshcast_ray_d) * kRaceRays);
+  meshcast_hit* hits = malloc(sizeof(meshcast_hit) * kRaceRays);
+  meshcast_scene_hit* scene_hits = malloc(sizeof(meshcast_scene_hit) * kRaceRays);
+  CHECK(vertices && indices && rays && scene_rays && hits && scene_hits);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      float* v = vertices + 3 * (y * side + x);
+      v[0] = (float)x / kGrid, v[1] = (float)y / kGrid, v[2] = 0;
+    }
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x) {
+      uint32_t* t = indices + 6 * (y * kGrid + x);
+      const uint32_t a = (uint32_t)(y * side + x);
+      t[0] = a, t[1] = a + 1, t[2] = a + side + 1, t[3] = a, t[4] = a + side + 1, t[5] = a + side;
+    }
+  for (int i = 0; i < kRaceRays; ++i) {
+    const unsigned k = (unsigned)i;
+    const float x = (float)((k * 7919u) % 1000u + 0.5) / 1000, y = (float)((k * 104729u) % 997u + 0.5) / 997;
+    meshcast_ray r = {{x, y, 1}, {0, 0, -1}, INFINITY, 0};
+    meshcast_ray_d d = {{x, y, 1}, {0, 0, -1}, INFINITY, 0, 0};
+    rays[i] = r, scene_rays[i] = d;
+  }
+  meshcast_mesh mesh;
+  meshcast_mesh_init(&mesh);
+  mesh.vertices = vertices, mesh.vertex_count = (uint64_t)side * side;
+  mesh.indices = indices, mesh.triangle_count = 2ull * kGrid * kGrid;
+  meshcast_blob* built = NULL;
+  EXPECT_OK(meshcast_blob_build(&mesh, NULL, &built));
+  const char* path = "c_api_race.blob";
+  EXPECT_OK(meshcast_blob_save(built, path));
+  EXPECT_OK(meshcast_blob_release(built));
+  meshcast_caster_options options;
+  meshcast_caster_options_init(&options);
+  options.backend = MESHCAST_BACKEND_CPU;
+  options.threads = 1;
+  for (int round = 0; round < 3; ++round)
+    for (int kind = 0; kind < 3; ++kind) {
+      racer r = {.kind = kind, .rays = rays, .scene_rays = scene_rays, .hits = hits, .scene_hits = scene_hits};
+      meshcast_blob* blob = NULL;
+      EXPECT_OK(meshcast_blob_load(path, MESHCAST_LOAD_MAP, &blob));
+      if (kind == 0) {
+        r.handle = blob;
+      } else if (kind == 1) {
+        meshcast_scene* scene = NULL;
+        uint32_t id, instance;
+        EXPECT_OK(meshcast_scene_create(&scene));
+        EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &id));
+        EXPECT_OK(meshcast_scene_add_instance(scene, id, NULL, 0xFF, 0, &instance));
+        EXPECT_OK(meshcast_scene_commit(scene));
+        EXPECT_OK(meshcast_blob_release(blob));
+        r.handle = scene;
+      } else {
+        meshcast_caster* caster = NULL;
+        EXPECT_OK(meshcast_caster_create(blob, &options, &caster));
+        EXPECT_OK(meshcast_blob_release(blob));
+        r.handle = caster;
+      }
+      race_release(&r);
+    }
+  remove(path);
+  free(vertices), free(indices), free(rays), free(scene_rays), free(hits), free(scene_hits);
+}
+
 int main(void) {
   test_version_and_errors();
   test_blob_casts(NULL);
@@ -365,6 +499,7 @@ int main(void) {
   test_build_load_save();
   test_scene();
   test_casters();
+  test_release_while_casting();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

@@ -5,7 +5,9 @@
  * - Handles (meshcast_blob, meshcast_scene, meshcast_caster) are opaque;
  *   each is made by one call and released by its _release call. A handle
  *   released, or never made here, is refused with MESHCAST_ERROR_USAGE,
- *   never read.
+ *   never read. A call already running on another thread when the handle
+ *   is released keeps it until that call returns: the release frees it
+ *   then, and later calls are refused.
  * - Every call that can fail returns a meshcast_status. On failure,
  *   meshcast_last_error() (this thread's) names the input and the limit it
  *   broke, and the error callback, where one is set, gets the same words.
@@ -194,7 +196,8 @@ typedef struct meshcast_blob_info {
   double error_bound;  /* the stated error, a fraction of the diagonal (0: exact) */
 } meshcast_blob_info;
 MESHCAST_C_API meshcast_status meshcast_blob_info_get(const meshcast_blob* blob, meshcast_blob_info* info);
-/* NULL is MESHCAST_OK; a scene the blob joined keeps its bytes. */
+/* NULL is MESHCAST_OK; a scene the blob joined keeps its bytes, and a cast
+ * through it already running on another thread keeps it until it returns. */
 MESHCAST_C_API meshcast_status meshcast_blob_release(meshcast_blob* blob);
 
 #define MESHCAST_CLOSEST 0u

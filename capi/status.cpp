@@ -21,9 +21,14 @@ Callback callback;
 }  // namespace
 
 meshcast_status fail(const char* call, meshcast_status status, const char* message) noexcept {
+  // The callback gets a copy of its own: a failing call it makes sets this
+  // thread's message again, and the copy lives until it returns.
+  std::string text;
   try {
-    last_message = std::string(call) + ": " + message;
+    text = std::string(call) + ": " + message;
+    last_message = text;
   } catch (...) {  // no memory for the message: the call's name at least
+    text.clear();
     last_message.clear();
   }
   Callback c;
@@ -31,7 +36,12 @@ meshcast_status fail(const char* call, meshcast_status status, const char* messa
     std::lock_guard<std::mutex> lock(callback_lock);
     c = callback;
   }
-  if (c.function) c.function(c.user, status, last_message.empty() ? call : last_message.c_str());
+  if (c.function) {
+    c.function(c.user, status, text.empty() ? call : text.c_str());
+    // The failed call's message is this call's, whatever the callback's
+    // own calls left.
+    last_message = std::move(text);
+  }
   return status;
 }
 

@@ -92,6 +92,38 @@ static void test_version_and_errors(void) {
   CHECK(strcmp(meshcast_last_error(), "") == 0);
 }
 
+/* A callback that fails calls of its own: the message it was given stays
+ * what it was, and readable, until it returns (its own calls' messages are
+ * shorter and longer than it, so they would be written over it or move it). */
+static int callback_depth = 0;
+static int callback_kept_message = -1;
+static void fail_inside_callback(void* user, meshcast_status status, const char* message) {
+  (void)status;
+  if (callback_depth) return;
+  callback_depth = 1;
+  char before[1024];
+  snprintf(before, sizeof before, "%s", message);
+  meshcast_hit hit;
+  meshcast_blob_cast(NULL, NULL, 0, NULL, &hit, 0, NULL);     /* fails: a short message */
+  meshcast_blob_release((meshcast_blob*)user);               /* fails: a long one */
+  callback_kept_message = strcmp(before, message) == 0;
+  callback_depth = 0;
+}
+
+static void test_callback_calls(void) {
+  meshcast_set_error_callback(fail_inside_callback, &callback_depth);
+  meshcast_query query;
+  meshcast_query_init(&query);
+  query.kind = 7;
+  meshcast_blob* blob = build(NULL);
+  meshcast_ray ray = down_at(0.5f, 0.5f);
+  meshcast_hit hit;
+  EXPECT_FAILS(meshcast_blob_cast(blob, &ray, 1, &query, &hit, 1, NULL), MESHCAST_ERROR_USAGE, "query->kind 7");
+  CHECK(callback_kept_message == 1);
+  meshcast_set_error_callback(NULL, NULL);
+  EXPECT_OK(meshcast_blob_release(blob));
+}
+
 /* layout: NULL (the recommended one) or a name; point queries walk the
  * OctTreeCompressed layouts alone. */
 static void test_blob_casts(const char* layout) {
@@ -493,6 +525,7 @@ static void test_release_while_casting(void) {
 
 int main(void) {
   test_version_and_errors();
+  test_callback_calls();
   test_blob_casts(NULL);
   test_blob_casts("OctTreeCompressed/ClusterFloat3SOA8");
   test_blob_casts("AABBTree/Float3");

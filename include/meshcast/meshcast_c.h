@@ -75,7 +75,11 @@ MESHCAST_C_API const char* meshcast_last_error(void);
 /* "MESHCAST_ERROR_INPUT" for MESHCAST_ERROR_INPUT, and so on. */
 MESHCAST_C_API const char* meshcast_status_name(meshcast_status status);
 /* Called on the failing thread with every failure's status and message
- * (the process's one callback; NULL: none). */
+ * (the process's one callback; NULL: none). The message is valid until the
+ * callback returns, whatever it calls meanwhile (a failing call included:
+ * its own failure calls the callback again, on the same thread); copy it
+ * to keep it. After the failed call returns, meshcast_last_error() gives
+ * that call's message again. */
 typedef void (*meshcast_error_callback)(void* user, meshcast_status status, const char* message);
 MESHCAST_C_API void meshcast_set_error_callback(meshcast_error_callback callback, void* user);
 

@@ -171,7 +171,7 @@ meshcast_status meshcast_caster_backend(meshcast_caster* caster, uint32_t ray_co
     const host::Backend b = c->caster->choose(ray_count);
     if (backend) *backend = b == host::Backend::Vulkan ? MESHCAST_BACKEND_VULKAN : MESHCAST_BACKEND_CPU;
     if (why) {
-      why_text = c->caster->why(ray_count);
+      why_text = c_api_words(c->caster->why(ray_count));
       *why = why_text.c_str();
     }
   });

@@ -327,6 +327,110 @@ static void test_scene(void) {
   EXPECT_FAILS(meshcast_scene_commit(scene), MESHCAST_ERROR_USAGE, "released already");
 }
 
+/* A scene cast before its first commit: refused, saying to commit (its
+ * edits are not yet what casts see); the same scene answers once committed.
+ * A scene nothing was added to casts as the empty world it is. */
+static void test_scene_before_commit(void) {
+  meshcast_blob* blob = build(NULL);
+  meshcast_scene* scene = NULL;
+  meshcast_scene* empty = NULL;
+  EXPECT_OK(meshcast_scene_create(&scene));
+  EXPECT_OK(meshcast_scene_create(&empty));
+  uint32_t mesh, instance;
+  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
+  EXPECT_OK(meshcast_scene_add_instance(scene, mesh, NULL, 0xFF, 0, &instance));
+  meshcast_ray_d ray = {{0.25, 0.75, 2}, {0, 0, -1}, INFINITY, 0, 0};
+  meshcast_scene_hit hit;
+  uint32_t found;
+  const double point[3] = {0.5, 0.5, 3};
+  meshcast_scene_closest_point nearest;
+  EXPECT_FAILS(meshcast_scene_cast(scene, &ray, 1, NULL, &hit, 1, NULL), MESHCAST_ERROR_USAGE, "commit it first");
+  EXPECT_FAILS(meshcast_scene_cast_all(scene, &ray, 1, NULL, 1, &found, &hit, 1, NULL), MESHCAST_ERROR_USAGE,
+               "never committed");
+  EXPECT_FAILS(meshcast_scene_closest_points(scene, point, 1, INFINITY, 0xFF, 1, &nearest, 1), MESHCAST_ERROR_USAGE,
+               "never committed");
+  meshcast_caster_options options;
+  meshcast_caster_options_init(&options);
+  options.backend = MESHCAST_BACKEND_CPU;
+  meshcast_caster* caster = NULL;
+  EXPECT_OK(meshcast_caster_create(NULL, &options, &caster));
+  meshcast_ticket ticket;
+  EXPECT_FAILS(meshcast_caster_submit_scene(caster, scene, &ray, 1, NULL, &ticket), MESHCAST_ERROR_USAGE,
+               "never committed");
+  EXPECT_OK(meshcast_scene_cast(empty, &ray, 1, NULL, &hit, 1, NULL));
+  CHECK(hit.instance == MESHCAST_NO_HIT);
+  EXPECT_OK(meshcast_scene_commit(scene));
+  EXPECT_OK(meshcast_scene_cast(scene, &ray, 1, NULL, &hit, 1, NULL));
+  CHECK(hit.instance == instance && hit.triangle == 3 && hit.t == 1.0f);
+  EXPECT_OK(meshcast_caster_release(caster));
+  EXPECT_OK(meshcast_scene_release(empty));
+  EXPECT_OK(meshcast_scene_release(scene));
+  EXPECT_OK(meshcast_blob_release(blob));
+}
+
+/* Messages in the C API's own words: its names (options->frames, not a C++
+ * type's), a blob longer than its header says with both sizes, a mesh too
+ * large for the address space said so, an empty path refused as one. */
+static void test_messages(void) {
+  meshcast_blob* blob = build(NULL);
+  meshcast_blob* none = NULL;
+  meshcast_caster_options options;
+  meshcast_caster_options_init(&options);
+  options.backend = MESHCAST_BACKEND_CPU;
+  options.frames = 0;
+  meshcast_caster* caster = NULL;
+  EXPECT_FAILS(meshcast_caster_create(NULL, &options, &caster), MESHCAST_ERROR_USAGE, "options->frames 0");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  options.frames = 4;
+  options.threads = 5000;
+  EXPECT_FAILS(meshcast_caster_create(NULL, &options, &caster), MESHCAST_ERROR_USAGE, "options->threads 5000");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  meshcast_scene* scene = NULL;
+  EXPECT_OK(meshcast_scene_create(&scene));
+  uint32_t instance;
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, 42, NULL, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE, "mesh 42");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  meshcast_transform flat;
+  meshcast_transform_identity(&flat);
+  flat.rotation_scale[8] = 0;
+  uint32_t mesh;
+  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, mesh, &flat, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE,
+               "not invertible");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  EXPECT_OK(meshcast_scene_release(scene));
+
+  /* Longer than its header says: both sizes. */
+  const void* bytes = NULL;
+  uint64_t size = 0;
+  EXPECT_OK(meshcast_blob_bytes(blob, &bytes, &size));
+  unsigned char longer[4096 + 8];
+  CHECK(size + 8 <= sizeof longer);
+  memcpy(longer, bytes, size);
+  memset(longer + size, 0, 8);
+  char words[128];
+  snprintf(words, sizeof words, "is %llu bytes, longer than the %llu bytes its header says",
+           (unsigned long long)(size + 8), (unsigned long long)size);
+  EXPECT_FAILS(meshcast_blob_from_memory(longer, size + 8, MESHCAST_MEMORY_COPY, "longer", &none), MESHCAST_ERROR_INPUT,
+               words);
+  CHECK(strstr(meshcast_last_error(), "truncated") == NULL);
+
+  /* A stride times a count past the address space, vertices and triangles. */
+  meshcast_mesh mesh_of = two_squares();
+  mesh_of.vertex_stride = UINT64_MAX / 4;
+  EXPECT_FAILS(meshcast_blob_build(&mesh_of, NULL, &none), MESHCAST_ERROR_INPUT,
+               "8 vertices of vertex stride 4611686018427387903 bytes do not fit in this process's address space");
+  mesh_of = two_squares();
+  mesh_of.triangle_stride = UINT64_MAX / 2;
+  EXPECT_FAILS(meshcast_blob_build(&mesh_of, NULL, &none), MESHCAST_ERROR_INPUT,
+               "4 triangles of triangle stride 9223372036854775807 bytes do not fit in this process's address space");
+
+  /* An empty path: refused as one, nothing about how files are written. */
+  EXPECT_FAILS(meshcast_blob_save(blob, ""), MESHCAST_ERROR_OUTPUT, "the path is empty");
+  CHECK(strstr(meshcast_last_error(), "rename") == NULL);
+  EXPECT_OK(meshcast_blob_release(blob));
+}
+
 static void test_casters(void) {
   meshcast_blob* blob = build(NULL);
   meshcast_caster_options options;
@@ -531,6 +635,8 @@ int main(void) {
   test_blob_casts("AABBTree/Float3");
   test_build_load_save();
   test_scene();
+  test_scene_before_commit();
+  test_messages();
   test_casters();
   test_release_while_casting();
   if (failures) {

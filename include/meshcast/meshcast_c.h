@@ -187,7 +187,7 @@ MESHCAST_C_API meshcast_status meshcast_blob_load(const char* path, uint32_t fla
 #define MESHCAST_MEMORY_BORROW 1u
 MESHCAST_C_API meshcast_status meshcast_blob_from_memory(const void* bytes, uint64_t size, uint32_t flags,
                                                          const char* name, meshcast_blob** out);
-/* Written beside path, then renamed over it. */
+/* Written beside path, then renamed over it (an empty path is refused). */
 MESHCAST_C_API meshcast_status meshcast_blob_save(const meshcast_blob* blob, const char* path);
 /* The blob's bytes, valid while the blob lives. */
 MESHCAST_C_API meshcast_status meshcast_blob_bytes(const meshcast_blob* blob, const void** bytes, uint64_t* size);
@@ -272,7 +272,9 @@ MESHCAST_C_API meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* sc
 MESHCAST_C_API meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, uint32_t instance_id,
                                                           uint32_t enabled);
 MESHCAST_C_API meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, uint32_t instance_id);
-/* The edits so far are seen by the casts from now on. */
+/* The edits so far are seen by the casts from now on. A scene given a mesh
+ * or an instance is cast (or submitted to a caster) only once committed:
+ * before its first commit, MESHCAST_ERROR_USAGE. */
 MESHCAST_C_API meshcast_status meshcast_scene_commit(meshcast_scene* scene);
 MESHCAST_C_API meshcast_status meshcast_scene_cast(const meshcast_scene* scene, const meshcast_ray_d* rays,
                                                    uint64_t ray_count, const meshcast_query* query,

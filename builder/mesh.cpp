@@ -75,11 +75,11 @@ Mesh copy_mesh(const MeshView& view, const std::string& name) {
       view.vertex_count != 0 && ((view.stride_in_floats && *view.stride_in_floats > SIZE_MAX / sizeof(float)) ||
                                  view.vertex_stride > SIZE_MAX / view.vertex_count);
   if (vertex_overflow)
-    throw InputError(name + ": " + stride_text(view) + " times " + std::to_string(view.vertex_count) +
-                     " vertices overflows the bytes memory addresses");
+    throw InputError(name + ": " + std::to_string(view.vertex_count) + " vertices of " + stride_text(view) +
+                     " do not fit in this process's address space");
   if (view.triangle_count && triangle_stride > SIZE_MAX / view.triangle_count)
-    throw InputError(name + ": triangle stride " + std::to_string(triangle_stride) + " bytes times " +
-                     std::to_string(view.triangle_count) + " triangles overflows the bytes memory addresses");
+    throw InputError(name + ": " + std::to_string(view.triangle_count) + " triangles of triangle stride " +
+                     std::to_string(triangle_stride) + " bytes do not fit in this process's address space");
   // Where a view states its buffers' sizes (the typed constructors do), the
   // last vertex and triangle must lie inside them: a stride or index type
   // that does not match the data reads past them otherwise.

@@ -143,12 +143,12 @@ meshcast_status meshcast_blob_from_memory(const void* bytes, uint64_t size, uint
 }
 
 meshcast_status meshcast_blob_save(const meshcast_blob* blob, const char* path) {
-  return guarded("meshcast_blob_save", [&] { save_blob(required(path, "path"), live(blob, "blob").view.bytes()); });
+  return guarded("meshcast_blob_save", [&] { save_blob(required(path, "path"), live(blob, "blob")->view.bytes()); });
 }
 
 meshcast_status meshcast_blob_bytes(const meshcast_blob* blob, const void** bytes, uint64_t* size) {
   return guarded("meshcast_blob_bytes", [&] {
-    const std::span<const uint8_t> b = live(blob, "blob").view.bytes();
+    const std::span<const uint8_t> b = live(blob, "blob")->view.bytes();
     *required(bytes, "bytes") = b.data();
     *required(size, "size") = b.size();
   });
@@ -156,20 +156,20 @@ meshcast_status meshcast_blob_bytes(const meshcast_blob* blob, const void** byte
 
 meshcast_status meshcast_blob_info_get(const meshcast_blob* blob, meshcast_blob_info* info) {
   return guarded("meshcast_blob_info_get", [&] {
-    const meshcast_blob& b = live(blob, "blob");
+    const auto b = live(blob, "blob");
     meshcast_blob_info* to = required(info, "info");
     if (to->struct_size < kBlobInfoV1)
       throw UsageError("info->struct_size " + std::to_string(to->struct_size) + " is less than the " +
                        std::to_string(kBlobInfoV1) + " bytes of its first version");
     meshcast_blob_info i{};
     i.struct_size = to->struct_size;
-    i.triangle_count = b.view.triangle_count();
-    i.bytes = b.view.bytes().size();
-    i.layout = b.layout.c_str();
-    const layout::BlobHeader& h = layout::header_of(b.view.bytes().data());
+    i.triangle_count = b->view.triangle_count();
+    i.bytes = b->view.bytes().size();
+    i.layout = b->layout.c_str();
+    const layout::BlobHeader& h = layout::header_of(b->view.bytes().data());
     double diagonal2 = 0;
     for (int k = 0; k < 3; ++k) diagonal2 += std::pow(double(h.bounds_max[k]) - h.bounds_min[k], 2);
-    i.error_bound = relative_error_bound(b.view.bytes(), std::sqrt(diagonal2));
+    i.error_bound = relative_error_bound(b->view.bytes(), std::sqrt(diagonal2));
     std::memcpy(static_cast<void*>(to), &i, std::min<size_t>(to->struct_size, sizeof i));
   });
 }
@@ -182,10 +182,10 @@ meshcast_status meshcast_blob_cast(const meshcast_blob* blob, const meshcast_ray
                                    const meshcast_query* query, meshcast_hit* hits, uint64_t hit_capacity,
                                    uint64_t* not_walkable) {
   return guarded("meshcast_blob_cast", [&] {
-    const meshcast_blob& b = live(blob, "blob");
+    const auto b = live(blob, "blob");
     cast_batch(rays, ray_count, query, hits, hit_capacity, not_walkable,
                [&](std::span<const Ray> r, std::span<Hit> h, const CastQuery& q) {
-                 return b.view.trace(r, h, q.outputs, q.query, q.cull);
+                 return b->view.trace(r, h, q.outputs, q.query, q.cull);
                });
   });
 }
@@ -194,10 +194,10 @@ meshcast_status meshcast_blob_cast_all(const meshcast_blob* blob, const meshcast
                                        const meshcast_query* query, uint32_t max_hits, uint32_t* found,
                                        meshcast_hit* hits, uint64_t hit_capacity, uint64_t* not_walkable) {
   return guarded("meshcast_blob_cast_all", [&] {
-    const meshcast_blob& b = live(blob, "blob");
+    const auto b = live(blob, "blob");
     cast_rows<HitLists>(rays, ray_count, query, max_hits, found, hits, hit_capacity, not_walkable,
                         [&](std::span<const Ray> r, HitLists& lists, const CastQuery& q) {
-                          return b.view.trace_all_hits(r, lists, q.outputs, q.cull);
+                          return b->view.trace_all_hits(r, lists, q.outputs, q.cull);
                         });
   });
 }
@@ -206,12 +206,12 @@ meshcast_status meshcast_blob_closest_points(const meshcast_blob* blob, const fl
                                              float max_distance, uint32_t threads, meshcast_closest_point* out,
                                              uint64_t out_capacity) {
   return guarded("meshcast_blob_closest_points", [&] {
-    const meshcast_blob& b = live(blob, "blob");
+    const auto b = live(blob, "blob");
     check_capacity(out_capacity, point_count, "out");
     const auto* p = reinterpret_cast<const Vec3*>(array(points, point_count, "points"));
     auto* o = reinterpret_cast<ClosestPoint*>(array(out, point_count, "out"));
     in_chunks(point_count, threads_of(threads), [&](size_t begin, size_t n) {
-      return b.view.closest_points({p + begin, n}, {o + begin, n}, max_distance);
+      return b->view.closest_points({p + begin, n}, {o + begin, n}, max_distance);
     });
   });
 }

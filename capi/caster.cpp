@@ -72,9 +72,9 @@ meshcast_status meshcast_caster_create(const meshcast_blob* blob, const meshcast
     c.hit_outputs = HitOutputs(o.outputs);
     auto made = std::make_unique<meshcast_caster>();
     if (blob) {
-      const meshcast_blob& b = live(blob, "blob");
-      made->blob_owner = b.owner;
-      made->caster = std::make_unique<host::Caster>(b.view.bytes(), b.name, c);
+      const auto b = live(blob, "blob");
+      made->blob_owner = b->owner;
+      made->caster = std::make_unique<host::Caster>(b->view.bytes(), b->name, c);
     } else {
       made->caster = std::make_unique<host::Caster>(c);
     }
@@ -85,18 +85,18 @@ meshcast_status meshcast_caster_create(const meshcast_blob* blob, const meshcast
 meshcast_status meshcast_caster_submit(meshcast_caster* caster, const meshcast_ray* rays, uint64_t ray_count,
                                        const meshcast_query* query, meshcast_ticket* ticket) {
   return guarded("meshcast_caster_submit", [&] {
-    meshcast_caster& c = live(caster, "caster");
+    const auto c = live(caster, "caster");
     meshcast_ticket* out = required(ticket, "ticket");
-    *out = c_ticket(c.caster->submit(rays_of(array(rays, ray_count, "rays"), ray_count), batch_query(query)));
+    *out = c_ticket(c->caster->submit(rays_of(array(rays, ray_count, "rays"), ray_count), batch_query(query)));
   });
 }
 
 meshcast_status meshcast_caster_open(meshcast_caster* caster, uint32_t ray_count, const meshcast_query* query,
                                      meshcast_open_batch* batch) {
   return guarded("meshcast_caster_open", [&] {
-    meshcast_caster& c = live(caster, "caster");
+    const auto c = live(caster, "caster");
     meshcast_open_batch* out = required(batch, "batch");
-    const host::OpenBatch open = c.caster->open(ray_count, batch_query(query));
+    const host::OpenBatch open = c->caster->open(ray_count, batch_query(query));
     out->ticket = c_ticket(open.ticket);
     out->rays = reinterpret_cast<meshcast_ray*>(open.rays.data());
     out->ray_count = open.rays.size();
@@ -106,14 +106,14 @@ meshcast_status meshcast_caster_open(meshcast_caster* caster, uint32_t ray_count
 meshcast_status meshcast_caster_submit_open(meshcast_caster* caster, const meshcast_open_batch* batch, uint64_t written,
                                             meshcast_ticket* ticket) {
   return guarded("meshcast_caster_submit_open", [&] {
-    meshcast_caster& c = live(caster, "caster");
+    const auto c = live(caster, "caster");
     const meshcast_open_batch& b = *required(batch, "batch");
     meshcast_ticket* out = required(ticket, "ticket");
     if (written > b.ray_count)
       throw UsageError("written " + std::to_string(written) + " is more than the " + std::to_string(b.ray_count) +
                        " rays the batch was opened for");
     host::OpenBatch open{ticket_of(&b.ticket), {reinterpret_cast<Ray*>(b.rays), size_t(written)}};
-    *out = c_ticket(c.caster->submit(open));
+    *out = c_ticket(c->caster->submit(open));
   });
 }
 
@@ -121,35 +121,35 @@ meshcast_status meshcast_caster_submit_scene(meshcast_caster* caster, const mesh
                                              const meshcast_ray_d* rays, uint64_t ray_count, const meshcast_query* query,
                                              meshcast_ticket* ticket) {
   return guarded("meshcast_caster_submit_scene", [&] {
-    meshcast_caster& c = live(caster, "caster");
-    const meshcast_scene& s = live(scene, "scene");
+    const auto c = live(caster, "caster");
+    const auto s = live(scene, "scene");
     meshcast_ticket* out = required(ticket, "ticket");
     const CastQuery q = cast_query(query);
     host::SceneBatchQuery b;
     b.query = q.query, b.cull = q.cull, b.mask = q.mask;
-    const host::Ticket t = c.caster->submit(s.scene, rays_of(array(rays, ray_count, "rays"), ray_count), b);
+    const host::Ticket t = c->caster->submit(s->scene, rays_of(array(rays, ray_count, "rays"), ray_count), b);
     // The batch walks the scene's commit until it is collected: the bytes
     // the scene references stay alive that long, released scene or not.
-    std::lock_guard<std::mutex> lock(c.held_lock);
-    c.held[t.id] = s.owners;
+    std::lock_guard<std::mutex> lock(c->held_lock);
+    c->held[t.id] = s->owners;
     *out = c_ticket(t);
   });
 }
 
 meshcast_status meshcast_caster_poll(meshcast_caster* caster, const meshcast_ticket* ticket, uint32_t* ready) {
   return guarded("meshcast_caster_poll", [&] {
-    meshcast_caster& c = live(caster, "caster");
+    const auto c = live(caster, "caster");
     uint32_t* out = required(ready, "ready");
-    *out = c.caster->poll(ticket_of(ticket)) ? 1 : 0;
+    *out = c->caster->poll(ticket_of(ticket)) ? 1 : 0;
   });
 }
 
 meshcast_status meshcast_caster_wait(meshcast_caster* caster, const meshcast_ticket* ticket, meshcast_hit* hits,
                                      uint64_t hit_capacity, meshcast_batch_record* record) {
   return guarded("meshcast_caster_wait", [&] {
-    meshcast_caster& c = live(caster, "caster");
+    const auto c = live(caster, "caster");
     const host::Ticket t = ticket_of(ticket);
-    record_to(c.caster->wait(t, hits_of(array(hits, hit_capacity, "hits"), hit_capacity)), record);
+    record_to(c->caster->wait(t, hits_of(array(hits, hit_capacity, "hits"), hit_capacity)), record);
   });
 }
 
@@ -157,21 +157,21 @@ meshcast_status meshcast_caster_wait_scene(meshcast_caster* caster, const meshca
                                            meshcast_scene_hit* hits, uint64_t hit_capacity,
                                            meshcast_batch_record* record) {
   return guarded("meshcast_caster_wait_scene", [&] {
-    meshcast_caster& c = live(caster, "caster");
+    const auto c = live(caster, "caster");
     const host::Ticket t = ticket_of(ticket);
-    record_to(c.caster->wait(t, hits_of(array(hits, hit_capacity, "hits"), hit_capacity)), record);
-    std::lock_guard<std::mutex> lock(c.held_lock);
-    c.held.erase(t.id);
+    record_to(c->caster->wait(t, hits_of(array(hits, hit_capacity, "hits"), hit_capacity)), record);
+    std::lock_guard<std::mutex> lock(c->held_lock);
+    c->held.erase(t.id);
   });
 }
 
 meshcast_status meshcast_caster_backend(meshcast_caster* caster, uint32_t ray_count, uint32_t* backend, const char** why) {
   return guarded("meshcast_caster_backend", [&] {
-    meshcast_caster& c = live(caster, "caster");
-    const host::Backend b = c.caster->choose(ray_count);
+    const auto c = live(caster, "caster");
+    const host::Backend b = c->caster->choose(ray_count);
     if (backend) *backend = b == host::Backend::Vulkan ? MESHCAST_BACKEND_VULKAN : MESHCAST_BACKEND_CPU;
     if (why) {
-      why_text = c.caster->why(ray_count);
+      why_text = c_api_words(c->caster->why(ray_count));
       *why = why_text.c_str();
     }
   });

@@ -1,6 +1,7 @@
 // The C API's handles: what each holds, and the registry that tells a
 // live handle from a released one (or a pointer never made here) without
-// reading it.
+// reading it. A call holds the handle it was given until it returns, so a
+// release on another thread meanwhile frees it after that call, not under it.
 #pragma once
 #include <memory>
 #include <mutex>
@@ -43,39 +44,41 @@ namespace meshcast::capi {
 
 enum class Kind { Blob, Scene, Caster };
 
-// Every live handle, with its kind.
-void register_handle(const void* handle, Kind kind);
-// UsageError naming `what` and `type` unless `handle` is live and of `kind`.
-void check_handle(const void* handle, Kind kind, const char* what);
-// Forgets a live handle (check_handle first).
-void forget_handle(const void* handle);
+// Every live handle, with its kind; the registry holds `handle` until it
+// is released.
+void register_handle(std::shared_ptr<void> handle, Kind kind);
+// The handle, held for the caller, unless it is not live or not of `kind`
+// (UsageError naming `what` and its type).
+std::shared_ptr<void> hold_handle(const void* handle, Kind kind, const char* what);
+// Takes a live handle out of the registry (UsageError as hold_handle's):
+// later calls refuse it; the calls holding it keep it until they return.
+std::shared_ptr<void> forget_handle(const void* handle, Kind kind, const char* what);
 
 template <class T> constexpr Kind kind_of();
 template <> constexpr Kind kind_of<meshcast_blob>() { return Kind::Blob; }
 template <> constexpr Kind kind_of<meshcast_scene>() { return Kind::Scene; }
 template <> constexpr Kind kind_of<meshcast_caster>() { return Kind::Caster; }
 
-// The handle, checked live.
+// The handle, checked live and held until the returned pointer goes: keep
+// it for the whole call.
 template <class T>
-T& live(T* handle, const char* what) {
-  check_handle(handle, kind_of<std::remove_const_t<T>>(), what);
-  return *handle;
+std::shared_ptr<T> live(T* handle, const char* what) {
+  return std::static_pointer_cast<T>(hold_handle(handle, kind_of<std::remove_const_t<T>>(), what));
 }
 
 // A new handle, registered; the caller's *out set to it.
 template <class T>
 void hand_out(std::unique_ptr<T> made, T** out) {
-  register_handle(made.get(), kind_of<T>());
-  *out = made.release();
+  T* raw = made.get();
+  register_handle(std::shared_ptr<T>(std::move(made)), kind_of<T>());
+  *out = raw;
 }
 
-// Releases a handle (null: nothing).
+// Releases a handle (null: nothing): freed now, or when the last call
+// still using it returns.
 template <class T>
 void release(T* handle, const char* what) {
-  if (!handle) return;
-  check_handle(handle, kind_of<T>(), what);
-  forget_handle(handle);
-  delete handle;
+  if (handle) forget_handle(handle, kind_of<T>(), what);
 }
 
 }  // namespace meshcast::capi

@@ -50,16 +50,16 @@ meshcast_status meshcast_scene_create(meshcast_scene** out) {
 
 meshcast_status meshcast_scene_add_mesh(meshcast_scene* scene, const meshcast_blob* blob, uint32_t* mesh_id) {
   return guarded("meshcast_scene_add_mesh", [&] {
-    meshcast_scene& s = live(scene, "scene");
-    const meshcast_blob& b = live(blob, "blob");
+    const auto s = live(scene, "scene");
+    const auto b = live(blob, "blob");
     uint32_t* id = required(mesh_id, "mesh_id");
     // A mapped blob's mapping is shared; any other blob is referenced, its
     // bytes kept alive by the scene.
-    if (b.mapped) {
-      *id = s.scene.add_mesh(b.mapped, b.name);
+    if (b->mapped) {
+      *id = s->scene.add_mesh(b->mapped, b->name);
     } else {
-      s.owners.push_back(b.owner);
-      *id = s.scene.add_mesh(b.view, b.name);
+      s->owners.push_back(b->owner);
+      *id = s->scene.add_mesh(b->view, b->name);
     }
   });
 }
@@ -67,51 +67,51 @@ meshcast_status meshcast_scene_add_mesh(meshcast_scene* scene, const meshcast_bl
 meshcast_status meshcast_scene_add_instance(meshcast_scene* scene, uint32_t mesh_id, const meshcast_transform* transform,
                                             uint32_t mask, uint32_t flip_facing, uint32_t* instance_id) {
   return guarded("meshcast_scene_add_instance", [&] {
-    meshcast_scene& s = live(scene, "scene");
+    const auto s = live(scene, "scene");
     uint32_t* id = required(instance_id, "instance_id");
-    *id = s.scene.add_instance(mesh_id, transform_of(transform), mask_of(mask), flag_of(flip_facing, "flip_facing"));
+    *id = s->scene.add_instance(mesh_id, transform_of(transform), mask_of(mask), flag_of(flip_facing, "flip_facing"));
   });
 }
 
 meshcast_status meshcast_scene_set_transform(meshcast_scene* scene, uint32_t instance_id,
                                              const meshcast_transform* transform) {
   return guarded("meshcast_scene_set_transform", [&] {
-    live(scene, "scene").scene.set_transform(instance_id, transform_of(required(transform, "transform")));
+    live(scene, "scene")->scene.set_transform(instance_id, transform_of(required(transform, "transform")));
   });
 }
 
 meshcast_status meshcast_scene_set_mask(meshcast_scene* scene, uint32_t instance_id, uint32_t mask) {
-  return guarded("meshcast_scene_set_mask", [&] { live(scene, "scene").scene.set_mask(instance_id, mask_of(mask)); });
+  return guarded("meshcast_scene_set_mask", [&] { live(scene, "scene")->scene.set_mask(instance_id, mask_of(mask)); });
 }
 
 meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* scene, uint32_t instance_id, uint32_t flip_facing) {
   return guarded("meshcast_scene_set_flip_facing", [&] {
-    live(scene, "scene").scene.set_flip_facing(instance_id, flag_of(flip_facing, "flip_facing"));
+    live(scene, "scene")->scene.set_flip_facing(instance_id, flag_of(flip_facing, "flip_facing"));
   });
 }
 
 meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, uint32_t instance_id, uint32_t enabled) {
   return guarded("meshcast_scene_set_enabled", [&] {
-    live(scene, "scene").scene.set_enabled(instance_id, flag_of(enabled, "enabled"));
+    live(scene, "scene")->scene.set_enabled(instance_id, flag_of(enabled, "enabled"));
   });
 }
 
 meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, uint32_t instance_id) {
-  return guarded("meshcast_scene_remove_instance", [&] { live(scene, "scene").scene.remove_instance(instance_id); });
+  return guarded("meshcast_scene_remove_instance", [&] { live(scene, "scene")->scene.remove_instance(instance_id); });
 }
 
 meshcast_status meshcast_scene_commit(meshcast_scene* scene) {
-  return guarded("meshcast_scene_commit", [&] { live(scene, "scene").scene.commit(); });
+  return guarded("meshcast_scene_commit", [&] { live(scene, "scene")->scene.commit(); });
 }
 
 meshcast_status meshcast_scene_cast(const meshcast_scene* scene, const meshcast_ray_d* rays, uint64_t ray_count,
                                     const meshcast_query* query, meshcast_scene_hit* hits, uint64_t hit_capacity,
                                     uint64_t* not_walkable) {
   return guarded("meshcast_scene_cast", [&] {
-    const meshcast_scene& s = live(scene, "scene");
+    const auto s = live(scene, "scene");
     cast_batch(rays, ray_count, query, hits, hit_capacity, not_walkable,
                [&](std::span<const RayD> r, std::span<SceneHit> h, const CastQuery& q) {
-                 return s.scene.trace(r, h, q.outputs, q.query, q.cull, q.mask);
+                 return s->scene.trace(r, h, q.outputs, q.query, q.cull, q.mask);
                });
   });
 }
@@ -120,10 +120,10 @@ meshcast_status meshcast_scene_cast_all(const meshcast_scene* scene, const meshc
                                         const meshcast_query* query, uint32_t max_hits, uint32_t* found,
                                         meshcast_scene_hit* hits, uint64_t hit_capacity, uint64_t* not_walkable) {
   return guarded("meshcast_scene_cast_all", [&] {
-    const meshcast_scene& s = live(scene, "scene");
+    const auto s = live(scene, "scene");
     cast_rows<SceneHitLists>(rays, ray_count, query, max_hits, found, hits, hit_capacity, not_walkable,
                              [&](std::span<const RayD> r, SceneHitLists& lists, const CastQuery& q) {
-                               return s.scene.trace_all_hits(r, lists, q.outputs, q.cull, q.mask);
+                               return s->scene.trace_all_hits(r, lists, q.outputs, q.cull, q.mask);
                              });
   });
 }
@@ -132,13 +132,13 @@ meshcast_status meshcast_scene_closest_points(const meshcast_scene* scene, const
                                               double max_distance, uint32_t mask, uint32_t threads,
                                               meshcast_scene_closest_point* out, uint64_t out_capacity) {
   return guarded("meshcast_scene_closest_points", [&] {
-    const meshcast_scene& s = live(scene, "scene");
+    const auto s = live(scene, "scene");
     check_capacity(out_capacity, point_count, "out");
     const uint8_t m = mask_of(mask);
     const auto* p = reinterpret_cast<const std::array<double, 3>*>(array(points, point_count, "points"));
     auto* o = reinterpret_cast<SceneClosestPoint*>(array(out, point_count, "out"));
     in_chunks(point_count, threads_of(threads), [&](size_t begin, size_t n) {
-      return s.scene.closest_points({p + begin, n}, {o + begin, n}, max_distance, m);
+      return s->scene.closest_points({p + begin, n}, {o + begin, n}, max_distance, m);
     });
   });
 }

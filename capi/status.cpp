@@ -1,7 +1,9 @@
 #include "capi/status.h"
 
 #include <atomic>
+#include <cctype>
 #include <mutex>
+#include <string_view>
 
 #include "host/shared_pool.h"
 
@@ -18,12 +20,57 @@ struct Callback {
 std::mutex callback_lock;
 Callback callback;
 
+// The C++ library's names in a message, and what a C caller knows them
+// as: the C API's own names, or nothing where the call's name says it.
+struct Words {
+  std::string_view cpp, c;
+};
+constexpr Words kCWords[] = {
+    {"(CasterOptions::device, $MESHCAST_VK_DEVICE)", "($MESHCAST_VK_DEVICE)"},
+    {"CasterOptions::", "options->"},
+    {"Backend::Cpu", "MESHCAST_BACKEND_CPU"},
+    {"Backend::Vulkan", "MESHCAST_BACKEND_VULKAN"},
+    {"Backend::Automatic", "MESHCAST_BACKEND_AUTOMATIC"},
+    {"HitOutputs::Uv", "MESHCAST_HIT_UV"},
+    {"HitOutputs::Point", "MESHCAST_HIT_POINT"},
+    {"as a std::vector<uint8_t>, load_blob and MappedBlob give it",
+     "as meshcast_blob_load and MESHCAST_MEMORY_COPY give it"},
+    {"meshcast::", ""},
+};
+// A C++ method's name opening a message ("Scene::add_instance: "): the C
+// call's name, already before it, says which.
+constexpr std::string_view kMethodOwners[] = {"Scene::", "Caster::"};
+
+// The end of the name that starts at `at` (letters, digits, _).
+size_t run_of(const std::string& text, size_t at) {
+  while (at < text.size() && (std::isalnum(static_cast<unsigned char>(text[at])) || text[at] == '_')) ++at;
+  return at;
+}
+
 }  // namespace
 
+std::string c_api_words(std::string text) {
+  for (const Words& w : kCWords)
+    for (size_t at = text.find(w.cpp); at != std::string::npos; at = text.find(w.cpp, at + w.c.size()))
+      text.replace(at, w.cpp.size(), w.c);
+  for (std::string_view owner : kMethodOwners)
+    for (size_t at = text.find(owner); at != std::string::npos; at = text.find(owner, at)) {
+      const size_t end = run_of(text, at + owner.size());
+      if (text.compare(end, 2, ": ") == 0) text.erase(at, end + 2 - at);
+      else at = end;
+    }
+  return text;
+}
+
 meshcast_status fail(const char* call, meshcast_status status, const char* message) noexcept {
+  // The callback gets a copy of its own: a failing call it makes sets this
+  // thread's message again, and the copy lives until it returns.
+  std::string text;
   try {
-    last_message = std::string(call) + ": " + message;
+    text = std::string(call) + ": " + c_api_words(message);
+    last_message = text;
   } catch (...) {  // no memory for the message: the call's name at least
+    text.clear();
     last_message.clear();
   }
   Callback c;
@@ -31,7 +78,12 @@ meshcast_status fail(const char* call, meshcast_status status, const char* messa
     std::lock_guard<std::mutex> lock(callback_lock);
     c = callback;
   }
-  if (c.function) c.function(c.user, status, last_message.empty() ? call : last_message.c_str());
+  if (c.function) {
+    c.function(c.user, status, text.empty() ? call : text.c_str());
+    // The failed call's message is this call's, whatever the callback's
+    // own calls left.
+    last_message = std::move(text);
+  }
   return status;
 }
 

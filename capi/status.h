@@ -17,6 +17,9 @@ namespace meshcast::capi {
 meshcast_status fail(const char* call, meshcast_status status, const char* message) noexcept;
 // Clears this thread's message after a call that succeeded.
 void succeed() noexcept;
+// A C++ message in the C API's words: its names where the C++ library's
+// types and methods are named.
+std::string c_api_words(std::string text);
 
 // Runs body(), the whole of a call: MESHCAST_OK, or the status of what it
 // threw, its message prefixed with the call's name. Nothing escapes.

@@ -63,9 +63,13 @@ void write_file(const std::string& path, std::initializer_list<Bytes> pieces) {
 }
 
 void write_file_pieces(const std::string& path, const std::function<Bytes()>& next) {
+  // Named in the caller's terms: the file it asked for and what failed of
+  // writing it (the step, where it is one the caller would know).
   auto failed = [&](const char* what, int err) {
-    return OutputError(path + ": cannot write the file (" + what + ": " + std::strerror(err) + ")");
+    return OutputError(path + ": cannot write the file (" + (*what ? what + std::string(": ") : "") +
+                       std::strerror(err) + ")");
   };
+  if (path.empty()) throw OutputError("the path is empty: name the file to write");
   // Written beside its name and renamed over it: a regular file or a new
   // path. In place: a device or pipe (renaming would replace it), a
   // symbolic link (renaming would replace the link, not what it names:
@@ -104,10 +108,12 @@ void write_file_pieces(const std::string& path, const std::function<Bytes()>& ne
   }
   // A replaced file keeps its mode; a new one gets what open() would give.
   const mode_t mode = exists ? (st.st_mode & 07777) : new_file_mode();
-  if (!err && !in_place && ::fchmod(fd, mode) != 0) err = errno, step = "chmod";
+  if (!err && !in_place && ::fchmod(fd, mode) != 0) err = errno, step = "set its permissions";
   if (!err && !in_place && ::fsync(fd) != 0) err = errno, step = "flush";
   if (::close(fd) != 0 && !err) err = errno, step = "close";
-  if (!err && !in_place && ::rename(temp.c_str(), path.c_str()) != 0) err = errno, step = "rename";
+  // The file written beside it taking its name is no step the caller took:
+  // its failure (the path a folder, say) is told by its reason alone.
+  if (!err && !in_place && ::rename(temp.c_str(), path.c_str()) != 0) err = errno, step = "";
   if (err) {
     if (!in_place) ::unlink(temp.c_str());
     throw failed(step, err);

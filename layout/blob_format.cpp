@@ -85,8 +85,12 @@ std::string validate(std::span<const uint8_t> blob) {
   if (h.magic != MC_BLOB_MAGIC) return "not a meshcast blob (bad magic)";
   if (h.version != MC_BLOB_VERSION)
     return "blob version " + num(h.version) + " is not the supported version " + num(MC_BLOB_VERSION);
-  if (h.total_size != blob.size())
-    return "blob is " + num(blob.size()) + " bytes but its header says " + num(h.total_size) + " (truncated?)";
+  if (blob.size() < h.total_size)
+    return "blob is " + num(blob.size()) + " bytes, shorter than the " + num(h.total_size) +
+           " bytes its header says (truncated)";
+  if (blob.size() > h.total_size)
+    return "blob is " + num(blob.size()) + " bytes, longer than the " + num(h.total_size) +
+           " bytes its header says (bytes after its end)";
   if (blob_checksum(blob) != h.checksum) return "blob checksum does not match its contents";
   if (tree_format_name(h.tree_format).empty()) return "unknown tree format " + num(h.tree_format);
   if (triangle_format_name(h.triangle_format).empty()) return "unknown triangle format " + num(h.triangle_format);

@@ -60,6 +60,16 @@ struct Scene::Edits {
   // (traces may run on other threads than the one that commits).
   mutable std::mutex committed_mutex;
   std::shared_ptr<const SceneSnapshot> committed = std::make_shared<SceneSnapshot>();
+  // Whether a mesh or an instance was added before the first commit (set
+  // by the thread that edits, read by traces on any thread): such a
+  // scene's casts are refused until it is committed, never answered as
+  // the empty world its first snapshot is. Under committed_mutex, as is
+  // whether it was ever committed.
+  bool added_before_commit = false, ever_committed = false;
+  void note_added() {
+    std::lock_guard<std::mutex> lock(committed_mutex);
+    if (!ever_committed) added_before_commit = true;
+  }
 
   Instance& at(InstanceId id, const char* who) {
     if (id >= instances.size() || instances[id].removed)
@@ -159,6 +169,7 @@ MeshId Scene::add_validated(const BlobView& view, std::shared_ptr<const void> ow
                        number_text(h.bounds_min[a]) + " to " + number_text(h.bounds_max[a]) + ")");
   e.meshes.push_back(std::make_shared<const SceneMesh>(view, std::move(owner), name));
   e.changed = true;
+  e.note_added();
   return MeshId(e.meshes.size() - 1);
 }
 
@@ -210,6 +221,7 @@ InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t 
   e.boxes.push_back(box);
   ++e.live;
   e.rebuild = e.changed = true;
+  e.note_added();
   return i.placed.id;
 }
 
@@ -301,11 +313,15 @@ void Scene::commit() {
   e.current = std::move(frame);
   std::lock_guard<std::mutex> lock(e.committed_mutex);
   e.committed = std::move(handed);
+  e.ever_committed = true;
 }
 
 std::shared_ptr<const SceneSnapshot> Scene::snapshot() const {
   Edits& e = edits("Scene::snapshot");
   std::lock_guard<std::mutex> lock(e.committed_mutex);
+  if (e.added_before_commit && !e.ever_committed)
+    throw UsageError("the scene was never committed: casts see its last commit, and its meshes and instances are not "
+                     "in one yet; commit it first");
   return e.committed;
 }
 

@@ -10,9 +10,12 @@
  * 2 hold the points with x >= y. Their corners run counter-clockwise seen
  * from above. */
 #include <math.h>
+#include <stdlib.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <threads.h>
 
 #include "meshcast/meshcast_c.h"
 
@@ -87,6 +90,38 @@ static void test_version_and_errors(void) {
   meshcast_set_error_callback(NULL, NULL);
   EXPECT_OK(meshcast_blob_release(NULL));
   CHECK(strcmp(meshcast_last_error(), "") == 0);
+}
+
+/* A callback that fails calls of its own: the message it was given stays
+ * what it was, and readable, until it returns (its own calls' messages are
+ * shorter and longer than it, so they would be written over it or move it). */
+static int callback_depth = 0;
+static int callback_kept_message = -1;
+static void fail_inside_callback(void* user, meshcast_status status, const char* message) {
+  (void)status;
+  if (callback_depth) return;
+  callback_depth = 1;
+  char before[1024];
+  snprintf(before, sizeof before, "%s", message);
+  meshcast_hit hit;
+  meshcast_blob_cast(NULL, NULL, 0, NULL, &hit, 0, NULL);     /* fails: a short message */
+  meshcast_blob_release((meshcast_blob*)user);               /* fails: a long one */
+  callback_kept_message = strcmp(before, message) == 0;
+  callback_depth = 0;
+}
+
+static void test_callback_calls(void) {
+  meshcast_set_error_callback(fail_inside_callback, &callback_depth);
+  meshcast_query query;
+  meshcast_query_init(&query);
+  query.kind = 7;
+  meshcast_blob* blob = build(NULL);
+  meshcast_ray ray = down_at(0.5f, 0.5f);
+  meshcast_hit hit;
+  EXPECT_FAILS(meshcast_blob_cast(blob, &ray, 1, &query, &hit, 1, NULL), MESHCAST_ERROR_USAGE, "query->kind 7");
+  CHECK(callback_kept_message == 1);
+  meshcast_set_error_callback(NULL, NULL);
+  EXPECT_OK(meshcast_blob_release(blob));
 }
 
 /* layout: NULL (the recommended one) or a name; point queries walk the
@@ -292,6 +327,110 @@ static void test_scene(void) {
   EXPECT_FAILS(meshcast_scene_commit(scene), MESHCAST_ERROR_USAGE, "released already");
 }
 
+/* A scene cast before its first commit: refused, saying to commit (its
+ * edits are not yet what casts see); the same scene answers once committed.
+ * A scene nothing was added to casts as the empty world it is. */
+static void test_scene_before_commit(void) {
+  meshcast_blob* blob = build(NULL);
+  meshcast_scene* scene = NULL;
+  meshcast_scene* empty = NULL;
+  EXPECT_OK(meshcast_scene_create(&scene));
+  EXPECT_OK(meshcast_scene_create(&empty));
+  uint32_t mesh, instance;
+  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
+  EXPECT_OK(meshcast_scene_add_instance(scene, mesh, NULL, 0xFF, 0, &instance));
+  meshcast_ray_d ray = {{0.25, 0.75, 2}, {0, 0, -1}, INFINITY, 0, 0};
+  meshcast_scene_hit hit;
+  uint32_t found;
+  const double point[3] = {0.5, 0.5, 3};
+  meshcast_scene_closest_point nearest;
+  EXPECT_FAILS(meshcast_scene_cast(scene, &ray, 1, NULL, &hit, 1, NULL), MESHCAST_ERROR_USAGE, "commit it first");
+  EXPECT_FAILS(meshcast_scene_cast_all(scene, &ray, 1, NULL, 1, &found, &hit, 1, NULL), MESHCAST_ERROR_USAGE,
+               "never committed");
+  EXPECT_FAILS(meshcast_scene_closest_points(scene, point, 1, INFINITY, 0xFF, 1, &nearest, 1), MESHCAST_ERROR_USAGE,
+               "never committed");
+  meshcast_caster_options options;
+  meshcast_caster_options_init(&options);
+  options.backend = MESHCAST_BACKEND_CPU;
+  meshcast_caster* caster = NULL;
+  EXPECT_OK(meshcast_caster_create(NULL, &options, &caster));
+  meshcast_ticket ticket;
+  EXPECT_FAILS(meshcast_caster_submit_scene(caster, scene, &ray, 1, NULL, &ticket), MESHCAST_ERROR_USAGE,
+               "never committed");
+  EXPECT_OK(meshcast_scene_cast(empty, &ray, 1, NULL, &hit, 1, NULL));
+  CHECK(hit.instance == MESHCAST_NO_HIT);
+  EXPECT_OK(meshcast_scene_commit(scene));
+  EXPECT_OK(meshcast_scene_cast(scene, &ray, 1, NULL, &hit, 1, NULL));
+  CHECK(hit.instance == instance && hit.triangle == 3 && hit.t == 1.0f);
+  EXPECT_OK(meshcast_caster_release(caster));
+  EXPECT_OK(meshcast_scene_release(empty));
+  EXPECT_OK(meshcast_scene_release(scene));
+  EXPECT_OK(meshcast_blob_release(blob));
+}
+
+/* Messages in the C API's own words: its names (options->frames, not a C++
+ * type's), a blob longer than its header says with both sizes, a mesh too
+ * large for the address space said so, an empty path refused as one. */
+static void test_messages(void) {
+  meshcast_blob* blob = build(NULL);
+  meshcast_blob* none = NULL;
+  meshcast_caster_options options;
+  meshcast_caster_options_init(&options);
+  options.backend = MESHCAST_BACKEND_CPU;
+  options.frames = 0;
+  meshcast_caster* caster = NULL;
+  EXPECT_FAILS(meshcast_caster_create(NULL, &options, &caster), MESHCAST_ERROR_USAGE, "options->frames 0");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  options.frames = 4;
+  options.threads = 5000;
+  EXPECT_FAILS(meshcast_caster_create(NULL, &options, &caster), MESHCAST_ERROR_USAGE, "options->threads 5000");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  meshcast_scene* scene = NULL;
+  EXPECT_OK(meshcast_scene_create(&scene));
+  uint32_t instance;
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, 42, NULL, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE, "mesh 42");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  meshcast_transform flat;
+  meshcast_transform_identity(&flat);
+  flat.rotation_scale[8] = 0;
+  uint32_t mesh;
+  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, mesh, &flat, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE,
+               "not invertible");
+  CHECK(strstr(meshcast_last_error(), "::") == NULL);
+  EXPECT_OK(meshcast_scene_release(scene));
+
+  /* Longer than its header says: both sizes. */
+  const void* bytes = NULL;
+  uint64_t size = 0;
+  EXPECT_OK(meshcast_blob_bytes(blob, &bytes, &size));
+  unsigned char longer[4096 + 8];
+  CHECK(size + 8 <= sizeof longer);
+  memcpy(longer, bytes, size);
+  memset(longer + size, 0, 8);
+  char words[128];
+  snprintf(words, sizeof words, "is %llu bytes, longer than the %llu bytes its header says",
+           (unsigned long long)(size + 8), (unsigned long long)size);
+  EXPECT_FAILS(meshcast_blob_from_memory(longer, size + 8, MESHCAST_MEMORY_COPY, "longer", &none), MESHCAST_ERROR_INPUT,
+               words);
+  CHECK(strstr(meshcast_last_error(), "truncated") == NULL);
+
+  /* A stride times a count past the address space, vertices and triangles. */
+  meshcast_mesh mesh_of = two_squares();
+  mesh_of.vertex_stride = UINT64_MAX / 4;
+  EXPECT_FAILS(meshcast_blob_build(&mesh_of, NULL, &none), MESHCAST_ERROR_INPUT,
+               "8 vertices of vertex stride 4611686018427387903 bytes do not fit in this process's address space");
+  mesh_of = two_squares();
+  mesh_of.triangle_stride = UINT64_MAX / 2;
+  EXPECT_FAILS(meshcast_blob_build(&mesh_of, NULL, &none), MESHCAST_ERROR_INPUT,
+               "4 triangles of triangle stride 9223372036854775807 bytes do not fit in this process's address space");
+
+  /* An empty path: refused as one, nothing about how files are written. */
+  EXPECT_FAILS(meshcast_blob_save(blob, ""), MESHCAST_ERROR_OUTPUT, "the path is empty");
+  CHECK(strstr(meshcast_last_error(), "rename") == NULL);
+  EXPECT_OK(meshcast_blob_release(blob));
+}
+
 static void test_casters(void) {
   meshcast_blob* blob = build(NULL);
   meshcast_caster_options options;
@@ -357,14 +496,149 @@ static void test_casters(void) {
   EXPECT_FAILS(meshcast_caster_release(caster), MESHCAST_ERROR_USAGE, "released already");
 }
 
+/* A handle released while another thread casts through it: the cast in
+ * flight keeps what it reads until it returns (a mapped blob's pages
+ * included), and the thread's next call is refused. Large batches, so the
+ * release lands inside a cast; three rounds of each kind. */
+enum { kGrid = 256, kRaceRays = 1 << 15 };
+typedef struct racer {
+  int kind; /* 0 a blob's cast, 1 a scene's, 2 a caster's batch */
+  void* handle;
+  const meshcast_ray* rays;
+  const meshcast_ray_d* scene_rays;
+  meshcast_hit* hits;
+  meshcast_scene_hit* scene_hits;
+  atomic_int casts;
+  atomic_int ended;
+  meshcast_status refused;
+  char message[512];
+} racer;
+
+static int cast_until_refused(void* arg) {
+  racer* r = arg;
+  for (;;) {
+    meshcast_status status;
+    if (r->kind == 0) {
+      status = meshcast_blob_cast(r->handle, r->rays, kRaceRays, NULL, r->hits, kRaceRays, NULL);
+    } else if (r->kind == 1) {
+      status = meshcast_scene_cast(r->handle, r->scene_rays, kRaceRays, NULL, r->scene_hits, kRaceRays, NULL);
+    } else {
+      meshcast_ticket ticket;
+      status = meshcast_caster_submit(r->handle, r->rays, kRaceRays, NULL, &ticket);
+      if (status == MESHCAST_OK) status = meshcast_caster_wait(r->handle, &ticket, r->hits, kRaceRays, NULL);
+    }
+    if (status != MESHCAST_OK) {
+      r->refused = status;
+      snprintf(r->message, sizeof r->message, "%s", meshcast_last_error());
+      atomic_store(&r->ended, 1);
+      return 0;
+    }
+    atomic_fetch_add(&r->casts, 1);
+  }
+}
+
+static void race_release(racer* r) {
+  atomic_store(&r->casts, 0);
+  atomic_store(&r->ended, 0);
+  r->refused = MESHCAST_OK;
+  r->message[0] = 0;
+  thrd_t thread;
+  CHECK(thrd_create(&thread, cast_until_refused, r) == thrd_success);
+  /* Released during its second cast (unless the first failed: reported below). */
+  while (atomic_load(&r->casts) < 1 && !atomic_load(&r->ended)) thrd_yield();
+  if (r->kind == 0) EXPECT_OK(meshcast_blob_release(r->handle));
+  else if (r->kind == 1) EXPECT_OK(meshcast_scene_release(r->handle));
+  else EXPECT_OK(meshcast_caster_release(r->handle));
+  CHECK(thrd_join(thread, NULL) == thrd_success);
+  if (r->refused != MESHCAST_ERROR_USAGE || !strstr(r->message, "released already")) {
+    fprintf(stderr, "%s:%d: the casting thread ended with %s: \"%s\"\n", __FILE__, __LINE__,
+            meshcast_status_name(r->refused), r->message);
+    ++failures;
+  }
+  CHECK(r->kind == 1 ? r->scene_hits[0].t == 1.0f : r->hits[0].t == 1.0f); /* its last whole cast */
+}
+
+static void test_release_while_casting(void) {
+  /* A grid of kGrid x kGrid squares at z = 0 over [0, 1]^2, mapped from a file. */
+  const int side = kGrid + 1;
+  float* vertices = malloc(sizeof(float) * 3 * side * side);
+  uint32_t* indices = malloc(sizeof(uint32_t) * 6 * kGrid * kGrid);
+  meshcast_ray* rays = malloc(sizeof(meshcast_ray) * kRaceRays);
+  meshcast_ray_d* scene_rays = malloc(sizeof(meshcast_ray_d) * kRaceRays);
+  meshcast_hit* hits = malloc(sizeof(meshcast_hit) * kRaceRays);
+  meshcast_scene_hit* scene_hits = malloc(sizeof(meshcast_scene_hit) * kRaceRays);
+  CHECK(vertices && indices && rays && scene_rays && hits && scene_hits);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      float* v = vertices + 3 * (y * side + x);
+      v[0] = (float)x / kGrid, v[1] = (float)y / kGrid, v[2] = 0;
+    }
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x) {
+      uint32_t* t = indices + 6 * (y * kGrid + x);
+      const uint32_t a = (uint32_t)(y * side + x);
+      t[0] = a, t[1] = a + 1, t[2] = a + side + 1, t[3] = a, t[4] = a + side + 1, t[5] = a + side;
+    }
+  for (int i = 0; i < kRaceRays; ++i) {
+    const unsigned k = (unsigned)i;
+    const float x = (float)((k * 7919u) % 1000u + 0.5) / 1000, y = (float)((k * 104729u) % 997u + 0.5) / 997;
+    meshcast_ray r = {{x, y, 1}, {0, 0, -1}, INFINITY, 0};
+    meshcast_ray_d d = {{x, y, 1}, {0, 0, -1}, INFINITY, 0, 0};
+    rays[i] = r, scene_rays[i] = d;
+  }
+  meshcast_mesh mesh;
+  meshcast_mesh_init(&mesh);
+  mesh.vertices = vertices, mesh.vertex_count = (uint64_t)side * side;
+  mesh.indices = indices, mesh.triangle_count = 2ull * kGrid * kGrid;
+  meshcast_blob* built = NULL;
+  EXPECT_OK(meshcast_blob_build(&mesh, NULL, &built));
+  const char* path = "c_api_race.blob";
+  EXPECT_OK(meshcast_blob_save(built, path));
+  EXPECT_OK(meshcast_blob_release(built));
+  meshcast_caster_options options;
+  meshcast_caster_options_init(&options);
+  options.backend = MESHCAST_BACKEND_CPU;
+  options.threads = 1;
+  for (int round = 0; round < 3; ++round)
+    for (int kind = 0; kind < 3; ++kind) {
+      racer r = {.kind = kind, .rays = rays, .scene_rays = scene_rays, .hits = hits, .scene_hits = scene_hits};
+      meshcast_blob* blob = NULL;
+      EXPECT_OK(meshcast_blob_load(path, MESHCAST_LOAD_MAP, &blob));
+      if (kind == 0) {
+        r.handle = blob;
+      } else if (kind == 1) {
+        meshcast_scene* scene = NULL;
+        uint32_t id, instance;
+        EXPECT_OK(meshcast_scene_create(&scene));
+        EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &id));
+        EXPECT_OK(meshcast_scene_add_instance(scene, id, NULL, 0xFF, 0, &instance));
+        EXPECT_OK(meshcast_scene_commit(scene));
+        EXPECT_OK(meshcast_blob_release(blob));
+        r.handle = scene;
+      } else {
+        meshcast_caster* caster = NULL;
+        EXPECT_OK(meshcast_caster_create(blob, &options, &caster));
+        EXPECT_OK(meshcast_blob_release(blob));
+        r.handle = caster;
+      }
+      race_release(&r);
+    }
+  remove(path);
+  free(vertices), free(indices), free(rays), free(scene_rays), free(hits), free(scene_hits);
+}
+
 int main(void) {
   test_version_and_errors();
+  test_callback_calls();
   test_blob_casts(NULL);
   test_blob_casts("OctTreeCompressed/ClusterFloat3SOA8");
   test_blob_casts("AABBTree/Float3");
   test_build_load_save();
   test_scene();
+  test_scene_before_commit();
+  test_messages();
   test_casters();
+  test_release_while_casting();
   if (failures) {
     fprintf(stderr, "%d checks failed\n", failures);
     return 1;

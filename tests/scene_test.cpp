@@ -1106,6 +1106,40 @@ TEST(Scene, CommitsOfNothing) {
   EXPECT_EQ(hits[0].instance, a);
 }
 
+// A scene given meshes and instances, cast before its first commit: every
+// cast, point query and snapshot refused, saying to commit (its first frame
+// holds none of them: every ray would miss); answered once committed. A
+// scene nothing was added to is empty, committed or not.
+TEST(Scene, CastsBeforeTheFirstCommitAreRefused) {
+  Scene scene;
+  const MeshId m = scene.add_mesh(build_blob(make_sphere(4, 6, 1, {0, 0, 0}), parse_layout("OctTreeCompressed/ClusterFloat3SOA8"), "s"), "s");
+  const std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}};
+  const std::vector<Ray> float_rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}};
+  std::vector<SceneHit> hits(1);
+  SceneHitLists lists;
+  lists.max_hits = 2;
+  const std::vector<std::array<double, 3>> points = {{0, 0, 5}};
+  std::vector<SceneClosestPoint> nearest(1);
+  for (int added = 0; added < 2; ++added) {  // a mesh alone, then an instance of it
+    const std::initializer_list<std::string> words = {"never committed", "commit it first"};
+    expect_throws<UsageError>([&] { scene.trace(rays, hits); }, words);
+    expect_throws<UsageError>([&] { scene.trace(float_rays, hits); }, words);
+    expect_throws<UsageError>([&] { scene.trace_all_hits(rays, lists); }, words);
+    expect_throws<UsageError>([&] { scene.closest_points(points, nearest); }, words);
+    expect_throws<UsageError>([&] { scene.snapshot(); }, words);
+    if (added == 0) scene.add_instance(m, Transform{});
+  }
+  scene.commit();
+  EXPECT_EQ(scene.trace(rays, hits), 0u);
+  EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
+  EXPECT_EQ(scene.closest_points(points, nearest), 0u);
+  EXPECT_NEAR(nearest[0].distance, 4.0, 1e-3);
+  Scene empty;
+  hits[0] = SceneHit{0, 0, 0};
+  EXPECT_EQ(empty.trace(rays, hits), 0u);
+  EXPECT_EQ(hits[0].instance, kNoHit);
+}
+
 TEST(Scene, RefusesBadInput) {
   Scene scene;
   EXPECT_THROW(scene.add_mesh({1, 2, 3}, "three bytes"), InputError);

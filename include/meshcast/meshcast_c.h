@@ -5,7 +5,9 @@
  * - Handles (meshcast_blob, meshcast_scene, meshcast_caster) are opaque;
  *   each is made by one call and released by its _release call. A handle
  *   released, or never made here, is refused with MESHCAST_ERROR_USAGE,
- *   never read.
+ *   never read. A call already running on another thread when the handle
+ *   is released keeps it until that call returns: the release frees it
+ *   then, and later calls are refused.
  * - Every call that can fail returns a meshcast_status. On failure,
  *   meshcast_last_error() (this thread's) names the input and the limit it
  *   broke, and the error callback, where one is set, gets the same words.
@@ -73,7 +75,11 @@ MESHCAST_C_API const char* meshcast_last_error(void);
 /* "MESHCAST_ERROR_INPUT" for MESHCAST_ERROR_INPUT, and so on. */
 MESHCAST_C_API const char* meshcast_status_name(meshcast_status status);
 /* Called on the failing thread with every failure's status and message
- * (the process's one callback; NULL: none). */
+ * (the process's one callback; NULL: none). The message is valid until the
+ * callback returns, whatever it calls meanwhile (a failing call included:
+ * its own failure calls the callback again, on the same thread); copy it
+ * to keep it. After the failed call returns, meshcast_last_error() gives
+ * that call's message again. */
 typedef void (*meshcast_error_callback)(void* user, meshcast_status status, const char* message);
 MESHCAST_C_API void meshcast_set_error_callback(meshcast_error_callback callback, void* user);
 
@@ -181,7 +187,7 @@ MESHCAST_C_API meshcast_status meshcast_blob_load(const char* path, uint32_t fla
 #define MESHCAST_MEMORY_BORROW 1u
 MESHCAST_C_API meshcast_status meshcast_blob_from_memory(const void* bytes, uint64_t size, uint32_t flags,
                                                          const char* name, meshcast_blob** out);
-/* Written beside path, then renamed over it. */
+/* Written beside path, then renamed over it (an empty path is refused). */
 MESHCAST_C_API meshcast_status meshcast_blob_save(const meshcast_blob* blob, const char* path);
 /* The blob's bytes, valid while the blob lives. */
 MESHCAST_C_API meshcast_status meshcast_blob_bytes(const meshcast_blob* blob, const void** bytes, uint64_t* size);
@@ -194,7 +200,8 @@ typedef struct meshcast_blob_info {
   double error_bound;  /* the stated error, a fraction of the diagonal (0: exact) */
 } meshcast_blob_info;
 MESHCAST_C_API meshcast_status meshcast_blob_info_get(const meshcast_blob* blob, meshcast_blob_info* info);
-/* NULL is MESHCAST_OK; a scene the blob joined keeps its bytes. */
+/* NULL is MESHCAST_OK; a scene the blob joined keeps its bytes, and a cast
+ * through it already running on another thread keeps it until it returns. */
 MESHCAST_C_API meshcast_status meshcast_blob_release(meshcast_blob* blob);
 
 #define MESHCAST_CLOSEST 0u
@@ -265,7 +272,9 @@ MESHCAST_C_API meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* sc
 MESHCAST_C_API meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, uint32_t instance_id,
                                                           uint32_t enabled);
 MESHCAST_C_API meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, uint32_t instance_id);
-/* The edits so far are seen by the casts from now on. */
+/* The edits so far are seen by the casts from now on. A scene given a mesh
+ * or an instance is cast (or submitted to a caster) only once committed:
+ * before its first commit, MESHCAST_ERROR_USAGE. */
 MESHCAST_C_API meshcast_status meshcast_scene_commit(meshcast_scene* scene);
 MESHCAST_C_API meshcast_status meshcast_scene_cast(const meshcast_scene* scene, const meshcast_ray_d* rays,
                                                    uint64_t ray_count, const meshcast_query* query,

@@ -154,7 +154,7 @@ class Scene {
   // The id is not given again. UsageError for an unknown or removed id.
   void remove_instance(InstanceId instance);
 
-  // The frame's changes are done: from now on traces see them.
+  // The frame's changes are done: from now on traces see them (and not before: see snapshot()).
   void commit();
 
   // The hit of each world ray under `query` (Closest or Any; All has
@@ -166,7 +166,7 @@ class Scene {
   // a direction, t_max or t_min BlobView would refuse (answered as misses), or a
   // ray some instance's frame cannot take (its direction scaled past the
   // walkers' range: that instance is not walked, the others are). UsageError
-  // when hits is shorter than rays, for Query::All or HitOutputs::Point.
+  // when hits is shorter than rays, for Query::All or HitOutputs::Point, and as snapshot().
   uint64_t trace(std::span<const RayD> rays, std::span<SceneHit> hits, HitOutputs outputs = HitOutputs::None,
                  Query query = Query::Closest, Cull cull = Cull::None, uint8_t mask = 0xFF) const;
   // Float rays, their origins taken as doubles.
@@ -195,8 +195,8 @@ class Scene {
   uint64_t closest_points(std::span<const std::array<double, 3>> points, std::span<SceneClosestPoint> out,
                           double max_distance = INFINITY, uint8_t mask = 0xFF) const;
 
-  // What the last commit() made, for a caster that keeps a batch on the
-  // scene it was submitted to (traces through it see that frame).
+  // What the last commit() made, for a caster that keeps a batch on the scene it was submitted to (traces see that
+  // frame). UsageError for a scene given a mesh or an instance but never committed (commit it first).
   std::shared_ptr<const SceneSnapshot> snapshot() const;
 
   size_t instance_count() const;  // not removed, committed or not

@@ -8,7 +8,7 @@ use std::time::Instant;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     assert!(args.len() == 3, "usage: one_ray BLOB RAYS");
-    let blob = Blob::load(&args[1], false).unwrap();
+    let blob = Blob::load(&args[1]).unwrap();
     let bytes = std::fs::read(&args[2]).unwrap();
     let word = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
     let query = Query::default();

@@ -175,11 +175,50 @@ impl Blob {
         Ok(Blob { raw })
     }
 
-    /// A blob file, read whole, or mapped read-only with `map`.
-    pub fn load(path: &str, map: bool) -> Result<Blob> {
+    /// A blob file, read whole and validated: later changes to the file
+    /// change nothing.
+    ///
+    /// A mapped load is [`Blob::map`], which is `unsafe`; this one takes no
+    /// flag for it:
+    ///
+    /// ```compile_fail
+    /// let blob = meshcast::Blob::load("terrain.blob", true);
+    /// ```
+    pub fn load(path: &str) -> Result<Blob> {
+        Self::load_with(path, 0)
+    }
+
+    /// A blob file mapped read-only, validated once: its pages are shared
+    /// with every other process mapping it, and never copied.
+    ///
+    /// # Safety
+    ///
+    /// The file must not be truncated or rewritten in place for as long as
+    /// the blob, or any scene or caster it was given to, lives: the bytes
+    /// are read where the file lies, so a truncated file ends the process
+    /// with SIGBUS at the next read of a page past its new end (`bytes()`
+    /// or a cast), and one rewritten in place is read unvalidated. Replacing
+    /// the file by renaming a new one over its name (as [`Blob::save`]
+    /// does) is safe: the mapping keeps the old file.
+    ///
+    /// Called outside an `unsafe` block it does not compile:
+    ///
+    /// ```compile_fail
+    /// let blob = meshcast::Blob::map("terrain.blob");
+    /// ```
+    ///
+    /// ```no_run
+    /// // Nothing truncates or rewrites terrain.blob while `blob` lives.
+    /// let blob = unsafe { meshcast::Blob::map("terrain.blob") }.unwrap();
+    /// ```
+    pub unsafe fn map(path: &str) -> Result<Blob> {
+        Self::load_with(path, sys::MESHCAST_LOAD_MAP)
+    }
+
+    fn load_with(path: &str, flags: u32) -> Result<Blob> {
         let path = c_string(path, "path")?;
         let mut raw = ptr::null_mut();
-        check(unsafe { sys::meshcast_blob_load(path.as_ptr(), if map { sys::MESHCAST_LOAD_MAP } else { 0 }, &mut raw) })?;
+        check(unsafe { sys::meshcast_blob_load(path.as_ptr(), flags, &mut raw) })?;
         Ok(Blob { raw })
     }
 

@@ -60,11 +60,12 @@ void decode_leaf(const uint8_t* blob, uint32_t block, uint32_t count, float (*ou
 std::string check_tree_bounds(const uint8_t* blob) {
   const BlobHeader& h = header_of(blob);
   std::string problem;
-  std::vector<float[3][3]> corners;
+  std::vector<float> floats;  // a leaf's corners, 9 floats a triangle
   for_each_leaf_path(blob, [&](uint32_t block, uint32_t count, const std::vector<PathBox>& path) {
     if (!problem.empty() || path.empty()) return;
-    corners.resize(count);
-    decode_leaf(blob, h.tree_offset + block, count, corners.data());
+    floats.resize(9 * size_t(count));
+    float (*corners)[3][3] = reinterpret_cast<float (*)[3][3]>(floats.data());
+    decode_leaf(blob, h.tree_offset + block, count, corners);
     // The leaf's corners' box against each box above it (comparisons that
     // fail on NaN too).
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

@@ -5,7 +5,7 @@
 // 1e-4 of its normal off its plane, through its centroid). t is measured
 // against the stored triangle's plane, in float ulps of the exact t; u and
 // v as absolute errors; the hit point against o + t d at the exact t, in
-// ulps of the point's largest coordinate.
+// ulps of the largest coordinate of o, t d and the point.
 #pragma once
 #include <string>
 #include <vector>
@@ -20,7 +20,7 @@ struct ExactnessRow {
   uint64_t rounded = 0;            // hits whose t is correctly rounded (within half an ulp)
   double t_ulps = 0;               // the largest t error, ulps
   double uv = 0;                   // the largest u or v error
-  double point_ulps = 0;           // the largest hit-point error, ulps of its largest coordinate
+  double point_ulps = 0;           // the largest hit-point error, ulps of the largest of o, t d and the point
 };
 
 std::vector<ExactnessRow> bench_exactness(const Mesh& mesh, const std::string& name, size_t rays);

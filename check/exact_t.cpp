@@ -66,11 +66,15 @@ ExactHitError exact_hit_error(const Ray& ray, const Vec3& a, const Vec3& b, cons
   out.defined = true;
   out.t_ulps = ulps_off(hit.t, e.t);
   out.uv = std::max(distance(hit.u, e.u), distance(hit.v, e.v));
+  // The scale: the largest of o, t d and the point on any axis (o + t d
+  // cancels where a long ray from far away ends near the origin, and t's
+  // rounding is relative to t d).
   double worst = 0, largest = 0;
   for (int k = 0; k < 3; ++k) {
-    const mpq_class p = mpq_class(double(ray.org[k])) + e.t * double(walked_direction(ray.dir[k]));
+    const mpq_class along = e.t * double(walked_direction(ray.dir[k]));
+    const mpq_class p = mpq_class(double(ray.org[k])) + along;
     worst = std::max(worst, distance(hit.point[k], p));
-    largest = std::max(largest, std::fabs(p.get_d()));
+    largest = std::max({largest, std::fabs(p.get_d()), std::fabs(along.get_d()), std::fabs(double(ray.org[k]))});
   }
   out.point_ulps = worst / float_ulp(largest);
   return out;

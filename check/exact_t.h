@@ -15,7 +15,7 @@ struct ExactHitError {
   double t_ulps = 0;     // |t - exact| in ulps of the exact t
   double uv = 0;         // the larger of |u - exact u| and |v - exact v| (barycentrics of b and c)
   // The point against o + t d at the exact t (t's own error included), in
-  // ulps of the exact point's largest coordinate.
+  // ulps of the largest coordinate of o, t d and the point.
   double point_ulps = 0;
 };
 

@@ -23,6 +23,7 @@
 #include "check/generate.h"
 #include "meshcast/read.h"
 #include "layout/blob_format.h"
+#include "layout/tree/octtree.h"
 #include "tests/testing.h"
 
 namespace fs = std::filesystem;
@@ -162,6 +163,25 @@ TEST(Hostile, DirectoriesAndDevicesAreRefusedBeforeReading) {
 // odd offset inside a buffer of one's own (a pack file) is refused with an
 // InputError naming its address and how far off it is, never read
 // misaligned; at a multiple of 4 in the same buffer it is walked.
+// A tree whose boxes miss their triangles would hide hits (each walk culls
+// the subtree, and answers by the order it takes): a blob resealed after
+// a node's box was narrowed is refused, naming the leaf and the box. The
+// fuzz corpus holds a blob found so (tree_boxes_miss_their_triangles.mcb).
+TEST(Hostile, ATreeWhoseBoxesMissTheirTrianglesIsRefused) {
+  const Mesh sphere = make_sphere(12, 24, 1.0f, {0, 0, 0});
+  std::vector<uint8_t> blob = build_blob(sphere, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "sphere");
+  const layout::BlobHeader& h = layout::header_of(blob.data());
+  ASSERT_EQ(layout::oct_count(h.root), 0u) << "the root is a node";
+  uint8_t* node = blob.data() + h.tree_offset + layout::oct_offset(h.root);
+  int child = 0;
+  while (child < 8 && !layout::oct_child_properties(node, child)) ++child;
+  ASSERT_LT(child, 8);
+  // The child's box flat at its lowest z: its triangles rise above it.
+  node[MC_OCT_QHI_AT + 16 + child] = node[MC_OCT_QLO_AT + 16 + child];
+  layout::seal(blob);
+  expect_throws<InputError>([&] { BlobView view(blob, "narrowed.mcb"); }, {"narrowed.mcb", "does not bound its triangles", "axis 2"});
+}
+
 TEST(Hostile, AMisalignedBlobIsRefusedNamingItsAddress) {
   const Mesh m = make_sphere(8, 16, 1, {0, 0, 0});
   const std::vector<uint8_t> blob = build_blob(m, parse_layout("AABBTree/Float3"), "sphere");

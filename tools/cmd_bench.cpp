@@ -499,8 +499,8 @@ void add_bench_exactness(CLI::App* bench) {
       std::sort(paths.begin(), paths.end());
     }
     std::printf("\nt against the exact distance to the stored triangle's plane (ulps of the exact t; 0.5: correctly "
-                "rounded), u and v (absolute), the hit point against o + t d at the exact t (ulps of its largest "
-                "coordinate); the closest hit, any hit and every hit together, %zu rays a kind\n\n"
+                "rounded), u and v (absolute), the hit point against o + t d at the exact t (ulps of the largest "
+                "coordinate of o, t d and the point); the closest hit, any hit and every hit together, %zu rays a kind\n\n"
                 "| mesh | layout | rays | hits | t correctly rounded | t, largest error (ulps) | u, v largest error | "
                 "point, largest error (ulps) |\n|---|---|---|---:|---:|---:|---:|---:|\n", *rays);
     ExactnessTotals totals;

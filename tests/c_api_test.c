@@ -80,6 +80,18 @@ static meshcast_blob* build(const char* layout) {
   return blob;
 }
 
+/* A committed scene of one instance of `blob` at the identity; its
+   instance's id in *instance. */
+static meshcast_scene* scene_of_one(meshcast_blob* blob, uint32_t* instance) {
+  meshcast_scene* scene = NULL;
+  uint32_t mesh;
+  EXPECT_OK(meshcast_scene_create(&scene));
+  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
+  EXPECT_OK(meshcast_scene_add_instance(scene, mesh, NULL, 0xFF, 0, instance));
+  EXPECT_OK(meshcast_scene_commit(scene));
+  return scene;
+}
+
 static void test_version_and_errors(void) {
   CHECK(meshcast_api_version() >> 16 == MESHCAST_C_API_VERSION_MAJOR);
   CHECK(meshcast_api_version() >= (uint32_t)MESHCAST_C_API_VERSION); /* the same major, a minor at or above */
@@ -469,12 +481,8 @@ static void test_casters(void) {
   CHECK(backend == MESHCAST_BACKEND_CPU && why != NULL && strlen(why) > 0);
   /* Scene batches. */
   meshcast_blob* again = build(NULL);
-  meshcast_scene* scene = NULL;
-  uint32_t mesh, instance;
-  EXPECT_OK(meshcast_scene_create(&scene));
-  EXPECT_OK(meshcast_scene_add_mesh(scene, again, &mesh));
-  EXPECT_OK(meshcast_scene_add_instance(scene, mesh, NULL, 0xFF, 0, &instance));
-  EXPECT_OK(meshcast_scene_commit(scene));
+  uint32_t instance;
+  meshcast_scene* scene = scene_of_one(again, &instance);
   meshcast_caster* scenes = NULL;
   EXPECT_OK(meshcast_caster_create(NULL, &options, &scenes));
   meshcast_ray_d ray = {{0.25, 0.75, 2}, {0, 0, -1}, INFINITY, 0, 0};
@@ -607,12 +615,8 @@ static void test_release_while_casting(void) {
       if (kind == 0) {
         r.handle = blob;
       } else if (kind == 1) {
-        meshcast_scene* scene = NULL;
-        uint32_t id, instance;
-        EXPECT_OK(meshcast_scene_create(&scene));
-        EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &id));
-        EXPECT_OK(meshcast_scene_add_instance(scene, id, NULL, 0xFF, 0, &instance));
-        EXPECT_OK(meshcast_scene_commit(scene));
+        uint32_t instance;
+        meshcast_scene* scene = scene_of_one(blob, &instance);
         EXPECT_OK(meshcast_blob_release(blob));
         r.handle = scene;
       } else {

@@ -95,15 +95,17 @@ std::vector<SceneRow> bench_scenes(const std::vector<Mesh>& meshes, const Scenes
       const std::vector<PeerInstance> level = plan_level(meshes, count, offset, 17);
       const std::vector<RayD> rays = level_rays(level, o.rays, 29);
       Scene scene;
-      for (size_t m = 0; m < blobs.size(); ++m) scene.add_mesh(blobs[m], "mesh " + std::to_string(m));
-      for (const PeerInstance& p : level) scene.add_instance(p.mesh, p.transform);
+      std::vector<MeshId> mesh_ids;
+      std::vector<InstanceId> instance_ids;
+      for (size_t m = 0; m < blobs.size(); ++m) mesh_ids.push_back(scene.add_mesh(blobs[m], "mesh " + std::to_string(m)));
+      for (const PeerInstance& p : level) instance_ids.push_back(scene.add_instance(mesh_ids[p.mesh], p.transform));
       scene.commit();
       std::vector<Contender> all;
       // Everything the scene holds besides the blobs: its records of the
       // instances, the tree it refits, the two snapshots it keeps.
       all.push_back({"meshcast " + o.layout, [&] { return blob_bytes + double(scene.top_level_bytes()); },
                      [&](const std::vector<RayD>& r, std::vector<SceneHit>& h) { scene.trace(r, h); },
-                     [&](uint32_t i, const Transform& t) { scene.set_transform(i, t); }, [&] { scene.commit(); }});
+                     [&](uint32_t i, const Transform& t) { scene.set_transform(instance_ids[i], t); }, [&] { scene.commit(); }});
       std::unique_ptr<ScenePeer> embree = make_embree_scene(mesh_pointers, level);
       if (embree)
         all.push_back({embree->name(), [&] { return double(embree->bytes()); },

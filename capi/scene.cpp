@@ -32,6 +32,17 @@ bool flag_of(uint32_t flag, const char* what) {
   return flag == 1;
 }
 
+// The C++ ids the C records carry (the scene refuses another scene's);
+// reserved stays 0, for a field a later version may give it.
+template <class Kind, class Record>
+SceneId<Kind> id_of(const Record& id, const char* what) {
+  if (id.reserved != 0)
+    throw UsageError(std::string(what) + ".reserved " + std::to_string(id.reserved) + ": 0 expected");
+  return SceneId<Kind>{id.index, id.scene};
+}
+MeshId mesh_of(const meshcast_mesh_id& id) { return id_of<MeshKind>(id, "mesh"); }
+InstanceId instance_of(const meshcast_instance_id& id) { return id_of<InstanceKind>(id, "instance"); }
+
 }  // namespace
 
 extern "C" {
@@ -48,56 +59,61 @@ meshcast_status meshcast_scene_create(meshcast_scene** out) {
   });
 }
 
-meshcast_status meshcast_scene_add_mesh(meshcast_scene* scene, const meshcast_blob* blob, uint32_t* mesh_id) {
+meshcast_status meshcast_scene_add_mesh(meshcast_scene* scene, const meshcast_blob* blob, meshcast_mesh_id* mesh) {
   return guarded("meshcast_scene_add_mesh", [&] {
     const auto s = live(scene, "scene");
     const auto b = live(blob, "blob");
-    uint32_t* id = required(mesh_id, "mesh_id");
+    meshcast_mesh_id* out = required(mesh, "mesh");
     // A mapped blob's mapping is shared; any other blob is referenced, its
     // bytes kept alive by the scene.
+    MeshId id;
     if (b->mapped) {
-      *id = s->scene.add_mesh(b->mapped, b->name);
+      id = s->scene.add_mesh(b->mapped, b->name);
     } else {
       s->owners.push_back(b->owner);
-      *id = s->scene.add_mesh(b->view, b->name);
+      id = s->scene.add_mesh(b->view, b->name);
     }
+    *out = meshcast_mesh_id{id.scene, id.index, 0};
   });
 }
 
-meshcast_status meshcast_scene_add_instance(meshcast_scene* scene, uint32_t mesh_id, const meshcast_transform* transform,
-                                            uint32_t mask, uint32_t flip_facing, uint32_t* instance_id) {
+meshcast_status meshcast_scene_add_instance(meshcast_scene* scene, meshcast_mesh_id mesh,
+                                            const meshcast_transform* transform, uint32_t mask, uint32_t flip_facing,
+                                            meshcast_instance_id* instance) {
   return guarded("meshcast_scene_add_instance", [&] {
     const auto s = live(scene, "scene");
-    uint32_t* id = required(instance_id, "instance_id");
-    *id = s->scene.add_instance(mesh_id, transform_of(transform), mask_of(mask), flag_of(flip_facing, "flip_facing"));
+    meshcast_instance_id* out = required(instance, "instance");
+    const InstanceId id = s->scene.add_instance(mesh_of(mesh), transform_of(transform), mask_of(mask),
+                                                flag_of(flip_facing, "flip_facing"));
+    *out = meshcast_instance_id{id.scene, id.index, 0};
   });
 }
 
-meshcast_status meshcast_scene_set_transform(meshcast_scene* scene, uint32_t instance_id,
+meshcast_status meshcast_scene_set_transform(meshcast_scene* scene, meshcast_instance_id instance,
                                              const meshcast_transform* transform) {
   return guarded("meshcast_scene_set_transform", [&] {
-    live(scene, "scene")->scene.set_transform(instance_id, transform_of(required(transform, "transform")));
+    live(scene, "scene")->scene.set_transform(instance_of(instance), transform_of(required(transform, "transform")));
   });
 }
 
-meshcast_status meshcast_scene_set_mask(meshcast_scene* scene, uint32_t instance_id, uint32_t mask) {
-  return guarded("meshcast_scene_set_mask", [&] { live(scene, "scene")->scene.set_mask(instance_id, mask_of(mask)); });
+meshcast_status meshcast_scene_set_mask(meshcast_scene* scene, meshcast_instance_id instance, uint32_t mask) {
+  return guarded("meshcast_scene_set_mask", [&] { live(scene, "scene")->scene.set_mask(instance_of(instance), mask_of(mask)); });
 }
 
-meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* scene, uint32_t instance_id, uint32_t flip_facing) {
+meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* scene, meshcast_instance_id instance, uint32_t flip_facing) {
   return guarded("meshcast_scene_set_flip_facing", [&] {
-    live(scene, "scene")->scene.set_flip_facing(instance_id, flag_of(flip_facing, "flip_facing"));
+    live(scene, "scene")->scene.set_flip_facing(instance_of(instance), flag_of(flip_facing, "flip_facing"));
   });
 }
 
-meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, uint32_t instance_id, uint32_t enabled) {
+meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, meshcast_instance_id instance, uint32_t enabled) {
   return guarded("meshcast_scene_set_enabled", [&] {
-    live(scene, "scene")->scene.set_enabled(instance_id, flag_of(enabled, "enabled"));
+    live(scene, "scene")->scene.set_enabled(instance_of(instance), flag_of(enabled, "enabled"));
   });
 }
 
-meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, uint32_t instance_id) {
-  return guarded("meshcast_scene_remove_instance", [&] { live(scene, "scene")->scene.remove_instance(instance_id); });
+meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, meshcast_instance_id instance) {
+  return guarded("meshcast_scene_remove_instance", [&] { live(scene, "scene")->scene.remove_instance(instance_of(instance)); });
 }
 
 meshcast_status meshcast_scene_commit(meshcast_scene* scene) {

@@ -15,7 +15,14 @@
 
 namespace meshcast {
 
+namespace {
+// The numbers scenes are given, the first 1 (0 is no scene's: a
+// default-made id's).
+std::atomic<uint64_t> next_scene_number{1};
+}  // namespace
+
 struct Scene::Edits {
+  const uint64_t number = next_scene_number.fetch_add(1, std::memory_order_relaxed);
   std::vector<std::shared_ptr<const SceneMesh>> meshes;
   size_t owned_bytes = 0;  // the meshes' blobs the scene copied (add_mesh of a vector)
   struct Instance {
@@ -71,10 +78,27 @@ struct Scene::Edits {
     if (!ever_committed) added_before_commit = true;
   }
 
+  // Where an id of another scene is refused, naming both scenes.
+  template <class Kind>
+  void check_ours(SceneId<Kind> id, const char* kind, const char* who) const {
+    if (id.scene != number)
+      throw UsageError(std::string(who) + ": " + kind + " " + std::to_string(id.index) + " was given by " +
+                       (id.scene == 0 ? std::string("no scene (a default-made id)")
+                                      : "another scene (scene " + std::to_string(id.scene) + ")") +
+                       ", not this one (scene " + std::to_string(number) + ")");
+  }
+  const SceneMesh& mesh(MeshId id, const char* who) const {
+    check_ours(id, "mesh", who);
+    if (id.index >= meshes.size())
+      throw UsageError(std::string(who) + ": mesh " + std::to_string(id.index) + " is unknown (" +
+                       std::to_string(meshes.size()) + " added)");
+    return *meshes[id.index];
+  }
   Instance& at(InstanceId id, const char* who) {
-    if (id >= instances.size() || instances[id].removed)
-      throw UsageError(std::string(who) + ": instance " + std::to_string(id) + " is unknown or removed");
-    return instances[id];
+    check_ours(id, "instance", who);
+    if (id.index >= instances.size() || instances[id.index].removed)
+      throw UsageError(std::string(who) + ": instance " + std::to_string(id.index) + " is unknown or removed");
+    return instances[id.index];
   }
 };
 
@@ -170,7 +194,7 @@ MeshId Scene::add_validated(const BlobView& view, std::shared_ptr<const void> ow
   e.meshes.push_back(std::make_shared<const SceneMesh>(view, std::move(owner), name));
   e.changed = true;
   e.note_added();
-  return MeshId(e.meshes.size() - 1);
+  return MeshId{uint32_t(e.meshes.size() - 1), e.number};
 }
 
 MeshId Scene::add_mesh(std::vector<uint8_t> blob, const std::string& name) {
@@ -193,36 +217,32 @@ MeshId Scene::add_mesh(std::shared_ptr<const MappedBlob> file, const std::string
 MeshId Scene::add_mesh(const BlobView& blob, const std::string& name) { return add_validated(blob, nullptr, name); }
 
 std::span<const uint8_t> Scene::mesh_blob(MeshId mesh) const {
-  const Edits& e = edits("Scene::mesh_blob");
-  if (mesh >= e.meshes.size())
-    throw UsageError("Scene::mesh_blob: mesh " + std::to_string(mesh) + " is unknown (" +
-                     std::to_string(e.meshes.size()) + " added)");
-  return e.meshes[mesh]->bytes;
+  return edits("Scene::mesh_blob").mesh(mesh, "Scene::mesh_blob").bytes;
 }
+
+uint64_t Scene::number() const { return edits("Scene::number").number; }
 
 size_t Scene::owned_blob_bytes() const { return edits("Scene::owned_blob_bytes").owned_bytes; }
 
 InstanceId Scene::add_instance(MeshId mesh, const Transform& transform, uint8_t mask, bool flip_facing) {
   Edits& e = edits("Scene::add_instance");
-  if (mesh >= e.meshes.size())
-    throw UsageError("Scene::add_instance: mesh " + std::to_string(mesh) + " is unknown (" +
-                     std::to_string(e.meshes.size()) + " added)");
+  const SceneMesh& walked = e.mesh(mesh, "Scene::add_instance");
   // The top level's slots tell an instance by its high bit (kTopInstance).
   if (e.instances.size() >= layout::kTopInstance)
     throw UsageError("Scene::add_instance: a scene holds at most 2^31 instances, removed ones counted");
   Edits::Instance i;
   i.placed.id = uint32_t(e.instances.size());
-  i.placed.mesh = mesh;
+  i.placed.mesh = mesh.index;
   i.placed.mask = mask;
   i.placed.flip_facing = flip_facing;
   WorldBox box;
-  place(i.placed, box, transform, *e.meshes[mesh], "Scene::add_instance");
+  place(i.placed, box, transform, walked, "Scene::add_instance");
   e.instances.push_back(i);
   e.boxes.push_back(box);
   ++e.live;
   e.rebuild = e.changed = true;
   e.note_added();
-  return i.placed.id;
+  return InstanceId{i.placed.id, e.number};
 }
 
 void Scene::set_transform(InstanceId instance, const Transform& transform) {
@@ -232,7 +252,7 @@ void Scene::set_transform(InstanceId instance, const Transform& transform) {
   WorldBox box;
   place(moved, box, transform, *e.meshes[moved.mesh], "Scene::set_transform");
   i.placed = moved;
-  e.boxes[instance] = box;
+  e.boxes[instance.index] = box;
   e.changed = true;
 }
 

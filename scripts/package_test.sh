@@ -198,8 +198,8 @@ run_first "$tmp/alone/build" "a library-only build in ~/.local"
 # The C example step 1 built against the first library, run unchanged on
 # this rebuilt one (scalar walkers, no Vulkan, -O0): its soname and its
 # versioned symbols keep a program built earlier running.
-LD_LIBRARY_PATH="$home/.local/lib" ldd "$tmp/c_api/floor_pc" | grep -q "$home/.local/lib/libmeshcast_c.so.1" ||
-  { echo "FAIL: the C example did not load the rebuilt libmeshcast_c.so.1"; exit 1; }
+LD_LIBRARY_PATH="$home/.local/lib" ldd "$tmp/c_api/floor_pc" | grep -q "$home/.local/lib/libmeshcast_c.so.2" ||
+  { echo "FAIL: the C example did not load the rebuilt libmeshcast_c.so.2"; exit 1; }
 [[ $(LD_LIBRARY_PATH="$home/.local/lib" "$tmp/c_api/floor_pc") == "$c_out" ]] ||
   { echo "FAIL: the C example built against the first library answers otherwise on the rebuilt one"; exit 1; }
 echo "  the C example built against the first library, run on the rebuilt one: the same answers"

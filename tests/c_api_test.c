@@ -82,9 +82,9 @@ static meshcast_blob* build(const char* layout) {
 
 /* A committed scene of one instance of `blob` at the identity; its
    instance's id in *instance. */
-static meshcast_scene* scene_of_one(meshcast_blob* blob, uint32_t* instance) {
+static meshcast_scene* scene_of_one(meshcast_blob* blob, meshcast_instance_id* instance) {
   meshcast_scene* scene = NULL;
-  uint32_t mesh;
+  meshcast_mesh_id mesh;
   EXPECT_OK(meshcast_scene_create(&scene));
   EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
   EXPECT_OK(meshcast_scene_add_instance(scene, mesh, NULL, 0xFF, 0, instance));
@@ -289,7 +289,8 @@ static void test_scene(void) {
   meshcast_blob* blob = build(NULL);
   meshcast_scene* scene = NULL;
   EXPECT_OK(meshcast_scene_create(&scene));
-  uint32_t mesh = 99, far = 99, near = 99;
+  meshcast_mesh_id mesh;
+  meshcast_instance_id far, near;
   EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
   EXPECT_OK(meshcast_blob_release(blob)); /* the scene keeps its bytes */
   meshcast_transform t;
@@ -301,19 +302,20 @@ static void test_scene(void) {
   meshcast_ray_d rays[2] = {{{1e9 + 0.75, 0.25, 2}, {0, 0, -1}, INFINITY, 0, 0}, {{0.25, 0.75, 2}, {0, 0, -1}, INFINITY, 0, 0}};
   meshcast_scene_hit hits[2];
   EXPECT_OK(meshcast_scene_cast(scene, rays, 2, NULL, hits, 2, NULL));
-  CHECK(hits[0].instance == far && hits[0].triangle == 2 && hits[0].t == 1.0f);
-  CHECK(hits[1].instance == near && hits[1].triangle == 3);
+  CHECK(far.index == 0 && near.index == 1 && far.scene == mesh.scene && near.scene == mesh.scene);
+  CHECK(hits[0].instance == far.index && hits[0].triangle == 2 && hits[0].t == 1.0f);
+  CHECK(hits[1].instance == near.index && hits[1].triangle == 3);
   meshcast_query query;
   meshcast_query_init(&query);
   query.mask = 0x02; /* the near instance's mask is 0x01 */
   EXPECT_OK(meshcast_scene_cast(scene, rays, 2, &query, hits, 2, NULL));
-  CHECK(hits[0].instance == far && hits[1].instance == MESHCAST_NO_HIT);
+  CHECK(hits[0].instance == far.index && hits[1].instance == MESHCAST_NO_HIT);
   EXPECT_OK(meshcast_scene_set_mask(scene, near, 0x03));
   EXPECT_OK(meshcast_scene_set_flip_facing(scene, near, 1));
   EXPECT_OK(meshcast_scene_commit(scene));
   query.cull = MESHCAST_CULL_BACK; /* flipped: the mesh's front faces are its back */
   EXPECT_OK(meshcast_scene_cast(scene, rays, 2, &query, hits, 2, NULL));
-  CHECK(hits[0].instance == far && hits[1].instance == MESHCAST_NO_HIT);
+  CHECK(hits[0].instance == far.index && hits[1].instance == MESHCAST_NO_HIT);
   uint32_t found[2];
   meshcast_scene_hit rows[4];
   EXPECT_OK(meshcast_scene_cast_all(scene, rays, 2, NULL, 2, found, rows, 4, NULL));
@@ -327,10 +329,12 @@ static void test_scene(void) {
   const double points[3] = {1e9 + 0.5, 0.5, 10.25};
   meshcast_scene_closest_point nearest;
   EXPECT_OK(meshcast_scene_closest_points(scene, points, 1, INFINITY, 0xFF, 1, &nearest, 1));
-  CHECK(nearest.instance == far && fabs(nearest.distance - 0.25) < 1e-6 && fabs(nearest.point[0] - (1e9 + 0.5)) < 1e-6);
+  CHECK(nearest.instance == far.index && fabs(nearest.distance - 0.25) < 1e-6 && fabs(nearest.point[0] - (1e9 + 0.5)) < 1e-6);
   EXPECT_OK(meshcast_scene_remove_instance(scene, near));
   EXPECT_FAILS(meshcast_scene_remove_instance(scene, near), MESHCAST_ERROR_USAGE, "");
-  EXPECT_FAILS(meshcast_scene_add_instance(scene, 42, NULL, 0xFF, 0, &near), MESHCAST_ERROR_USAGE, "42");
+  meshcast_mesh_id unknown = mesh;
+  unknown.index = 42;
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, unknown, NULL, 0xFF, 0, &near), MESHCAST_ERROR_USAGE, "42");
   EXPECT_FAILS(meshcast_scene_add_instance(scene, mesh, NULL, 0x100, 0, &near), MESHCAST_ERROR_USAGE, "mask 256");
   EXPECT_FAILS(meshcast_scene_cast(scene, rays, 2, NULL, hits, 1, NULL), MESHCAST_ERROR_USAGE, "fewer than the 2");
   /* A scene where a blob belongs. */
@@ -348,7 +352,8 @@ static void test_scene_before_commit(void) {
   meshcast_scene* empty = NULL;
   EXPECT_OK(meshcast_scene_create(&scene));
   EXPECT_OK(meshcast_scene_create(&empty));
-  uint32_t mesh, instance;
+  meshcast_mesh_id mesh;
+  meshcast_instance_id instance;
   EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
   EXPECT_OK(meshcast_scene_add_instance(scene, mesh, NULL, 0xFF, 0, &instance));
   meshcast_ray_d ray = {{0.25, 0.75, 2}, {0, 0, -1}, INFINITY, 0, 0};
@@ -373,9 +378,49 @@ static void test_scene_before_commit(void) {
   CHECK(hit.instance == MESHCAST_NO_HIT);
   EXPECT_OK(meshcast_scene_commit(scene));
   EXPECT_OK(meshcast_scene_cast(scene, &ray, 1, NULL, &hit, 1, NULL));
-  CHECK(hit.instance == instance && hit.triangle == 3 && hit.t == 1.0f);
+  CHECK(hit.instance == instance.index && hit.triangle == 3 && hit.t == 1.0f);
   EXPECT_OK(meshcast_caster_release(caster));
   EXPECT_OK(meshcast_scene_release(empty));
+  EXPECT_OK(meshcast_scene_release(scene));
+  EXPECT_OK(meshcast_blob_release(blob));
+}
+
+/* Ids are good with the scene that gave them alone: another scene's mesh
+ * or instance is refused by name, even where its index is one this scene
+ * also gave, as is a default-made (zeroed) id and a reserved field set. */
+static void test_ids_of_another_scene(void) {
+  meshcast_blob* blob = build(NULL);
+  meshcast_instance_id mine, theirs;
+  meshcast_scene* scene = scene_of_one(blob, &mine);
+  meshcast_scene* other = scene_of_one(blob, &theirs);
+  CHECK(mine.index == theirs.index && mine.scene != theirs.scene);
+  meshcast_mesh_id their_mesh;
+  EXPECT_OK(meshcast_scene_add_mesh(other, blob, &their_mesh));
+  meshcast_instance_id added;
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, their_mesh, NULL, 0xFF, 0, &added), MESHCAST_ERROR_USAGE,
+               "was given by another scene");
+  meshcast_transform t;
+  meshcast_transform_identity(&t);
+  EXPECT_FAILS(meshcast_scene_set_transform(scene, theirs, &t), MESHCAST_ERROR_USAGE, "another scene");
+  EXPECT_FAILS(meshcast_scene_set_mask(scene, theirs, 1), MESHCAST_ERROR_USAGE, "another scene");
+  EXPECT_FAILS(meshcast_scene_set_flip_facing(scene, theirs, 1), MESHCAST_ERROR_USAGE, "another scene");
+  EXPECT_FAILS(meshcast_scene_set_enabled(scene, theirs, 0), MESHCAST_ERROR_USAGE, "another scene");
+  EXPECT_FAILS(meshcast_scene_remove_instance(scene, theirs), MESHCAST_ERROR_USAGE, "another scene");
+  CHECK(strstr(meshcast_last_error(), "meshcast_scene_remove_instance: instance 0 was given by") != NULL);
+  meshcast_instance_id zeroed = {0, 0, 0};
+  EXPECT_FAILS(meshcast_scene_set_mask(scene, zeroed, 1), MESHCAST_ERROR_USAGE, "no scene");
+  meshcast_instance_id reserved = mine;
+  reserved.reserved = 1;
+  EXPECT_FAILS(meshcast_scene_set_mask(scene, reserved, 1), MESHCAST_ERROR_USAGE, "instance.reserved 1");
+  /* Nothing refused changed either scene: both still answer their one instance. */
+  EXPECT_OK(meshcast_scene_commit(scene));
+  meshcast_ray_d ray = {{0.25, 0.75, 2}, {0, 0, -1}, INFINITY, 0, 0};
+  meshcast_scene_hit hit;
+  EXPECT_OK(meshcast_scene_cast(scene, &ray, 1, NULL, &hit, 1, NULL));
+  CHECK(hit.instance == mine.index && hit.triangle == 3);
+  EXPECT_OK(meshcast_scene_remove_instance(other, theirs));
+  EXPECT_OK(meshcast_scene_remove_instance(scene, mine));
+  EXPECT_OK(meshcast_scene_release(other));
   EXPECT_OK(meshcast_scene_release(scene));
   EXPECT_OK(meshcast_blob_release(blob));
 }
@@ -399,14 +444,17 @@ static void test_messages(void) {
   CHECK(strstr(meshcast_last_error(), "::") == NULL);
   meshcast_scene* scene = NULL;
   EXPECT_OK(meshcast_scene_create(&scene));
-  uint32_t instance;
-  EXPECT_FAILS(meshcast_scene_add_instance(scene, 42, NULL, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE, "mesh 42");
+  meshcast_instance_id instance;
+  meshcast_mesh_id mesh;
+  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
+  meshcast_mesh_id unknown = mesh;
+  unknown.index = 42;
+  EXPECT_FAILS(meshcast_scene_add_instance(scene, unknown, NULL, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE,
+               "mesh 42");
   CHECK(strstr(meshcast_last_error(), "::") == NULL);
   meshcast_transform flat;
   meshcast_transform_identity(&flat);
   flat.rotation_scale[8] = 0;
-  uint32_t mesh;
-  EXPECT_OK(meshcast_scene_add_mesh(scene, blob, &mesh));
   EXPECT_FAILS(meshcast_scene_add_instance(scene, mesh, &flat, 0xFF, 0, &instance), MESHCAST_ERROR_USAGE,
                "not invertible");
   CHECK(strstr(meshcast_last_error(), "::") == NULL);
@@ -481,7 +529,7 @@ static void test_casters(void) {
   CHECK(backend == MESHCAST_BACKEND_CPU && why != NULL && strlen(why) > 0);
   /* Scene batches. */
   meshcast_blob* again = build(NULL);
-  uint32_t instance;
+  meshcast_instance_id instance;
   meshcast_scene* scene = scene_of_one(again, &instance);
   meshcast_caster* scenes = NULL;
   EXPECT_OK(meshcast_caster_create(NULL, &options, &scenes));
@@ -491,7 +539,7 @@ static void test_casters(void) {
   EXPECT_OK(meshcast_blob_release(again));
   meshcast_scene_hit hit;
   EXPECT_OK(meshcast_caster_wait_scene(scenes, &ticket, &hit, 1, NULL));
-  CHECK(hit.instance == instance && hit.triangle == 3 && hit.t == 1.0f);
+  CHECK(hit.instance == instance.index && hit.triangle == 3 && hit.t == 1.0f);
   EXPECT_FAILS(meshcast_caster_submit(scenes, rays, 1, NULL, &ticket), MESHCAST_ERROR_USAGE, "");
   EXPECT_OK(meshcast_caster_release(other));
   options.frames = 0;
@@ -615,7 +663,7 @@ static void test_release_while_casting(void) {
       if (kind == 0) {
         r.handle = blob;
       } else if (kind == 1) {
-        uint32_t instance;
+        meshcast_instance_id instance;
         meshcast_scene* scene = scene_of_one(blob, &instance);
         EXPECT_OK(meshcast_blob_release(blob));
         r.handle = scene;
@@ -640,6 +688,7 @@ int main(void) {
   test_build_load_save();
   test_scene();
   test_scene_before_commit();
+  test_ids_of_another_scene();
   test_messages();
   test_casters();
   test_release_while_casting();

@@ -1457,8 +1457,9 @@ TEST(Host, SceneBatchesReadMappedBlobs) {
       auto shared = std::make_unique<Scene>();
       {
         auto file = std::make_shared<const MappedBlob>(path);
-        place(*shared, shared->add_mesh(file, path));
-        EXPECT_EQ(shared->mesh_blob(0).data(), file->bytes().data());
+        const MeshId mesh = shared->add_mesh(file, path);
+        place(*shared, mesh);
+        EXPECT_EQ(shared->mesh_blob(mesh).data(), file->bytes().data());
       }  // the caller lets go of its mapping: the scene holds it
       const host::Ticket from_shared = caster.submit(*shared, world, {Query::Closest, cull, 0xFF});
       shared.reset();  // the scene goes too: the batch's snapshot holds the mapping

@@ -463,10 +463,11 @@ TEST(SceneClosestPoints, WorldDistancesUnderUnevenScales) {
   Scene scene;
   std::vector<std::vector<uint8_t>> blobs;
   std::vector<Mesh> stored;
+  std::vector<MeshId> mesh_ids;
   for (const Mesh* m : {&sphere, &grid}) {
     blobs.push_back(build_blob(*m, parse_layout(kPointLayouts[blobs.size() % 2]), "mesh"));
     stored.push_back(stored_mesh(blobs.back()));
-    scene.add_mesh(blobs.back(), "mesh " + std::to_string(blobs.size() - 1));
+    mesh_ids.push_back(scene.add_mesh(blobs.back(), "mesh " + std::to_string(blobs.size() - 1)));
   }
   // The world, as the oracle sees it, and which instance and triangle
   // each of its triangles is.
@@ -483,7 +484,7 @@ TEST(SceneClosestPoints, WorldDistancesUnderUnevenScales) {
       for (int c = 0; c < 3; ++c) t.rotation_scale[3 * r + c] = float(rotation[3 * r + c] * s[c] * (i == 3 && c == 0 ? -1 : 1));
     for (int k = 0; k < 3; ++k) t.translation[k] = spot(rng);
     const uint8_t mask = i == 5 ? 2 : 1;  // instance 5 is seen only by mask 2
-    const InstanceId id = scene.add_instance(mesh, t, mask);
+    const InstanceId id = scene.add_instance(mesh_ids[mesh], t, mask);
     if (mask != 1) continue;
     const Mesh& m = stored[mesh];
     for (size_t tri = 0; tri < m.triangles.size(); ++tri) {
@@ -498,7 +499,7 @@ TEST(SceneClosestPoints, WorldDistancesUnderUnevenScales) {
         world.vertices.push_back(w);
       }
       world.triangles.push_back(placed);
-      owner.push_back({id, uint32_t(tri)});
+      owner.push_back({id.index, uint32_t(tri)});
     }
   }
   scene.commit();

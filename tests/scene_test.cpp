@@ -12,6 +12,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <random>
 #include <string>
 
@@ -105,13 +106,17 @@ Level make_level(const std::string& layout, size_t count, double spread, double 
   return level;
 }
 
+// The scene's mesh and instance at an index (the oracle's numbers).
+MeshId mesh_of(const Scene& scene, uint32_t index) { return {index, scene.number()}; }
+InstanceId instance_of(const Scene& scene, uint32_t index) { return {index, scene.number()}; }
+
 Scene make_scene(const Level& level) {
   Scene scene;
   for (size_t m = 0; m < level.blobs.size(); ++m) scene.add_mesh(level.blobs[m], "level mesh " + std::to_string(m));
   for (size_t i = 0; i < level.instances.size(); ++i) {
     const OracleInstance& o = level.instances[i];
-    EXPECT_EQ(scene.add_instance(o.mesh, o.transform, o.mask, o.flip_facing), o.id);
-    if (!level.enabled[i]) scene.set_enabled(o.id, false);
+    EXPECT_EQ(scene.add_instance(mesh_of(scene, o.mesh), o.transform, o.mask, o.flip_facing).index, o.id);
+    if (!level.enabled[i]) scene.set_enabled(instance_of(scene, o.id), false);
   }
   scene.commit();
   return scene;
@@ -498,9 +503,9 @@ TEST(Scene, MirroredInstancesFaceAsTheirMesh) {
     // Flipped after the first commit; a new transform keeps the flag.
     for (uint32_t k : {2u, 3u}) {
       level.instances[k].flip_facing = true;
-      scene.set_flip_facing(k, true);
+      scene.set_flip_facing(instance_of(scene, k), true);
     }
-    scene.set_transform(3, level.instances[3].transform);
+    scene.set_transform(instance_of(scene, 3), level.instances[3].transform);
     scene.commit();
     const SceneOracle oracle = oracle_of(level);
     std::normal_distribution<double> n(0, 1);
@@ -772,19 +777,19 @@ TEST(Scene, EditsShowAfterCommitAndSnapshotsKeepTheirFrame) {
       const uint32_t id = rng() % uint32_t(level.instances.size());
       if (level.instances[id].mask == 0) continue;  // removed
       level.instances[id].transform = random_transform(rng, 40, 0, k % 2 == 0, k == 3);
-      scene.set_transform(id, level.instances[id].transform);
+      scene.set_transform(instance_of(scene, id), level.instances[id].transform);
     }
     const uint32_t hide = rng() % uint32_t(level.instances.size()), show = rng() % uint32_t(level.instances.size());
-    if (level.instances[hide].mask != 0) scene.set_enabled(hide, false), level.enabled[hide] = false;
-    if (level.instances[show].mask != 0) scene.set_enabled(show, true), level.enabled[show] = true;
+    if (level.instances[hide].mask != 0) scene.set_enabled(instance_of(scene, hide), false), level.enabled[hide] = false;
+    if (level.instances[show].mask != 0) scene.set_enabled(instance_of(scene, show), true), level.enabled[show] = true;
     const uint32_t gone = rng() % uint32_t(level.instances.size());
     if (level.instances[gone].mask != 0) {
-      scene.remove_instance(gone);
+      scene.remove_instance(instance_of(scene, gone));
       level.instances[gone].mask = 0, level.enabled[gone] = false;  // an oracle instance no ray mask reaches
-      EXPECT_THROW(scene.set_mask(gone, 1), UsageError);
+      EXPECT_THROW(scene.set_mask(instance_of(scene, gone), 1), UsageError);
     }
     const OracleInstance added{uint32_t(level.instances.size()), uint32_t(frame % 3), random_transform(rng, 40, 0, true, false), 0xFF};
-    EXPECT_EQ(scene.add_instance(added.mesh, added.transform), added.id);
+    EXPECT_EQ(scene.add_instance(mesh_of(scene, added.mesh), added.transform), instance_of(scene, added.id));
     level.instances.push_back(added), level.enabled.push_back(true);
     // Not committed yet: the last frame's answers, every one.
     const std::vector<SceneHit> uncommitted = trace(scene, rays);
@@ -828,23 +833,23 @@ TEST(Scene, ReferencedBlobsAnswerAsCopies) {
   Scene shared, viewed;
   for (size_t m = 0; m < files.size(); ++m) {
     const std::string name = "level mesh " + std::to_string(m);
-    EXPECT_EQ(shared.add_mesh(std::shared_ptr(files[m]), name), m);
-    EXPECT_EQ(viewed.add_mesh(BlobView(files[m]->bytes(), name), name), m);
+    EXPECT_EQ(shared.add_mesh(std::shared_ptr(files[m]), name), mesh_of(shared, uint32_t(m)));
+    EXPECT_EQ(viewed.add_mesh(BlobView(files[m]->bytes(), name), name), mesh_of(viewed, uint32_t(m)));
   }
   for (Scene* s : {&shared, &viewed}) {
     for (size_t i = 0; i < level.instances.size(); ++i) {
       const OracleInstance& o = level.instances[i];
-      s->add_instance(o.mesh, o.transform, o.mask, o.flip_facing);
-      if (!level.enabled[i]) s->set_enabled(o.id, false);
+      s->add_instance(mesh_of(*s, o.mesh), o.transform, o.mask, o.flip_facing);
+      if (!level.enabled[i]) s->set_enabled(instance_of(*s, o.id), false);
     }
     s->commit();
   }
   // Held once: the scenes walk the mapped pages; only the copy counts bytes.
   for (size_t m = 0; m < files.size(); ++m) {
-    EXPECT_EQ(shared.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
-    EXPECT_EQ(viewed.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
-    EXPECT_EQ(viewed.mesh_blob(MeshId(m)).size(), level.blobs[m].size()) << m;
-    EXPECT_NE(copied.mesh_blob(MeshId(m)).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(shared.mesh_blob(mesh_of(shared, uint32_t(m))).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(viewed.mesh_blob(mesh_of(viewed, uint32_t(m))).data(), files[m]->bytes().data()) << m;
+    EXPECT_EQ(viewed.mesh_blob(mesh_of(viewed, uint32_t(m))).size(), level.blobs[m].size()) << m;
+    EXPECT_NE(copied.mesh_blob(mesh_of(copied, uint32_t(m))).data(), files[m]->bytes().data()) << m;
   }
   EXPECT_GE(copied.owned_blob_bytes(), blob_bytes);
   {  // A vector moved in is kept where it lies.
@@ -856,7 +861,8 @@ TEST(Scene, ReferencedBlobsAnswerAsCopies) {
   }
   EXPECT_EQ(shared.owned_blob_bytes(), 0u);
   EXPECT_EQ(viewed.owned_blob_bytes(), 0u);
-  EXPECT_THROW(viewed.mesh_blob(MeshId(files.size())), UsageError);
+  EXPECT_THROW(viewed.mesh_blob(mesh_of(viewed, uint32_t(files.size()))), UsageError);
+  EXPECT_THROW(viewed.mesh_blob(mesh_of(shared, 0)), UsageError);  // another scene's
   // The caller lets go of its mappings: the shared scene keeps its own.
   std::vector<const uint8_t*> mapped_at;
   for (const auto& f : files) mapped_at.push_back(f->bytes().data());
@@ -1023,11 +1029,11 @@ TEST(Scene, FramesOfMovesAlone) {
     for (int k = 0; k < 8; ++k) {
       const uint32_t id = rng() % uint32_t(level.instances.size());
       level.instances[id].transform = random_transform(rng, 60, 1e7, k % 2 == 0, k % 3 == 0);
-      scene.set_transform(id, level.instances[id].transform);
+      scene.set_transform(instance_of(scene, id), level.instances[id].transform);
     }
     const uint32_t remask = rng() % uint32_t(level.instances.size());
     level.instances[remask].mask = uint8_t(1u << (frame % 3));
-    scene.set_mask(remask, level.instances[remask].mask);
+    scene.set_mask(instance_of(scene, remask), level.instances[remask].mask);
     scene.commit();
     const Judged j = judge(oracle_of(level), rays, trace(scene, rays, Query::Closest, Cull::None, 0x03), Cull::None, 0x03, false);
     EXPECT_EQ(j.wrong, 0u) << "frame " << frame << ": " << j.first_problem;
@@ -1103,7 +1109,7 @@ TEST(Scene, CommitsOfNothing) {
   scene.set_transform(a, Transform{});  // back under the ray
   scene.commit();
   scene.trace(rays, hits);
-  EXPECT_EQ(hits[0].instance, a);
+  EXPECT_EQ(hits[0].instance, a.index);
 }
 
 // A scene given meshes and instances, cast before its first commit: every
@@ -1140,6 +1146,53 @@ TEST(Scene, CastsBeforeTheFirstCommitAreRefused) {
   EXPECT_EQ(hits[0].instance, kNoHit);
 }
 
+// An id is good with the scene that gave it alone: another scene refuses
+// it by name, though its index is one the scene gave too, as it refuses a
+// default-made id; a refused edit changes nothing. A moved scene keeps its
+// number, so the ids it gave stay good.
+TEST(Scene, RefusesIdsOfAnotherScene) {
+  const std::vector<uint8_t> blob = build_blob(make_sphere(4, 6, 1, {0, 0, 0}), parse_layout("AABBTree/Float3"), "s");
+  Scene scene, other;
+  const MeshId mine = scene.add_mesh(blob, "s"), theirs = other.add_mesh(blob, "s");
+  const InstanceId placed = scene.add_instance(mine, Transform{});
+  const InstanceId their_placed = other.add_instance(theirs, Transform{});
+  EXPECT_EQ(mine.index, theirs.index);
+  EXPECT_EQ(placed.index, their_placed.index);
+  EXPECT_NE(scene.number(), other.number());
+  auto refused = [](const std::function<void()>& edit, const std::string& words) {
+    try {
+      edit();
+      ADD_FAILURE() << "accepted: " << words;
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  const std::string given_by_other = "was given by another scene (scene " + std::to_string(other.number()) + ")";
+  refused([&] { scene.add_instance(theirs, Transform{}); }, "Scene::add_instance: mesh 0 " + given_by_other);
+  refused([&] { scene.mesh_blob(theirs); }, given_by_other);
+  Transform moved;
+  moved.translation[0] = 100;
+  refused([&] { scene.set_transform(their_placed, moved); }, "Scene::set_transform: instance 0 " + given_by_other);
+  refused([&] { scene.set_mask(their_placed, 0); }, given_by_other);
+  refused([&] { scene.set_flip_facing(their_placed, true); }, given_by_other);
+  refused([&] { scene.set_enabled(their_placed, false); }, given_by_other);
+  refused([&] { scene.remove_instance(their_placed); }, given_by_other);
+  refused([&] { scene.set_mask(InstanceId{}, 0); }, "no scene (a default-made id)");
+  scene.commit();
+  const std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}};
+  std::vector<SceneHit> hits(1);
+  scene.trace(rays, hits);
+  EXPECT_EQ(hits[0].instance, placed.index);
+  EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
+  EXPECT_EQ(scene.instance_count(), 1u);
+  // Moved, the scene keeps its number and its ids.
+  Scene moved_to = std::move(scene);
+  moved_to.set_transform(placed, moved);
+  moved_to.commit();
+  moved_to.trace(rays, hits);
+  EXPECT_EQ(hits[0].instance, kNoHit);
+}
+
 TEST(Scene, RefusesBadInput) {
   Scene scene;
   EXPECT_THROW(scene.add_mesh({1, 2, 3}, "three bytes"), InputError);
@@ -1153,10 +1206,10 @@ TEST(Scene, RefusesBadInput) {
   Transform far;
   far.translation[2] = 1e31;
   EXPECT_THROW(scene.add_instance(m, far), UsageError);
-  EXPECT_THROW(scene.add_instance(m + 1, Transform{}), UsageError);
+  EXPECT_THROW(scene.add_instance(MeshId{m.index + 1, m.scene}, Transform{}), UsageError);
   const InstanceId id = scene.add_instance(m, Transform{});
   EXPECT_THROW(scene.set_transform(id, flat), UsageError);
-  EXPECT_THROW(scene.set_enabled(id + 1, false), UsageError);
+  EXPECT_THROW(scene.set_enabled(InstanceId{id.index + 1, id.scene}, false), UsageError);
   scene.commit();
   // The refused transform left the instance where it was.
   std::vector<RayD> rays = {{{0, 0, 5}, {0, 0, -1}, INFINITY}, {{NAN, 0, 5}, {0, 0, -1}, INFINITY},
@@ -1166,7 +1219,7 @@ TEST(Scene, RefusesBadInput) {
   // The NaN origin, the far origin, the zero direction, the NaN t_min and
   // t_min past t_max.
   EXPECT_EQ(scene.trace(rays, hits), 5u);
-  EXPECT_EQ(hits[0].instance, id);
+  EXPECT_EQ(hits[0].instance, id.index);
   EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
   for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(hits[i].instance, kNoHit);
   std::vector<SceneHit> short_hits(1);
@@ -1178,7 +1231,7 @@ TEST(Scene, RefusesBadInput) {
   lists.max_hits = 2;
   EXPECT_EQ(scene.trace_all_hits(rays, lists), 5u);
   EXPECT_GE(lists.found[0], 2u);  // through both poles: every triangle around each, once
-  EXPECT_EQ(lists.row(0)[0].instance, id);
+  EXPECT_EQ(lists.row(0)[0].instance, id.index);
   EXPECT_FLOAT_EQ(lists.row(0)[0].t, 4.0f);
   // The rays not walked: empty rows, nothing held for them.
   for (size_t i = 1; i < rays.size(); ++i) EXPECT_EQ(lists.found[i], 0u) << "ray " << i;
@@ -1210,7 +1263,7 @@ TEST(Scene, RefusesBadInput) {
   // A moved-from scene refuses every call.
   Scene moved = std::move(empty);
   EXPECT_THROW(empty.commit(), UsageError);
-  EXPECT_THROW(empty.add_instance(0, Transform{}), UsageError);
+  EXPECT_THROW(empty.add_instance(m, Transform{}), UsageError);
   EXPECT_THROW(empty.instance_count(), UsageError);
   EXPECT_THROW(empty.trace(rays, hits), UsageError);
 }

@@ -94,6 +94,22 @@ public struct Ticket {
   public uint Slot, Reserved;
 }
 
+/// <summary>A mesh a scene gave (meshcast_mesh_id): good with that scene
+/// alone, another refuses it. Index counts the scene's meshes from 0.</summary>
+[StructLayout(LayoutKind.Sequential)]
+public struct MeshId {
+  public ulong Scene;
+  public uint Index, Reserved;
+}
+
+/// <summary>An instance a scene gave (meshcast_instance_id): good with that
+/// scene alone. Index is what hits report (SceneHit.Instance).</summary>
+[StructLayout(LayoutKind.Sequential)]
+public struct InstanceId {
+  public ulong Scene;
+  public uint Index, Reserved;
+}
+
 /// <summary>What a batch cost and where it ran (meshcast_batch_record).</summary>
 [StructLayout(LayoutKind.Sequential)]
 public struct BatchRecord {
@@ -163,14 +179,14 @@ static class Native {
                                                                              float maxDistance, uint threads,
                                                                              [Out] ClosestPoint[] output, ulong capacity);
   [DllImport(Lib)] internal static extern Status meshcast_scene_create(out IntPtr scene);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_add_mesh(IntPtr scene, IntPtr blob, out uint mesh);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_add_instance(IntPtr scene, uint mesh, ref Transform transform,
-                                                                            uint mask, uint flipFacing, out uint instance);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_set_transform(IntPtr scene, uint instance, ref Transform transform);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_set_mask(IntPtr scene, uint instance, uint mask);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_set_flip_facing(IntPtr scene, uint instance, uint flip);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_set_enabled(IntPtr scene, uint instance, uint enabled);
-  [DllImport(Lib)] internal static extern Status meshcast_scene_remove_instance(IntPtr scene, uint instance);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_add_mesh(IntPtr scene, IntPtr blob, out MeshId mesh);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_add_instance(IntPtr scene, MeshId mesh, ref Transform transform,
+                                                                            uint mask, uint flipFacing, out InstanceId instance);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_set_transform(IntPtr scene, InstanceId instance, ref Transform transform);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_set_mask(IntPtr scene, InstanceId instance, uint mask);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_set_flip_facing(IntPtr scene, InstanceId instance, uint flip);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_set_enabled(IntPtr scene, InstanceId instance, uint enabled);
+  [DllImport(Lib)] internal static extern Status meshcast_scene_remove_instance(IntPtr scene, InstanceId instance);
   [DllImport(Lib)] internal static extern Status meshcast_scene_commit(IntPtr scene);
   [DllImport(Lib)] internal static extern Status meshcast_scene_cast(IntPtr scene, [In] RayD[] rays, ulong count, ref Query query,
                                                                     [Out] SceneHit[] hits, ulong capacity, out ulong notWalkable);
@@ -362,22 +378,22 @@ public sealed class Scene : Handle {
   protected override Status Release(IntPtr pointer) => Native.meshcast_scene_release(pointer);
 
   /// <summary>The scene keeps the blob's bytes: the blob may be disposed after.</summary>
-  public uint AddMesh(Blob blob) {
+  public MeshId AddMesh(Blob blob) {
     Native.Check(Native.meshcast_scene_add_mesh(Live, blob.Live, out var mesh));
     return mesh;
   }
-  public uint AddInstance(uint mesh, Transform transform, byte mask = 0xFF, bool flipFacing = false) {
+  public InstanceId AddInstance(MeshId mesh, Transform transform, byte mask = 0xFF, bool flipFacing = false) {
     Native.Check(Native.meshcast_scene_add_instance(Live, mesh, ref transform, mask, flipFacing ? 1u : 0u, out var id));
     return id;
   }
-  public void SetTransform(uint instance, Transform transform) =>
+  public void SetTransform(InstanceId instance, Transform transform) =>
       Native.Check(Native.meshcast_scene_set_transform(Live, instance, ref transform));
-  public void SetMask(uint instance, byte mask) => Native.Check(Native.meshcast_scene_set_mask(Live, instance, mask));
-  public void SetFlipFacing(uint instance, bool flip) =>
+  public void SetMask(InstanceId instance, byte mask) => Native.Check(Native.meshcast_scene_set_mask(Live, instance, mask));
+  public void SetFlipFacing(InstanceId instance, bool flip) =>
       Native.Check(Native.meshcast_scene_set_flip_facing(Live, instance, flip ? 1u : 0u));
-  public void SetEnabled(uint instance, bool enabled) =>
+  public void SetEnabled(InstanceId instance, bool enabled) =>
       Native.Check(Native.meshcast_scene_set_enabled(Live, instance, enabled ? 1u : 0u));
-  public void RemoveInstance(uint instance) => Native.Check(Native.meshcast_scene_remove_instance(Live, instance));
+  public void RemoveInstance(InstanceId instance) => Native.Check(Native.meshcast_scene_remove_instance(Live, instance));
   /// <summary>The edits so far, seen by the casts from now on.</summary>
   public void Commit() => Native.Check(Native.meshcast_scene_commit(Live));
 

@@ -47,7 +47,7 @@ extern "C" {
 
 /* The API's version: a program built against major M runs on a library
  * of major M and any minor at or above its header's. */
-#define MESHCAST_C_API_VERSION_MAJOR 1
+#define MESHCAST_C_API_VERSION_MAJOR 2
 #define MESHCAST_C_API_VERSION_MINOR 0
 #define MESHCAST_C_API_VERSION ((MESHCAST_C_API_VERSION_MAJOR << 16) | MESHCAST_C_API_VERSION_MINOR)
 
@@ -255,23 +255,40 @@ typedef struct meshcast_transform {
 } meshcast_transform;
 MESHCAST_C_API void meshcast_transform_identity(meshcast_transform* transform);
 
+/* A mesh or an instance a scene gave. index counts from 0 in the order
+ * they were added (a meshcast_scene_hit's instance is its instance's
+ * index); scene is the number of the scene that gave it, never given to
+ * another scene of the process, which refuses the id (MESHCAST_ERROR_USAGE)
+ * as a caster refuses another caster's ticket. */
+typedef struct meshcast_mesh_id {
+  uint64_t scene;
+  uint32_t index;
+  uint32_t reserved;
+} meshcast_mesh_id;
+typedef struct meshcast_instance_id {
+  uint64_t scene;
+  uint32_t index;
+  uint32_t reserved;
+} meshcast_instance_id;
+
 MESHCAST_C_API meshcast_status meshcast_scene_create(meshcast_scene** out);
 /* The scene keeps the blob's bytes (the blob may be released after). */
 MESHCAST_C_API meshcast_status meshcast_scene_add_mesh(meshcast_scene* scene, const meshcast_blob* blob,
-                                                       uint32_t* mesh_id);
+                                                       meshcast_mesh_id* mesh);
 /* transform NULL: the identity. mask: 8 bits. flip_facing: 1 turns its
  * faces (culling then drops the mesh's front faces). */
-MESHCAST_C_API meshcast_status meshcast_scene_add_instance(meshcast_scene* scene, uint32_t mesh_id,
+MESHCAST_C_API meshcast_status meshcast_scene_add_instance(meshcast_scene* scene, meshcast_mesh_id mesh,
                                                            const meshcast_transform* transform, uint32_t mask,
-                                                           uint32_t flip_facing, uint32_t* instance_id);
-MESHCAST_C_API meshcast_status meshcast_scene_set_transform(meshcast_scene* scene, uint32_t instance_id,
+                                                           uint32_t flip_facing, meshcast_instance_id* instance);
+MESHCAST_C_API meshcast_status meshcast_scene_set_transform(meshcast_scene* scene, meshcast_instance_id instance,
                                                             const meshcast_transform* transform);
-MESHCAST_C_API meshcast_status meshcast_scene_set_mask(meshcast_scene* scene, uint32_t instance_id, uint32_t mask);
-MESHCAST_C_API meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* scene, uint32_t instance_id,
+MESHCAST_C_API meshcast_status meshcast_scene_set_mask(meshcast_scene* scene, meshcast_instance_id instance,
+                                                       uint32_t mask);
+MESHCAST_C_API meshcast_status meshcast_scene_set_flip_facing(meshcast_scene* scene, meshcast_instance_id instance,
                                                               uint32_t flip_facing);
-MESHCAST_C_API meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, uint32_t instance_id,
+MESHCAST_C_API meshcast_status meshcast_scene_set_enabled(meshcast_scene* scene, meshcast_instance_id instance,
                                                           uint32_t enabled);
-MESHCAST_C_API meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, uint32_t instance_id);
+MESHCAST_C_API meshcast_status meshcast_scene_remove_instance(meshcast_scene* scene, meshcast_instance_id instance);
 /* The edits so far are seen by the casts from now on. A scene given a mesh
  * or an instance is cast (or submitted to a caster) only once committed:
  * before its first commit, MESHCAST_ERROR_USAGE. */

@@ -100,8 +100,23 @@ struct Transform {
   double translation[3] = {0, 0, 0};
 };
 
-using MeshId = uint32_t;
-using InstanceId = uint32_t;
+// A mesh or an instance a scene gave. `index` counts from 0 in the order
+// they were added (a SceneHit's `instance` is its instance's index, for the
+// caller's own tables); `scene` is the number of the scene that gave it,
+// one a scene and never given twice in the process (as a caster's tickets
+// carry the caster's), so an id handed to another scene is refused with
+// UsageError, never taken for one of that scene's own. A scene moved keeps
+// its number, and the ids it gave stay good.
+template <class Kind>
+struct SceneId {
+  uint32_t index = UINT32_MAX;
+  uint64_t scene = 0;
+  friend bool operator==(const SceneId&, const SceneId&) = default;
+};
+struct MeshKind;
+struct InstanceKind;
+using MeshId = SceneId<MeshKind>;
+using InstanceId = SceneId<InstanceKind>;
 
 class SceneSnapshot;  // what one commit() made (internal: scene/snapshot.h)
 
@@ -131,7 +146,8 @@ class Scene {
   // method reads them only while a batch is begun, to upload them.
   MeshId add_mesh(const BlobView& blob, const std::string& name);
   // The bytes instances of `mesh` walk (the scene's copy, or the caller's
-  // where it shares or references them). UsageError for an unknown mesh.
+  // where it shares or references them). UsageError for an unknown mesh or
+  // another scene's.
   std::span<const uint8_t> mesh_blob(MeshId mesh) const;
   // The memory the scene holds for blob copies (add_mesh of a vector: each
   // vector's capacity, spare bytes included); shared and referenced
@@ -141,17 +157,18 @@ class Scene {
   // An instance of `mesh`, enabled, with an 8-bit mask (a ray's mask must
   // share a bit with it for the instance to be walked) and its faces as the
   // mesh has them, or turned with `flip_facing` (see Transform: Cull::Back
-  // then drops the mesh's front faces). UsageError for an unknown mesh, a
-  // transform that is not finite or not invertible, a 3x3 or inverse entry
-  // beyond 2^40, a translation or world box beyond 2^100 (kMaxCoordinate),
-  // or a 2^31st instance.
+  // then drops the mesh's front faces). UsageError for an unknown mesh or
+  // another scene's, a transform that is not finite or not invertible, a
+  // 3x3 or inverse entry beyond 2^40, a translation or world box beyond
+  // 2^100 (kMaxCoordinate), or a 2^31st instance.
   InstanceId add_instance(MeshId mesh, const Transform& transform, uint8_t mask = 0xFF, bool flip_facing = false);
-  // A new transform keeps the instance's mask and flip_facing.
+  // Each edit of an instance: UsageError for an unknown or removed id, or
+  // another scene's. A new transform keeps the instance's mask and flip_facing.
   void set_transform(InstanceId instance, const Transform& transform);
   void set_mask(InstanceId instance, uint8_t mask);
   void set_flip_facing(InstanceId instance, bool flip_facing);
   void set_enabled(InstanceId instance, bool enabled);
-  // The id is not given again. UsageError for an unknown or removed id.
+  // The id is not given again.
   void remove_instance(InstanceId instance);
 
   // The frame's changes are done: from now on traces see them (and not before: see snapshot()).
@@ -198,6 +215,9 @@ class Scene {
   // What the last commit() made, for a caster that keeps a batch on the scene it was submitted to (traces see that
   // frame). UsageError for a scene given a mesh or an instance but never committed (commit it first).
   std::shared_ptr<const SceneSnapshot> snapshot() const;
+
+  // The number every id this scene gives carries (see SceneId).
+  uint64_t number() const;
 
   size_t instance_count() const;  // not removed, committed or not
   // What the scene holds besides its meshes' blobs: the instances' records,

@@ -16,7 +16,7 @@ namespace meshcast::layout {
 // more; its world box lives with the scene's edits, builds and refits read
 // it there).
 struct PlacedInstance {
-  uint32_t id;           // the caller's InstanceId
+  uint32_t id;           // the caller's InstanceId's index
   uint32_t mesh;         // index into the snapshot's meshes
   uint32_t mask;         // 8 bits: a ray's mask must share one
   uint32_t flip_facing;  // 1 when the caller turned its faces (Scene::add_instance): its front is the mesh's back

@@ -63,14 +63,15 @@ import uuid as _uuid
 import numpy as _np
 
 from . import _meshcast, _shipping
+from ._scene_ids import InstanceId, MeshId  # noqa: F401
 from .images import write_png  # noqa: F401
 from ._meshcast import (NO_HIT, Blob, Scene, __version__, features, layouts,  # noqa: F401
                         walker_isa)
 
 # Tensor, the answers' type, is left out: help(meshcast) would repeat
 # numpy.ndarray's whole documentation under it.
-__all__ = ["Blob", "Scene", "RaycastingScene", "build", "load", "read_mesh", "layouts", "features",
-           "walker_isa", "write_png", "from_bytes", "NO_HIT", "__version__"]
+__all__ = ["Blob", "Scene", "MeshId", "InstanceId", "RaycastingScene", "build", "load", "read_mesh", "layouts",
+           "features", "walker_isa", "write_png", "from_bytes", "NO_HIT", "__version__"]
 
 # Blob's pickling: a mapped file's path, or the bytes (meshcast/_shipping.py).
 _shipping.install()

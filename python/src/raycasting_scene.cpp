@@ -851,7 +851,7 @@ class RaycastingScene {
     const InstanceId id = scene_.add_instance(mesh_id, placed);
     geometries_.push_back(std::make_shared<const Geometry>(std::move(normals), scene_.mesh_blob(mesh_id), name, centre));
     changed_ = true;
-    return id;
+    return id.index;
   }
   // A point in a geometry's frame, as its blob stores the mesh.
   static Vec3 local_point(const PointArrays& points, size_t i, const double centre[3]) {

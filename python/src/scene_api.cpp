@@ -6,8 +6,10 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <random>
 #include <vector>
 
+#include "meshcast/errors.h"
 #include "meshcast/scene.h"
 #include "python/src/answers.h"
 #include "python/src/arrays.h"
@@ -22,44 +24,90 @@ namespace meshcast::python {
 namespace {
 
 struct Placed {
-  MeshId mesh = 0;
+  uint32_t mesh = 0;  // the mesh's index
   Transform transform;
   uint8_t mask = 0xFF;
   bool flip_facing = false, enabled = true, removed = false;
 };
 
+// A scene's number for the ids it gives Python (meshcast/_scene_ids.py):
+// drawn at random, so that a scene pickled into another process keeps one
+// no scene of that process has.
+uint64_t drawn_scene_number() {
+  std::random_device device;
+  return (uint64_t(device()) << 32) ^ uint64_t(device());
+}
+
+// Python's ids: the int subclasses meshcast/_scene_ids.py defines.
+py::object python_id(const char* kind, uint32_t index, uint64_t number) {
+  return py::module_::import("meshcast._scene_ids").attr(kind)(index, number);
+}
+
 class PyScene {
  public:
-  MeshId add_mesh(const std::shared_ptr<PyBlob>& blob) {
+  explicit PyScene(uint64_t scene_number = drawn_scene_number()) : number(scene_number) {}
+
+  py::object add_mesh(const std::shared_ptr<PyBlob>& blob) {
     // A mapped file is shared with the scene; bytes built here are
     // referenced, and the Blob kept alive beside the scene.
     const MeshId id = blob->mapped() ? scene.add_mesh(blob->mapped_file(), blob->name())
                                      : scene.add_mesh(blob->view(), blob->name());
     blobs.push_back(blob);
-    return id;
+    return python_id("MeshId", id.index, number);
   }
-  InstanceId add_instance(MeshId mesh, const Transform& t, uint8_t mask, bool flip_facing) {
-    const InstanceId id = scene.add_instance(mesh, t, mask, flip_facing);
-    instances.resize(size_t(id) + 1);
-    instances[id] = {mesh, t, mask, flip_facing};
+  py::object add_instance(uint32_t mesh, const Transform& t, uint8_t mask, bool flip_facing) {
+    const InstanceId id = scene.add_instance(MeshId{mesh, scene.number()}, t, mask, flip_facing);
+    instances.resize(size_t(id.index) + 1);
+    instances[id.index] = {mesh, t, mask, flip_facing};
     edited = true;
-    return id;
+    return python_id("InstanceId", id.index, number);
+  }
+  // The index a Python id stands for: one this scene gave (or a copy of
+  // it), or a plain int taken as an index; another scene's is refused.
+  uint32_t index_of(const py::handle& id, const char* kind, const char* who) const {
+    const py::object scene_id = py::module_::import("meshcast._scene_ids").attr("SceneId");
+    if (py::isinstance(id, scene_id)) {
+      const py::object given_by = id.attr("scene");
+      if (!given_by.equal(py::int_(number)))
+        throw UsageError(std::string(who) + ": " + kind + " " + py::repr(id).cast<std::string>() +
+                         " was given by another scene, not this one");
+    }
+    // Any integer (numpy's too, as casts answer them), never a bool.
+    if (py::isinstance<py::bool_>(id) || !PyIndex_Check(id.ptr()))
+      throw py::type_error(std::string(who) + ": a " + kind + " id (an int) expected, " +
+                           py::str(py::type::of(id).attr("__name__")).cast<std::string>() + " found");
+    const py::int_ whole = py::reinterpret_steal<py::int_>(PyNumber_Index(id.ptr()));
+    if (!whole) throw py::error_already_set();
+    const bool fits = PyObject_RichCompareBool(whole.ptr(), py::int_(0).ptr(), Py_GE) == 1 &&
+                      PyObject_RichCompareBool(whole.ptr(), py::int_(0xFFFFFFFFu).ptr(), Py_LE) == 1;
+    if (!fits)
+      throw UsageError(std::string(who) + ": " + kind + " " + py::repr(whole).cast<std::string>() +
+                       " is unknown (ids count from 0 to 2^32 - 1)");
+    return whole.cast<uint32_t>();
+  }
+  InstanceId instance_id(const py::handle& id, const char* who) const {
+    return InstanceId{index_of(id, "instance", who), scene.number()};
   }
   // The instance's record, after the library has accepted an edit of it
   // (its error names an unknown or removed id first).
   Placed& edit(InstanceId i) {
     edited = true;
-    return instances.at(i);
+    return instances.at(i.index);
   }
-  void set_enabled(InstanceId i, bool enabled) {
+  void set_enabled(const py::handle& id, bool enabled) {
+    const InstanceId i = instance_id(id, "Scene.set_enabled");
     scene.set_enabled(i, enabled);
     edit(i).enabled = enabled;
   }
-  void remove_instance(InstanceId i) {
+  void remove_instance(const py::handle& id) {
+    const InstanceId i = instance_id(id, "Scene.remove_instance");
     scene.remove_instance(i);
     edit(i).removed = true;
   }
   std::vector<std::shared_ptr<PyBlob>> blobs;  // before the scene: they outlive it
+  // The number the ids this scene gives Python carry: its own, or, for a
+  // scene unpickled, the number of the scene pickled.
+  uint64_t number;
   Scene scene;
   // Each instance as last edited: set_transform's parts left as they were,
   // and what a pickled Scene replays.
@@ -143,9 +191,10 @@ py::dict closest_points_scene(const PyScene& s, const py::handle& points_in, dou
   return answer;
 }
 
-// A committed scene's state: (1, blobs, instances), each instance (mesh,
-// rotation_scale (9 floats, row-major), translation (3 doubles), mask,
-// flip_facing, enabled, removed).
+// A committed scene's state: (2, blobs, instances, number), each instance
+// (mesh, rotation_scale (9 floats, row-major), translation (3 doubles),
+// mask, flip_facing, enabled, removed), and the number its ids carry.
+// Version 1's (no number) loads as a scene of a number of its own.
 py::object scene_state(const PyScene& s) {
   if (s.edited)
     throw py::value_error("Scene: edits since the last commit(); commit them (or undo them) before pickling");
@@ -157,15 +206,17 @@ py::object scene_state(const PyScene& s) {
     for (double v : p.transform.translation) t.append(v);
     instances.append(py::make_tuple(p.mesh, m, t, p.mask, p.flip_facing, p.enabled, p.removed));
   }
-  return py::make_tuple(1, blobs, instances);
+  return py::make_tuple(2, blobs, instances, s.number);
 }
 
 std::unique_ptr<PyScene> scene_from_state(const py::object& pickled_state) {
   const std::string of = "Scene: the pickled state";
   const py::tuple state = pickled<py::tuple>(pickled_state, of, "a tuple");
-  if (state.size() != 3 || pickled<long long>(state[0], of + "'s version", "an int") != 1)
+  const long long version = state.empty() ? 0 : pickled<long long>(state[0], of + "'s version", "an int");
+  if (!(version == 1 && state.size() == 3) && !(version == 2 && state.size() == 4))
     throw py::value_error("Scene: a pickled state of another version of meshcast");
-  auto s = std::make_unique<PyScene>();
+  auto s = version == 2 ? std::make_unique<PyScene>(pickled<uint64_t>(state[3], of + "'s number", "an int"))
+                        : std::make_unique<PyScene>();
   for (const py::handle b : pickled<py::list>(state[1], of + "'s blobs", "a list")) {
     const std::string what = of + "'s blob " + std::to_string(s->blobs.size());
     if (!py::isinstance<PyBlob>(b)) throw pickled_error(b, what, "a meshcast.Blob");
@@ -181,7 +232,7 @@ std::unique_ptr<PyScene> scene_from_state(const py::object& pickled_state) {
     Transform placed;
     std::copy(m.begin(), m.end(), placed.rotation_scale);
     std::copy(t.begin(), t.end(), placed.translation);
-    const InstanceId id = s->add_instance(pickled<MeshId>(i[0], what + " mesh", "a mesh id (an int)"), placed,
+    const py::object id = s->add_instance(pickled<uint32_t>(i[0], what + " mesh", "a mesh index (an int)"), placed,
                                           checked_mask(pickled<long long>(i[3], what + " mask", "an int")),
                                           pickled<bool>(i[4], what + " flip_facing", "a bool"));
     if (!pickled<bool>(i[5], what + " enabled", "a bool")) s->set_enabled(id, false);
@@ -203,23 +254,29 @@ by casts after commit(). One thread edits and commits; any number cast.
 Pickled (pickle, Dask, multiprocessing), a committed scene travels as its
 blobs, each once (a mapped one as its file's path), and its instance table.)")
       .def(py::init<>())
-      .def("add_mesh", &PyScene::add_mesh, py::arg("blob"), "Adds a Blob (kept alive by the scene); returns its mesh id.")
+      .def("add_mesh", &PyScene::add_mesh, py::arg("blob"),
+           "Adds a Blob (kept alive by the scene); returns its MeshId (0, 1, ... in order).")
       .def(
           "add_instance",
-          [](PyScene& s, MeshId mesh, const py::handle& rotation_scale, const py::handle& translation, long long mask,
-             bool flip_facing) {
-            return s.add_instance(mesh, transform_from(rotation_scale, translation), checked_mask(mask), flip_facing);
+          [](PyScene& s, const py::handle& mesh, const py::handle& rotation_scale, const py::handle& translation,
+             long long mask, bool flip_facing) {
+            const Transform t = transform_from(rotation_scale, translation);
+            return s.add_instance(s.index_of(mesh, "mesh", "Scene.add_instance"), t, checked_mask(mask), flip_facing);
           },
           py::arg("mesh"), py::arg("rotation_scale") = py::none(), py::arg("translation") = py::none(),
           py::arg("mask") = 0xFF, py::arg("flip_facing") = false,
-          "A placed copy of a mesh; returns its instance id (0, 1, ... in order).")
+          R"(A placed copy of a mesh; returns its InstanceId (0, 1, ... in order).
+
+Ids are ints that remember their scene: another scene refuses them
+(ValueError); a plain int is taken as an index of this scene.)")
       .def(
           "set_transform",
-          [](PyScene& s, InstanceId i, const py::handle& rotation_scale, const py::handle& translation) {
-            if (i >= s.instances.size()) {
+          [](PyScene& s, const py::handle& id, const py::handle& rotation_scale, const py::handle& translation) {
+            const InstanceId i = s.instance_id(id, "Scene.set_transform");
+            if (i.index >= s.instances.size()) {
               s.scene.set_transform(i, Transform{});  // the library's error, naming the instance
             }
-            const Transform t = transform_from(rotation_scale, translation, s.instances[i].transform);
+            const Transform t = transform_from(rotation_scale, translation, s.instances[i.index].transform);
             s.scene.set_transform(i, t);
             s.edit(i).transform = t;
           },
@@ -227,14 +284,16 @@ blobs, each once (a mapped one as its file's path), and its instance table.)")
           "A new rotation_scale, translation or both; a part not given is kept.")
       .def(
           "set_mask",
-          [](PyScene& s, InstanceId i, long long mask) {
+          [](PyScene& s, const py::handle& id, long long mask) {
+            const InstanceId i = s.instance_id(id, "Scene.set_mask");
             s.scene.set_mask(i, checked_mask(mask));
             s.edit(i).mask = uint8_t(mask);
           },
           py::arg("instance"), py::arg("mask"))
       .def(
           "set_flip_facing",
-          [](PyScene& s, InstanceId i, bool flip) {
+          [](PyScene& s, const py::handle& id, bool flip) {
+            const InstanceId i = s.instance_id(id, "Scene.set_flip_facing");
             s.scene.set_flip_facing(i, flip);
             s.edit(i).flip_facing = flip;
           },

@@ -215,14 +215,17 @@ def test_normals_altered_in_a_raycasting_scene_pickle_are_never_answered():
 
 def test_a_pickled_state_of_other_types_is_refused_naming_them():
     scene, _ = _scene()
-    version, blobs, instances = scene.__getstate__()
-    for state, message in (((version, ["a blob"] + blobs[1:], instances),
+    version, blobs, instances, number = scene.__getstate__()
+    for state, message in (((version, ["a blob"] + blobs[1:], instances, number),
                             r"Scene: the pickled state's blob 0: a meshcast\.Blob expected, str 'a blob' found"),
-                           ((version, blobs, [("0",) + tuple(instances[0][1:])] + instances[1:]),
-                            r"Scene: the pickled state's instance 0 mesh: a mesh id \(an int\) expected, str '0' found"),
-                           ((version, tuple(blobs), instances),
+                           ((version, blobs, [("0",) + tuple(instances[0][1:])] + instances[1:], number),
+                            r"Scene: the pickled state's instance 0 mesh: a mesh index \(an int\) expected, str '0' "),
+                           ((version, tuple(blobs), instances, number),
                             r"Scene: the pickled state's blobs: a list expected, tuple found"),
-                           (list((version, blobs, instances)), r"Scene: the pickled state: a tuple expected, list found")):
+                           ((version, blobs, instances, "7"),
+                            r"Scene: the pickled state's number: an int expected, str '7' found"),
+                           (list((version, blobs, instances, number)),
+                            r"Scene: the pickled state: a tuple expected, list found")):
         twin = meshcast.Scene.__new__(meshcast.Scene)
         with pytest.raises(TypeError, match=message):
             twin.__setstate__(state)
@@ -289,3 +292,24 @@ def test_spawned_processes_take_blobs_directly(tmp_path):
             answer, arrivals = pool.apply(_cast_in_child, (blob, o, d))
             _equal(answer, blob.cast(o, d))
             assert arrivals[kind] == 1
+
+
+def test_a_scene_pickled_keeps_its_ids_and_refuses_others():
+    scene, v = _scene()
+    state = scene.__getstate__()
+    twin = pickle.loads(pickle.dumps(scene))
+    sphere = meshcast.Scene().add_mesh(meshcast.build(v, shapes.sphere()[1]))
+    mine = twin.add_instance(0, translation=[0.0, 0.0, 9.0])
+    assert state[0] == 2 and mine.scene == state[3] == scene.add_instance(0).scene  # the copy's ids are the scene's
+    twin.set_mask(mine, 4)  # good with the copy
+    with pytest.raises(ValueError, match="another scene"):
+        twin.add_instance(sphere)
+    for carried in (pickle.loads(pickle.dumps(mine)), copy.deepcopy(mine)):
+        assert type(carried) is meshcast.InstanceId and (carried, carried.scene) == (mine, mine.scene)
+    # A state of the version before numbers loads as a scene of its own.
+    old = meshcast.Scene.__new__(meshcast.Scene)
+    old.__setstate__((1,) + state[1:3])
+    assert old.instance_count == 4
+    with pytest.raises(ValueError, match="another scene"):
+        old.set_mask(mine, 1)
+    old.set_mask(int(mine) - 1, 1)

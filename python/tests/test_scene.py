@@ -229,3 +229,36 @@ def test_scene_keeps_its_blobs(tmp_path):
     r = s.cast(o, d, query="all")
     np.testing.assert_array_equal(r["found"], 4)
     np.testing.assert_array_equal(r["t"].reshape(-1, 4), np.tile([4, 6, 8, 10], (9, 1)))
+
+
+def test_ids_of_another_scene_are_refused(cube_blob):
+    """An id is an int that remembers its scene: another scene refuses it by
+    name though its index is one that scene gave too; a plain int (or numpy's,
+    as casts answer) is an index of the scene it is given to."""
+    s, other = meshcast.Scene(), meshcast.Scene()
+    m, their_m = s.add_mesh(cube_blob), other.add_mesh(cube_blob)
+    a = s.add_instance(m, translation=(0.0, 0.0, 0.0))
+    theirs = other.add_instance(their_m)
+    assert (a, m) == (theirs, their_m) == (0, 0)
+    assert isinstance(a, meshcast.InstanceId) and isinstance(m, meshcast.MeshId)
+    assert a.scene != theirs.scene
+    for edit in (lambda: s.add_instance(their_m), lambda: s.set_transform(theirs, translation=(1.0, 0.0, 0.0)),
+                 lambda: s.set_mask(theirs, 0), lambda: s.set_flip_facing(theirs, True),
+                 lambda: s.set_enabled(theirs, False), lambda: s.remove_instance(theirs)):
+        with pytest.raises(ValueError, match="was given by another scene"):
+            edit()
+    with pytest.raises(TypeError, match="an int"):
+        s.set_mask(True, 1)
+    with pytest.raises(ValueError, match="unknown"):
+        s.set_mask(-1, 1)
+    with pytest.raises(ValueError, match="unknown"):
+        s.set_mask(2 ** 40, 1)
+    s.commit()
+    o, d = down_rays(footprint(0, 0, 1, 1))
+    r = s.cast(o, d)
+    np.testing.assert_array_equal(r["instance"], a)  # nothing refused changed the scene
+    s.set_mask(r["instance"][0], 0x02)  # an index as casts answer it
+    s.set_enabled(0, False)
+    s.commit()
+    np.testing.assert_array_equal(s.cast(o, d)["instance"], NO_HIT)
+    assert repr(a).startswith("InstanceId(0, scene=")

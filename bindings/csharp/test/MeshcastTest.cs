@@ -89,7 +89,7 @@ static class MeshcastTest {
     }
     using (var blob = Blob.Load(blobPath))
     using (var scene = new Scene()) {
-      uint m = scene.AddMesh(blob);
+      MeshId m = scene.AddMesh(blob);
       scene.AddInstance(m, Transform.Translate(0, 0, 0));
       scene.AddInstance(m, new Transform { RotationScale = new float[] { 0, -0.5f, 0, 0.5f, 0, 0, 0, 0, 0.5f },
                                            Translation = new double[] { 0, 0, 0 } });
@@ -153,15 +153,23 @@ static class MeshcastTest {
       Check(Math.Abs(near[0].Distance - 0.3f) < 1e-6f && near[0].Triangle == 0, "the nearest point");
 
       using (var scene = new Scene()) {
-        uint mesh = scene.AddMesh(blob);
-        uint far = scene.AddInstance(mesh, Transform.Translate(1e9, 0, 0));
-        uint near0 = scene.AddInstance(mesh, Transform.Translate(0, 0, 0), mask: 1);
+        MeshId mesh = scene.AddMesh(blob);
+        InstanceId far = scene.AddInstance(mesh, Transform.Translate(1e9, 0, 0));
+        InstanceId near0 = scene.AddInstance(mesh, Transform.Translate(0, 0, 0), mask: 1);
         scene.Commit();
         var sceneRays = new[] { new RayD(1e9 + 0.75, 0.25, 2, 0, 0, -1), new RayD(0.25, 0.75, 2, 0, 0, -1) };
         var sceneHits = new SceneHit[2];
         scene.Cast(sceneRays, sceneHits);
-        Check(sceneHits[0].Instance == far && sceneHits[0].Triangle == 2 && sceneHits[0].T == 1, "a far instance's hit");
-        Check(sceneHits[1].Instance == near0 && sceneHits[1].Triangle == 3, "the near instance's hit");
+        Check(sceneHits[0].Instance == far.Index && sceneHits[0].Triangle == 2 && sceneHits[0].T == 1, "a far instance's hit");
+        Check(sceneHits[1].Instance == near0.Index && sceneHits[1].Triangle == 3, "the near instance's hit");
+        using (var second = new Scene()) {
+          MeshId theirMesh = second.AddMesh(blob);
+          InstanceId theirs = second.AddInstance(theirMesh, Transform.Translate(0, 0, 0));
+          Check(theirs.Index == far.Index && theirs.Scene != far.Scene, "two scenes' first instances");
+          Throws<MeshcastException>(() => scene.SetEnabled(theirs, false), "another scene", "another scene's instance");
+          Throws<MeshcastException>(() => scene.AddInstance(theirMesh, Transform.Translate(0, 0, 0)), "another scene",
+                                    "another scene's mesh");
+        }
         scene.SetEnabled(near0, false);
         scene.Commit();
         scene.Cast(sceneRays, sceneHits);
@@ -183,7 +191,7 @@ static class MeshcastTest {
           Ticket ticket = scenes.SubmitScene(scene, sceneRays);
           var batch = new SceneHit[2];
           scenes.WaitScene(ticket, batch);
-          Check(batch[0].Instance == far && !batch[1].Found, "a scene batch");
+          Check(batch[0].Instance == far.Index && !batch[1].Found, "a scene batch");
         }
       }
     }

@@ -8,7 +8,7 @@
 
 use std::os::raw::{c_char, c_void};
 
-pub const MESHCAST_C_API_VERSION_MAJOR: u32 = 1;
+pub const MESHCAST_C_API_VERSION_MAJOR: u32 = 2;
 pub const MESHCAST_C_API_VERSION_MINOR: u32 = 0;
 pub const MESHCAST_C_API_VERSION: u32 = (MESHCAST_C_API_VERSION_MAJOR << 16) | MESHCAST_C_API_VERSION_MINOR;
 
@@ -162,6 +162,22 @@ pub struct meshcast_transform {
 }
 
 #[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct meshcast_mesh_id {
+    pub scene: u64,
+    pub index: u32,
+    pub reserved: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct meshcast_instance_id {
+    pub scene: u64,
+    pub index: u32,
+    pub reserved: u32,
+}
+
+#[repr(C)]
 pub struct meshcast_caster {
     _opaque: [u8; 0],
 }
@@ -235,17 +251,21 @@ extern "C" {
                                         out_capacity: u64) -> meshcast_status;
     pub fn meshcast_transform_identity(transform: *mut meshcast_transform);
     pub fn meshcast_scene_create(out: *mut *mut meshcast_scene) -> meshcast_status;
-    pub fn meshcast_scene_add_mesh(scene: *mut meshcast_scene, blob: *const meshcast_blob, mesh_id: *mut u32)
-                                   -> meshcast_status;
-    pub fn meshcast_scene_add_instance(scene: *mut meshcast_scene, mesh_id: u32, transform: *const meshcast_transform,
-                                       mask: u32, flip_facing: u32, instance_id: *mut u32) -> meshcast_status;
-    pub fn meshcast_scene_set_transform(scene: *mut meshcast_scene, instance_id: u32,
+    pub fn meshcast_scene_add_mesh(scene: *mut meshcast_scene, blob: *const meshcast_blob,
+                                   mesh: *mut meshcast_mesh_id) -> meshcast_status;
+    pub fn meshcast_scene_add_instance(scene: *mut meshcast_scene, mesh: meshcast_mesh_id,
+                                       transform: *const meshcast_transform, mask: u32, flip_facing: u32,
+                                       instance: *mut meshcast_instance_id) -> meshcast_status;
+    pub fn meshcast_scene_set_transform(scene: *mut meshcast_scene, instance: meshcast_instance_id,
                                         transform: *const meshcast_transform) -> meshcast_status;
-    pub fn meshcast_scene_set_mask(scene: *mut meshcast_scene, instance_id: u32, mask: u32) -> meshcast_status;
-    pub fn meshcast_scene_set_flip_facing(scene: *mut meshcast_scene, instance_id: u32, flip_facing: u32)
+    pub fn meshcast_scene_set_mask(scene: *mut meshcast_scene, instance: meshcast_instance_id, mask: u32)
+                                   -> meshcast_status;
+    pub fn meshcast_scene_set_flip_facing(scene: *mut meshcast_scene, instance: meshcast_instance_id,
+                                          flip_facing: u32) -> meshcast_status;
+    pub fn meshcast_scene_set_enabled(scene: *mut meshcast_scene, instance: meshcast_instance_id, enabled: u32)
+                                      -> meshcast_status;
+    pub fn meshcast_scene_remove_instance(scene: *mut meshcast_scene, instance: meshcast_instance_id)
                                           -> meshcast_status;
-    pub fn meshcast_scene_set_enabled(scene: *mut meshcast_scene, instance_id: u32, enabled: u32) -> meshcast_status;
-    pub fn meshcast_scene_remove_instance(scene: *mut meshcast_scene, instance_id: u32) -> meshcast_status;
     pub fn meshcast_scene_commit(scene: *mut meshcast_scene) -> meshcast_status;
     pub fn meshcast_scene_cast(scene: *const meshcast_scene, rays: *const meshcast_ray_d, ray_count: u64,
                                query: *const meshcast_query, hits: *mut meshcast_scene_hit, hit_capacity: u64,

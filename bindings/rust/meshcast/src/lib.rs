@@ -22,6 +22,8 @@ use meshcast_sys as sys;
 
 pub use sys::meshcast_closest_point as ClosestPoint;
 pub use sys::meshcast_hit as Hit;
+pub use sys::meshcast_instance_id as InstanceId;
+pub use sys::meshcast_mesh_id as MeshId;
 pub use sys::meshcast_ray as Ray;
 pub use sys::meshcast_ray_d as RayD;
 pub use sys::meshcast_scene_closest_point as SceneClosestPoint;
@@ -332,31 +334,36 @@ impl Scene {
         Ok(Scene { raw })
     }
     /// The scene keeps the blob's bytes: the blob may be dropped after.
-    pub fn add_mesh(&mut self, blob: &Blob) -> Result<u32> {
-        let mut id = 0;
+    /// The id is good with this scene alone: another scene refuses it
+    /// (`MESHCAST_ERROR_USAGE`); its `index` counts meshes from 0.
+    pub fn add_mesh(&mut self, blob: &Blob) -> Result<MeshId> {
+        let mut id = MeshId::default();
         check(unsafe { sys::meshcast_scene_add_mesh(self.raw, blob.raw, &mut id) })?;
         Ok(id)
     }
-    pub fn add_instance(&mut self, mesh: u32, transform: &Transform, mask: u8, flip_facing: bool) -> Result<u32> {
-        let mut id = 0;
+    /// The id is good with this scene alone, as add_mesh's; its `index` is
+    /// what hits report (`SceneHit::instance`).
+    pub fn add_instance(&mut self, mesh: MeshId, transform: &Transform, mask: u8, flip_facing: bool)
+                        -> Result<InstanceId> {
+        let mut id = InstanceId::default();
         check(unsafe {
             sys::meshcast_scene_add_instance(self.raw, mesh, transform, mask as u32, flip_facing as u32, &mut id)
         })?;
         Ok(id)
     }
-    pub fn set_transform(&mut self, instance: u32, transform: &Transform) -> Result<()> {
+    pub fn set_transform(&mut self, instance: InstanceId, transform: &Transform) -> Result<()> {
         check(unsafe { sys::meshcast_scene_set_transform(self.raw, instance, transform) })
     }
-    pub fn set_mask(&mut self, instance: u32, mask: u8) -> Result<()> {
+    pub fn set_mask(&mut self, instance: InstanceId, mask: u8) -> Result<()> {
         check(unsafe { sys::meshcast_scene_set_mask(self.raw, instance, mask as u32) })
     }
-    pub fn set_flip_facing(&mut self, instance: u32, flip: bool) -> Result<()> {
+    pub fn set_flip_facing(&mut self, instance: InstanceId, flip: bool) -> Result<()> {
         check(unsafe { sys::meshcast_scene_set_flip_facing(self.raw, instance, flip as u32) })
     }
-    pub fn set_enabled(&mut self, instance: u32, enabled: bool) -> Result<()> {
+    pub fn set_enabled(&mut self, instance: InstanceId, enabled: bool) -> Result<()> {
         check(unsafe { sys::meshcast_scene_set_enabled(self.raw, instance, enabled as u32) })
     }
-    pub fn remove_instance(&mut self, instance: u32) -> Result<()> {
+    pub fn remove_instance(&mut self, instance: InstanceId) -> Result<()> {
         check(unsafe { sys::meshcast_scene_remove_instance(self.raw, instance) })
     }
     /// The edits so far, seen by the casts from now on.

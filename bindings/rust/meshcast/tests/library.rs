@@ -140,6 +140,7 @@ fn known_answers_scenes_and_casters() {
 
     let mut scene = Scene::new().unwrap();
     let mesh = scene.add_mesh(&blob).unwrap();
+    let copy_for_second = Blob::from_bytes(blob.bytes()).unwrap();
     drop(blob); // the scene keeps its bytes
     let far = scene.add_instance(mesh, &meshcast::translation(1e9, 0.0, 0.0), 0xFF, false).unwrap();
     let near0 = scene.add_instance(mesh, &meshcast::translation(0.0, 0.0, 0.0), 1, false).unwrap();
@@ -147,14 +148,23 @@ fn known_answers_scenes_and_casters() {
     let scene_rays = [meshcast::ray_d([1e9 + 0.75, 0.25, 2.0], [0.0, 0.0, -1.0]), meshcast::ray_d([0.25, 0.75, 2.0], [0.0, 0.0, -1.0])];
     let mut scene_hits = [SceneHit::default(); 2];
     scene.cast(&scene_rays, &mut scene_hits, &Query::default()).unwrap();
-    assert_eq!((scene_hits[0].instance, scene_hits[0].triangle, scene_hits[0].t), (far, 2, 1.0));
-    assert_eq!((scene_hits[1].instance, scene_hits[1].triangle), (near0, 3));
+    assert_eq!((scene_hits[0].instance, scene_hits[0].triangle, scene_hits[0].t), (far.index, 2, 1.0));
+    assert_eq!((scene_hits[1].instance, scene_hits[1].triangle), (near0.index, 3));
+    // Another scene's ids are refused, though their indices are this one's too.
+    let mut second = Scene::new().unwrap();
+    let their_mesh = second.add_mesh(&copy_for_second).unwrap();
+    let theirs = second.add_instance(their_mesh, &meshcast::translation(0.0, 0.0, 0.0), 0xFF, false).unwrap();
+    assert_eq!((theirs.index, their_mesh.index), (far.index, mesh.index));
+    let refused = scene.set_enabled(theirs, false).unwrap_err();
+    assert!(refused.status == meshcast_sys::MESHCAST_ERROR_USAGE && refused.message.contains("another scene"), "{}", refused);
+    let refused = scene.add_instance(their_mesh, &meshcast::translation(0.0, 0.0, 0.0), 0xFF, false).unwrap_err();
+    assert!(refused.message.contains("another scene"), "{}", refused);
     scene.set_enabled(near0, false).unwrap();
     scene.commit().unwrap();
     scene.cast(&scene_rays, &mut scene_hits, &Query::default()).unwrap();
     assert_eq!(scene_hits[1].triangle, meshcast::NO_HIT);
     let point = scene.closest_points(&[[1e9 + 0.5, 0.5, 0.25]], f64::INFINITY, 1).unwrap();
-    assert!(point[0].instance == far && (point[0].distance - 0.25).abs() < 1e-6);
+    assert!(point[0].instance == far.index && (point[0].distance - 0.25).abs() < 1e-6);
 
     let caster = Caster::new(Some(&copy), Backend::Cpu, 2).unwrap();
     let other = Caster::new(Some(&copy), Backend::Cpu, 1).unwrap();
@@ -170,7 +180,7 @@ fn known_answers_scenes_and_casters() {
     let ticket = scenes.submit_scene(&scene, &scene_rays, &Query::default()).unwrap();
     drop(scene); // the batch keeps what it walks
     scenes.wait_scene(&ticket, &mut scene_hits).unwrap();
-    assert_eq!((scene_hits[0].instance, scene_hits[1].triangle), (far, meshcast::NO_HIT));
+    assert_eq!((scene_hits[0].instance, scene_hits[1].triangle), (far.index, meshcast::NO_HIT));
 }
 
 #[test]

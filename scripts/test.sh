@@ -23,8 +23,7 @@ package_install_job=$!
 # set (the sanitizer builds and the other instruction sets; Release walks
 # everything). A failing
 # suite prints its log; xargs waits for the others and fails the pipeline.
-# The longest first; walker_test and robustness_test (every layout) in two
-# shards each, so the two cores finish together.
+# The longest first; those of `sharded` (below) in two shards each.
 cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_test pairing_test zerobyte_test scene_test point_test
             hostile_test oracle_test io_test)
 # Under AddressSanitizer: the suites that read hostile input, walk points, place
@@ -41,13 +40,19 @@ cpu_suites=(walker_test robustness_test auto_test limits_test layout_test build_
 asan_suites=(limits_test zerobyte_test scene_test hostile_test io_test point_test)
 # What another instruction set changes (cpu/simd.h's lanes): the suites that walk.
 walk_suites=(walker_test robustness_test limits_test pairing_test zerobyte_test scene_test point_test)
+# The suites long enough to run in two shards, so the two cores finish together.
+sharded=(walker_test robustness_test gpu_test gpu_robustness_test)
+# The host layer and the Vulkan suites (CTest label `gpu`), one process a
+# suite as the CPU suites, with the validation layers on: a test fails on
+# any message they send. The longest first.
+gpu_suites=(gpu_robustness_test gpu_test host_test gpu_scene_test)
 run_suites() {  # run_suites BUILD_DIR quick|full SUITE...
   local dir=$1 quick=()
   [[ $2 == quick ]] && quick=(MESHCAST_TEST_QUICK=1)
   shift 2
   local items=() s
   for s in "$@"; do
-    if [[ $s == walker_test || $s == robustness_test ]]; then items+=("$s#0" "$s#1"); else items+=("$s"); fi
+    if [[ " ${sharded[*]} " == *" $s "* ]]; then items+=("$s#0" "$s#1"); else items+=("$s"); fi
   done
   printf '%s\n' "${items[@]}" |
     env MESHCAST_DATA="$PWD/data" "${quick[@]}" LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp" \
@@ -88,8 +93,14 @@ if [[ $widest != scalar ]]; then
   stage "Release, the portable scalar walkers (MESHCAST_ISA=scalar): the suites that walk"
   MESHCAST_ISA=scalar run_suites build quick "${walk_suites[@]}"
 fi
-stage "Release: the Vulkan suites, the host layer, the command line and the fuzz corpora (CTest)"
-ctest --test-dir build --output-on-failure -j"$jobs" --timeout 900 -LE cpu
+stage "Release: the Vulkan suites and the host layer, one process a suite, beside the command line, the C API, the headers and the fuzz corpora (CTest)"
+# CTest's tests here are one long script (the command line's, two minutes)
+# and many short ones: on one core beside the suites, the cores finish
+# together.
+ctest --test-dir build --output-on-failure -j1 --timeout 900 -LE "cpu|gpu" > build/ctest.log 2>&1 &
+ctest_job=$!
+MESHCAST_VK_VALIDATION=1 run_suites build full "${gpu_suites[@]}"
+finish $ctest_job "CTest" build/ctest.log
 
 finish $package_install_job "installing Dask and Mono" build/package_install.log
 stage "C#: the binding (bindings/csharp) under Mono, its answers against the C++ library's"

@@ -84,6 +84,7 @@ constexpr const char* kQuickPublicMesh = "ChineseDragon-10kv";
 }  // namespace
 
 bool is_chosen_public_mesh(const std::string& name) { return name == (quick() ? kQuickPublicMesh : "bunny00"); }
+bool is_smallest_public_mesh(const std::string& name) { return name == kQuickPublicMesh; }
 
 std::vector<NamedMesh> test_meshes(bool large) {
   static std::map<std::string, std::shared_ptr<const Mesh>> cache;

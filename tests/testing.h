@@ -45,6 +45,10 @@ std::vector<NamedMesh> test_meshes(bool large);
 // The public mesh that suites walking a chosen few meshes take: bunny00, or
 // in the quick runs the one public mesh they have.
 bool is_chosen_public_mesh(const std::string& name);
+// The smallest public mesh (ChineseDragon-10kv, a quarter of bunny00's
+// triangles): the quick runs' one, and the one that suites whose time
+// grows with rays times triangles (a brute force on lavapipe) take.
+bool is_smallest_public_mesh(const std::string& name);
 // True when MESHCAST_TEST_QUICK is set: the suites walk fewer rays a set.
 bool quick();
 // The layouts of `names` a suite runs: all of them, or in the quick runs a

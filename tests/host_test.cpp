@@ -740,6 +740,19 @@ TEST(Host, AWarmCasterAllocatesNothingAFrame) {
 // caster on the Vulkan backend, frames in flight: nothing either.
 TEST(Host, AWarmGpuBatchAllocatesNothing) {
   if (cpu_only()) GTEST_SKIP() << "the Vulkan backend is kept out";
+  // $MESHCAST_VK_VALIDATION=1 (the test command's) would turn the layer on
+  // for this test's instances too: left out while they are made.
+  struct WithoutValidationEnv {
+    std::string was;
+    bool set = false;
+    WithoutValidationEnv() {
+      if (const char* v = std::getenv("MESHCAST_VK_VALIDATION")) was = v, set = true;
+      unsetenv("MESHCAST_VK_VALIDATION");
+    }
+    ~WithoutValidationEnv() {
+      if (set) setenv("MESHCAST_VK_VALIDATION", was.c_str(), 1);
+    }
+  } without_validation;
   Mesh m = make_sphere(16, 32, 1, {0, 0, 0});
   std::vector<uint8_t> blob = build_blob(m, parse_layout("OctTreeCompressed/ClusterBitPackSOA8"), "sphere");
   std::vector<Ray> a = make_rays(m, RayKind::Long, 2000, 1), b = make_rays(m, RayKind::Radial, 1500, 2);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "builder/tree_source.h"
 #include "meshcast/mesh.h"
 #include "cpu/intersect.h"
 #include "meshcast/scene.h"
@@ -41,6 +42,12 @@ class Peer {
 // nullptr when meshcast was built without Embree.
 enum class EmbreeMode { Default, Robust, Compact, High };
 std::unique_ptr<Peer> make_embree(const Mesh& mesh, EmbreeMode mode = EmbreeMode::Default, uint32_t threads = 1);
+
+// Embree's builder as the binary tree a blob is laid out over
+// (bench/embree_tree.cpp): rtcBuildBVH's binned SAH (RTC_BUILD_QUALITY_MEDIUM,
+// one thread) over the stored triangles' boxes, a node of at most the
+// layout's leaf size a leaf, as meshcast's own splitter decides. An empty function when meshcast was built without Embree.
+TreeSource embree_tree_source();
 
 // A peer's instanced scene: each mesh its own scene, built once;
 // the instances over them in a top scene rebuilt by commit().

@@ -47,7 +47,7 @@ struct Contender {
 }  // namespace
 
 std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& o,
-                                 std::vector<CoreRow>* cores) {
+                                 std::vector<CoreRow>* cores, std::vector<CountRow>* counts) {
   const double triangles = double(mesh.triangles.size());
   std::vector<RayKind> kinds;
   for (const std::string& k : o.kinds) kinds.push_back(parse_ray_kind(k));
@@ -76,17 +76,25 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   std::vector<std::unique_ptr<uint8_t[], void (*)(void*)>> aligned;  // the blobs the views read
   std::vector<std::unique_ptr<BlobView>> views;
   blobs.reserve(o.layouts.size());
-  // "TREE/TRIANGLES@LEAF": a leaf size other than the default.
-  auto options_of = [](const std::string& layout, uint32_t threads) {
-    const size_t at = layout.find('@');
-    BuildOptions bo = parse_layout(layout.substr(0, at));
-    if (at != std::string::npos) bo.leaf_size = uint32_t(std::stoul(layout.substr(at + 1)));
+  // "TREE/TRIANGLES@LEAF": a leaf size other than the default;
+  // "...:embree": laid out over Embree's binary tree (embree_tree_source),
+  // not meshcast's own.
+  auto build_of = [&](const std::string& layout, uint32_t threads) {
+    const size_t colon = layout.find(':');
+    const std::string named = layout.substr(0, colon);
+    const size_t at = named.find('@');
+    BuildOptions bo = parse_layout(named.substr(0, at));
+    if (at != std::string::npos) bo.leaf_size = uint32_t(std::stoul(named.substr(at + 1)));
     bo.threads = threads;
-    return bo;
+    if (colon == std::string::npos) return build_blob(mesh, bo, name);
+    if (layout.substr(colon) != ":embree") throw InputError(layout + ": the tree's source after ':' is embree or nothing");
+    const TreeSource source = embree_tree_source();
+    if (!source) throw InputError(layout + ": meshcast was built without Embree, whose tree it names");
+    return build_blob_over(mesh, bo, name, source);
   };
   for (const std::string& layout : o.layouts) {
     std::fprintf(stderr, "  %s: building %s\n", name.c_str(), layout.c_str());
-    blobs.push_back(build_blob(mesh, options_of(layout, 1), name));
+    blobs.push_back(build_of(layout, 1));
     // 64-byte aligned, as Embree aligns its nodes and as a mapped blob file
     // is: a heap vector is aligned to 16 only, and a 96-byte node off a cache
     // line costs a third line half the time (about 8% a ray, measured).
@@ -115,7 +123,10 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   }
   std::vector<std::unique_ptr<Peer>> peers;
   std::vector<EmbreeMode> modes;
-  for (EmbreeMode mode : {EmbreeMode::Default, EmbreeMode::High, EmbreeMode::Robust, EmbreeMode::Compact}) {
+  const std::pair<const char*, EmbreeMode> embree_modes[] = {
+      {"default", EmbreeMode::Default}, {"high", EmbreeMode::High}, {"robust", EmbreeMode::Robust}, {"compact", EmbreeMode::Compact}};
+  for (const auto& [mode_name, mode] : embree_modes) {
+    if (std::find(o.peers.begin(), o.peers.end(), mode_name) == o.peers.end()) continue;
     std::unique_ptr<Peer> peer = make_embree(mesh, mode, 1);
     if (peer) std::fprintf(stderr, "  %s: built %s\n", name.c_str(), peer->name().c_str());
     if (!peer) break;  // built without Embree
@@ -132,7 +143,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   }
   // Embree default's 16-wide packets (rtcIntersect16 / rtcOccluded16) on
   // the sorted sets: the peer's own packets on the rays meshcast packs.
-  if (!peers.empty() && o.packets) {
+  if (!peers.empty() && modes[0] == EmbreeMode::Default && o.packets) {
     const Peer* p = peers[0].get();
     all.push_back({p->name() + ", 16-wide packets", true, double(p->bytes()) / triangles, 0, 0,
                    [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool sorted) {
@@ -157,7 +168,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
       for (size_t l = 0; l < o.layouts.size(); ++l, c += layout_twins) {
         for (uint32_t threads : {1u, 0u}) {
           const auto t0 = std::chrono::steady_clock::now();
-          const std::vector<uint8_t> again = build_blob(mesh, options_of(o.layouts[l], threads), name);
+          const std::vector<uint8_t> again = build_of(o.layouts[l], threads);
           (threads == 1 ? one : every)[c].push_back(ms_since(t0));
           if (again != blobs[l])
             throw std::runtime_error(name + ": " + o.layouts[l] + " built to other bytes on " +
@@ -275,12 +286,13 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   // not for comparison).
   if constexpr (kCountTests)
     for (Contender& c : all)
-      for (size_t s = 0; s < sets.size() && !c.is_peer; ++s) {
+      for (size_t s = 0; s < sets.size() && !c.is_peer && counts; ++s) {
         test_counts = {};
         if (!c.trace(rays[sets[s].kind], hits, queries[sets[s].query], sorted[sets[s].kind])) continue;
-        std::fprintf(stderr, "  %s %s %s %s: %.1f box tests, %.1f triangle tests a ray\n", name.c_str(),
-                     set_names[sets[s].kind].c_str(), o.queries[sets[s].query].c_str(), c.name.c_str(),
-                     double(test_counts.boxes) / double(o.rays), double(test_counts.triangles) / double(o.rays));
+        const double n = double(o.rays);
+        counts->push_back({name, set_names[sets[s].kind], o.queries[sets[s].query], c.name,
+                           double(test_counts.nodes) / n, double(test_counts.leaves) / n,
+                           double(test_counts.triangles) / n});
       }
 
   std::vector<PeerRow> rows;
@@ -295,10 +307,11 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
       for (size_t t = 0; t < sets.size(); ++t)
         if (sets[t].kind == sets[s].kind && o.queries[sets[t].query] == "closest")
           r.to_closest = r.ns_per_ray / median(c.ns[t]);
-      // The first peer is the default build, the second the high-quality one.
+      // The ratios' peers: Embree's default and high-quality builds (by the
+      // names make_embree gives them), its 16-wide packets.
       if (c.packets_peer) embree_packets = r.ns_per_ray;
-      else if (c.is_peer && embree_default == 0) embree_default = r.ns_per_ray;
-      else if (c.is_peer && embree_high == 0) embree_high = r.ns_per_ray;
+      else if (c.is_peer && c.name.ends_with(" default")) embree_default = r.ns_per_ray;
+      else if (c.is_peer && c.name.ends_with(" high quality")) embree_high = r.ns_per_ray;
       set_rows.push_back(r);
     }
     for (PeerRow& r : set_rows) {

@@ -43,6 +43,14 @@ struct CoreRow {
   double ratio_all = 0;           // time on every core / Embree default's on every core (0 without Embree)
 };
 
+// A counting build's (MESHCAST_COUNT_TESTS) one more walk of each meshcast
+// layout on each set: inner nodes (a node's children tested together),
+// leaves and triangle lanes tested, a ray. Its times are not for comparison.
+struct CountRow {
+  std::string mesh, kind, query, contender;
+  double nodes = 0, leaves = 0, triangles = 0;
+};
+
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
   std::vector<std::string> kinds = ray_kind_names();  // ray kinds measured
@@ -53,13 +61,17 @@ struct PeersOptions {
   // A kind whose rays share one origin (radial) timed again sorted by
   // direction: meshcast's packets, Embree's single rays and 16-wide packets.
   bool packets = true;
+  // Embree's builds measured (a counting Embree's counters then name one):
+  // default, high, robust, compact.
+  std::vector<std::string> peers = {"default", "high", "robust", "compact"};
 };
 
 // The meshcast layouts `bench peers` measures unless told otherwise.
 std::vector<std::string> default_peer_layouts();
 
-// `cores`: the multi-core rows are appended there (when options.cores).
+// `cores`: the multi-core rows are appended there (when options.cores);
+// `counts`: a counting build's rows (nothing in a timed build).
 std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& options,
-                                 std::vector<CoreRow>* cores = nullptr);
+                                 std::vector<CoreRow>* cores = nullptr, std::vector<CountRow>* counts = nullptr);
 
 }  // namespace meshcast::bench

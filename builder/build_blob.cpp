@@ -16,6 +16,7 @@
 #include "builder/layout_names.h"
 #include "builder/pairing.h"
 #include "builder/quantize.h"
+#include "builder/tree_source.h"
 #include "layout/tree/aabbtree.h"
 #include "layout/triangles/codecs.h"
 #include "layout/tree/quadtree.h"
@@ -61,8 +62,30 @@ void TreeWriter::check(const Mesh&, const BuildOptions& o) const {
   if (std::string why = node_order_refusal(uint32_t(o.layout.tree), o.node_order); !why.empty()) throw InputError(why);
 }
 
+// A source's tree, checked: every triangle in one leaf, leaves within the
+// capacity, children inside the node count.
+BuildTree sourced_tree(const TreeInput& in, uint32_t depth_limit) {
+  if (in.options.pairing) throw InputError("pairing builds its own tree over pairs; a given tree cannot pair");
+  BuildTree t = (*in.source)(in.boxes, in.options.leaf_size, depth_limit, MC_QUAD_MAX_COUNT);
+  std::vector<uint8_t> seen(in.boxes.size(), 0);
+  if (t.nodes.empty() || t.order.size() != in.boxes.size())
+    throw InputError("the given tree orders " + std::to_string(t.order.size()) + " triangles of " +
+                     std::to_string(in.boxes.size()));
+  for (uint32_t i : t.order) {
+    if (i >= seen.size() || seen[i]) throw InputError("the given tree holds triangle " + std::to_string(i) + " twice or out of range");
+    seen[i] = 1;
+  }
+  const uint32_t count = uint32_t(t.nodes.size());
+  for (const BuildNode& n : t.nodes)
+    if (n.leaf() ? n.count > MC_QUAD_MAX_COUNT || uint64_t(n.first) + n.count > t.order.size()
+                 : n.left == 0 || n.right == 0 || n.left >= count || n.right >= count)
+      throw InputError("the given tree has a malformed node");
+  return t;
+}
+
 BuildTree TreeWriter::build(const TreeInput& in, uint32_t depth_limit) {
   const BuildOptions& o = in.options;
+  if (in.source) return sourced_tree(in, depth_limit);
   if (o.pairing) return build_paired(in, depth_limit);
   return build_tree(in.boxes, o.splitter, o.leaf_size, depth_limit, MC_QUAD_MAX_COUNT, in.threads);
 }
@@ -142,8 +165,10 @@ std::vector<uint8_t> build_blob(const MeshView& mesh, const BuildOptions& option
 // start would cost more than it saves.
 constexpr size_t kParallelTriangles = 16384;
 
-std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, const std::string& name,
-                                BuildReport* report) {
+namespace {
+
+std::vector<uint8_t> build_blob_with(const Mesh& mesh, const BuildOptions& options, const std::string& name,
+                                     BuildReport* report, const TreeSource* source) {
   auto start = std::chrono::steady_clock::now();
   BuildOptions o = options;
   if (o.leaf_size == 0) o.leaf_size = default_leaf_size(o.layout);
@@ -183,7 +208,11 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
   }
   BuildTree tree;
   try {
-    tree = tree_writer->build(TreeInput{mesh, o, boxes, codec, report, parallel}, depth_limit);
+    const uint32_t format = uint32_t(o.layout.tree);
+    if (source && (format == MC_TREE_BRUTEFORCE || format == MC_TREE_AABBLIST || format == MC_TREE_ZEROBYTE ||
+                   format == MC_TREE_ZEROBYTEHYBRID))
+      throw InputError("keeps its own triangle order; a given tree cannot lay it out");
+    tree = tree_writer->build(TreeInput{mesh, o, boxes, codec, report, parallel, source}, depth_limit);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());
   }
@@ -230,6 +259,18 @@ std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, c
     report->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
   return std::move(writer.bytes);
+}
+
+}  // namespace
+
+std::vector<uint8_t> build_blob(const Mesh& mesh, const BuildOptions& options, const std::string& name,
+                                BuildReport* report) {
+  return build_blob_with(mesh, options, name, report, nullptr);
+}
+
+std::vector<uint8_t> build_blob_over(const Mesh& mesh, const BuildOptions& options, const std::string& name,
+                                     const TreeSource& source, BuildReport* report) {
+  return build_blob_with(mesh, options, name, report, &source);
 }
 
 }  // namespace meshcast

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -166,6 +167,9 @@ struct TreeInput {
   const CodecOps& codec;
   BuildReport* report;
   BuildThreads* threads;
+  // Another builder's binary tree (builder/tree_source.h), taken where the
+  // options' splitter would build one; null: the splitter's.
+  const std::function<BuildTree(const std::vector<Box3>&, uint32_t, uint32_t, uint32_t)>* source = nullptr;
 };
 
 // The tree writers of builder/write_*.cpp, one a tree format, each step of

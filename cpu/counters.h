@@ -1,5 +1,8 @@
 // Box and triangle tests, counted per thread for the tables that report
-// them (seed 003's pairing table). Compiled in only with the CMake option
+// them (seed 003's pairing table, `bench peers` beside Embree's own
+// counters), with the inner nodes whose children a walk tested together (a
+// 4- or 8-wide test: the quad and oct trees) and the leaves it tested.
+// Compiled in only with the CMake option
 // MESHCAST_COUNT_TESTS (the scalar test build has it), so a timed build
 // does no extra work; elsewhere kCountTests is false and the counts stay 0.
 #pragma once
@@ -10,7 +13,7 @@
 namespace meshcast {
 
 struct TestCounts {
-  uint64_t boxes = 0, triangles = 0;
+  uint64_t boxes = 0, triangles = 0, nodes = 0, leaves = 0;
 };
 
 #ifdef MESHCAST_COUNT_TESTS
@@ -27,6 +30,13 @@ inline void count_boxes(uint64_t n) {
 }
 inline void count_triangles(uint64_t n) {
   if constexpr (kCountTests) test_counts.triangles += n;
+}
+// One node's children tested together (`width` boxes).
+inline void count_node(uint64_t width) {
+  if constexpr (kCountTests) test_counts.boxes += width, ++test_counts.nodes;
+}
+inline void count_leaves(uint64_t n) {
+  if constexpr (kCountTests) test_counts.leaves += n;
 }
 MC_ISA_END
 

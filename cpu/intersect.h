@@ -144,7 +144,7 @@ inline bool interval_open(float tn, float tf, float closest) { return tn <= min_
 
 // Four boxes at once; `nearp[a]`/`farp[a]` are the near and far planes of axis a.
 [[gnu::always_inline]] inline simd::F4 box_test4(const RayPre& r, const simd::F4 nearp[3], const simd::F4 farp[3], float closest) {
-  count_boxes(4);
+  count_node(4);
   using simd::F4;
   F4 tn = F4::splat(0.0f), tf = F4::splat(INFINITY);
   for (int a = 0; a < 3; ++a) {

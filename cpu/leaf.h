@@ -360,6 +360,7 @@ inline void test_cluster_leaf_rays(const uint8_t* blob, const RayPre* pre, Close
 template <class Codec, TriangleTest kTest>
 inline uint64_t test_leaf(const uint8_t* blob, const RayPre& r, uint32_t block, uint32_t count, uint32_t slot0,
                           Closest& c) {
+  count_leaves(1);
   if constexpr (requires { Codec::kClusters; }) {
     return test_cluster_leaf<Codec, kTest>(blob, r, block, count, slot0, c);
   } else if constexpr (requires { Codec::kSequential; }) {  // strips have no loader
@@ -394,6 +395,7 @@ template <class Codec, TriangleTest kTest>
 inline void test_leaf_rays(const uint8_t* blob, const RayPre* pre, Closest* c, uint32_t rays, uint32_t block,
                            uint32_t count, uint32_t slot0) {
   if constexpr (requires { Codec::kClusters; }) {
+    count_leaves(uint64_t(std::popcount(rays)));
     test_cluster_leaf_rays<Codec, kTest>(blob, pre, c, rays, block, count, slot0);
   } else {
     for (uint32_t m = rays; m; m &= m - 1) {

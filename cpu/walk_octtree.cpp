@@ -105,7 +105,7 @@ struct OctHits {
 template <bool Fused>
 inline OctHits oct_box_test(const uint8_t* node, const RayPre& r, const OctRows& rows, const OctFused& fused,
                             float closest) {
-  count_boxes(8);
+  count_node(8);
   using simd::F8;
   F8 tn[3], tf[3];
   const F8 zero = F8::splat(0.0f), cut = F8::splat(closest);
@@ -286,7 +286,7 @@ void walk_packet(const uint8_t* blob, const layout::BlobHeader& h, const RayPre*
       for (uint32_t m = rays; m; m &= m - 1) {
         const int i = __builtin_ctz(m);
         const RayPre& r = pre[i];
-        count_boxes(8);
+        count_node(8);
         F8 tn[3], tf[3];
         const F8 cut = F8::splat(c[i].t);
         for (int a = 0; a < 3; ++a) {

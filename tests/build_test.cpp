@@ -9,6 +9,7 @@
 
 #include "builder/binary_tree.h"
 #include "builder/build_threads.h"
+#include "builder/tree_source.h"
 #include "builder/writer.h"
 #include "check/generate.h"
 #include "layout/blob_format.h"
@@ -558,6 +559,66 @@ TEST(Build, ZeroByteTreesIgnoreLeafSizeAndNodeOrder) {
     o.node_order = NodeOrder::BreadthFirst;
     EXPECT_EQ(build_blob(m, o, "sphere"), plain) << name;
   }
+}
+
+// A blob laid out over a tree another builder made (builder/tree_source.h):
+// given the tree the options' splitter builds, the very bytes build_blob
+// writes; a walk of it answers as the oracle; a tree that misses a
+// triangle, holds one twice or names a child past the nodes is refused,
+// as is a layout that keeps its own order.
+TEST(Build, AGivenTreeLaysOutAsTheBuildersOwn) {
+  const Mesh m = make_sphere(12, 24, 1, {0.5f, -0.25f, 1.0f});
+  for (const char* name : {"OctTreeCompressed/ClusterBitPackSOA8", "QuadTree/Float3", "AABBTree/Float3"}) {
+    const BuildOptions o = parse_layout(name);
+    const TreeSource own = [&](const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit, uint32_t capacity) {
+      return build_tree(boxes, o.splitter, leaf_size, depth_limit, capacity);
+    };
+    EXPECT_EQ(build_blob_over(m, o, "sphere", own), build_blob(m, o, "sphere")) << name;
+  }
+  // Another tree: every triangle a leaf of its own, in reverse, under a
+  // chain of nodes. Laid out, it walks to the oracle's answers.
+  const BuildOptions o = parse_layout("OctTreeCompressed/ClusterBitPackSOA8");
+  const TreeSource chain = [](const std::vector<Box3>& boxes, uint32_t, uint32_t, uint32_t) {
+    BuildTree t;
+    const uint32_t n = uint32_t(boxes.size());
+    for (uint32_t i = 0; i < n; ++i) t.order.push_back(n - 1 - i);
+    // Balanced halves over `order`, leaves of 3 at most.
+    std::function<uint32_t(uint32_t, uint32_t, uint32_t)> node = [&](uint32_t first, uint32_t count, uint32_t depth) {
+      const uint32_t at = uint32_t(t.nodes.size());
+      t.nodes.emplace_back();
+      t.depth = std::max(t.depth, depth);
+      for (uint32_t k = first; k < first + count; ++k) t.nodes[at].box.grow(boxes[t.order[k]]);
+      if (count <= 3) {
+        t.nodes[at].first = first, t.nodes[at].count = count;
+        return at;
+      }
+      const uint32_t left = node(first, count / 2, depth + 1), right = node(first + count / 2, count - count / 2, depth + 1);
+      t.nodes[at].left = left, t.nodes[at].right = right;
+      return at;
+    };
+    node(0, n, 0);
+    return t;
+  };
+  const std::vector<uint8_t> blob = build_blob_over(m, o, "sphere", chain);
+  const NamedMesh named{"sphere", std::make_shared<const Mesh>(m)};
+  const NamedMesh stored{"sphere#given tree", std::make_shared<const Mesh>(stored_mesh(blob))};
+  const std::vector<Ray>& rays = test_rays(named, RayKind::Long, 2000);
+  const Agreement a = compare(*stored.mesh, rays, trace_all(blob, rays), oracle_answers(stored, RayKind::Long, rays),
+                              1e-5 * m.bounds().diagonal());
+  EXPECT_EQ(a.wrong + a.t_errors + a.t_rounding, 0u) << a.first_problem;
+  // Malformed trees, and the layouts that keep their own order.
+  auto broken = [&](const std::function<void(BuildTree&)>& spoil) -> TreeSource {
+    return [&, spoil](const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit, uint32_t capacity) {
+      BuildTree t = build_tree(boxes, o.splitter, leaf_size, depth_limit, capacity);
+      spoil(t);
+      return t;
+    };
+  };
+  EXPECT_THROW(build_blob_over(m, o, "sphere", broken([](BuildTree& t) { t.order.pop_back(); })), InputError);
+  EXPECT_THROW(build_blob_over(m, o, "sphere", broken([](BuildTree& t) { t.order[1] = t.order[0]; })), InputError);
+  EXPECT_THROW(build_blob_over(m, o, "sphere", broken([](BuildTree& t) { t.nodes[0].left = uint32_t(t.nodes.size()); })),
+               InputError);
+  EXPECT_THROW(build_blob_over(m, parse_layout("BruteForce/Float3SOA128"), "sphere", chain), InputError);
 }
 
 TEST(Build, LayoutNamesAreCaseInsensitive) {

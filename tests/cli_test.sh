@@ -61,6 +61,14 @@ benches() {
   check bench-latency 0 "crossover \\(automatic backend" -- "$meshcast" bench latency "$small_mesh" --frame-ms 1 --out-dir "$work"
   check bench-robustness 0 "leaks plain" -- "$meshcast" bench robustness "$small_mesh" --rays 8 --repeat 1
   check bench-offset 0 "150 units at 30000" -- "$meshcast" bench offset "$small_mesh" --rays 8 --repeat 1
+  # Embree default alone, and the layout over the tree Embree's builder makes (Debian's Embree: setup.sh installs it).
+  check bench-peers-embree-tree 0 "long \\| closest \\| OctTreeCompressed/ClusterBitPackSOA8:embree \\| " -- "$meshcast" bench peers \
+    --meshes "$small_mesh" --layouts OctTreeCompressed/ClusterBitPackSOA8,OctTreeCompressed/ClusterBitPackSOA8:embree \
+    --peers default --kinds long --rays 100 --rounds 1 --no-cores --no-packets --out-dir "$work"
+  check bench-peers-unknown-peer 2 '"fast" is not an Embree build: default, high, robust or compact' -- "$meshcast" bench peers \
+    --meshes "$small_mesh" --peers default,fast --out-dir "$work"
+  check bench-peers-unknown-source 2 "after ':' is embree or nothing" -- "$meshcast" bench peers --meshes "$small_mesh" \
+    --layouts OctTreeCompressed/ClusterBitPackSOA8:kd --kinds long --rays 100 --rounds 1 --no-cores --out-dir "$work"
 }
 if [[ $part == benches ]]; then
   benches

@@ -24,7 +24,7 @@ void add_bench_peers(CLI::App* bench) {
   struct Args {
     std::string meshes = "data/bunny00.off,data/armadillo.off,data/refined_elephant.off,data/ChineseDragon-10kv.off,"
                          "terrain_2M,city_1M";
-    std::string layouts, kinds, queries = "closest,any", out_dir = "out";
+    std::string layouts, kinds, queries = "closest,any", out_dir = "out", peers = "default,high,robust,compact";
     size_t rays = 10000;
     uint32_t rounds = 7;
     bool no_cores = false, no_packets = false;
@@ -32,12 +32,24 @@ void add_bench_peers(CLI::App* bench) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = bench->add_subcommand("peers", "meshcast's layouts beside Embree's default, high-quality, robust and compact builds");
   cmd->add_option("--meshes", args->meshes, "comma-separated mesh files, terrain_2M or city_1M (default: all six)");
-  cmd->add_option("--layouts", args->layouts, "comma-separated meshcast layouts (default: the OctTree and QuadTree ones)");
+  cmd->add_option("--layouts", args->layouts,
+                  "comma-separated meshcast layouts, each TREE/TRIANGLES, @LEAF for another leaf size, :embree to lay "
+                  "it out over the binary tree Embree's builder makes (rtcBuildBVH) instead of meshcast's own "
+                  "(default: the OctTree and QuadTree ones)");
   cmd->add_option("--kinds", args->kinds, "comma-separated ray kinds: long, probe, radial, segment (default: all four)");
   cmd->add_option("--queries", args->queries,
                   "comma-separated queries: closest, any (Embree: rtcOccluded1), all (every hit, rows of 16), "
                   "each with a culling as in closest-back or any-front; Embree answers closest and any "
                   "(default: closest,any)");
+  cmd->add_option("--peers", args->peers,
+                  "comma-separated Embree builds: default, high, robust, compact (default: all four; ratios are to "
+                  "default and high where measured)")
+      ->check([](const std::string& text) -> std::string {
+        for (const std::string& p : split(text))
+          if (p != "default" && p != "high" && p != "robust" && p != "compact")
+            return "\"" + p + "\" is not an Embree build: default, high, robust or compact";
+        return "";
+      });
   cmd->add_option("--rays", args->rays, "rays a set (each ray kind)")->check(integer_in(100, 1000000));
   cmd->add_option("--rounds", args->rounds, "interleaved rounds; the median is reported")->check(integer_in(1, 100));
   cmd->add_option("--out-dir", args->out_dir, "where peers.csv, cores.csv and peers.png go");
@@ -56,13 +68,16 @@ void add_bench_peers(CLI::App* bench) {
     o.rays = args->rays, o.rounds = args->rounds;
     o.cores = !args->no_cores;
     o.packets = !args->no_packets;
+    o.peers = split(args->peers);
     std::filesystem::create_directories(args->out_dir);
     std::vector<bench::PeerRow> rows;
     std::vector<bench::CoreRow> core_rows;
+    std::vector<bench::CountRow> count_rows;
     for (const std::string& input : split(args->meshes)) {
       Mesh mesh = bench_mesh(input);
       std::fprintf(stderr, "%s: %zu triangles\n", input.c_str(), mesh.triangles.size());
-      std::vector<bench::PeerRow> r = bench::bench_peers(mesh, std::filesystem::path(input).stem().string(), o, &core_rows);
+      std::vector<bench::PeerRow> r =
+          bench::bench_peers(mesh, std::filesystem::path(input).stem().string(), o, &core_rows, &count_rows);
       rows.insert(rows.end(), r.begin(), r.end());
     }
     std::printf("\n%s; one thread tracing, %zu rays a set, median of %u interleaved rounds; ratio: to Embree default "
@@ -117,6 +132,14 @@ void add_bench_peers(CLI::App* bench) {
                   << r.rays_per_s_one << "," << r.rays_per_s_all << "," << r.scaling() << "," << r.ratio_all << "\n";
       }
       cores_csv.commit();
+    }
+    if (!count_rows.empty()) {
+      std::printf("\nCounted (a build with MESHCAST_COUNT_TESTS, one more walk of each set, one ray at a time): "
+                  "inner nodes (a node's children tested together), leaves and triangle lanes tested, a ray\n\n"
+                  "| mesh | rays | query | layout | nodes | leaves | triangles |\n|---|---|---|---|---:|---:|---:|\n");
+      for (const bench::CountRow& r : count_rows)
+        std::printf("| %s | %s | %s | %s | %.2f | %.2f | %.2f |\n", r.mesh.c_str(), r.kind.c_str(), r.query.c_str(),
+                    r.contender.c_str(), r.nodes, r.leaves, r.triangles);
     }
     bench::Series meshcast{"meshcast", {}}, embree{"Embree", {}};
     for (const std::string& c : order) {

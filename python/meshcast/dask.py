@@ -252,11 +252,14 @@ def _ship(target):
     if isinstance(target, _meshcast.Blob):
         token = tokenize(target)
         return _Shipped("blob", _ship_object(target, token), token)
-    version, blobs, instances = target.__getstate__()  # ValueError for uncommitted edits
+    # The rest of the state (the number its ids carry) travels, and stays
+    # out of the token: workers cast, never edit, so scenes of the same
+    # blobs and instances share one built scene there.
+    version, blobs, instances, *rest = target.__getstate__()  # ValueError for uncommitted edits
     tokens = [tokenize(b) for b in blobs]
     token = tokenize("meshcast.Scene", version, tokens, instances)
     shipped = [(t, _ship_object(b, t)) for b, t in zip(blobs, tokens)]
-    return _Shipped("scene", (version, shipped, instances), token)
+    return _Shipped("scene", (version, shipped, instances, *rest), token)
 
 
 _scenes = {}  # in a worker: content token -> the Scene built from its blobs there
@@ -280,9 +283,9 @@ def _target_of(kind, value, token):
         return _resolved(value, token)
     scene = _scenes.get(token)
     if scene is None:
-        version, blobs, instances = value
+        version, blobs, instances, *rest = value
         scene = _meshcast.Scene.__new__(_meshcast.Scene)
-        scene.__setstate__((version, [_resolved(b, t) for t, b in blobs], instances))
+        scene.__setstate__((version, [_resolved(b, t) for t, b in blobs], instances, *rest))
         _scenes[token] = scene
     return scene
 

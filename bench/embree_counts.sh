@@ -12,8 +12,9 @@
 # peer, never a dependency):
 #  - Embree 3.13.5, the version Debian ships, from its public source with
 #    EMBREE_STAT_COUNTERS=ON, triangles only, no tutorials, no ISPC, the
-#    SSE2 kernels and the widest this processor runs (AVX2 or AVX-512, as
-#    Debian's library picks here), installed to a prefix of its own. Put in
+#    SSE2 kernels and the widest this processor runs (AVX2, with AVX's, or
+#    AVX-512, as Debian's library picks here), installed to a prefix of its
+#    own. Put in
 #    front of Debian's with LD_LIBRARY_PATH, it counts for a program linked
 #    against Debian's libembree3.so.3, unchanged; it prints its counters
 #    when the process ends (one process per mesh and ray kind below: closest
@@ -55,7 +56,10 @@ if [[ ! -f $prefix/lib/libembree3.so.3 ]]; then
   [[ $version == "${tag#v}" ]] || { echo "embree_counts: $work/src is Embree $version, not ${tag#v}"; exit 1; }
   geometries=()
   for g in QUAD CURVE SUBDIVISION USER INSTANCE GRID POINT; do geometries+=("-DEMBREE_GEOMETRY_$g=OFF"); done
-  isas=(-DEMBREE_MAX_ISA=NONE -DEMBREE_ISA_SSE2=ON -DEMBREE_ISA_SSE42=OFF -DEMBREE_ISA_AVX=OFF
+  # AVX's kernels with AVX2's: the SSE2 library's 8-wide factory links to
+  # the BVHN<8> they hold (SSE2 and AVX2 alone fail to link).
+  isas=(-DEMBREE_MAX_ISA=NONE -DEMBREE_ISA_SSE2=ON -DEMBREE_ISA_SSE42=OFF
+        "-DEMBREE_ISA_AVX=$([[ $widest == avx2 ]] && echo ON || echo OFF)"
         "-DEMBREE_ISA_AVX2=$([[ $widest == avx2 ]] && echo ON || echo OFF)"
         "-DEMBREE_ISA_AVX512=$([[ $widest == avx512 ]] && echo ON || echo OFF)")
   cmake -S "$work/src" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release "-DCMAKE_INSTALL_PREFIX=$prefix" \

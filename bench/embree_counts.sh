@@ -97,7 +97,7 @@ for mesh in ${meshes//,/ }; do
     log=$out/$name-$kind.txt
     LD_LIBRARY_PATH="$prefix/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$work/meshcast/bin/meshcast" bench peers \
       --meshes "$mesh" --kinds "$kind" --queries "$queries" --layouts "$layout,$layout:embree" --peers default --no-cores \
-      --no-packets --rounds 1 --rays "$rays" --out-dir "$out/peers" > "$log" 2> "$out/$name-$kind.err"
+      --no-packets --no-build-times --rounds 1 --rays "$rays" --out-dir "$out/peers" > "$log" 2> "$out/$name-$kind.err"
     grep -q -- "--------- PER TRAVERSAL ---------" "$log" ||
       { echo "embree_counts: no counters from Embree in $log (was $prefix/lib's library loaded?)"; exit 1; }
     # Embree's: the per-traversal block, normal (closest) then shadow (any).

@@ -157,7 +157,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   // Build times: every contender built again in interleaved rounds, on one
   // thread and on every core, the median of each (a first build pays for
   // page faults and thread starts that later ones do not).
-  {
+  if (o.build_times) {
     const uint32_t build_rounds = std::max(3u, o.rounds);
     std::vector<std::vector<double>> one(all.size()), every(all.size());
     // A layout's packets and Embree's 16-wide packets walk the build

@@ -64,6 +64,9 @@ struct PeersOptions {
   // Embree's builds measured (a counting Embree's counters then name one):
   // default, high, robust, compact.
   std::vector<std::string> peers = {"default", "high", "robust", "compact"};
+  // The build times (every contender built again in rounds); without them
+  // the rows' build columns are 0.
+  bool build_times = true;
 };
 
 // The meshcast layouts `bench peers` measures unless told otherwise.

@@ -27,7 +27,7 @@ void add_bench_peers(CLI::App* bench) {
     std::string layouts, kinds, queries = "closest,any", out_dir = "out", peers = "default,high,robust,compact";
     size_t rays = 10000;
     uint32_t rounds = 7;
-    bool no_cores = false, no_packets = false;
+    bool no_cores = false, no_packets = false, no_build_times = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = bench->add_subcommand("peers", "meshcast's layouts beside Embree's default, high-quality, robust and compact builds");
@@ -56,6 +56,9 @@ void add_bench_peers(CLI::App* bench) {
   cmd->add_flag("--no-cores", args->no_cores,
                 "leave out the multi-core rows (the first layout through the Caster's CPU workers and Embree default "
                 "through a TBB loop, rays a second on one thread and on every core)");
+  cmd->add_flag("--no-build-times", args->no_build_times,
+                "leave out the build times (every contender built again in interleaved rounds; the build columns "
+                "read 0)");
   cmd->add_flag("--no-packets", args->no_packets,
                 "leave out the sorted sets (a kind of one origin's rays, radial, sorted by direction: meshcast's "
                 "packets beside Embree's single rays and its 16-wide packets)");
@@ -69,6 +72,7 @@ void add_bench_peers(CLI::App* bench) {
     o.cores = !args->no_cores;
     o.packets = !args->no_packets;
     o.peers = split(args->peers);
+    o.build_times = !args->no_build_times;
     std::filesystem::create_directories(args->out_dir);
     std::vector<bench::PeerRow> rows;
     std::vector<bench::CoreRow> core_rows;

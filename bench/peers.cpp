@@ -31,6 +31,10 @@ namespace {
 
 using layout::QuerySpec;
 
+// Embree's builds by the names --peers takes.
+constexpr std::pair<const char*, EmbreeMode> kEmbreeBuilds[] = {
+    {"default", EmbreeMode::Default}, {"high", EmbreeMode::High}, {"robust", EmbreeMode::Robust}, {"compact", EmbreeMode::Compact}};
+
 struct Contender {
   std::string name;
   bool is_peer;
@@ -45,6 +49,15 @@ struct Contender {
 };
 
 }  // namespace
+
+const std::vector<std::string>& embree_build_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& build : kEmbreeBuilds) out.push_back(build.first);
+    return out;
+  }();
+  return names;
+}
 
 std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, const PeersOptions& o,
                                  std::vector<CoreRow>* cores, std::vector<CountRow>* counts) {
@@ -123,9 +136,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   }
   std::vector<std::unique_ptr<Peer>> peers;
   std::vector<EmbreeMode> modes;
-  const std::pair<const char*, EmbreeMode> embree_modes[] = {
-      {"default", EmbreeMode::Default}, {"high", EmbreeMode::High}, {"robust", EmbreeMode::Robust}, {"compact", EmbreeMode::Compact}};
-  for (const auto& [mode_name, mode] : embree_modes) {
+  for (const auto& [mode_name, mode] : kEmbreeBuilds) {
     if (std::find(o.peers.begin(), o.peers.end(), mode_name) == o.peers.end()) continue;
     std::unique_ptr<Peer> peer = make_embree(mesh, mode, 1);
     if (peer) std::fprintf(stderr, "  %s: built %s\n", name.c_str(), peer->name().c_str());

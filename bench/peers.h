@@ -51,6 +51,9 @@ struct CountRow {
   double nodes = 0, leaves = 0, triangles = 0;
 };
 
+// The names PeersOptions::peers takes, in the order the builds are measured.
+const std::vector<std::string>& embree_build_names();
+
 struct PeersOptions {
   std::vector<std::string> layouts;  // meshcast layouts to measure
   std::vector<std::string> kinds = ray_kind_names();  // ray kinds measured
@@ -63,7 +66,7 @@ struct PeersOptions {
   bool packets = true;
   // Embree's builds measured (a counting Embree's counters then name one):
   // default, high, robust, compact.
-  std::vector<std::string> peers = {"default", "high", "robust", "compact"};
+  std::vector<std::string> peers = embree_build_names();
   // The build times (every contender built again in rounds); without them
   // the rows' build columns are 0.
   bool build_times = true;

@@ -1,6 +1,7 @@
 // `meshcast bench peers`: meshcast's layouts beside Embree's
 // builds on the test meshes, the 2M terrain and the 1M city; Markdown, CSV
 // and a plot of time against bytes, one point per layout and peer.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -45,8 +46,9 @@ void add_bench_peers(CLI::App* bench) {
                   "comma-separated Embree builds: default, high, robust, compact (default: all four; ratios are to "
                   "default and high where measured)")
       ->check([](const std::string& text) -> std::string {
+        const std::vector<std::string>& builds = bench::embree_build_names();
         for (const std::string& p : split(text))
-          if (p != "default" && p != "high" && p != "robust" && p != "compact")
+          if (std::find(builds.begin(), builds.end(), p) == builds.end())
             return "\"" + p + "\" is not an Embree build: default, high, robust or compact";
         return "";
       });

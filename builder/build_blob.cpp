@@ -90,7 +90,14 @@ BuildTree TreeWriter::build(const TreeInput& in, uint32_t depth_limit) {
   return build_tree(in.boxes, o.splitter, o.leaf_size, depth_limit, MC_QUAD_MAX_COUNT, in.threads);
 }
 
+void refuse_given_tree(const TreeInput& in) {
+  if (in.source)
+    throw InputError(std::string(layout::tree_format_name(uint32_t(in.options.layout.tree))) +
+                     " keeps its own triangle order; a given tree cannot lay it out");
+}
+
 BuildTree record_tree(const TreeInput& in, std::vector<uint32_t> order) {
+  refuse_given_tree(in);
   if (in.options.pairing)
     throw InputError("pairing builds trees; " + std::string(layout::tree_format_name(uint32_t(in.options.layout.tree))) +
                      " keeps its own triangle order");
@@ -208,10 +215,6 @@ std::vector<uint8_t> build_blob_with(const Mesh& mesh, const BuildOptions& optio
   }
   BuildTree tree;
   try {
-    const uint32_t format = uint32_t(o.layout.tree);
-    if (source && (format == MC_TREE_BRUTEFORCE || format == MC_TREE_AABBLIST || format == MC_TREE_ZEROBYTE ||
-                   format == MC_TREE_ZEROBYTEHYBRID))
-      throw InputError("keeps its own triangle order; a given tree cannot lay it out");
     tree = tree_writer->build(TreeInput{mesh, o, boxes, codec, report, parallel, source}, depth_limit);
   } catch (const InputError& e) {
     throw InputError(name + ": " + std::string(layout::tree_format_name(uint32_t(o.layout.tree))) + ": " + e.what());

@@ -287,6 +287,7 @@ class ZeroByteWriter : public TreeWriter {
   }
 
   BuildTree build(const TreeInput& in, uint32_t) override {
+    refuse_given_tree(in);
     const Mesh& mesh = *(mesh_ = &in.mesh);
     const std::vector<Box3>& boxes = in.boxes;
     std::vector<Vec3> centres(boxes.size());

@@ -204,6 +204,9 @@ struct TreeWriter {
 // of brute_chunk(lanes) triangles of `order`, each written as a record
 // [count][block].
 BuildTree record_tree(const TreeInput& in, std::vector<uint32_t> order);
+// InputError for a given tree (TreeInput::source) where the writer keeps
+// its own order: the record trees above, the zero-byte trees.
+void refuse_given_tree(const TreeInput& in);
 
 // Each tree format's writer: a make_writer overload on its catalog tag, in
 // its family's write_*.cpp.

@@ -619,6 +619,9 @@ TEST(Build, AGivenTreeLaysOutAsTheBuildersOwn) {
   EXPECT_THROW(build_blob_over(m, o, "sphere", broken([](BuildTree& t) { t.nodes[0].left = uint32_t(t.nodes.size()); })),
                InputError);
   EXPECT_THROW(build_blob_over(m, parse_layout("BruteForce/Float3SOA128"), "sphere", chain), InputError);
+  EXPECT_THROW(build_blob_over(m, parse_layout("AABBList/Float3SOA128"), "sphere", chain), InputError);
+  EXPECT_THROW(build_blob_over(m, parse_layout("ZeroByteTree/Indexed24"), "sphere", chain), InputError);
+  EXPECT_THROW(build_blob_over(m, parse_layout("ZeroByteHybrid/Indexed24"), "sphere", chain), InputError);
 }
 
 TEST(Build, LayoutNamesAreCaseInsensitive) {

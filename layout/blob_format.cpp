@@ -55,11 +55,10 @@ namespace {
 
 // The tree format's validator (the catalog's switch); the zero-byte trees
 // have their own (validate_zerobyte).
-template <class Codec>
-std::string walk_tree(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string walk_tree(const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   return with_tree_format(h.tree_format, "unknown tree format " + num(h.tree_format), [&](auto tag) -> std::string {
     if constexpr (decltype(tag)::kTriangles == TreeTriangles::AllCodecs)
-      return validate_tree<Codec>(tag, blob, h, triangles);
+      return validate_tree(tag, codec, blob, h, triangles);
     else
       return "the zero-byte trees hold Indexed24 triangles alone";
   });
@@ -153,16 +152,13 @@ std::string validate(std::span<const uint8_t> blob) {
   }
   if (h.triangle_format == MC_TRI_INDEXED24) return "Indexed24 triangles belong to the zero-byte trees alone";
 
+#define MC_DIVISOR(Codec, text) \
+  if (h.triangle_format == Codec::kFormat && h.slot_divisor != Codec::kSlotDivisor) return "slot divisor does not match " text;
+  MC_FOR_EACH_TRIANGLE_CODEC(MC_DIVISOR)
+#undef MC_DIVISOR
   uint64_t triangles = 0;
-  std::string e;
-#define MC_WALK(Codec, text)                                                          \
-  if (h.triangle_format == Codec::kFormat) {                                          \
-    if (h.slot_divisor != Codec::kSlotDivisor) return "slot divisor does not match " text; \
-    e = walk_tree<Codec>(blob.data(), h, &triangles);                                 \
-  }
-  MC_FOR_EACH_TRIANGLE_CODEC(MC_WALK)
-#undef MC_WALK
-  if (!e.empty()) return e;
+  if (const LeafCodec* codec = leaf_codec(h.triangle_format))
+    if (std::string e = walk_tree(*codec, blob.data(), h, &triangles); !e.empty()) return e;
   if (triangles != h.triangle_count)
     return "leaves hold " + num(triangles) + " triangles but the header says " + num(h.triangle_count);
   return check_tree_bounds(blob.data());

@@ -24,8 +24,7 @@ void descend_aabblist(Descent& d) {
 // AABBList: the entries, then the batches' records tiling the rest of the
 // section in batch order, each batch's records holding its count, and every
 // batch but the last full (the shaders find records by arithmetic).
-template <class Codec>
-std::string validate_tree(tree::AABBList, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::AABBList, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   const uint8_t* tree = blob + h.tree_offset;
   if (h.node_count == 0 || h.triangle_base != uint64_t(h.node_count) * MC_LIST_ENTRY_BYTES)
     return "AABBList of " + num(h.node_count) + " batches does not start its records at tree offset " +
@@ -41,17 +40,12 @@ std::string validate_tree(tree::AABBList, const uint8_t* blob, const BlobHeader&
     const uint32_t end = list_records_end(tree, h, b);
     if (end < at || end > h.tree_size) return batch + "'s records end at " + num(end) + ", outside the tree section";
     uint64_t held = 0;
-    if (std::string why = check_records<Codec>(blob, h, &at, end, &held, &records); !why.empty()) return why;
+    if (std::string why = check_records(codec, blob, h, &at, end, &held, &records); !why.empty()) return why;
     if (held != e.count) return batch + "'s records hold " + num(held) + " triangles, its entry says " + num(e.count);
     *triangles += held;
   }
   return "";
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::AABBList, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::AABBList) { descend_aabblist(d); }
 

@@ -11,8 +11,7 @@ namespace {
 
 // AABBTree and AABBTreeSplitAxis: depth first from offset 0, each second
 // child after its first.
-template <class Codec>
-std::string validate_aabb_nodes(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles, bool split_axis) {
+std::string validate_aabb_nodes(const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles, bool split_axis) {
   return walk_nodes(h, 0, "node at tree offset ", [&](uint32_t at, auto push) -> std::string {
     if (at % 4 != 0 || uint64_t(at) + MC_AABB_NODE_BYTES > h.tree_size)
       return "node at tree offset " + num(at) + " is misaligned or past the tree section";
@@ -20,7 +19,7 @@ std::string validate_aabb_nodes(const uint8_t* blob, const BlobHeader& h, uint64
     uint32_t next = at + MC_AABB_NODE_BYTES;
     if (n.is_leaf()) {
       *triangles += n.value();
-      return check_leaf<Codec>(blob, h, next, n.value());
+      return check_leaf(codec, blob, h, next, n.value());
     }
     uint32_t second = aabb_second_child(n, split_axis);
     if (second <= next)
@@ -54,19 +53,16 @@ void descend_pns(Descent& d, uint32_t index) {
 
 }  // namespace
 
-template <class Codec>
-std::string validate_tree(tree::AABBTree, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  return validate_aabb_nodes<Codec>(blob, h, triangles, false);
+std::string validate_tree(tree::AABBTree, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  return validate_aabb_nodes(codec, blob, h, triangles, false);
 }
 
-template <class Codec>
-std::string validate_tree(tree::AABBTreeSplitAxis, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  return validate_aabb_nodes<Codec>(blob, h, triangles, true);
+std::string validate_tree(tree::AABBTreeSplitAxis, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  return validate_aabb_nodes(codec, blob, h, triangles, true);
 }
 
 // AABBTreePNS: nodes by index, each child after its parent.
-template <class Codec>
-std::string validate_tree(tree::AABBTreePNS, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::AABBTreePNS, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   if (h.node_count == 0 || uint64_t(h.node_count) * MC_AABB_NODE_BYTES != h.triangle_base)
     return "AABBTreePNS: the triangle base must follow the " + num(h.node_count) + " nodes";
   return walk_nodes(h, 0, "node ", [&](uint32_t index, auto push) -> std::string {
@@ -76,7 +72,7 @@ std::string validate_tree(tree::AABBTreePNS, const uint8_t* blob, const BlobHead
       uint64_t block = uint64_t(h.triangle_base) + 4ull * (n.properties & MC_PNS_BLOCK_MASK);
       if (block > h.tree_size) return "leaf " + num(index) + " points past the tree section";
       *triangles += pns_leaf_count(n);
-      return check_leaf<Codec>(blob, h, uint32_t(block), pns_leaf_count(n));
+      return check_leaf(codec, blob, h, uint32_t(block), pns_leaf_count(n));
     }
     uint32_t second = pns_second_index(n);
     if (second <= index + 1) return "node " + num(index) + " has its second child at " + num(second) + ", not after its first";
@@ -84,13 +80,6 @@ std::string validate_tree(tree::AABBTreePNS, const uint8_t* blob, const BlobHead
     return "";
   });
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::AABBTree, const uint8_t*, const BlobHeader&, uint64_t*); \
-  template std::string validate_tree<Codec>(tree::AABBTreeSplitAxis, const uint8_t*, const BlobHeader&, uint64_t*); \
-  template std::string validate_tree<Codec>(tree::AABBTreePNS, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::AABBTree) { descend_aabbtree(d, 0, false); }
 void from_root(Descent& d, tree::AABBTreeSplitAxis) { descend_aabbtree(d, 0, true); }

@@ -6,32 +6,32 @@
 
 namespace meshcast::layout {
 
+const LeafCodec* leaf_codec(uint32_t triangle_format) {
+#define MC_RECORD(Codec, name) {Codec::kFormat, leaf_codec_of<Codec>()},
+  static constexpr struct { uint32_t format; LeafCodec codec; } kCodecs[] = {MC_FOR_EACH_TRIANGLE_CODEC(MC_RECORD)};
+#undef MC_RECORD
+  for (const auto& c : kCodecs)
+    if (c.format == triangle_format) return &c.codec;
+  return nullptr;
+}
+
 void Descent::records(uint32_t at, uint32_t end) {
   while (at < end) {
     uint32_t count = load<uint32_t>(tree + at);
     leaf(at + MC_BRUTE_RECORD_BYTES, count, nullptr);
-    uint64_t bytes = 0;
-#define MC_BYTES(Codec, name) \
-if (h.triangle_format == Codec::kFormat) bytes = stored_bytes<Codec>(blob, h.tree_offset + at + MC_BRUTE_RECORD_BYTES, count, ~0ull);
-    MC_FOR_EACH_TRIANGLE_CODEC(MC_BYTES)
-#undef MC_BYTES
+    const LeafCodec* codec = leaf_codec(h.triangle_format);
+    const uint64_t bytes = codec ? codec->stored_bytes(blob, h.tree_offset + at + MC_BRUTE_RECORD_BYTES, count, ~0ull) : 0;
     at += MC_BRUTE_RECORD_BYTES + uint32_t(bytes);
   }
 }
 
 // BruteForce: the records must tile the tree section exactly.
-template <class Codec>
-std::string validate_tree(tree::BruteForce, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::BruteForce, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   uint64_t at = 0, records = 0;
-  if (std::string e = check_records<Codec>(blob, h, &at, h.tree_size, triangles, &records); !e.empty()) return e;
+  if (std::string e = check_records(codec, blob, h, &at, h.tree_size, triangles, &records); !e.empty()) return e;
   if (records != h.node_count) return "BruteForce holds " + num(records) + " records, the header says " + num(h.node_count);
   return "";
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::BruteForce, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::BruteForce) { d.records(0, d.h.tree_size); }
 

@@ -27,8 +27,7 @@ void descend_compressed(Descent& d, uint32_t at, const CompressedBox& box) {
 
 // AABBTreeCompressed: the section header, then nodes and blocks, each
 // right child after its node, each left child right behind it.
-template <class Codec>
-std::string validate_tree(tree::AABBTreeCompressed, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::AABBTreeCompressed, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   if (h.tree_size < MC_COMPRESSED_HEADER_BYTES) return "AABBTreeCompressed: the tree section is shorter than its header";
   const uint8_t* tree = blob + h.tree_offset;
   CompressedBox root = compressed_root_box(tree);
@@ -36,7 +35,7 @@ std::string validate_tree(tree::AABBTreeCompressed, const uint8_t* blob, const B
     if (!(root.min[a] <= root.max[a]) || !std::isfinite(root.min[a]) || !std::isfinite(root.max[a]))
       return "AABBTreeCompressed: the root box is empty or not finite";
   if (uint32_t count = compressed_root_count(tree)) {
-    std::string e = check_leaf<Codec>(blob, h, MC_COMPRESSED_HEADER_BYTES, count);
+    std::string e = check_leaf(codec, blob, h, MC_COMPRESSED_HEADER_BYTES, count);
     *triangles += count;
     return e;
   }
@@ -53,17 +52,12 @@ std::string validate_tree(tree::AABBTreeCompressed, const uint8_t* blob, const B
         push(child[k]);
         continue;
       }
-      if (std::string e = check_leaf<Codec>(blob, h, child[k], count[k]); !e.empty()) return e;
+      if (std::string e = check_leaf(codec, blob, h, child[k], count[k]); !e.empty()) return e;
       *triangles += count[k];
     }
     return "";
   });
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::AABBTreeCompressed, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::AABBTreeCompressed) {
   const CompressedBox root = compressed_root_box(d.tree);

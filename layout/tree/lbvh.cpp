@@ -23,8 +23,7 @@ void descend_lbvh(Descent& d, uint32_t index) {
 
 // StacklessLBVH: every node a walk reaches is a leaf or has both children
 // inside the array; holes are never reached.
-template <class Codec>
-std::string validate_tree(tree::StacklessLBVH, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::StacklessLBVH, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   const uint8_t* tree = blob + h.tree_offset;
   if (h.node_count == 0 || h.node_count > (1u << (MC_LBVH_MAX_DEPTH + 1)) - 1 ||
       uint64_t(h.node_count) * MC_LBVH_NODE_BYTES != h.triangle_base)
@@ -34,7 +33,7 @@ std::string validate_tree(tree::StacklessLBVH, const uint8_t* blob, const BlobHe
     if (n.count == 0) return "node " + num(index) + " is a hole but its parent is an interior node";
     if (n.count > 0) {
       *triangles += uint32_t(n.count);
-      return check_leaf<Codec>(blob, h, n.position, uint32_t(n.count));
+      return check_leaf(codec, blob, h, n.position, uint32_t(n.count));
     }
     if (uint64_t(index) * 2 + 1 > h.node_count)
       return "node " + num(index) + " has children past the " + num(h.node_count) + " node slots";
@@ -42,11 +41,6 @@ std::string validate_tree(tree::StacklessLBVH, const uint8_t* blob, const BlobHe
     return "";
   });
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::StacklessLBVH, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::StacklessLBVH) { descend_lbvh(d, 1); }
 

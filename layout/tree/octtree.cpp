@@ -76,8 +76,7 @@ void descend_octtree(Descent& d, uint32_t properties) {
 // Nodes lie in the node area, each after its parent (so no walk loops), with
 // finite origins and normal scales within the header's reach; every leaf
 // passes check_leaf.
-template <class Codec>
-std::string validate_tree(tree::OctTreeCompressed, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::OctTreeCompressed, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   // The header's node reach (what the walker pads its planes by): finite
   // and not negative, and below each node checks against it.
   for (int a = 0; a < 3; ++a)
@@ -94,7 +93,7 @@ std::string validate_tree(tree::OctTreeCompressed, const uint8_t* blob, const Bl
     stack.pop_back();
     const uint32_t count = oct_count(it.properties), offset = oct_offset(it.properties);
     if (count != 0) {
-      std::string e = check_leaf<Codec>(blob, h, offset, count, MC_OCT_MAX_COUNT);
+      std::string e = check_leaf(codec, blob, h, offset, count, MC_OCT_MAX_COUNT);
       if (!e.empty()) return e;
       *triangles += count;
       continue;
@@ -120,11 +119,6 @@ std::string validate_tree(tree::OctTreeCompressed, const uint8_t* blob, const Bl
   }
   return "";
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::OctTreeCompressed, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::OctTreeCompressed) {
   if (oct_count(d.h.root)) return d.leaf(oct_offset(d.h.root), oct_count(d.h.root), nullptr);

@@ -10,8 +10,8 @@ namespace meshcast::layout {
 namespace {
 
 // QuadTree and QuadTreeHalfFloat: the same walk over their own child bounds.
-template <class Codec, class Bounds>
-std::string validate_quad_nodes(const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+template <class Bounds>
+std::string validate_quad_nodes(const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   struct Item { uint32_t properties, parent, depth; };
   std::vector<Item> stack{{h.root, 0, 0}};
   uint64_t visited = 0;
@@ -21,7 +21,7 @@ std::string validate_quad_nodes(const uint8_t* blob, const BlobHeader& h, uint64
     stack.pop_back();
     uint32_t count = quad_count(it.properties), offset = quad_offset(it.properties);
     if (count != 0) {
-      std::string e = check_leaf<Codec>(blob, h, offset, count);
+      std::string e = check_leaf(codec, blob, h, offset, count);
       if (!e.empty()) return e;
       *triangles += count;
       continue;
@@ -72,21 +72,13 @@ void descend_quad_root(Descent& d) {
 
 }  // namespace
 
-template <class Codec>
-std::string validate_tree(tree::QuadTree, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  return validate_quad_nodes<Codec, QuadBoundsFloat>(blob, h, triangles);
+std::string validate_tree(tree::QuadTree, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  return validate_quad_nodes<QuadBoundsFloat>(codec, blob, h, triangles);
 }
 
-template <class Codec>
-std::string validate_tree(tree::QuadTreeHalfFloat, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
-  return validate_quad_nodes<Codec, QuadBoundsHalf>(blob, h, triangles);
+std::string validate_tree(tree::QuadTreeHalfFloat, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+  return validate_quad_nodes<QuadBoundsHalf>(codec, blob, h, triangles);
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::QuadTree, const uint8_t*, const BlobHeader&, uint64_t*); \
-  template std::string validate_tree<Codec>(tree::QuadTreeHalfFloat, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::QuadTree) { descend_quad_root<QuadBoundsFloat>(d); }
 void from_root(Descent& d, tree::QuadTreeHalfFloat) { descend_quad_root<QuadBoundsHalf>(d); }

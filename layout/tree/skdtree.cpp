@@ -24,8 +24,7 @@ void descend_skd(Descent& d, uint32_t at, const PathBox& region) {
 
 // SKDTree: interior nodes and leaves of two sizes, each right child after
 // its node.
-template <class Codec>
-std::string validate_tree(tree::SKDTree, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
+std::string validate_tree(tree::SKDTree, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles) {
   const uint8_t* tree = blob + h.tree_offset;
   for (int a = 0; a < 3; ++a)
     if (!(h.bounds_min[a] <= h.bounds_max[a]) || !std::isfinite(h.bounds_min[a]) || !std::isfinite(h.bounds_max[a]))
@@ -36,7 +35,7 @@ std::string validate_tree(tree::SKDTree, const uint8_t* blob, const BlobHeader& 
     uint32_t p = load<uint32_t>(tree + at);
     if (skd_is_leaf(p)) {
       *triangles += skd_value(p);
-      return check_leaf<Codec>(blob, h, at + MC_SKD_LEAF_BYTES, skd_value(p));
+      return check_leaf(codec, blob, h, at + MC_SKD_LEAF_BYTES, skd_value(p));
     }
     uint32_t left = at + MC_SKD_INTERIOR_BYTES;
     if (uint64_t(left) > h.tree_size || skd_value(p) <= left)
@@ -47,11 +46,6 @@ std::string validate_tree(tree::SKDTree, const uint8_t* blob, const BlobHeader& 
     return "";
   });
 }
-
-#define MC_INSTANTIATE(Codec, name) \
-  template std::string validate_tree<Codec>(tree::SKDTree, const uint8_t*, const BlobHeader&, uint64_t*);
-MC_FOR_EACH_TRIANGLE_CODEC(MC_INSTANTIATE)
-#undef MC_INSTANTIATE
 
 void from_root(Descent& d, tree::SKDTree) { descend_skd(d, 0, box_of(d.h.bounds_min, d.h.bounds_max)); }
 

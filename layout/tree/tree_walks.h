@@ -2,8 +2,8 @@
 // (proves every offset and count in range, before any walker trusts them)
 // and the leaf descent (a validated blob's leaves with the boxes above them).
 // Each family's own readings live beside its bits in layout/tree/<family>.cpp,
-// declared here from the catalog: validate_tree (one template a format,
-// instantiated for every codec there) and from_root.
+// declared here from the catalog: validate_tree (one a format, given the
+// codec's LeafCodec) and from_root.
 #pragma once
 #include <algorithm>
 #include <string>
@@ -18,18 +18,40 @@ namespace meshcast::layout {
 
 inline std::string num(uint64_t v) { return std::to_string(v); }
 
+// What a leaf's check needs of its triangle codec, as one record: the tree
+// validators take it as an argument, so each is compiled once rather than
+// once a codec (nineteen times over, most of the layout folder's build).
+struct LeafCodec {
+  uint32_t lanes;  // triangles a test takes (sizes BruteForce's records)
+  // Bytes a block of `count` takes (block.h's stored_bytes).
+  uint64_t (*stored_bytes)(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit);
+  // What validation must prove of a block (the codec's check).
+  bool (*check)(const uint8_t* blob, uint32_t block, uint32_t count, std::string* why);
+};
+
+template <class Codec>
+constexpr LeafCodec leaf_codec_of() {
+  return {Codec::kLanes, &stored_bytes<Codec>,
+          [](const uint8_t* blob, uint32_t block, uint32_t count, std::string* why) -> bool {
+            return Codec::check(blob, block, count, why);
+          }};
+}
+
+// The blob's triangle format's record (bruteforce.cpp); null where the
+// format has no codec (Indexed24, the zero-byte trees' own).
+const LeafCodec* leaf_codec(uint32_t triangle_format);
+
 // Checks one leaf: its block lies in the triangle area of the tree section,
 // its slots lie in the remap, and the codec's own indices are in range.
-template <class Codec>
-std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block, uint32_t count,
-                       uint32_t max_count = MC_QUAD_MAX_COUNT) {
+inline std::string check_leaf(const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint32_t block,
+                              uint32_t count, uint32_t max_count = MC_QUAD_MAX_COUNT) {
   if (count == 0 || count > max_count)
     return "leaf at tree offset " + num(block) + " has " + num(count) + " triangles (allowed 1.." +
            num(max_count) + ")";
   if (block < h.triangle_base || (block - h.triangle_base) % 4 != 0)
     return "triangle block at tree offset " + num(block) + " lies before the triangle area (" +
            num(h.triangle_base) + ") or is misaligned";
-  uint64_t bytes = block <= h.tree_size ? stored_bytes<Codec>(blob, h.tree_offset + block, count, h.tree_size - block) : 0;
+  uint64_t bytes = block <= h.tree_size ? codec.stored_bytes(blob, h.tree_offset + block, count, h.tree_size - block) : 0;
   if (bytes == 0 || uint64_t(block) + bytes > h.tree_size)
     return "triangle block at tree offset " + num(block) + " for " + num(count) +
            " triangles is broken or runs past the tree section (" + num(h.tree_size) + " bytes)";
@@ -41,7 +63,7 @@ std::string check_leaf(const uint8_t* blob, const BlobHeader& h, uint32_t block,
     if (!(remap_used(blob, h, uint32_t(s >> 6)) >> (s & 63) & 1))
       return "triangle block at tree offset " + num(block) + " uses slot " + num(s) + ", which the remap marks unused";
   std::string why;
-  if (!Codec::check(blob, h.tree_offset + block, count, &why)) return why;
+  if (!codec.check(blob, h.tree_offset + block, count, &why)) return why;
   return "";
 }
 
@@ -75,16 +97,15 @@ std::string walk_nodes(const BlobHeader& h, uint32_t root, const char* noun, Vis
 
 // BruteForce records from tree-section offset *at up to `end`: each a
 // valid leaf of at most brute_chunk() triangles, the last ending at `end`.
-template <class Codec>
-std::string check_records(const uint8_t* blob, const BlobHeader& h, uint64_t* at, uint64_t end, uint64_t* triangles,
+inline std::string check_records(const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h, uint64_t* at, uint64_t end, uint64_t* triangles,
                           uint64_t* records) {
   while (*at < end) {
     if (*at + MC_BRUTE_RECORD_BYTES > end) return "record at tree offset " + num(*at) + " is cut short";
     uint32_t count = load<uint32_t>(blob + h.tree_offset + *at);
-    std::string e = check_leaf<Codec>(blob, h, uint32_t(*at + MC_BRUTE_RECORD_BYTES), count, brute_chunk(Codec::kLanes));
+    std::string e = check_leaf(codec, blob, h, uint32_t(*at + MC_BRUTE_RECORD_BYTES), count, brute_chunk(codec.lanes));
     if (!e.empty()) return e;
     *triangles += count;
-    *at += MC_BRUTE_RECORD_BYTES + stored_bytes<Codec>(blob, h.tree_offset + uint32_t(*at) + MC_BRUTE_RECORD_BYTES, count, ~0ull);
+    *at += MC_BRUTE_RECORD_BYTES + codec.stored_bytes(blob, h.tree_offset + uint32_t(*at) + MC_BRUTE_RECORD_BYTES, count, ~0ull);
     ++*records;
   }
   if (*at != end) return "record ending at tree offset " + num(*at) + " runs past " + num(end);
@@ -118,8 +139,8 @@ struct Descent {
 // Each format's readings (the zero-byte trees validate as a whole, in
 // validate_zerobyte, whatever their codec).
 #define MC_READERS_AllCodecs(Name)                                                                          \
-  template <class Codec>                                                                                     \
-  std::string validate_tree(tree::Name, const uint8_t* blob, const BlobHeader& h, uint64_t* triangles);       \
+  std::string validate_tree(tree::Name, const LeafCodec& codec, const uint8_t* blob, const BlobHeader& h,     \
+                            uint64_t* triangles);                                                            \
   void from_root(Descent& d, tree::Name);
 #define MC_READERS_Indexed24(Name) void from_root(Descent& d, tree::Name);
 #define MC_DECLARE_READERS(Name, id, node_bytes, triangles, ...) MC_READERS_##triangles(Name)

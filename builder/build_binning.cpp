@@ -1,7 +1,8 @@
 // Binning (seed 000 §4.1, after Günther et al. 2007): triangle centres are
 // sorted into 32 bins along each axis and the split with the lowest surface
 // area heuristic is taken.
-#include <array>
+#include <algorithm>
+#include <cfloat>
 
 #include "builder/build_topdown.h"
 
@@ -24,52 +25,78 @@ namespace {
 
 constexpr int kBins = 32;
 
-// Bin of a centre: computed the same way when binning and partitioning, and
-// safe for any finite input (a tiny or huge extent never yields NaN or an
-// index outside the bins).
-int bin_of(float c, float lo, float extent) {
-  float f = float((double(c) - lo) / extent * kBins);
+// Bin of a centre, from the axis's least centre `lo` and its bins a unit
+// of length `scale` (kBins / extent, at most FLT_MAX: so (c - lo) scale
+// stays finite, never NaN, for any finite input, however thin the axis).
+// The binning loop computes the same in four lanes at once (bins_of):
+// the same float operations, so both always agree.
+int bin_of(float c, float lo, float scale) {
+  const float f = (c - lo) * scale;
   return !(f > 0) ? 0 : (f >= kBins ? kBins - 1 : int(f));
 }
+
+float bin_scale(float extent) { return float(std::min(kBins / double(extent), double(FLT_MAX))); }
 
 // A bin's box as two 4-float vectors: min and max of a whole corner in one
 // instruction each, with no branch (std::min on floats inlined into this
 // loop became compare-and-branch, mispredicted on every other triangle).
 using Float4 = float __attribute__((vector_size(16)));
 struct BinBox {
-  Float4 min = {INFINITY, INFINITY, INFINITY, INFINITY}, max = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  Float4 min, max;  // empty once clear()ed
+  void clear() { min = Float4{} + INFINITY, max = Float4{} - INFINITY; }
   void grow(Float4 lo, Float4 hi) {
     min = lo < min ? lo : min;  // std::min(min, lo), lane by lane
     max = max < hi ? hi : max;  // std::max(max, hi)
   }
-  Box3 box() const { return {{min[0], min[1], min[2]}, {max[0], max[1], max[2]}}; }
+  void grow(const BinBox& b) { grow(b.min, b.max); }
+  // box_half_area of the box, the same operations: the sweep below takes
+  // its areas here without forming a Box3 a bin (that sweep, 32 bins on
+  // three axes, cost more than binning the ranges of the lower levels).
+  double half_area() const {
+    if (min[0] > max[0]) return 0.0;
+    const double x = double(max[0]) - min[0], y = double(max[1]) - min[1], z = double(max[2]) - min[2];
+    return x * y + y * z + z * x;
+  }
 };
 
 Float4 load3(const Vec3& v) { return Float4{v.x, v.y, v.z, 0.0f}; }
+
+// bin_of on three axes at once: the product truncated, then clamped to the
+// bins as bin_of does (a centre below lo, which the callers' boxes rule
+// out, and NaN, which the truncation makes INT_MIN, to bin 0).
+using Int4 = int32_t __attribute__((vector_size(16)));
+Int4 bins_of(Float4 c, Float4 lo, Float4 scale) {
+  Int4 b = __builtin_convertvector((c - lo) * scale, Int4);
+  b = b < 0 ? 0 : b;
+  return b > kBins - 1 ? kBins - 1 : b;
+}
 
 }  // namespace
 
 uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cbox) const {
   // One pass over the triangles bins all three axes (each triangle's box
   // and centre read once); an axis whose centres coincide is not binned.
-  float lo[3], extent[3];
+  float lo[3], scale[3];
   bool binned[3];
   for (int axis = 0; axis < 3; ++axis) {
-    lo[axis] = cbox.min[axis], extent[axis] = cbox.max[axis] - lo[axis];
-    binned[axis] = extent[axis] > 0;
+    const float extent = cbox.max[axis] - cbox.min[axis];
+    binned[axis] = extent > 0;
+    lo[axis] = cbox.min[axis], scale[axis] = binned[axis] ? bin_scale(extent) : 0.0f;
   }
-  std::array<std::array<BinBox, kBins>, 3> bin_box;
-  std::array<std::array<uint32_t, kBins>, 3> bin_count{};
+  const Float4 lo4 = {lo[0], lo[1], lo[2], 0.0f}, scale4 = {scale[0], scale[1], scale[2], 0.0f};
+  BinBox bin_box[3][kBins];
+  uint32_t bin_count[3][kBins] = {};
+  for (auto& row : bin_box)
+    for (BinBox& b : row) b.clear();
   for (uint32_t* p = begin; p != end; ++p) {
     const Box3& box = boxes[*p];
     const Float4 box_min = load3(box.min), box_max = load3(box.max);
-    const Vec3& c = centres[*p];
+    const Int4 b = bins_of(load3(centres[*p]), lo4, scale4);
     for (int axis = 0; axis < 3; ++axis) {
       if (!binned[axis]) continue;
-      const int b = bin_of(c[axis], lo[axis], extent[axis]);
-      bin_box[axis][b].grow(box_min, box_max);
-      ++bin_count[axis][b];
-      if (bins) bins[3 * size_t(*p) + size_t(axis)] = uint8_t(b);
+      bin_box[axis][b[axis]].grow(box_min, box_max);
+      ++bin_count[axis][b[axis]];
+      if (bins) bins[3 * size_t(*p) + size_t(axis)] = uint8_t(b[axis]);
     }
   }
   double best_cost = INFINITY;
@@ -77,29 +104,30 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
   for (int axis = 0; axis < 3; ++axis) {
     if (!binned[axis]) continue;
     // Sweep from the right, then evaluate each split from the left.
-    std::array<double, kBins> right_area{};
-    std::array<uint32_t, kBins> right_count{};
-    Box3 acc;
+    double right_area[kBins];  // [1, kBins) set and read
+    uint32_t right_count[kBins];
+    BinBox acc;
+    acc.clear();
     uint32_t n = 0;
     for (int b = kBins - 1; b > 0; --b) {
-      acc.grow(bin_box[axis][b].box());
+      acc.grow(bin_box[axis][b]);
       n += bin_count[axis][b];
-      right_area[b] = box_half_area(acc), right_count[b] = n;
+      right_area[b] = acc.half_area(), right_count[b] = n;
     }
-    acc = Box3{};
+    acc.clear();
     n = 0;
     for (int b = 0; b < kBins - 1; ++b) {
-      acc.grow(bin_box[axis][b].box());
+      acc.grow(bin_box[axis][b]);
       n += bin_count[axis][b];
       if (n == 0 || right_count[b + 1] == 0) continue;
-      double cost = box_half_area(acc) * n + right_area[b + 1] * right_count[b + 1];
+      double cost = acc.half_area() * n + right_area[b + 1] * right_count[b + 1];
       if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = b;
     }
   }
   if (best_axis < 0) return 0;  // all centres coincide
   uint32_t* mid = bins ? std::partition(begin, end, [&](uint32_t t) { return bins[3 * size_t(t) + size_t(best_axis)] <= best_bin; })
                        : std::partition(begin, end, [&](uint32_t t) {
-                           return bin_of(centres[t][best_axis], lo[best_axis], extent[best_axis]) <= best_bin;
+                           return bin_of(centres[t][best_axis], lo[best_axis], scale[best_axis]) <= best_bin;
                          });
   return uint32_t(mid - begin);
 }

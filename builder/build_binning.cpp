@@ -14,10 +14,9 @@ uint32_t BuildTree::leaf_count() const {
   return n;
 }
 
-std::vector<Vec3> box_centres(const std::vector<Box3>& boxes) {
-  std::vector<Vec3> c;
-  c.reserve(boxes.size());
-  for (const Box3& b : boxes) c.push_back(b.centre());
+std::vector<Vec3> box_centres(const std::vector<Box3>& boxes, BuildThreads* threads) {
+  std::vector<Vec3> c(boxes.size());
+  for_each_on(threads, boxes.size(), 16384, [&](uint64_t i) { c[i] = boxes[i].centre(); });
   return c;
 }
 
@@ -134,7 +133,7 @@ uint32_t BinningSplit::operator()(uint32_t* begin, uint32_t* end, const Box3& cb
 
 BuildTree build_binning(const std::vector<Box3>& boxes, uint32_t leaf_size, uint32_t depth_limit, uint32_t leaf_capacity,
                         BuildThreads* threads) {
-  std::vector<Vec3> centres = box_centres(boxes);
+  std::vector<Vec3> centres = box_centres(boxes, threads);
   std::vector<uint8_t> bins(3 * boxes.size());
   BinningSplit split{boxes, centres, bins.data()};
   return TopDown<BinningSplit>{boxes, centres, std::max(1u, leaf_size), split, {}, depth_limit, leaf_capacity, "triangles",

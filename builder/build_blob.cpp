@@ -204,7 +204,7 @@ std::vector<uint8_t> build_blob_with(const Mesh& mesh, const BuildOptions& optio
   BuildThreads threads(o.threads);
   BuildThreads* parallel = threads.total() > 1 && mesh.triangles.size() >= kParallelTriangles ? &threads : nullptr;
   StoredTriangles stored = store_triangles(mesh, codec, h, parallel);
-  std::vector<TriCorners>& corners = stored.corners;
+  FilledVector<TriCorners>& corners = stored.corners;
   const std::vector<Box3>& boxes = stored.boxes;
 
   uint32_t depth_limit;

@@ -105,7 +105,7 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
   std::vector<Box3> group_boxes(groups);
   for (uint32_t k = 0; k <= groups; ++k) start[k] = std::min<uint32_t>(k * kGroup, uint32_t(members.size()));
   for (size_t i = 0; i < members.size(); ++i) group_boxes[i / kGroup].grow(boxes[members[i]]);
-  std::vector<Vec3> group_centres = box_centres(group_boxes);
+  std::vector<Vec3> group_centres = box_centres(group_boxes, threads);
   BinningSplit split{group_boxes, group_centres};
   TopDown<BinningSplit> group_top{group_boxes, group_centres, std::max(1u, leaf / kGroup), split, {}, depth_limit};
   group_top.leaf_capacity = std::max(1u, leaf_capacity / kGroup);  // whole groups within the leaf capacity
@@ -119,9 +119,11 @@ BuildTree build_fixed_leaf_size(const std::vector<Box3>& boxes, const std::vecto
 BuildTree build_tree(const std::vector<Box3>& boxes, Splitter splitter, uint32_t leaf_size, uint32_t depth_limit,
                      uint32_t leaf_capacity, BuildThreads* threads) {
   leaf_size = std::max(1u, leaf_size);
-  std::vector<Vec3> centres = box_centres(boxes);
+  // Binning works out its centres itself.
+  if (splitter == Splitter::Binning) return build_binning(boxes, leaf_size, depth_limit, leaf_capacity, threads);
+  std::vector<Vec3> centres = box_centres(boxes, threads);
   switch (splitter) {
-    case Splitter::Binning: return build_binning(boxes, leaf_size, depth_limit, leaf_capacity, threads);
+    case Splitter::Binning: break;
     case Splitter::LongestAxis: {
       LongestAxisSplit s{centres};
       return TopDown<LongestAxisSplit>{boxes, centres, leaf_size, s, {}, depth_limit, leaf_capacity, "triangles", threads}

@@ -144,7 +144,7 @@ struct TopDown {
   }
 };
 
-std::vector<Vec3> box_centres(const std::vector<Box3>& boxes);
+std::vector<Vec3> box_centres(const std::vector<Box3>& boxes, BuildThreads* threads = nullptr);
 
 
 }  // namespace meshcast

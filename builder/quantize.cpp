@@ -59,7 +59,7 @@ void set_mesh_grid(const Box3& mesh_box, const CodecOps& codec, const std::strin
 StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const layout::BlobHeader& h,
                                 BuildThreads* threads) {
   const bool grid = codec.grid != layout::kGridNone;
-  std::vector<uint64_t> packed(grid ? mesh.vertices.size() : 0);
+  FilledVector<uint64_t> packed(grid ? mesh.vertices.size() : 0);
   for_each_on(threads, packed.size(), 4096, [&](uint64_t v) {
     float p[3] = {mesh.vertices[v].x, mesh.vertices[v].y, mesh.vertices[v].z};
     packed[v] = layout::bitpack_encode(p, h.quant_offset, h.quant_scale);
@@ -67,11 +67,12 @@ StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const l
   // A format with no blocks to encode (CodecOps::encode null) keeps no
   // corners: its tree is built from the boxes alone.
   const bool blocks = codec.encode != nullptr;
-  StoredTriangles s{std::vector<TriCorners>(blocks ? mesh.triangles.size() : 0), std::vector<Box3>(mesh.triangles.size())};
+  StoredTriangles s{FilledVector<TriCorners>(blocks ? mesh.triangles.size() : 0), std::vector<Box3>(mesh.triangles.size())};
   std::vector<Box3>& boxes = s.boxes;
   for_each_on(threads, mesh.triangles.size(), 4096, [&](uint64_t t) {
     TriCorners unkept;
     TriCorners& tri = blocks ? s.corners[t] : unkept;
+    tri.input = uint32_t(t);
     for (int c = 0; c < 3; ++c) {
       uint32_t v = mesh.triangles[t][c];
       if (grid) {
@@ -97,9 +98,9 @@ StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const l
 // Positions are keyed by their mesh-grid word (so unwelded copies of a
 // vertex move together) and rounded once, from the grid position, to their
 // final lattice. Returns the largest shift.
-uint32_t snap_to_block_lattices(const BuildTree& t, std::vector<TriCorners>& corners, uint32_t lanes,
+uint32_t snap_to_block_lattices(const BuildTree& t, FilledVector<TriCorners>& corners, uint32_t lanes,
                                 const float grid[3]) {
-  const std::vector<TriCorners> original = corners;
+  const FilledVector<TriCorners> original = corners;
   uint32_t largest = 0;
   for (int axis = 0; axis < 3; ++axis) {
     std::unordered_map<uint64_t, uint32_t> shift;  // grid word -> lattice shift

@@ -9,6 +9,7 @@
 
 #include "builder/binary_tree.h"
 #include "builder/build_threads.h"
+#include "builder/first_touch.h"
 #include "builder/writer.h"
 #include "layout/blob_format.h"
 
@@ -23,7 +24,7 @@ void set_mesh_grid(const Box3& mesh_box, const CodecOps& codec, const std::strin
 // one; none for a codec with no blocks to encode) and the box of those
 // corners.
 struct StoredTriangles {
-  std::vector<layout::TriCorners> corners;
+  FilledVector<layout::TriCorners> corners;  // every field set by store_triangles
   std::vector<Box3> boxes;
 };
 StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const layout::BlobHeader& h,
@@ -33,7 +34,7 @@ StoredTriangles store_triangles(const Mesh& mesh, const CodecOps& codec, const l
 // coarsest lattice among the blocks of `lanes` consecutive triangles of a
 // leaf of `t` that use it; returns the largest shift (the header's
 // max_block_shift).
-uint32_t snap_to_block_lattices(const BuildTree& t, std::vector<layout::TriCorners>& corners, uint32_t lanes,
+uint32_t snap_to_block_lattices(const BuildTree& t, FilledVector<layout::TriCorners>& corners, uint32_t lanes,
                                 const float grid[3]);
 
 }  // namespace meshcast

@@ -14,6 +14,7 @@
 
 #include "builder/binary_tree.h"
 #include "builder/build_threads.h"
+#include "builder/first_touch.h"
 #include "builder/error_bounds.h"
 #include "builder/layout_names.h"
 #include "layout/blob_format.h"
@@ -48,7 +49,7 @@ void append_remap(std::vector<uint8_t>& bytes, layout::BlobHeader& h, const std:
 
 // Shared by both tree writers: the blob under construction.
 struct Writer {
-  const std::vector<layout::TriCorners>& corners;
+  const FilledVector<layout::TriCorners>& corners;
   BuildTree& tree;  // leaf boxes are refitted to what the codec stores
   CodecOps codec;
   layout::BlobHeader h{};

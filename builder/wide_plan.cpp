@@ -24,32 +24,31 @@ struct Collapse {
   double node_cost(const BuildTree& t, uint32_t n, double tie) const { return t.nodes[n].box.half_area() + tie; }
 
   Collapse(const BuildTree& t, uint32_t w) : width(w), cost(t.nodes.size() * w, 0.0), left(t.nodes.size() * w, 0) {
-    const double tie = 1e-9 * t.nodes[0].box.half_area();
-    // Children before their parent (a post-order walk; recursion as deep as
-    // the binary tree, which the builders bound).
-    std::function<void(uint32_t)> fill = [&](uint32_t n) {
-      const BuildNode& b = t.nodes[n];
-      if (b.leaf()) return;  // cost 0 at every i
-      fill(b.left), fill(b.right);
-      // Opened into at most i roots: the best split of i between the children.
-      std::array<double, kMaxWidth + 1> opened;
-      std::array<uint8_t, kMaxWidth + 1> split{};
-      opened.fill(INFINITY);
-      for (uint32_t i = 2; i <= w; ++i)
-        for (uint32_t k = 1; k < i; ++k) {
-          const double c = at(b.left, k) + at(b.right, i - k);
-          if (c < opened[i]) opened[i] = c, split[i] = uint8_t(k);
-        }
-      const size_t row = size_t(n) * w;
-      const double as_node = node_cost(t, n, tie) + opened[w];
-      cost[row] = as_node;
-      for (uint32_t i = 2; i <= w; ++i) {
-        const bool open = opened[i] <= as_node;
-        cost[row + i - 1] = open ? opened[i] : as_node;
-        left[row + i - 1] = open ? split[i] : 0;
+    fill(t, 0, 1e-9 * t.nodes[0].box.half_area());
+  }
+  // n's rows, its children's first (a post-order walk; recursion as deep as
+  // the binary tree, which the builders bound).
+  void fill(const BuildTree& t, uint32_t n, double tie) {
+    const BuildNode& b = t.nodes[n];
+    if (b.leaf()) return;  // cost 0 at every i
+    fill(t, b.left, tie), fill(t, b.right, tie);
+    // Opened into at most i roots: the best split of i between the children.
+    std::array<double, kMaxWidth + 1> opened;
+    std::array<uint8_t, kMaxWidth + 1> split{};
+    opened.fill(INFINITY);
+    for (uint32_t i = 2; i <= width; ++i)
+      for (uint32_t k = 1; k < i; ++k) {
+        const double c = at(b.left, k) + at(b.right, i - k);
+        if (c < opened[i]) opened[i] = c, split[i] = uint8_t(k);
       }
-    };
-    fill(0);
+    const size_t row = size_t(n) * width;
+    const double as_node = node_cost(t, n, tie) + opened[width];
+    cost[row] = as_node;
+    for (uint32_t i = 2; i <= width; ++i) {
+      const bool open = opened[i] <= as_node;
+      cost[row + i - 1] = open ? opened[i] : as_node;
+      left[row + i - 1] = open ? split[i] : 0;
+    }
   }
   double at(uint32_t n, uint32_t i) const { return cost[size_t(n) * width + i - 1]; }
 

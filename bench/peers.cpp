@@ -9,6 +9,7 @@
 #include <memory>
 #include <thread>
 
+#include "bench/peak_memory.h"
 #include "bench/timing.h"
 #include "bench/peer.h"
 #include "builder/layout_names.h"
@@ -39,6 +40,7 @@ struct Contender {
   std::string name;
   bool is_peer;
   double bytes, build_one, build_all;
+  double build_peak = 0;  // bytes a triangle (PeerRow::build_peak_bytes_per_triangle)
   // False for a query the contender has no answer to (Embree: all hits,
   // culling, which its build takes only at compile time).
   // `sorted`: a set of one origin's rays sorted by direction, which
@@ -107,7 +109,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   };
   for (const std::string& layout : o.layouts) {
     std::fprintf(stderr, "  %s: building %s\n", name.c_str(), layout.c_str());
-    blobs.push_back(build_of(layout, 1));
+    const double peak = peak_added_bytes([&] { blobs.push_back(build_of(layout, 1)); });
     // 64-byte aligned, as Embree aligns its nodes and as a mapped blob file
     // is: a heap vector is aligned to 16 only, and a 96-byte node off a cache
     // line costs a third line half the time (about 8% a ray, measured).
@@ -116,7 +118,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     views.push_back(std::make_unique<BlobView>(std::span<const uint8_t>(aligned.back().get(), blobs.back().size()), name));
     const BlobView* view = views.back().get();
     auto lists = std::make_shared<HitLists>();  // Query::All's rows, kept from pass to pass as a game would
-    all.push_back({layout, false, double(blobs.back().size()) / triangles, 0, 0,
+    all.push_back({layout, false, double(blobs.back().size()) / triangles, 0, 0, peak / triangles,
                    [view, lists](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool) {
                      if (q.query == Query::All) view->trace_all_hits(r, *lists, HitOutputs::None, q.cull);
                      else view->trace(r, h, HitOutputs::None, q.query, q.cull, Packets::Off);
@@ -126,7 +128,7 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     // The same layout's packets, on the sorted sets alone (where the
     // layout's walker has none, its single rays again).
     if (o.packets)
-      all.push_back({layout + ", packets", false, double(blobs.back().size()) / triangles, 0, 0,
+      all.push_back({layout + ", packets", false, double(blobs.back().size()) / triangles, 0, 0, peak / triangles,
                      [view](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool sorted) {
                        if (!sorted || q.query == Query::All) return false;
                        view->trace(r, h, HitOutputs::None, q.query, q.cull, Packets::Auto);
@@ -138,11 +140,12 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   std::vector<EmbreeMode> modes;
   for (const auto& [mode_name, mode] : kEmbreeBuilds) {
     if (std::find(o.peers.begin(), o.peers.end(), mode_name) == o.peers.end()) continue;
-    std::unique_ptr<Peer> peer = make_embree(mesh, mode, 1);
+    std::unique_ptr<Peer> peer;
+    const double peak = peak_added_bytes([&] { peer = make_embree(mesh, mode, 1); });
     if (peer) std::fprintf(stderr, "  %s: built %s\n", name.c_str(), peer->name().c_str());
     if (!peer) break;  // built without Embree
     const Peer* p = peer.get();
-    all.push_back({peer->name(), true, double(peer->bytes()) / triangles, 0, 0,
+    all.push_back({peer->name(), true, double(peer->bytes()) / triangles, 0, 0, peak / triangles,
                    [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool) {
                      if (q.query == Query::All || q.cull != Cull::None) return false;
                      p->trace(r, h, q.query);
@@ -156,7 +159,8 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
   // the sorted sets: the peer's own packets on the rays meshcast packs.
   if (!peers.empty() && modes[0] == EmbreeMode::Default && o.packets) {
     const Peer* p = peers[0].get();
-    all.push_back({p->name() + ", 16-wide packets", true, double(p->bytes()) / triangles, 0, 0,
+    const double peak = all[o.layouts.size() * 2].build_peak;  // Embree default's, after each layout and its packets
+    all.push_back({p->name() + ", 16-wide packets", true, double(p->bytes()) / triangles, 0, 0, peak,
                    [p](const std::vector<Ray>& r, std::vector<Hit>& h, QuerySpec q, bool sorted) {
                      if (!sorted || q.query == Query::All || q.cull != Cull::None) return false;
                      p->trace_packets(r, h, q.query);
@@ -312,7 +316,8 @@ std::vector<PeerRow> bench_peers(const Mesh& mesh, const std::string& name, cons
     std::vector<PeerRow> set_rows;
     for (Contender& c : all) {
       if (c.ns[s].empty()) continue;  // a query the contender does not answer
-      PeerRow r{name, set_names[sets[s].kind], c.name, c.is_peer, median(c.ns[s]), 0, c.bytes, c.build_one, c.build_all};
+      PeerRow r{name, set_names[sets[s].kind], c.name, c.is_peer, median(c.ns[s]), 0, c.bytes, c.build_one, c.build_all,
+                c.build_peak};
       r.query = o.queries[sets[s].query];
       // The same contender's closest hit on the same rays, when measured.
       for (size_t t = 0; t < sets.size(); ++t)

@@ -19,6 +19,10 @@ struct PeerRow {
   double bytes_per_triangle;  // all included: the blob with its remap; Embree's scene and the mesh it keeps
   double build_ms_one = 0;    // one thread
   double build_ms_all = 0;    // every core (BuildOptions::threads 0; Embree's threads)
+  // The resident memory the first build (one thread) added at its peak, the
+  // structure it keeps included, a triangle (bench/peak_memory.h; 0 where
+  // it cannot be read).
+  double build_peak_bytes_per_triangle = 0;
   // closest, any (Embree: rtcOccluded1), all (every hit, rows of 16) or
   // closest-back (back faces culled): Embree rows for the first two only
   // (its culling is a compile-time option), so `ratio` is 0 for the others.

@@ -40,6 +40,9 @@ constexpr GeneratedMesh kGeneratedMeshes[] = {
     {"terrain_2M", [] { return make_terrain(1024, 1024, 5); }},
     {"terrain_66k", [] { return make_terrain(256, 256, 5); }},
     {"city_1M", [] { return make_city(1000000, 7); }},
+    // Where neither meshcast's structure nor Embree's fits in the caches: the
+    // terrain of terrain_2M over a ten times larger area (20.5M triangles).
+    {"terrain_20M", [] { return make_terrain(3200, 3200, 5); }},
 };
 
 }  // namespace

@@ -32,7 +32,7 @@ void add_demo(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("demo", "the main job: three layouts, three ray kinds, oracle, picture");
-  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
+  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M, terrain_20M")->required();
   cmd->add_option("--count", args->count, "rays of each kind")->check(integer_in(1, 10000000));
   cmd->add_option("--repeat", args->repeat, "timed rounds (each casts every CPU row and ray kind once); the median is reported")->check(integer_in(1, 100));
   cmd->add_option("--leaf", args->leaf, "largest triangle count of a leaf (default: each layout's own)")->check(integer_in(1, 31));

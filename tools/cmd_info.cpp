@@ -19,7 +19,7 @@ void add_info(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("info", "describe a mesh's blob: counts, bounds, bytes per section");
-  cmd->add_option("input", args->input, "mesh file, generated mesh (terrain_2M, terrain_66k, city_1M) or blob")->required();
+  cmd->add_option("input", args->input, "mesh file, generated mesh (terrain_2M, terrain_66k, city_1M, terrain_20M) or blob")->required();
   add_layout_options(cmd, args->layout);
   cmd->add_flag("--json", args->json, "print the same as one JSON object");
   cmd->callback([args] {

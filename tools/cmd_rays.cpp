@@ -20,7 +20,7 @@ void add_rays(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("rays", "write a rays file for a mesh");
-  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
+  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M, terrain_20M")->required();
   cmd->add_option("--kind", args->kind, "long, probe, radial or segment")->check(CLI::IsMember(ray_kind_names()));
   cmd->add_option("--count", args->count, "number of rays, at most 2^27")->check(integer_in(1, kMaxRayCount));
   cmd->add_option("--seed", args->seed, "random seed")->check(integer_in(0, UINT64_MAX));
@@ -42,8 +42,8 @@ void add_generate(CLI::App& app) {
     std::string name, out;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("generate", "write a generated benchmark mesh (terrain_2M, terrain_66k, city_1M) as OFF");
-  cmd->add_option("name", args->name, "terrain_2M, terrain_66k or city_1M")
+  CLI::App* cmd = app.add_subcommand("generate", "write a generated benchmark mesh (terrain_2M, terrain_66k, city_1M, terrain_20M) as OFF");
+  cmd->add_option("name", args->name, "terrain_2M, terrain_66k, city_1M or terrain_20M")
       ->required()
       ->check(CLI::Validator(
           [](std::string& name) -> std::string {

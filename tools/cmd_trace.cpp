@@ -113,7 +113,7 @@ void trace_scene(TraceArgs a) {
 void add_trace(CLI::App& app) {
   auto args = std::make_shared<TraceArgs>();
   CLI::App* cmd = app.add_subcommand("trace", "cast a rays file against a mesh, blob or scene (.json), write a hits file");
-  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), generated mesh (terrain_2M, terrain_66k, city_1M), blob or scene file (.json: RAYD or RAYS rays in, HITI hits out)")->required();
+  cmd->add_option("input", args->input, "mesh file (OFF, OBJ, PLY, STL), generated mesh (terrain_2M, terrain_66k, city_1M, terrain_20M), blob or scene file (.json: RAYD or RAYS rays in, HITI hits out)")->required();
   cmd->add_option("--rays", args->rays, "rays file")->required();
   cmd->add_option("--out", args->out, "hits file to write")->required();
   add_layout_options(cmd, args->layout);
@@ -323,7 +323,7 @@ void add_build(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("build", "build a mesh into a blob file");
-  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M")->required();
+  cmd->add_option("input", args->input, "mesh file, or a generated mesh: terrain_2M, terrain_66k, city_1M, terrain_20M")->required();
   cmd->add_option("--out", args->out, "blob file to write")->required();
   add_layout_options(cmd, args->layout);
   cmd->callback([args] {

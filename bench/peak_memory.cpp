@@ -1,5 +1,7 @@
 #include "bench/peak_memory.h"
 
+#include <malloc.h>
+
 #include <cstdio>
 #include <cstring>
 
@@ -35,6 +37,9 @@ bool reset_peak() {
 }  // namespace
 
 double peak_added_bytes(const std::function<void()>& work) {
+  // The heap's free pages handed back first: memory freed by earlier work,
+  // reused by this, would otherwise not count towards its peak.
+  malloc_trim(0);
   const bool reset = reset_peak();
   const double before = status_bytes("VmRSS");
   work();

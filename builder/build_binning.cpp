@@ -26,7 +26,9 @@ constexpr int kBins = 32;
 
 // Bin of a centre, from the axis's least centre `lo` and its bins a unit
 // of length `scale` (bin_scale: at most FLT_MAX, so (c - lo) scale stays
-// finite, never NaN, for any finite input, however thin the axis). The
+// finite, never NaN, for any finite input; an axis thinner than about
+// 1e-37 then has fewer than 32 bins in use, below about 3e-39 one, and is
+// split at its median instead). The
 // binning loop computes the same in four lanes at once (bins_of): the same
 // float operations, so both always agree.
 int bin_of(float c, float lo, float scale) {
@@ -68,14 +70,16 @@ struct BinBox {
 
 Float4 load3(const Vec3& v) { return Float4{v.x, v.y, v.z, 0.0f}; }
 
-// bin_of on three axes at once: the product truncated, then clamped to the
-// bins as bin_of does (a centre below lo, which the callers' boxes rule
-// out, and NaN, which the truncation makes INT_MIN, to bin 0).
+// bin_of on three axes at once: the product clamped in float as bin_of
+// does (not above 0, NaN included: bin 0; from the last bin's start up:
+// the last bin), then truncated, so the conversion never meets a value
+// outside int's range.
 using Int4 = int32_t __attribute__((vector_size(16)));
 Int4 bins_of(Float4 c, Float4 lo, Float4 scale) {
-  Int4 b = __builtin_convertvector((c - lo) * scale, Int4);
-  b = b < 0 ? 0 : b;
-  return b > kBins - 1 ? kBins - 1 : b;
+  Float4 f = (c - lo) * scale;
+  f = f > 0.0f ? f : 0.0f;
+  f = f < float(kBins - 1) ? f : float(kBins - 1);
+  return __builtin_convertvector(f, Int4);
 }
 
 }  // namespace

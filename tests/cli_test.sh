@@ -107,9 +107,9 @@ for command in "rays:--out $work/x.rays" "info:" "build:--out $work/x.blob" "tra
                "render:--png $work/x.png" "demo:" "bench encodings:--out-dir $work" "bench latency:--out-dir $work"; do
   IFS=: read -r name options <<<"$command"
   # shellcheck disable=SC2086 # the command's words and options split
-  check "mistyped-generated-${name// /-}" 2 "terrain_66K: cannot open the file .*; nor is it a generated mesh: did you mean terrain_66k, terrain_2M or city_1M\?" -- "$meshcast" $name terrain_66K $options
+  check "mistyped-generated-${name// /-}" 2 "terrain_66K: cannot open the file .*; nor is it a generated mesh: did you mean terrain_66k, terrain_2M or terrain_20M\?" -- "$meshcast" $name terrain_66K $options
 done
-check mistyped-generated-generate 2 '"terrain_66K" is not a generated mesh; did you mean terrain_66k, terrain_2M or city_1M\?' -- "$meshcast" generate terrain_66K --out "$work/x.off"
+check mistyped-generated-generate 2 '"terrain_66K" is not a generated mesh; did you mean terrain_66k, terrain_2M or terrain_20M\?' -- "$meshcast" generate terrain_66K --out "$work/x.off"
 check missing-path-no-names 2 "nope.off: cannot open the file \([^)]*\)$" -- "$meshcast" info "$work/nope.off"
 # ... and the names offered are taken by each of them.
 check generated-info 0 '"triangles":131072' -- "$meshcast" info terrain_66k --json

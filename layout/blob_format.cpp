@@ -152,13 +152,12 @@ std::string validate(std::span<const uint8_t> blob) {
   }
   if (h.triangle_format == MC_TRI_INDEXED24) return "Indexed24 triangles belong to the zero-byte trees alone";
 
-#define MC_DIVISOR(Codec, text) \
-  if (h.triangle_format == Codec::kFormat && h.slot_divisor != Codec::kSlotDivisor) return "slot divisor does not match " text;
-  MC_FOR_EACH_TRIANGLE_CODEC(MC_DIVISOR)
-#undef MC_DIVISOR
   uint64_t triangles = 0;
-  if (const LeafCodec* codec = leaf_codec(h.triangle_format))
+  if (const LeafCodec* codec = leaf_codec(h.triangle_format)) {
+    if (h.slot_divisor != codec->slot_divisor)
+      return "slot divisor does not match " + std::string(triangle_format_name(h.triangle_format));
     if (std::string e = walk_tree(*codec, blob.data(), h, &triangles); !e.empty()) return e;
+  }
   if (triangles != h.triangle_count)
     return "leaves hold " + num(triangles) + " triangles but the header says " + num(h.triangle_count);
   return check_tree_bounds(blob.data());

@@ -22,7 +22,8 @@ inline std::string num(uint64_t v) { return std::to_string(v); }
 // validators take it as an argument, so each is compiled once rather than
 // once a codec (nineteen times over, most of the layout folder's build).
 struct LeafCodec {
-  uint32_t lanes;  // triangles a test takes (sizes BruteForce's records)
+  uint32_t lanes;         // triangles a test takes (sizes BruteForce's records)
+  uint32_t slot_divisor;  // block bytes a remap slot (the header's must match)
   // Bytes a block of `count` takes (block.h's stored_bytes).
   uint64_t (*stored_bytes)(const uint8_t* blob, uint32_t block, uint32_t count, uint64_t limit);
   // What validation must prove of a block (the codec's check).
@@ -31,7 +32,7 @@ struct LeafCodec {
 
 template <class Codec>
 constexpr LeafCodec leaf_codec_of() {
-  return {Codec::kLanes, &stored_bytes<Codec>,
+  return {Codec::kLanes, Codec::kSlotDivisor, &stored_bytes<Codec>,
           [](const uint8_t* blob, uint32_t block, uint32_t count, std::string* why) -> bool {
             return Codec::check(blob, block, count, why);
           }};
